@@ -1,0 +1,1 @@
+//! §5 step 2: Hummel's power-reduction model.

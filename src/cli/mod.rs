@@ -1,0 +1,88 @@
+//! Command-line definitions (clap derive). Flags are parsed into plain structs, validated once,
+//! and handed to library functions that never print and never exit.
+
+use clap::{Parser, Subcommand};
+use formation::Result;
+
+mod animate;
+mod extract;
+mod initiate;
+mod plot;
+mod power;
+pub mod progress;
+mod render;
+mod solve;
+mod steady;
+mod wingbeat;
+
+/// Animate bird flocks flying in line formations (V, U, J, echelon), after Klotsman & Tal.
+#[derive(Debug, Parser)]
+#[command(name = "formation", version, about, long_about = None)]
+pub struct Cli {
+    #[command(subcommand)]
+    command: Command,
+    /// Hide progress bars.
+    #[arg(long, short = 'q', global = true)]
+    quiet: bool,
+    /// Seed of every random draw; equal seeds and inputs give byte-identical outputs.
+    #[arg(long, global = true, default_value_t = 0)]
+    seed: u64,
+}
+
+/// Options shared by every command.
+#[derive(Debug, Clone, Copy)]
+pub struct Global {
+    /// `--quiet`.
+    pub quiet: bool,
+    /// `--seed`.
+    pub seed: u64,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// §4 parameter extraction: annotated frames → formation parameters (RANSAC shape fits).
+    Extract(extract::ExtractArgs),
+    /// Power reduction e_i, relative values ξ_i and total E of a shape (Hummel's model).
+    Power(power::PowerArgs),
+    /// Key shape whose ξ matches the targets (Levenberg–Marquardt, eq. 4).
+    Solve(solve::SolveArgs),
+    /// §5 Algorithm 1: a steady-flight animation from formation parameters.
+    Steady(steady::SteadyArgs),
+    /// §6 initiation: random take-off converging into the first key shape.
+    Initiate(initiate::InitiateArgs),
+    /// The whole chain: annotations or params → extract → steady → initiate → outputs.
+    Animate(animate::AnimateArgs),
+    /// Render or export an animation file (GIF, PNG frames, glTF, CSV, JSON).
+    Render(render::RenderArgs),
+    /// Charts: power, xi, shape, paths, wingbeat.
+    Plot(plot::PlotArgs),
+}
+
+/// Runs the parsed command line.
+pub fn run(cli: Cli) -> Result<()> {
+    let g = Global {
+        quiet: cli.quiet,
+        seed: cli.seed,
+    };
+    match cli.command {
+        Command::Extract(a) => extract::run(a, g),
+        Command::Power(a) => power::run(a, g),
+        Command::Solve(a) => solve::run(a, g),
+        Command::Steady(a) => steady::run(a, g),
+        Command::Initiate(a) => initiate::run(a, g),
+        Command::Animate(a) => animate::run(a, g),
+        Command::Render(a) => render::run(a, g),
+        Command::Plot(a) => plot::run(a, g),
+    }
+}
+
+/// On Ctrl-C or SIGTERM, remove temporary output files before exiting (no partial outputs).
+pub fn install_signal_cleanup() {
+    // Installed by the hardening work (issue 8); temporaries are tracked in `formation::io`.
+}
+
+/// The error for a command that is not built yet.
+#[allow(dead_code)]
+pub fn not_yet(what: &str) -> formation::Error {
+    formation::Error::Internal(format!("`{what}` is not implemented yet"))
+}

@@ -1,0 +1,38 @@
+//! `formation plot KIND`: dispatch to the chart of each stage.
+
+use clap::{Args, Subcommand};
+use formation::Result;
+
+use super::Global;
+
+/// Arguments of `formation plot`.
+#[derive(Debug, Args)]
+pub struct PlotArgs {
+    #[command(subcommand)]
+    kind: PlotKind,
+}
+
+#[derive(Debug, Subcommand)]
+enum PlotKind {
+    /// Per-bird power reduction of a shape, key shape or frame, with feasible ranges.
+    Power(super::steady::PlotPowerArgs),
+    /// ξ of every bird over time in an animation.
+    Xi(super::steady::PlotXiArgs),
+    /// Birds, fitted curve, leader and outliers of one frame of a params file.
+    Shape(super::extract::PlotShapeArgs),
+    /// Top view of the birds' trajectories during initiation.
+    Paths(super::initiate::PlotPathsArgs),
+    /// Joint angles of one wingbeat over its phase.
+    Wingbeat(super::wingbeat::PlotWingbeatArgs),
+}
+
+/// Runs `formation plot`.
+pub fn run(args: PlotArgs, g: Global) -> Result<()> {
+    match args.kind {
+        PlotKind::Power(a) => super::steady::run_plot_power(a, g),
+        PlotKind::Xi(a) => super::steady::run_plot_xi(a, g),
+        PlotKind::Shape(a) => super::extract::run_plot_shape(a, g),
+        PlotKind::Paths(a) => super::initiate::run_plot_paths(a, g),
+        PlotKind::Wingbeat(a) => super::wingbeat::run_plot_wingbeat(a, g),
+    }
+}

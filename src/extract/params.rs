@@ -1,0 +1,228 @@
+//! The formation-parameters file (SPEC §4.2): what `extract` learns from each annotated frame and
+//! `steady` consumes. Formation frame (leader at the origin, `x` right of the flight direction,
+//! `y` behind the leader), wingspans.
+
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+use crate::error::{Error, Result};
+
+/// Format tag of params files.
+pub const PARAMS_FORMAT: &str = "formation-params/1";
+
+/// Parameters of a whole annotated movie.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FormationParams {
+    /// Always [`PARAMS_FORMAT`].
+    pub format: String,
+    /// Free text from the annotations (`source`).
+    pub source: String,
+    /// Number of distinct birds in the movie (N̂).
+    pub birds: usize,
+    /// One entry per annotated frame, in file order.
+    pub frames: Vec<FrameParams>,
+}
+
+/// §4 steps 1 and 2 for one frame.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FrameParams {
+    /// Frame index from the annotations.
+    pub index: i64,
+    /// Bird ids ordered by lateral position, left to right.
+    pub order: Vec<usize>,
+    /// Id of the front-most bird.
+    pub leader: usize,
+    /// Mean lateral distance between lateral neighbours, wingspans.
+    pub mu_x: f64,
+    /// Standard deviation of the lateral neighbour distances, wingspans.
+    pub sigma_x: f64,
+    /// Mean deviation of the inliers from the fitted curve (y − curve(x)), wingspans.
+    pub mu_y: f64,
+    /// Standard deviation of the inliers' deviations from the curve, wingspans.
+    pub sigma_y: f64,
+    /// The fitted curve.
+    pub shape: ShapeModel,
+    /// Ids of the birds the curve explains.
+    pub inliers: Vec<usize>,
+    /// Ids of the birds RANSAC rejects.
+    pub outliers: Vec<usize>,
+    /// Every marked bird of the frame in the formation frame (leader at the origin), with its
+    /// deviation from the curve; in `order`.
+    #[serde(default)]
+    pub positions: Vec<BirdPosition>,
+}
+
+/// A marked bird in the formation frame.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct BirdPosition {
+    /// Bird id.
+    pub id: usize,
+    /// Lateral offset from the leader, wingspans.
+    pub x: f64,
+    /// Distance behind the leader, wingspans.
+    pub y: f64,
+    /// Deviation from the fitted curve, `y − curve(x)`, wingspans.
+    pub dy: f64,
+}
+
+/// A straight line `y = intercept + slope·x` in the formation frame (wingspans).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct LineCoef {
+    /// `y` at `x = 0`, wingspans.
+    pub intercept: f64,
+    /// dy/dx.
+    pub slope: f64,
+}
+
+impl LineCoef {
+    /// `y` at lateral offset `x`.
+    pub fn y_at(&self, x: f64) -> f64 {
+        self.intercept + self.slope * x
+    }
+}
+
+/// The curve fitted to one frame (§4 step 2), formation frame, wingspans.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "lowercase")]
+pub enum ShapeModel {
+    /// Two lines meeting near the leader: `left` for x < 0, `right` for x ≥ 0.
+    V {
+        /// Arm to the left of the leader.
+        left: LineCoef,
+        /// Arm to the right of the leader.
+        right: LineCoef,
+    },
+    /// One line (echelon or line abreast).
+    Line {
+        /// `y` at `x = 0`.
+        intercept: f64,
+        /// dy/dx.
+        slope: f64,
+    },
+    /// Symmetric-ish parabola `y = a·x² + b·x + c`, vertex near the flock's centre.
+    U {
+        /// Quadratic coefficient.
+        a: f64,
+        /// Linear coefficient.
+        b: f64,
+        /// Constant.
+        c: f64,
+    },
+    /// Parabola whose vertex is well off the flock's centre (one arm longer).
+    J {
+        /// Quadratic coefficient.
+        a: f64,
+        /// Linear coefficient.
+        b: f64,
+        /// Constant.
+        c: f64,
+    },
+}
+
+impl ShapeModel {
+    /// The curve's `y` (distance behind the leader) at lateral offset `x`, wingspans.
+    pub fn y_at(&self, x: f64) -> f64 {
+        match *self {
+            ShapeModel::V { left, right } => {
+                if x < 0.0 {
+                    left.y_at(x)
+                } else {
+                    right.y_at(x)
+                }
+            }
+            ShapeModel::Line { intercept, slope } => intercept + slope * x,
+            ShapeModel::U { a, b, c } | ShapeModel::J { a, b, c } => (a * x + b) * x + c,
+        }
+    }
+
+    /// `"v"`, `"line"`, `"u"` or `"j"`.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            ShapeModel::V { .. } => "v",
+            ShapeModel::Line { .. } => "line",
+            ShapeModel::U { .. } => "u",
+            ShapeModel::J { .. } => "j",
+        }
+    }
+}
+
+impl FormationParams {
+    /// Reads and validates a params file.
+    pub fn read(path: &Path) -> Result<FormationParams> {
+        let p: FormationParams = crate::io::read_json(path)?;
+        p.validate(path)?;
+        Ok(p)
+    }
+
+    /// Checks the format tag and that every number is finite and every id known.
+    pub fn validate(&self, origin: &Path) -> Result<()> {
+        if self.format != PARAMS_FORMAT {
+            return Err(Error::format(
+                origin,
+                format!(
+                    "format: expected \"{PARAMS_FORMAT}\", found \"{}\" (is this a params file written by `formation extract`?)",
+                    self.format
+                ),
+            ));
+        }
+        if self.frames.is_empty() {
+            return Err(Error::format(origin, "frames: no frames"));
+        }
+        for (k, f) in self.frames.iter().enumerate() {
+            let nums = [
+                ("mu_x", f.mu_x),
+                ("sigma_x", f.sigma_x),
+                ("mu_y", f.mu_y),
+                ("sigma_y", f.sigma_y),
+            ];
+            for (name, v) in nums {
+                if !v.is_finite() {
+                    return Err(Error::format(
+                        origin,
+                        format!("frames[{k}].{name}: not a finite number"),
+                    ));
+                }
+            }
+            if f.sigma_x < 0.0 || f.sigma_y < 0.0 {
+                return Err(Error::format(
+                    origin,
+                    format!("frames[{k}]: standard deviations must not be negative"),
+                ));
+            }
+            if f.order.len() < 2 {
+                return Err(Error::format(
+                    origin,
+                    format!("frames[{k}].order: {} bird(s), at least 2 needed", f.order.len()),
+                ));
+            }
+            if !f.order.contains(&f.leader) {
+                return Err(Error::format(
+                    origin,
+                    format!("frames[{k}].leader: bird {} is not in `order`", f.leader),
+                ));
+            }
+            let coefs: Vec<f64> = match f.shape {
+                ShapeModel::V { left, right } => {
+                    vec![left.intercept, left.slope, right.intercept, right.slope]
+                }
+                ShapeModel::Line { intercept, slope } => vec![intercept, slope],
+                ShapeModel::U { a, b, c } | ShapeModel::J { a, b, c } => vec![a, b, c],
+            };
+            if coefs.iter().any(|v| !v.is_finite()) {
+                return Err(Error::format(
+                    origin,
+                    format!("frames[{k}].shape: coefficients must be finite numbers"),
+                ));
+            }
+            for (i, p) in f.positions.iter().enumerate() {
+                if !(p.x.is_finite() && p.y.is_finite() && p.dy.is_finite()) {
+                    return Err(Error::format(
+                        origin,
+                        format!("frames[{k}].positions[{i}]: not a finite number"),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+}

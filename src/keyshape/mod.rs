@@ -1,0 +1,2 @@
+//! §5 steps 1–4: initial shapes, power ranges, the Levenberg–Marquardt key-shape solve, and the
+//! interpolation into a steady flight.

@@ -1,0 +1,44 @@
+//! # formation
+//!
+//! Animates bird flocks flying in line formations (V, U, J, echelon), after M. Klotsman and
+//! A. Tal, "Animation of Flocks Flying in Line Formations". The pipeline (SPEC §1):
+//!
+//! ```text
+//! annotated frames ─extract─▶ formation parameters ─steady─▶ key shapes + steady-flight frames
+//!                                  (RANSAC, §4)          (Hummel upwash + Levenberg–Marquardt, §5)
+//! random start ─initiate (HPR perception, drives, §6)─▶ converges into the first key shape
+//! initiation + steady flight ─render─▶ GIF · PNG frames · glTF (.glb) · CSV · JSON · plots
+//! ```
+//!
+//! | stage | module |
+//! |---|---|
+//! | reading annotations (every input format) | [`annotations`] |
+//! | §4 parameter extraction, RANSAC | [`extract`] |
+//! | §5 step 2, Hummel's power-reduction model | [`aero`] |
+//! | §5 steps 1–4, key shapes and steady flight | [`keyshape`] |
+//! | §6 initiation | [`initiate`] |
+//! | wingbeats (Wu & Popović) | [`wingbeat`] |
+//! | GIF, PNG, glTF, CSV, JSON | [`export`] |
+//! | charts | [`plot`] |
+//!
+//! Conventions (SPEC §2): lengths in wingspans; formation frame `x` right of the flight direction,
+//! `y` behind the leader; world frame `x` east, `y` north, `z` up, cruise heading +y.
+
+pub mod aero;
+pub mod animation;
+pub mod annotations;
+pub mod error;
+pub mod export;
+pub mod extract;
+pub mod initiate;
+pub mod io;
+pub mod keyshape;
+pub mod plot;
+pub mod progress;
+pub mod rng;
+pub mod shape;
+pub mod wingbeat;
+
+pub use animation::Animation;
+pub use error::{Error, Result};
+pub use shape::{Bird, Shape};

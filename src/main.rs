@@ -1,0 +1,46 @@
+//! The `formation` binary: parse the command line, run the library, map errors to exit codes.
+//! This is the only place that prints errors: one line on stderr, exit 2 for bad input or usage,
+//! 1 for the tool's own failures.
+
+mod cli;
+
+use std::process::ExitCode;
+
+use clap::Parser;
+
+fn main() -> ExitCode {
+    let args = match cli::Cli::try_parse() {
+        Ok(a) => a,
+        Err(e) => {
+            use clap::error::ErrorKind;
+            return match e.kind() {
+                ErrorKind::DisplayHelp
+                | ErrorKind::DisplayVersion
+                | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
+                    let _ = e.print();
+                    if e.kind() == ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand {
+                        ExitCode::from(2)
+                    } else {
+                        ExitCode::SUCCESS
+                    }
+                }
+                _ => {
+                    // clap's message is several lines (usage, tip); keep the first, which says
+                    // what is wrong, and point at --help.
+                    let rendered = e.render().to_string();
+                    let first = rendered.lines().next().unwrap_or("error: invalid usage");
+                    eprintln!("{first} (see `formation --help`)");
+                    ExitCode::from(2)
+                }
+            };
+        }
+    };
+    cli::install_signal_cleanup();
+    match cli::run(args) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(e.exit_code())
+        }
+    }
+}

@@ -1,0 +1,1 @@
+//! Kinematic flapping after Wu & Popović (issue 7).
