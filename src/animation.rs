@@ -130,7 +130,10 @@ impl Animation {
             return Err(Error::format(origin, "fps: must be a positive number"));
         }
         if !(self.wingspan_m.is_finite() && self.wingspan_m > 0.0) {
-            return Err(Error::format(origin, "wingspan_m: must be a positive number"));
+            return Err(Error::format(
+                origin,
+                "wingspan_m: must be a positive number",
+            ));
         }
         if self.birds == 0 {
             return Err(Error::format(origin, "birds: must be at least 1"));
@@ -141,7 +144,10 @@ impl Animation {
         let n = self.birds;
         for (k, f) in self.frames.iter().enumerate() {
             if !f.t.is_finite() {
-                return Err(Error::format(origin, format!("frames[{k}].t: not a finite number")));
+                return Err(Error::format(
+                    origin,
+                    format!("frames[{k}].t: not a finite number"),
+                ));
             }
             let arrays: [(&str, Option<&Vec<f64>>); 8] = [
                 ("x", Some(&f.x)),

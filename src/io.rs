@@ -39,7 +39,10 @@ pub fn read_text(path: &Path) -> Result<String> {
     String::from_utf8(bytes).map_err(|e| {
         Error::format(
             path,
-            format!("not UTF-8 text (invalid byte at offset {})", e.utf8_error().valid_up_to()),
+            format!(
+                "not UTF-8 text (invalid byte at offset {})",
+                e.utf8_error().valid_up_to()
+            ),
         )
     })
 }
@@ -83,7 +86,10 @@ pub fn check_finite(name: &str, v: f64) -> Result<f64> {
     if v.is_finite() {
         Ok(v)
     } else {
-        Err(Error::parameter(name, format!("must be a finite number, got {v}")))
+        Err(Error::parameter(
+            name,
+            format!("must be a finite number, got {v}"),
+        ))
     }
 }
 
@@ -185,7 +191,10 @@ impl AtomicFile {
     /// or not writable.
     pub fn create(target: &Path) -> Result<AtomicFile> {
         if target.is_dir() {
-            return Err(Error::format(target, "is a directory, expected a file name"));
+            return Err(Error::format(
+                target,
+                "is a directory, expected a file name",
+            ));
         }
         let tmp = temp_path_for(target);
         let file = fs::File::create(&tmp).map_err(|e| Error::io(target, e))?;

@@ -74,10 +74,16 @@ impl Shape {
         }
         for (i, b) in self.birds.iter().enumerate() {
             if !b.x.is_finite() {
-                return Err(Error::format(origin, format!("birds[{i}].x: not a finite number")));
+                return Err(Error::format(
+                    origin,
+                    format!("birds[{i}].x: not a finite number"),
+                ));
             }
             if !b.y.is_finite() {
-                return Err(Error::format(origin, format!("birds[{i}].y: not a finite number")));
+                return Err(Error::format(
+                    origin,
+                    format!("birds[{i}].y: not a finite number"),
+                ));
             }
         }
         Ok(())

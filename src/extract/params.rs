@@ -192,7 +192,10 @@ impl FormationParams {
             if f.order.len() < 2 {
                 return Err(Error::format(
                     origin,
-                    format!("frames[{k}].order: {} bird(s), at least 2 needed", f.order.len()),
+                    format!(
+                        "frames[{k}].order: {} bird(s), at least 2 needed",
+                        f.order.len()
+                    ),
                 ));
             }
             if !f.order.contains(&f.leader) {
