@@ -31,6 +31,10 @@ pub struct Animation {
     /// Key shapes of the steady flight, formation frame.
     #[serde(default)]
     pub key_shapes: Vec<KeyShapeRecord>,
+    /// Feasible range [(1 − ε) p_i, (1 + ε) P_i] of each bird's ξ in the steady flight (§5 eq. 2),
+    /// when known.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub xi_ranges: Option<Vec<[f64; 2]>>,
     /// One entry per frame.
     pub frames: Vec<Frame>,
 }
@@ -104,6 +108,7 @@ impl Animation {
             species: None,
             stages: Vec::new(),
             key_shapes: Vec::new(),
+            xi_ranges: None,
             frames: Vec::new(),
         }
     }

@@ -1,0 +1,406 @@
+//! §5 step 1: the correspondence between the N animated birds and the N̂ movie birds, and one
+//! N-bird initial shape per movie frame. Takes the formation parameters of §4 (SPEC §4.2); gives
+//! shapes in the formation frame (`x` right of the flight direction, `y` behind the leader),
+//! wingspans. Animated birds are indexed left to right (smallest `x` first).
+//!
+//! The correspondence (derived from the first movie frame, as the paper does): the leaders are
+//! matched; each side of the animated flock gets a share of the N − 1 followers proportional to the
+//! movie's side sizes, so the side with more birds is matched to the side with more birds; then,
+//! per side, the bird closest to the leader, the farthest one, the outliers and finally the inliers
+//! are placed at the animated slot whose rank from the leader is proportional to theirs (the nearest
+//! free slot). When N > N̂ the slots left free are the added birds, spread uniformly between the
+//! matched ones; when N < N̂ the movie birds that find no free slot are dropped, inliers first,
+//! so the special roles (closest, farthest, outliers) survive the reduction.
+
+use rand::Rng;
+use rand_distr::{Distribution, Normal};
+
+use crate::aero::VORTEX_SPAN;
+use crate::error::{Error, Result};
+use crate::extract::params::{FormationParams, FrameParams, ShapeModel};
+use crate::shape::Shape;
+
+/// Which movie bird each animated bird stands for.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Correspondence {
+    /// Number of animated birds, N.
+    pub birds: usize,
+    /// Index of the animated leader (= number of birds to its left).
+    pub leader: usize,
+    /// Movie bird id per animated bird (left to right); `None` for added birds.
+    pub movie: Vec<Option<usize>>,
+    /// Movie birds of the first frame that have no animated counterpart (N < N̂).
+    pub dropped: Vec<usize>,
+}
+
+/// Options of step 1.
+#[derive(Debug, Clone)]
+pub struct InitialOptions {
+    /// Lateral gaps are redrawn until they exceed the vortex span π/4 by this margin, wingspans.
+    pub downwash_margin: f64,
+    /// Redraws of one gap before it is clamped to π/4 + margin (or the mean, if larger).
+    pub max_gap_draws: usize,
+}
+
+impl Default for InitialOptions {
+    fn default() -> Self {
+        InitialOptions {
+            downwash_margin: 0.05,
+            max_gap_draws: 64,
+        }
+    }
+}
+
+/// Builds the correspondence of §5 step 1 from the first movie frame for `n` animated birds.
+pub fn correspondence(first: &FrameParams, n: usize) -> Result<Correspondence> {
+    if n < 2 {
+        return Err(Error::parameter(
+            "--birds",
+            format!("{n} bird(s): a formation needs at least 2"),
+        ));
+    }
+    let order = &first.order;
+    let lead_pos = order
+        .iter()
+        .position(|&id| id == first.leader)
+        .ok_or_else(|| Error::Internal("leader not in order (params not validated)".into()))?;
+    let n_hat = order.len();
+    // Proportional split of the N − 1 followers; monotone in the movie's left share, so the
+    // larger movie side stays the larger (or equal) animated side.
+    let left = if n_hat <= 1 {
+        0
+    } else {
+        (((n - 1) as f64) * (lead_pos as f64) / ((n_hat - 1) as f64)).round() as usize
+    };
+    let left = left.min(n - 1);
+    let right = n - 1 - left;
+
+    let mut movie = vec![None; n];
+    movie[left] = Some(first.leader);
+    let mut dropped = Vec::new();
+
+    // Movie side lists, closest to the leader first.
+    let movie_left: Vec<usize> = order[..lead_pos].iter().rev().copied().collect();
+    let movie_right: Vec<usize> = order[lead_pos + 1..].to_vec();
+    for (side_ids, slots, to_index) in [
+        (
+            movie_left,
+            left,
+            Box::new(|s: usize| left - 1 - s) as Box<dyn Fn(usize) -> usize>,
+        ),
+        (movie_right, right, Box::new(|s: usize| left + 1 + s)),
+    ] {
+        let assigned = match_side(&side_ids, slots, &first.outliers, &mut dropped);
+        for (slot, id) in assigned.into_iter().enumerate() {
+            movie[to_index(slot)] = id;
+        }
+    }
+    dropped.sort_unstable();
+    Ok(Correspondence {
+        birds: n,
+        leader: left,
+        movie,
+        dropped,
+    })
+}
+
+/// Places the movie birds of one side (closest first) into `slots` animated slots (closest first).
+fn match_side(
+    ids: &[usize],
+    slots: usize,
+    outliers: &[usize],
+    dropped: &mut Vec<usize>,
+) -> Vec<Option<usize>> {
+    let mut out = vec![None; slots];
+    let k = ids.len();
+    if k == 0 {
+        return out;
+    }
+    // Priority: closest, farthest, outliers (closest first), inliers (closest first).
+    let mut priority: Vec<usize> = vec![0];
+    if k > 1 {
+        priority.push(k - 1);
+    }
+    for r in 1..k.saturating_sub(1) {
+        if outliers.contains(&ids[r]) {
+            priority.push(r);
+        }
+    }
+    for r in 1..k.saturating_sub(1) {
+        if !outliers.contains(&ids[r]) {
+            priority.push(r);
+        }
+    }
+    for r in priority {
+        let target = if k == 1 || slots == 0 {
+            0
+        } else {
+            ((r as f64) * ((slots - 1) as f64) / ((k - 1) as f64)).round() as usize
+        };
+        match nearest_free(&out, target) {
+            Some(s) => out[s] = Some(ids[r]),
+            None => dropped.push(ids[r]),
+        }
+    }
+    out
+}
+
+/// The free slot nearest to `target`, ties toward the leader.
+fn nearest_free(slots: &[Option<usize>], target: usize) -> Option<usize> {
+    let n = slots.len();
+    for d in 0..n {
+        if target >= d && target - d < n && slots[target - d].is_none() {
+            return Some(target - d);
+        }
+        if target + d < n && slots[target + d].is_none() {
+            return Some(target + d);
+        }
+    }
+    None
+}
+
+/// `count` lateral gaps from N(μ, σ), each redrawn while it is within π/4 + margin (the downwash,
+/// where Hummel's g is undefined, and just above it, where g is huge), wingspans.
+pub fn lateral_gaps(
+    rng: &mut impl Rng,
+    mu: f64,
+    sigma: f64,
+    count: usize,
+    opts: &InitialOptions,
+) -> Vec<f64> {
+    let floor = VORTEX_SPAN + opts.downwash_margin;
+    let normal = Normal::new(mu, sigma.max(0.0)).ok();
+    (0..count)
+        .map(|_| {
+            if let Some(normal) = &normal {
+                for _ in 0..opts.max_gap_draws {
+                    let g = normal.sample(rng);
+                    if g > floor {
+                        return g;
+                    }
+                }
+            }
+            mu.max(floor)
+        })
+        .collect()
+}
+
+/// Lateral positions with the leader (index `leader`) at 0 from the N − 1 gaps between lateral
+/// neighbours, left to right, wingspans.
+pub fn positions_from_gaps(gaps: &[f64], leader: usize) -> Vec<f64> {
+    let n = gaps.len() + 1;
+    let mut x = vec![0.0; n];
+    for i in (0..leader).rev() {
+        x[i] = x[i + 1] - gaps[i];
+    }
+    for i in leader + 1..n {
+        x[i] = x[i - 1] + gaps[i - 1];
+    }
+    x
+}
+
+/// The curve's `y` behind the leader at animated lateral offset `x` (leader on the curve).
+///
+/// V and line curves are evaluated as they are (their arms keep their angle however many birds
+/// fly); U and J parabolas are evaluated at `x` scaled by the ratio of movie to animated birds on
+/// that side, so a larger flock makes a wider U of the movie's depth instead of a much deeper one.
+pub fn curve_y(model: &ShapeModel, x: f64, scale_left: f64, scale_right: f64) -> f64 {
+    let xs = match model {
+        ShapeModel::U { .. } | ShapeModel::J { .. } => {
+            if x < 0.0 {
+                x * scale_left
+            } else {
+                x * scale_right
+            }
+        }
+        _ => x,
+    };
+    model.y_at(xs) - model.y_at(0.0)
+}
+
+/// One initial shape per movie frame (§5 step 1): lateral gaps from N(μ_x, σ_x), `y` on the
+/// frame's curve, the movie outliers' deviations carried over to their animated counterparts and
+/// N(μ_y, σ_y) deviations for every other follower. The leader sits at (0, 0).
+pub fn initial_shapes(
+    params: &FormationParams,
+    corr: &Correspondence,
+    rng: &mut impl Rng,
+    opts: &InitialOptions,
+) -> Vec<Shape> {
+    let n = corr.birds;
+    let first = &params.frames[0];
+    let lead_pos = first
+        .order
+        .iter()
+        .position(|&id| id == first.leader)
+        .unwrap_or(0);
+    let movie_left = lead_pos as f64;
+    let movie_right = (first.order.len() - 1 - lead_pos) as f64;
+    let anim_left = corr.leader as f64;
+    let anim_right = (n - 1 - corr.leader) as f64;
+    let ratio = |m: f64, a: f64| if m > 0.0 && a > 0.0 { m / a } else { 1.0 };
+    let (scale_left, scale_right) = (ratio(movie_left, anim_left), ratio(movie_right, anim_right));
+
+    params
+        .frames
+        .iter()
+        .map(|f| {
+            let gaps = lateral_gaps(rng, f.mu_x, f.sigma_x, n - 1, opts);
+            let x = positions_from_gaps(&gaps, corr.leader);
+            let dev = Normal::new(f.mu_y, f.sigma_y.max(0.0)).ok();
+            let y: Vec<f64> = x
+                .iter()
+                .enumerate()
+                .map(|(i, &xi)| {
+                    if i == corr.leader {
+                        return 0.0;
+                    }
+                    let base = curve_y(&f.shape, xi, scale_left, scale_right);
+                    let carried = corr.movie[i].and_then(|id| {
+                        if f.outliers.contains(&id) {
+                            f.positions.iter().find(|p| p.id == id).map(|p| p.dy)
+                        } else {
+                            None
+                        }
+                    });
+                    // Always draw, so the random stream does not depend on the outlier pattern.
+                    let gauss = dev.as_ref().map_or(f.mu_y, |d| d.sample(rng));
+                    base + carried.unwrap_or(gauss)
+                })
+                .collect();
+            Shape::from_xy(&x, &y)
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::extract::params::LineCoef;
+    use crate::rng::seeded;
+
+    fn frame(order: Vec<usize>, leader: usize, outliers: Vec<usize>) -> FrameParams {
+        FrameParams {
+            index: 0,
+            inliers: order
+                .iter()
+                .copied()
+                .filter(|i| !outliers.contains(i))
+                .collect(),
+            order,
+            leader,
+            mu_x: 1.0,
+            sigma_x: 0.2,
+            mu_y: 0.0,
+            sigma_y: 0.1,
+            shape: ShapeModel::V {
+                left: LineCoef {
+                    intercept: 0.0,
+                    slope: -0.7,
+                },
+                right: LineCoef {
+                    intercept: 0.0,
+                    slope: 0.7,
+                },
+            },
+            outliers,
+            positions: vec![],
+        }
+    }
+
+    fn matched(c: &Correspondence) -> Vec<usize> {
+        let mut m: Vec<usize> = c.movie.iter().flatten().copied().collect();
+        m.sort_unstable();
+        m
+    }
+
+    #[test]
+    fn equal_counts_match_one_to_one_in_order() {
+        let f = frame(vec![0, 1, 2, 3, 4, 5, 6, 7, 8], 3, vec![6]);
+        let c = correspondence(&f, 9).unwrap();
+        assert_eq!(c.leader, 3);
+        assert_eq!(
+            c.movie,
+            (0..9).map(Some).collect::<Vec<_>>(),
+            "N = N̂ keeps every bird in place"
+        );
+        assert!(c.dropped.is_empty());
+    }
+
+    #[test]
+    fn more_birds_keep_roles_and_spread_added_ones() {
+        let f = frame(vec![0, 1, 2, 3, 4, 5, 6, 7, 8], 3, vec![6]);
+        let c = correspondence(&f, 14).unwrap();
+        assert_eq!(c.movie[c.leader], Some(3));
+        assert_eq!(
+            matched(&c),
+            (0..9).collect::<Vec<_>>(),
+            "every movie bird kept"
+        );
+        // Closest and farthest per side.
+        assert_eq!(c.movie[c.leader - 1], Some(2));
+        assert_eq!(c.movie[c.leader + 1], Some(4));
+        assert_eq!(c.movie[0], Some(0));
+        assert_eq!(c.movie[13], Some(8));
+        // Larger side stays larger.
+        assert!(13 - c.leader > c.leader);
+        // Added birds are not bunched: no two adjacent added birds on the right side of 5 slots.
+        let added: Vec<usize> = (0..14).filter(|&i| c.movie[i].is_none()).collect();
+        assert_eq!(added.len(), 5);
+    }
+
+    #[test]
+    fn fewer_birds_drop_inliers_first() {
+        let f = frame(vec![0, 1, 2, 3, 4, 5, 6, 7, 8], 3, vec![6]);
+        let c = correspondence(&f, 5).unwrap();
+        assert_eq!(c.movie[c.leader], Some(3));
+        let m = matched(&c);
+        assert!(m.contains(&6), "the outlier survives: {m:?}");
+        assert!(
+            m.contains(&8) && m.contains(&4),
+            "closest and farthest kept: {m:?}"
+        );
+        assert_eq!(m.len() + c.dropped.len(), 9);
+    }
+
+    #[test]
+    fn gaps_never_in_downwash() {
+        let mut rng = seeded(1);
+        let opts = InitialOptions::default();
+        let g = lateral_gaps(&mut rng, 0.85, 0.2, 5000, &opts);
+        assert!(g.iter().all(|&v| v > VORTEX_SPAN + opts.downwash_margin));
+        let g = lateral_gaps(&mut rng, 0.5, 0.0, 3, &opts);
+        assert!(g.iter().all(|&v| v > VORTEX_SPAN));
+    }
+
+    #[test]
+    fn positions_put_leader_at_zero() {
+        let x = positions_from_gaps(&[1.0, 2.0, 3.0], 1);
+        assert_eq!(x, vec![-1.0, 0.0, 2.0, 5.0]);
+    }
+
+    #[test]
+    fn initial_shapes_follow_curve_and_carry_outliers() {
+        let mut f = frame(vec![0, 1, 2, 3, 4], 2, vec![4]);
+        f.sigma_y = 0.0;
+        f.positions = vec![crate::extract::params::BirdPosition {
+            id: 4,
+            x: 2.0,
+            y: 2.5,
+            dy: 1.1,
+        }];
+        let p = FormationParams {
+            format: crate::extract::params::PARAMS_FORMAT.into(),
+            source: String::new(),
+            birds: 5,
+            frames: vec![f],
+        };
+        let c = correspondence(&p.frames[0], 5).unwrap();
+        let s = initial_shapes(&p, &c, &mut seeded(0), &InitialOptions::default());
+        assert_eq!(s.len(), 1);
+        let b = &s[0].birds;
+        assert_eq!(b[2].y, 0.0);
+        assert!((b[1].y - 0.7 * b[1].x.abs()).abs() < 1e-12);
+        assert!((b[4].y - (0.7 * b[4].x + 1.1)).abs() < 1e-12, "{:?}", b[4]);
+    }
+}

@@ -1,0 +1,408 @@
+//! §5 step 3: new key shapes. Each key k draws relative power reductions ξ̂_k by eq. (2) inside the
+//! birds' feasible ranges and near ξ̂_{k−1}, and places the birds fore and aft by the
+//! Levenberg–Marquardt solve of eq. (4) ([`crate::keyshape::solve`]) with the lateral positions
+//! fixed. Formation frame, wingspans; ξ dimensionless.
+//!
+//! ```math
+//! \hat\xi_{i,k} \in [(1-\varepsilon)\,p_i,\ (1+\varepsilon)\,P_i] \cap [C_1\,\hat\xi_{i,k-1},\ C_2\,\hat\xi_{i,k-1}]
+//! \qquad \text{(Klotsman \& Tal, eq. 2)}
+//! ```
+//! (`p_i, P_i` = [`XiRanges`], `ε, C_1, C_2` = [`KeyOptions::epsilon`, `c1`, `c2`]).
+//! Munk's stagger theorem fixes E = Σ e_i by the lateral positions alone, so eq. (3)–(4) reduce to
+//! ξ(x, y) = ξ̂ with Σ ξ̂ = 1: a draw is renormalised, clipped back into its range and renormalised
+//! again, which keeps the system consistent.
+//!
+//! A key shape is accepted only when the solve reaches the residual bound, the leader stays
+//! front-most, no bird falls further back than the depth limit, the arms keep the monotone steps of
+//! the first key shape (side structure), and no bird moves more than `max_jump` from the previous key.
+//! A rejected shape is never used as a starting point. Failing draws are redrawn (`max_draws`);
+//! when all fail, the first draw is damped toward ξ̂_{k−1} (ξ̂_{k−1} + λ (ξ̂ − ξ̂_{k−1})), whose
+//! solution is the previous key shape at λ = 0, so the reachable set always contains a fallback.
+
+use rand::Rng;
+use serde::Serialize;
+
+use crate::error::{Error, Result};
+use crate::keyshape::ranges::XiRanges;
+use crate::keyshape::solve::{solve, SolveOptions};
+
+/// Options of step 3.
+#[derive(Debug, Clone)]
+pub struct KeyOptions {
+    /// ε of eq. (2): widening of [p_i, P_i] (paper: 0 ≤ ε ≤ 0.2).
+    pub epsilon: f64,
+    /// C₁ of eq. (2): smallest ratio ξ̂_{i,k} / ξ̂_{i,k−1} (paper: 0.75–0.9).
+    pub c1: f64,
+    /// C₂ of eq. (2): largest ratio ξ̂_{i,k} / ξ̂_{i,k−1} (paper: 1.1–1.25).
+    pub c2: f64,
+    /// A key shape is solved when ‖ξ − ξ̂‖₂ is at most this.
+    pub accept_residual: f64,
+    /// Draws of ξ̂ per key before damping.
+    pub max_draws: usize,
+    /// Damping steps (λ shrinks each time) before the previous key shape is held.
+    pub max_damping: usize,
+    /// Largest longitudinal move of any bird between consecutive key shapes, wingspans.
+    pub max_jump: f64,
+    /// No bird may be further behind the leader than this, wingspans.
+    pub max_depth: f64,
+    /// Options of the Levenberg–Marquardt solve.
+    pub solve: SolveOptions,
+}
+
+impl Default for KeyOptions {
+    fn default() -> Self {
+        KeyOptions {
+            epsilon: 0.1,
+            c1: 0.85,
+            c2: 1.15,
+            accept_residual: 1e-6,
+            max_draws: 3,
+            max_damping: 12,
+            max_jump: 0.5,
+            max_depth: f64::INFINITY,
+            solve: SolveOptions::default(),
+        }
+    }
+}
+
+/// One key shape, formation frame (lateral positions are shared by all keys).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct KeyShape {
+    /// Distance of each bird behind the leader, wingspans (leader at 0).
+    pub y: Vec<f64>,
+    /// The target ξ̂ the shape was solved for (after damping).
+    pub xi_target: Vec<f64>,
+    /// ξ achieved.
+    pub xi: Vec<f64>,
+    /// ‖ξ − ξ̂‖₂.
+    pub residual: f64,
+    /// Damping λ used: 1 for an undamped draw, 0 when the previous shape was held.
+    pub damping: f64,
+    /// Draws of ξ̂ spent on this key.
+    pub draws: usize,
+}
+
+/// Counts of step 3 over all keys.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct KeyStats {
+    /// Key shapes made (including the first, taken from an initial shape).
+    pub keys: usize,
+    /// Draws of ξ̂ in total.
+    pub draws: usize,
+    /// Draws beyond the first of a key.
+    pub redraws: usize,
+    /// Keys accepted only after damping (0 < λ < 1).
+    pub damped: usize,
+    /// Keys where every damped target failed and the previous shape was held (λ = 0).
+    pub held: usize,
+    /// Solves run.
+    pub solves: usize,
+    /// Solves that reported an error (unreachable target, downwash).
+    pub solve_errors: usize,
+    /// Solves above the residual bound.
+    pub rejected_residual: usize,
+    /// Solved shapes rejected for the leader, depth or arm order.
+    pub rejected_structure: usize,
+    /// Solved shapes rejected for a jump above `max_jump`.
+    pub rejected_jump: usize,
+    /// Model evaluations of all solves.
+    pub evaluations: usize,
+    /// Smallest λ among accepted keys (1 when none was damped).
+    pub min_damping: f64,
+    /// Largest residual among accepted keys.
+    pub max_residual: f64,
+    /// Largest move of a bird between consecutive keys, wingspans.
+    pub max_jump: f64,
+}
+
+/// The structure every key shape must keep: leader, arm steps and depth.
+#[derive(Debug, Clone)]
+pub struct Structure {
+    /// Index of the leader (front-most bird).
+    pub leader: usize,
+    /// (inner, outer) lateral neighbours on the same arm whose outer bird is not ahead of the inner
+    /// one in the first key shape; they must stay that way.
+    pub monotone_pairs: Vec<(usize, usize)>,
+    /// Deepest allowed position, wingspans.
+    pub max_depth: f64,
+}
+
+impl Structure {
+    /// The structure of a first key shape with lateral positions `x` and depths `y`.
+    pub fn of(x: &[f64], y: &[f64], leader: usize, max_depth: f64) -> Structure {
+        let mut idx: Vec<usize> = (0..x.len()).collect();
+        idx.sort_by(|&a, &b| x[a].total_cmp(&x[b]));
+        let lp = idx.iter().position(|&i| i == leader).unwrap_or(0);
+        let mut pairs = Vec::new();
+        // Left arm: from the leader outward is toward smaller rank.
+        for r in (1..=lp).rev() {
+            let (inner, outer) = (idx[r], idx[r - 1]);
+            if y[outer] >= y[inner] {
+                pairs.push((inner, outer));
+            }
+        }
+        for r in lp..idx.len().saturating_sub(1) {
+            let (inner, outer) = (idx[r], idx[r + 1]);
+            if y[outer] >= y[inner] {
+                pairs.push((inner, outer));
+            }
+        }
+        Structure {
+            leader,
+            monotone_pairs: pairs,
+            max_depth,
+        }
+    }
+
+    /// True when `y` keeps the leader front-most, the depth limit and the arms' monotone steps.
+    pub fn accepts(&self, y: &[f64]) -> bool {
+        let Some(&yl) = y.get(self.leader) else {
+            return false;
+        };
+        let ok_leader = y
+            .iter()
+            .enumerate()
+            .all(|(i, &v)| i == self.leader || v > yl);
+        let ok_depth = y.iter().all(|&v| v - yl <= self.max_depth);
+        let ok_arms = self
+            .monotone_pairs
+            .iter()
+            .all(|&(inner, outer)| y[outer] >= y[inner]);
+        ok_leader && ok_depth && ok_arms
+    }
+}
+
+/// Draws ξ̂_k by eq. (2) uniformly in each bird's interval, then renormalises, clips into the
+/// feasible ranges and renormalises again (Σ ξ̂ = 1, as Munk's theorem requires).
+pub fn draw_target(
+    prev: &[f64],
+    feasible: &XiRanges,
+    c1: f64,
+    c2: f64,
+    rng: &mut impl Rng,
+) -> Vec<f64> {
+    let mut xi: Vec<f64> = prev
+        .iter()
+        .zip(&feasible.min)
+        .zip(&feasible.max)
+        .map(|((&p, &lo), &hi)| {
+            let a = lo.max(c1 * p);
+            let b = hi.min(c2 * p);
+            let u: f64 = rng.random();
+            if a <= b {
+                a + u * (b - a)
+            } else {
+                // Empty intersection (ξ̂_{k−1} outside its range): the range end nearest to it.
+                p.clamp(lo, hi.max(lo))
+            }
+        })
+        .collect();
+    renormalise(&mut xi);
+    feasible.clip(&mut xi);
+    renormalise(&mut xi);
+    xi
+}
+
+fn renormalise(xi: &mut [f64]) {
+    let s: f64 = xi.iter().sum();
+    if s > 0.0 && s.is_finite() {
+        for v in xi.iter_mut() {
+            *v /= s;
+        }
+    }
+}
+
+enum Attempt {
+    Accepted(Vec<f64>, Vec<f64>, f64),
+    Rejected,
+}
+
+/// Solves for `target` from `prev`, checks the result; counts into `stats`.
+fn attempt(
+    x: &[f64],
+    prev: &KeyShape,
+    target: &[f64],
+    structure: &Structure,
+    opts: &KeyOptions,
+    stats: &mut KeyStats,
+) -> Result<Attempt> {
+    stats.solves += 1;
+    let report = match solve(x, target, Some(&prev.y), &opts.solve) {
+        Ok(r) => r,
+        Err(Error::Unreachable(_)) | Err(Error::Downwash { .. }) | Err(Error::NotConverged(_)) => {
+            stats.solve_errors += 1;
+            return Ok(Attempt::Rejected);
+        }
+        Err(e) => return Err(e),
+    };
+    stats.evaluations += report.evaluations;
+    if !(report.residual.is_finite() && report.residual <= opts.accept_residual)
+        || report.y.len() != x.len()
+        || report.y.iter().any(|v| !v.is_finite())
+    {
+        stats.rejected_residual += 1;
+        return Ok(Attempt::Rejected);
+    }
+    // Leader at 0 (the solver puts the front-most bird there; re-anchor on ours).
+    let yl = report.y[structure.leader];
+    let y: Vec<f64> = report.y.iter().map(|v| v - yl).collect();
+    if !structure.accepts(&y) {
+        stats.rejected_structure += 1;
+        return Ok(Attempt::Rejected);
+    }
+    if max_jump(&prev.y, &y) > opts.max_jump {
+        stats.rejected_jump += 1;
+        return Ok(Attempt::Rejected);
+    }
+    Ok(Attempt::Accepted(y, report.xi, report.residual))
+}
+
+/// Largest |Δy_i| between two shapes, wingspans.
+pub fn max_jump(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(p, q)| (p - q).abs())
+        .fold(0.0, f64::max)
+}
+
+/// The next key shape after `prev` (§5 step 3): redraws first, damping as the fallback, the
+/// previous shape held as the last resort (never an error for an unlucky draw).
+pub fn next_key(
+    x: &[f64],
+    prev: &KeyShape,
+    feasible: &XiRanges,
+    structure: &Structure,
+    opts: &KeyOptions,
+    rng: &mut impl Rng,
+    stats: &mut KeyStats,
+) -> Result<KeyShape> {
+    let mut first_draw: Option<Vec<f64>> = None;
+    let mut draws = 0;
+    for _ in 0..opts.max_draws.max(1) {
+        let target = draw_target(&prev.xi_target, feasible, opts.c1, opts.c2, rng);
+        draws += 1;
+        stats.draws += 1;
+        if draws > 1 {
+            stats.redraws += 1;
+        }
+        if let Attempt::Accepted(y, xi, residual) =
+            attempt(x, prev, &target, structure, opts, stats)?
+        {
+            return Ok(KeyShape {
+                y,
+                xi_target: target,
+                xi,
+                residual,
+                damping: 1.0,
+                draws,
+            });
+        }
+        first_draw.get_or_insert(target);
+    }
+    let draw = first_draw.unwrap_or_else(|| prev.xi_target.clone());
+    let mut lambda = 1.0;
+    for _ in 0..opts.max_damping {
+        lambda *= 0.5;
+        let target: Vec<f64> = prev
+            .xi_target
+            .iter()
+            .zip(&draw)
+            .map(|(p, d)| p + lambda * (d - p))
+            .collect();
+        if let Attempt::Accepted(y, xi, residual) =
+            attempt(x, prev, &target, structure, opts, stats)?
+        {
+            stats.damped += 1;
+            return Ok(KeyShape {
+                y,
+                xi_target: target,
+                xi,
+                residual,
+                damping: lambda,
+                draws,
+            });
+        }
+    }
+    stats.held += 1;
+    Ok(KeyShape {
+        damping: 0.0,
+        draws,
+        ..prev.clone()
+    })
+}
+
+/// `count` key shapes starting from `first` (already solved), each from the one before.
+pub fn key_shapes(
+    x: &[f64],
+    first: KeyShape,
+    feasible: &XiRanges,
+    structure: &Structure,
+    count: usize,
+    opts: &KeyOptions,
+    rng: &mut impl Rng,
+    mut on_key: impl FnMut(),
+) -> Result<(Vec<KeyShape>, KeyStats)> {
+    let mut stats = KeyStats {
+        min_damping: 1.0,
+        max_residual: first.residual,
+        ..KeyStats::default()
+    };
+    let mut keys = Vec::with_capacity(count);
+    keys.push(first);
+    on_key();
+    while keys.len() < count {
+        let prev = keys
+            .last()
+            .ok_or_else(|| Error::Internal("no key".into()))?;
+        let k = next_key(x, prev, feasible, structure, opts, rng, &mut stats)?;
+        stats.min_damping = stats.min_damping.min(k.damping);
+        stats.max_residual = stats.max_residual.max(k.residual);
+        stats.max_jump = stats.max_jump.max(max_jump(&prev.y, &k.y));
+        keys.push(k);
+        on_key();
+    }
+    stats.keys = keys.len();
+    Ok((keys, stats))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rng::seeded;
+
+    #[test]
+    fn draws_respect_eq2_and_sum_to_one() {
+        let feasible = XiRanges {
+            min: vec![0.05, 0.1, 0.2, 0.1],
+            max: vec![0.2, 0.3, 0.5, 0.4],
+        };
+        let mut prev = vec![0.1, 0.2, 0.4, 0.3];
+        let mut rng = seeded(3);
+        for _ in 0..500 {
+            let d = draw_target(&prev, &feasible, 0.85, 1.15, &mut rng);
+            let s: f64 = d.iter().sum();
+            assert!((s - 1.0).abs() < 1e-12);
+            for i in 0..4 {
+                // Inside the feasible range up to the final renormalisation's small rescaling.
+                assert!(d[i] >= feasible.min[i] * 0.8 && d[i] <= feasible.max[i] * 1.2);
+                assert!(d[i] >= prev[i] * 0.85 * 0.8 && d[i] <= prev[i] * 1.15 * 1.2);
+            }
+            prev = d;
+        }
+    }
+
+    #[test]
+    fn structure_keeps_leader_and_arms() {
+        let x = [-2.0, -1.0, 0.0, 1.0, 2.0];
+        let y = [1.4, 0.7, 0.0, 0.7, 1.4];
+        let s = Structure::of(&x, &y, 2, 5.0);
+        assert_eq!(s.monotone_pairs.len(), 4);
+        assert!(s.accepts(&y));
+        assert!(
+            !s.accepts(&[1.4, 0.7, 0.0, -0.1, 1.4]),
+            "bird ahead of leader"
+        );
+        assert!(!s.accepts(&[0.5, 0.7, 0.0, 0.7, 1.4]), "arm not monotone");
+        assert!(!s.accepts(&[1.4, 0.7, 0.0, 0.7, 6.0]), "too deep");
+    }
+}

@@ -1,0 +1,123 @@
+//! §5 step 2: e_i and ξ_i of every bird in every initial shape, and each bird's range
+//! [p_i, P_i] of ξ over the shapes. Takes shapes in the formation frame (wingspans); gives
+//! dimensionless relative power reductions.
+//!
+//! The values are computed at the key shapes' lateral positions `x_key` (with each initial shape's
+//! own `y`): key shapes keep `x` fixed and only move birds fore and aft, so only the spread of ξ
+//! that comes from the longitudinal placement can be reproduced. Ranges taken at the initial
+//! shapes' own, noisy lateral gaps would be dominated by lateral noise and mostly unreachable.
+
+use serde::{Deserialize, Serialize};
+
+use crate::aero::{power_reduction, PowerReduction};
+use crate::error::{Error, Result};
+use crate::shape::Shape;
+
+/// Per-bird range of ξ over the initial shapes, [p_i, P_i].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct XiRanges {
+    /// p_i, the smallest ξ_i.
+    pub min: Vec<f64>,
+    /// P_i, the largest ξ_i.
+    pub max: Vec<f64>,
+}
+
+impl XiRanges {
+    /// The feasible range of eq. (2), [(1 − ε) p_i, (1 + ε) P_i].
+    pub fn widened(&self, epsilon: f64) -> XiRanges {
+        XiRanges {
+            min: self.min.iter().map(|p| (1.0 - epsilon) * p).collect(),
+            max: self.max.iter().map(|p| (1.0 + epsilon) * p).collect(),
+        }
+    }
+
+    /// Number of birds.
+    pub fn len(&self) -> usize {
+        self.min.len()
+    }
+
+    /// True for zero birds.
+    pub fn is_empty(&self) -> bool {
+        self.min.is_empty()
+    }
+
+    /// Clips `xi` into the ranges, bird by bird.
+    pub fn clip(&self, xi: &mut [f64]) {
+        for ((v, lo), hi) in xi.iter_mut().zip(&self.min).zip(&self.max) {
+            *v = v.clamp(*lo, hi.max(*lo));
+        }
+    }
+
+    /// Largest amount by which `xi` leaves the ranges (0 when inside).
+    pub fn excess(&self, xi: &[f64]) -> f64 {
+        xi.iter()
+            .zip(&self.min)
+            .zip(&self.max)
+            .map(|((v, lo), hi)| (lo - v).max(v - hi).max(0.0))
+            .fold(0.0, f64::max)
+    }
+}
+
+/// e_i, ξ_i of every initial shape's longitudinal positions at the lateral positions `x_key`.
+pub fn power_at(x_key: &[f64], shapes: &[Shape]) -> Result<Vec<PowerReduction>> {
+    shapes
+        .iter()
+        .map(|s| {
+            if s.len() != x_key.len() {
+                return Err(Error::Internal(format!(
+                    "initial shape of {} birds for {} lateral positions",
+                    s.len(),
+                    x_key.len()
+                )));
+            }
+            power_reduction(x_key, &s.ys())
+        })
+        .collect()
+}
+
+/// [p_i, P_i] over the ξ vectors of step 2.
+pub fn xi_ranges(values: &[PowerReduction]) -> Result<XiRanges> {
+    let first = values
+        .first()
+        .ok_or_else(|| Error::Internal("no initial shapes".into()))?;
+    let mut r = XiRanges {
+        min: first.xi.clone(),
+        max: first.xi.clone(),
+    };
+    for v in &values[1..] {
+        for (i, &x) in v.xi.iter().enumerate() {
+            if let (Some(lo), Some(hi)) = (r.min.get_mut(i), r.max.get_mut(i)) {
+                *lo = lo.min(x);
+                *hi = hi.max(x);
+            }
+        }
+    }
+    Ok(r)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn pr(xi: Vec<f64>) -> PowerReduction {
+        PowerReduction {
+            e: xi.clone(),
+            total: xi.iter().sum(),
+            xi,
+        }
+    }
+
+    #[test]
+    fn ranges_are_min_and_max_and_widen() {
+        let r = xi_ranges(&[pr(vec![0.2, 0.8]), pr(vec![0.4, 0.6])]).unwrap();
+        assert_eq!(r.min, vec![0.2, 0.6]);
+        assert_eq!(r.max, vec![0.4, 0.8]);
+        let w = r.widened(0.1);
+        assert!((w.min[0] - 0.18).abs() < 1e-15 && (w.max[1] - 0.88).abs() < 1e-15);
+        let mut v = vec![0.1, 0.9];
+        w.clip(&mut v);
+        assert_eq!(v, vec![0.18, 0.88]);
+        assert_eq!(w.excess(&v), 0.0);
+        assert!((w.excess(&[0.1, 0.5]) - 0.08).abs() < 1e-12);
+    }
+}

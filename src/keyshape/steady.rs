@@ -1,0 +1,497 @@
+//! §5 Algorithm 1, the whole steady flight: from the formation parameters of an N̂-bird movie
+//! (SPEC §4.2) to an F-frame animation of N birds (SPEC §4.4) whose key shapes keep the movie's
+//! energy-savings pattern. Lengths in wingspans, times in seconds, speeds in wingspans per second.
+//!
+//! 1. [`initial`](crate::keyshape::initial): correspondence and one N-bird shape per movie frame.
+//! 2. [`ranges`](crate::keyshape::ranges): ξ of every bird in every initial shape, evaluated at the
+//!    key shapes' lateral positions, and the ranges [p_i, P_i].
+//! 3. [`keys`](crate::keyshape::keys): key shapes by eq. (2) and the solve of eq. (4).
+//! 4. [`interpolate`](crate::keyshape::interpolate): C¹ monotone cubic of each bird's `y` between
+//!    keys, the flock cruising along +y.
+//!
+//! The lateral positions are drawn once and kept for the whole flight: gaps from N(d̄, σ̄_x) with
+//! d̄ uniform in the movie's range of mean gaps [min_f μ_xf, max_f μ_xf] and σ̄_x the mean of σ_xf,
+//! redrawn within π/4 + margin. Munk's theorem then fixes E = Σ_{i≠j} g(|x_i − x_j|, 0) for every
+//! key shape (`aero::munk_total`), which makes eq. (3) exact instead of an estimate from a
+//! constant-gap flock. The world frame places the leader at (0, speed·t, 0) and every bird at
+//! (x_i, speed·t − y_i(t), 0) (SPEC §2).
+
+use rand::Rng;
+use serde::Serialize;
+
+use crate::aero::{munk_total, power_reduction, VORTEX_SPAN};
+use crate::animation::{Animation, Frame, KeyBird, KeyShapeRecord, Stage};
+use crate::error::{Error, Result};
+use crate::extract::params::FormationParams;
+use crate::keyshape::initial::{
+    correspondence, curve_y, initial_shapes, lateral_gaps, positions_from_gaps, Correspondence,
+    InitialOptions,
+};
+use crate::keyshape::interpolate::Track;
+use crate::keyshape::keys::{key_shapes, KeyOptions, KeyShape, KeyStats, Structure};
+use crate::keyshape::ranges::{power_at, xi_ranges, XiRanges};
+use crate::keyshape::solve::SolveOptions;
+use crate::progress::Progress;
+
+/// Options of the steady flight (`formation steady` flags).
+#[derive(Debug, Clone)]
+pub struct SteadyOptions {
+    /// N, birds to animate (≥ 2).
+    pub birds: usize,
+    /// F, frames to produce (≥ 1).
+    pub frames: usize,
+    /// Frames per second.
+    pub fps: f64,
+    /// Time between key shapes, seconds (keys are spread evenly over the flight, about this far apart).
+    pub key_every_s: f64,
+    /// Cruise speed of the flock along +y, wingspans per second.
+    pub speed: f64,
+    /// ε of eq. (2): widening of each bird's range of ξ (paper: 0–0.2).
+    pub epsilon: f64,
+    /// C₁ of eq. (2): smallest step ratio of ξ̂ between keys (paper: 0.75–0.9).
+    pub c1: f64,
+    /// C₂ of eq. (2): largest step ratio of ξ̂ between keys (paper: 1.1–1.25).
+    pub c2: f64,
+    /// Wingspan of one bird, metres (recorded in the file for exports).
+    pub wingspan_m: f64,
+    /// Seed recorded in the animation file (the generator itself is passed in).
+    pub seed: u64,
+    /// Largest move of a bird between consecutive key shapes, wingspans.
+    pub max_jump: f64,
+    /// Draws of ξ̂ per key before damping.
+    pub max_draws: usize,
+    /// Halvings of the damping factor λ before the previous key is held.
+    pub max_damping: usize,
+    /// Largest accepted ‖ξ − ξ̂‖₂ of a key shape.
+    pub accept_residual: f64,
+    /// Lateral gaps are kept this far above π/4, wingspans.
+    pub downwash_margin: f64,
+    /// Depth limit of key shapes: this factor times the deepest initial shape, plus one wingspan.
+    pub max_depth_factor: f64,
+}
+
+impl Default for SteadyOptions {
+    fn default() -> Self {
+        SteadyOptions {
+            birds: 9,
+            frames: 300,
+            fps: 30.0,
+            key_every_s: 3.0,
+            speed: 10.0,
+            epsilon: 0.1,
+            c1: 0.85,
+            c2: 1.15,
+            wingspan_m: 1.5,
+            seed: 0,
+            max_jump: 0.5,
+            max_draws: 3,
+            max_damping: 12,
+            accept_residual: 1e-6,
+            downwash_margin: 0.05,
+            max_depth_factor: 1.5,
+        }
+    }
+}
+
+impl SteadyOptions {
+    /// Checks every option; the error names the command-line flag.
+    pub fn validate(&self) -> Result<()> {
+        let p = |name: &str, msg: String| Error::parameter(name, msg);
+        if self.birds < 2 {
+            return Err(p(
+                "--birds",
+                format!("{}: a formation needs at least 2 birds", self.birds),
+            ));
+        }
+        if self.birds > 100_000 {
+            return Err(p(
+                "--birds",
+                format!("{}: at most 100000 birds", self.birds),
+            ));
+        }
+        if self.frames == 0 {
+            return Err(p("--frames", "0: at least 1 frame is needed".into()));
+        }
+        if !(self.fps.is_finite() && self.fps > 0.0 && self.fps <= 1000.0) {
+            return Err(p(
+                "--fps",
+                format!("{}: must be in (0, 1000] frames per second", self.fps),
+            ));
+        }
+        if !(self.key_every_s.is_finite() && self.key_every_s > 0.0) {
+            return Err(p(
+                "--key-every",
+                format!("{}: must be a positive number of seconds", self.key_every_s),
+            ));
+        }
+        if !(self.speed.is_finite() && self.speed > 0.0 && self.speed <= 1000.0) {
+            return Err(p(
+                "--speed",
+                format!("{}: must be in (0, 1000] wingspans per second", self.speed),
+            ));
+        }
+        if !(self.epsilon.is_finite() && (0.0..=0.5).contains(&self.epsilon)) {
+            return Err(p(
+                "--epsilon",
+                format!(
+                    "{}: must be in [0, 0.5] (the paper uses 0 to 0.2)",
+                    self.epsilon
+                ),
+            ));
+        }
+        if !(self.c1.is_finite() && (0.5..=1.0).contains(&self.c1)) {
+            return Err(p(
+                "--c1",
+                format!(
+                    "{}: must be in [0.5, 1] (the paper uses 0.75 to 0.9)",
+                    self.c1
+                ),
+            ));
+        }
+        if !(self.c2.is_finite() && (1.0..=2.0).contains(&self.c2)) {
+            return Err(p(
+                "--c2",
+                format!(
+                    "{}: must be in [1, 2] (the paper uses 1.1 to 1.25)",
+                    self.c2
+                ),
+            ));
+        }
+        if !(self.wingspan_m.is_finite() && self.wingspan_m > 0.0 && self.wingspan_m <= 100.0) {
+            return Err(p(
+                "--wingspan-m",
+                format!("{}: must be in (0, 100] metres", self.wingspan_m),
+            ));
+        }
+        if !(self.max_jump.is_finite() && self.max_jump > 0.0) {
+            return Err(p(
+                "max_jump",
+                "must be a positive number of wingspans".into(),
+            ));
+        }
+        if !(self.accept_residual.is_finite() && self.accept_residual > 0.0) {
+            return Err(p("accept_residual", "must be positive".into()));
+        }
+        if !(self.downwash_margin.is_finite() && self.downwash_margin >= 0.0) {
+            return Err(p("downwash_margin", "must not be negative".into()));
+        }
+        if !(self.max_depth_factor.is_finite() && self.max_depth_factor >= 1.0) {
+            return Err(p("max_depth_factor", "must be at least 1".into()));
+        }
+        Ok(())
+    }
+
+    /// Number of key shapes and the frame of each (evenly spread, first at 0, last at F − 1).
+    pub fn key_frames(&self) -> Vec<usize> {
+        let f = self.frames;
+        if f <= 1 {
+            return vec![0];
+        }
+        let spacing = (self.key_every_s * self.fps).round().max(1.0);
+        let k = (((f - 1) as f64 / spacing).round() as usize).max(1) + 1;
+        (0..k)
+            .map(|i| ((i as f64) * ((f - 1) as f64) / ((k - 1) as f64)).round() as usize)
+            .collect()
+    }
+}
+
+/// What Algorithm 1 did, for reports and tests.
+#[derive(Debug, Clone, Serialize)]
+pub struct SteadyReport {
+    /// Step 1's correspondence (animated birds left to right).
+    pub correspondence: Vec<Option<usize>>,
+    /// Animated leader index.
+    pub leader: usize,
+    /// Movie birds dropped (N < N̂).
+    pub dropped: Vec<usize>,
+    /// Mean lateral gap d̄ drawn for the key shapes, wingspans.
+    pub mean_gap: f64,
+    /// Lateral positions of the key shapes, wingspans.
+    pub x: Vec<f64>,
+    /// E of every key shape (Munk), dimensionless.
+    pub total: f64,
+    /// Raw ranges [p_i, P_i] of step 2.
+    pub ranges: XiRanges,
+    /// Feasible ranges [(1 − ε) p_i, (1 + ε) P_i].
+    pub feasible: XiRanges,
+    /// Movie frame (position in the params file) whose initial shape is the first key shape;
+    /// `None` when none qualified and the first frame's noise-free curve was used.
+    pub first_key_from: Option<usize>,
+    /// Frame index of each key shape.
+    pub key_frames: Vec<usize>,
+    /// Step 3 counts.
+    pub keys: KeyStats,
+    /// Frames where some bird's ξ leaves its feasible range.
+    pub frames_outside_range: usize,
+    /// Largest amount by which a frame's ξ leaves the feasible range.
+    pub max_frame_excess: f64,
+}
+
+/// The steady flight of Algorithm 1 as an animation (one `steady` stage covering all frames).
+pub fn steady_flight(
+    params: &FormationParams,
+    opts: &SteadyOptions,
+    rng: &mut impl Rng,
+    progress: &dyn Progress,
+) -> Result<Animation> {
+    steady_flight_report(params, opts, rng, progress).map(|(a, _)| a)
+}
+
+/// [`steady_flight`] plus the report of what each step did.
+pub fn steady_flight_report(
+    params: &FormationParams,
+    opts: &SteadyOptions,
+    rng: &mut impl Rng,
+    progress: &dyn Progress,
+) -> Result<(Animation, SteadyReport)> {
+    opts.validate()?;
+    let first = params
+        .frames
+        .first()
+        .ok_or_else(|| Error::parameter("params", "no frames"))?;
+    let n = opts.birds;
+    let init_opts = InitialOptions {
+        downwash_margin: opts.downwash_margin,
+        ..InitialOptions::default()
+    };
+
+    // Step 1.
+    let corr: Correspondence = correspondence(first, n)?;
+    let (lo_mu, hi_mu) = params
+        .frames
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), f| {
+            (a.min(f.mu_x), b.max(f.mu_x))
+        });
+    let sigma_bar =
+        params.frames.iter().map(|f| f.sigma_x).sum::<f64>() / params.frames.len() as f64;
+    let u: f64 = rng.random();
+    let mean_gap = (lo_mu + u * (hi_mu - lo_mu)).max(VORTEX_SPAN + opts.downwash_margin);
+    let gaps = lateral_gaps(rng, mean_gap, sigma_bar, n - 1, &init_opts);
+    let x = positions_from_gaps(&gaps, corr.leader);
+    let shapes = initial_shapes(params, &corr, rng, &init_opts);
+
+    // Step 2, at the key shapes' lateral positions.
+    let values = power_at(&x, &shapes)?;
+    let ranges = xi_ranges(&values)?;
+    let feasible = ranges.widened(opts.epsilon);
+    let total = munk_total(&x)?;
+
+    // The first key shape: the first initial shape whose leader is front-most.
+    let deepest = shapes
+        .iter()
+        .map(|s| s.ys().iter().copied().fold(0.0, f64::max))
+        .fold(0.0, f64::max);
+    let max_depth = opts.max_depth_factor * deepest + 1.0;
+    let loose = Structure {
+        leader: corr.leader,
+        monotone_pairs: vec![],
+        max_depth,
+    };
+    let first_key_from = shapes.iter().position(|s| loose.accepts(&s.ys()));
+    let y0: Vec<f64> = match first_key_from {
+        Some(i) => shapes[i].ys(),
+        None => x
+            .iter()
+            .enumerate()
+            .map(|(i, &xi)| {
+                if i == corr.leader {
+                    0.0
+                } else {
+                    curve_y(&first.shape, xi, 1.0, 1.0).max(0.1)
+                }
+            })
+            .collect(),
+    };
+    let p0 = power_reduction(&x, &y0)?;
+    let key0 = KeyShape {
+        y: y0.clone(),
+        xi_target: p0.xi.clone(),
+        xi: p0.xi,
+        residual: 0.0,
+        damping: 1.0,
+        draws: 0,
+    };
+    let structure = Structure::of(&x, &y0, corr.leader, max_depth);
+
+    // Step 3.
+    let key_frames = opts.key_frames();
+    let key_opts = KeyOptions {
+        epsilon: opts.epsilon,
+        c1: opts.c1,
+        c2: opts.c2,
+        accept_residual: opts.accept_residual,
+        max_draws: opts.max_draws,
+        max_damping: opts.max_damping,
+        max_jump: opts.max_jump,
+        max_depth,
+        solve: SolveOptions {
+            tolerance: (opts.accept_residual * 1e-3).max(1e-12),
+            ..SolveOptions::default()
+        },
+    };
+    progress.start("steady: key shapes", key_frames.len() as u64);
+    let (keys, key_stats) = key_shapes(
+        &x,
+        key0,
+        &feasible,
+        &structure,
+        key_frames.len(),
+        &key_opts,
+        rng,
+        || progress.advance(1),
+    )?;
+    progress.finish();
+
+    // Step 4.
+    progress.start("steady: frames", opts.frames as u64);
+    let times: Vec<f64> = key_frames.iter().map(|&f| f as f64 / opts.fps).collect();
+    let tracks: Vec<Track> = (0..n)
+        .map(|i| {
+            let v: Vec<f64> = keys.iter().map(|k| k.y[i]).collect();
+            Track::pchip(&times, &v)
+        })
+        .collect();
+    let mut frames = Vec::with_capacity(opts.frames);
+    let mut frames_outside_range = 0;
+    let mut max_frame_excess: f64 = 0.0;
+    for j in 0..opts.frames {
+        let t = j as f64 / opts.fps;
+        let lead_y = opts.speed * t;
+        let mut fr = Frame {
+            t,
+            x: x.clone(),
+            y: Vec::with_capacity(n),
+            z: vec![0.0; n],
+            heading: Vec::with_capacity(n),
+            speed: Vec::with_capacity(n),
+            ..Frame::default()
+        };
+        let mut ys = Vec::with_capacity(n);
+        for tr in &tracks {
+            let (y, dy) = tr.eval(t);
+            ys.push(y);
+            fr.y.push(lead_y - y);
+            // World velocity (0, speed − dy/dt): the flock frame moves at `speed` along +y.
+            let (vx, vy) = (0.0f64, opts.speed - dy);
+            fr.heading.push(vx.atan2(vy));
+            fr.speed.push(vx.hypot(vy));
+        }
+        let pr = power_reduction(&x, &ys)?;
+        let excess = feasible.excess(&pr.xi);
+        if excess > 1e-12 {
+            frames_outside_range += 1;
+        }
+        max_frame_excess = max_frame_excess.max(excess);
+        fr.e = Some(pr.e);
+        fr.xi = Some(pr.xi);
+        frames.push(fr);
+        progress.advance(1);
+    }
+    progress.finish();
+
+    let mut anim = Animation::new(opts.seed, opts.fps, opts.wingspan_m, n);
+    anim.stages.push(Stage {
+        name: "steady".into(),
+        start: 0,
+        end: opts.frames,
+    });
+    anim.key_shapes = keys
+        .iter()
+        .zip(&key_frames)
+        .map(|(k, &frame)| KeyShapeRecord {
+            frame,
+            birds: x
+                .iter()
+                .zip(&k.y)
+                .zip(&k.xi)
+                .map(|((&x, &y), &xi)| KeyBird { x, y, xi })
+                .collect(),
+        })
+        .collect();
+    anim.frames = frames;
+    anim.xi_ranges = Some(
+        feasible
+            .min
+            .iter()
+            .zip(&feasible.max)
+            .map(|(&a, &b)| [a, b])
+            .collect(),
+    );
+    let report = SteadyReport {
+        correspondence: corr.movie.clone(),
+        leader: corr.leader,
+        dropped: corr.dropped.clone(),
+        mean_gap,
+        x,
+        total,
+        ranges,
+        feasible,
+        first_key_from,
+        key_frames,
+        keys: key_stats,
+        frames_outside_range,
+        max_frame_excess,
+    };
+    Ok((anim, report))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn key_frames_are_spread_and_end_at_last_frame() {
+        let o = SteadyOptions {
+            frames: 301,
+            fps: 30.0,
+            key_every_s: 3.0,
+            ..SteadyOptions::default()
+        };
+        assert_eq!(o.key_frames(), vec![0, 100, 200, 300]);
+        let o = SteadyOptions {
+            frames: 1,
+            ..SteadyOptions::default()
+        };
+        assert_eq!(o.key_frames(), vec![0]);
+        let o = SteadyOptions {
+            frames: 5,
+            key_every_s: 0.001,
+            ..SteadyOptions::default()
+        };
+        assert_eq!(o.key_frames(), vec![0, 1, 2, 3, 4]);
+    }
+
+    #[test]
+    fn validation_names_the_flag() {
+        let bad = [
+            SteadyOptions {
+                birds: 0,
+                ..SteadyOptions::default()
+            },
+            SteadyOptions {
+                frames: 0,
+                ..SteadyOptions::default()
+            },
+            SteadyOptions {
+                epsilon: 0.9,
+                ..SteadyOptions::default()
+            },
+            SteadyOptions {
+                c1: 1.2,
+                ..SteadyOptions::default()
+            },
+            SteadyOptions {
+                c2: 0.9,
+                ..SteadyOptions::default()
+            },
+        ];
+        let flags = ["--birds", "--frames", "--epsilon", "--c1", "--c2"];
+        for (o, f) in bad.iter().zip(flags) {
+            let e = o.validate().unwrap_err().to_string();
+            assert!(e.starts_with(f), "{e}");
+            assert_eq!(e.lines().count(), 1);
+        }
+        assert!(SteadyOptions::default().validate().is_ok());
+    }
+}
