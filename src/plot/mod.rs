@@ -5,6 +5,9 @@
 use std::path::Path;
 use std::sync::Once;
 
+pub mod power;
+pub mod xi;
+
 use plotters::coord::Shift;
 use plotters::prelude::*;
 

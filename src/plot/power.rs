@@ -1,0 +1,124 @@
+//! `formation plot power`: the power reduction of every bird of one shape (a shape file, a key
+//! shape or a frame of an animation) as bars at the birds' lateral positions (wingspans), with each
+//! bird's feasible range of ξ drawn as a whisker when it is known (steady flight, §5 eq. 2).
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use super::{Chart, DrawResult, FONT_FAMILY};
+
+/// Which quantity the bars show.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PowerMetric {
+    /// Relative power reduction ξ_i = e_i / E.
+    Xi,
+    /// Power reduction e_i (Hummel's model without the drag ratio).
+    E,
+}
+
+/// Bars of e_i or ξ_i per bird.
+#[derive(Debug, Clone)]
+pub struct PowerChart {
+    /// Chart title.
+    pub title: String,
+    /// Lateral position of each bird, wingspans (bar positions).
+    pub x: Vec<f64>,
+    /// Value per bird (same order as `x`).
+    pub values: Vec<f64>,
+    /// What `values` are.
+    pub metric: PowerMetric,
+    /// Feasible range [lo, hi] per bird, drawn as whiskers (ξ only).
+    pub ranges: Option<Vec<[f64; 2]>>,
+    /// Index of the leader, drawn in a distinct colour.
+    pub leader: Option<usize>,
+}
+
+impl Chart for PowerChart {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult<DB> {
+        let (xmin, xmax) = self
+            .x
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+                (a.min(v), b.max(v))
+            });
+        let (xmin, xmax) = if xmin.is_finite() {
+            (xmin - 0.8, xmax + 0.8)
+        } else {
+            (-1.0, 1.0)
+        };
+        let mut top = self.values.iter().copied().fold(0.0, f64::max);
+        let mut bottom = self.values.iter().copied().fold(0.0, f64::min);
+        if let Some(r) = &self.ranges {
+            for [lo, hi] in r {
+                top = top.max(*hi);
+                bottom = bottom.min(*lo);
+            }
+        }
+        let top = if top > 0.0 { top * 1.12 } else { 1.0 };
+        let ylabel = match self.metric {
+            PowerMetric::Xi => "relative power reduction ξ",
+            PowerMetric::E => "power reduction e",
+        };
+        let mut chart = ChartBuilder::on(root)
+            .caption(&self.title, (FONT_FAMILY, 22))
+            .margin(16)
+            .x_label_area_size(44)
+            .y_label_area_size(70)
+            .build_cartesian_2d(xmin..xmax, bottom..top)?;
+        chart
+            .configure_mesh()
+            .x_desc("lateral position x (wingspans, right of the flight direction)")
+            .y_desc(ylabel)
+            .label_style((FONT_FAMILY, 14))
+            .light_line_style(WHITE.mix(0.0))
+            .draw()?;
+        let bar = RGBColor(70, 120, 180);
+        let lead = RGBColor(220, 120, 40);
+        let half = 0.25;
+        chart
+            .draw_series(
+                self.x
+                    .iter()
+                    .zip(&self.values)
+                    .enumerate()
+                    .map(|(i, (&x, &v))| {
+                        let c = if Some(i) == self.leader { lead } else { bar };
+                        Rectangle::new([(x - half, 0.0), (x + half, v)], c.filled())
+                    }),
+            )?
+            .label(if self.leader.is_some() {
+                "bird (orange: leader)"
+            } else {
+                "bird"
+            })
+            .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 14, y + 5)], bar.filled()));
+        if let (Some(r), PowerMetric::Xi) = (&self.ranges, self.metric) {
+            let style = ShapeStyle::from(&BLACK).stroke_width(2);
+            let cap = half * 0.6;
+            chart
+                .draw_series(
+                    self.x
+                        .iter()
+                        .zip(r)
+                        .map(|(&x, [lo, hi])| PathElement::new(vec![(x, *lo), (x, *hi)], style)),
+                )?
+                .label("feasible range [(1−ε)p, (1+ε)P]")
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 14, y)], style));
+            for (&x, [lo, hi]) in self.x.iter().zip(r) {
+                chart.draw_series(
+                    [*lo, *hi]
+                        .into_iter()
+                        .map(|v| PathElement::new(vec![(x - cap, v), (x + cap, v)], style)),
+                )?;
+            }
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .label_font((FONT_FAMILY, 14))
+            .position(SeriesLabelPosition::UpperRight)
+            .draw()?;
+        Ok(())
+    }
+}
