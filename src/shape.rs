@@ -8,7 +8,6 @@ use crate::error::{Error, Result};
 
 /// One bird of a shape, formation frame, wingspans.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
 pub struct Bird {
     /// Lateral offset to the right of the flight direction, wingspans.
     pub x: f64,

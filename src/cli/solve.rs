@@ -1,20 +1,96 @@
-//! `formation solve` (issue 2).
+//! `formation solve TARGET -o shape.json`: the key shape whose ξ matches the targets (eq. 4).
 
 use std::path::PathBuf;
 
 use clap::Args;
-use formation::Result;
+use formation::io::{write_json_atomic, OutputKind};
+use formation::keyshape::{solve, SolveOptions};
+use formation::{Error, Result};
+use serde::{Deserialize, Serialize};
 
+use super::power::in_file;
 use super::Global;
 
 /// Arguments of `formation solve`.
 #[derive(Debug, Args)]
 pub struct SolveArgs {
-    /// Input file.
-    pub input: PathBuf,
+    /// Target file: {"x": [lateral positions], "xi": [targets], "y": [optional initial guess]}.
+    pub target: PathBuf,
+    /// Output shape (.json).
+    #[arg(short = 'o', long = "output")]
+    pub output: PathBuf,
+    /// Converged means ‖ξ − ξ̂‖₂ at most this.
+    #[arg(long, default_value_t = 1e-9)]
+    pub tolerance: f64,
+    /// Write the shape even when the solver does not converge (the exit code is still 1).
+    #[arg(long)]
+    pub keep_unconverged: bool,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Target {
+    x: Vec<f64>,
+    xi: Vec<f64>,
+    #[serde(default)]
+    y: Option<Vec<f64>>,
+}
+
+#[derive(Serialize)]
+struct Solved {
+    birds: Vec<formation::Bird>,
+    xi: Vec<f64>,
+    target: Vec<f64>,
+    residual: f64,
+    converged: bool,
+    evaluations: usize,
+    total: f64,
 }
 
 /// Runs `formation solve`.
-pub fn run(_args: SolveArgs, _g: Global) -> Result<()> {
-    Err(super::not_yet("solve"))
+pub fn run(args: SolveArgs, _g: Global) -> Result<()> {
+    OutputKind::from_path(&args.output, &[OutputKind::Json])?;
+    if !(args.tolerance.is_finite() && args.tolerance > 0.0) {
+        return Err(Error::parameter("--tolerance", "must be a positive number"));
+    }
+    let target: Target = formation::io::read_json(&args.target)?;
+    let opts = SolveOptions {
+        tolerance: args.tolerance,
+        ..SolveOptions::default()
+    };
+    let rep = solve(&target.x, &target.xi, target.y.as_deref(), &opts)
+        .map_err(|e| in_file(&args.target, e))?;
+    if !rep.converged && !args.keep_unconverged {
+        return Err(Error::NotConverged(format!(
+            "{}: the solver stopped at residual ‖ξ − ξ̂‖ = {:.3e} (tolerance {:.1e}) after {} evaluations; nothing written (try another initial guess \"y\", or --keep-unconverged to see the shape)",
+            args.target.display(),
+            rep.residual,
+            opts.tolerance,
+            rep.evaluations
+        )));
+    }
+    let out = Solved {
+        birds: target
+            .x
+            .iter()
+            .zip(&rep.y)
+            .map(|(&x, &y)| formation::Bird { x, y })
+            .collect(),
+        xi: rep.xi.clone(),
+        target: rep.target.clone(),
+        residual: rep.residual,
+        converged: rep.converged,
+        evaluations: rep.evaluations,
+        total: rep.total,
+    };
+    write_json_atomic(&args.output, &out)?;
+    if !rep.converged {
+        return Err(Error::NotConverged(format!(
+            "{}: not converged (residual {:.3e}); shape written to {} with \"converged\": false",
+            args.target.display(),
+            rep.residual,
+            args.output.display()
+        )));
+    }
+    Ok(())
 }
