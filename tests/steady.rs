@@ -1,0 +1,169 @@
+//! Algorithm 1 invariants (issue 4): for N = N̂, N > N̂ and N < N̂, every key shape is solved,
+//! inside the feasible ranges, out of each other's downwash, and the motion between frames is
+//! smooth; equal seeds give equal bytes.
+
+mod steady_support;
+
+use formation::aero::{power_reduction, VORTEX_SPAN};
+use formation::extract::params::FormationParams;
+use formation::keyshape::{steady_flight, steady_flight_report, SteadyOptions, SteadyReport};
+use formation::progress::Silent;
+use formation::rng::seeded;
+use formation::Animation;
+
+fn run(params: &FormationParams, birds: usize, frames: usize, seed: u64) -> (Animation, SteadyReport) {
+    let opts = SteadyOptions {
+        birds,
+        frames,
+        seed,
+        ..SteadyOptions::default()
+    };
+    steady_flight_report(params, &opts, &mut seeded(seed), &Silent).expect("steady flight")
+}
+
+/// Every invariant the issue asks for, on one run.
+fn check(anim: &Animation, rep: &SteadyReport, opts: &SteadyOptions) {
+    let n = opts.birds;
+    assert_eq!(anim.birds, n);
+    assert_eq!(anim.frames.len(), opts.frames);
+    assert_eq!(anim.stage("steady").map(|s| (s.start, s.end)), Some((0, opts.frames)));
+    assert_eq!(anim.key_shapes.len(), rep.key_frames.len());
+    assert!(anim.key_shapes.len() >= 2);
+    let ranges = anim.xi_ranges.as_ref().expect("xi_ranges");
+    assert_eq!(ranges.len(), n);
+
+    // Every key shape solved (residual bound), its ξ consistent with its positions and inside the
+    // feasible ranges; no pair inside the downwash.
+    assert!(rep.keys.max_residual <= 1e-6, "max residual {}", rep.keys.max_residual);
+    for (k, ks) in anim.key_shapes.iter().enumerate() {
+        let x: Vec<f64> = ks.birds.iter().map(|b| b.x).collect();
+        let y: Vec<f64> = ks.birds.iter().map(|b| b.y).collect();
+        let p = power_reduction(&x, &y).expect("key shape out of downwash");
+        for (i, b) in ks.birds.iter().enumerate() {
+            assert!((p.xi[i] - b.xi).abs() < 1e-9, "key {k} bird {i}: stored ξ differs");
+            let [lo, hi] = ranges[i];
+            assert!(
+                b.xi >= lo - 1e-6 && b.xi <= hi + 1e-6,
+                "key {k} bird {i}: ξ {} outside [{lo}, {hi}]",
+                b.xi
+            );
+        }
+        let mut xs = x.clone();
+        xs.sort_by(f64::total_cmp);
+        assert!(xs.windows(2).all(|w| w[1] - w[0] > VORTEX_SPAN), "key {k}: downwash pair");
+        // Leader front-most.
+        let lead = rep.leader;
+        assert!(y.iter().enumerate().all(|(i, &v)| i == lead || v > y[lead]), "key {k}");
+    }
+
+    // Motion relative to the flock (formation-frame y = leader's north − bird's north) is smooth:
+    // bounded step per frame and bounded change of step.
+    let spacing = (rep.key_frames[1] - rep.key_frames[0]) as f64;
+    let step_bound = 3.0 * opts.max_jump / spacing + 1e-9;
+    let accel_bound = 20.0 * opts.max_jump / (spacing * spacing) + 1e-9;
+    let rel = |f: usize| -> Vec<f64> {
+        let fr = &anim.frames[f];
+        let lead_n = fr.y[rep.leader];
+        fr.y.iter().map(|v| lead_n - v).collect()
+    };
+    let mut prev_step: Option<Vec<f64>> = None;
+    for f in 1..anim.frames.len() {
+        let (a, b) = (rel(f - 1), rel(f));
+        let step: Vec<f64> = a.iter().zip(&b).map(|(p, q)| q - p).collect();
+        for (i, s) in step.iter().enumerate() {
+            assert!(s.abs() <= step_bound, "frame {f} bird {i}: step {s} > {step_bound}");
+        }
+        if let Some(ps) = &prev_step {
+            for (i, (s, p)) in step.iter().zip(ps).enumerate() {
+                assert!(
+                    (s - p).abs() <= accel_bound,
+                    "frame {f} bird {i}: change of step {} > {accel_bound}",
+                    (s - p).abs()
+                );
+            }
+        }
+        prev_step = Some(step);
+        // Lateral positions never change, so no pair ever enters the downwash between keys.
+        assert_eq!(anim.frames[f].x, anim.frames[0].x);
+    }
+    // Speeds are continuous too (C¹ interpolation: no velocity kink at key frames).
+    for f in 1..anim.frames.len() {
+        for i in 0..n {
+            let dv = (anim.frames[f].speed[i] - anim.frames[f - 1].speed[i]).abs();
+            assert!(dv <= accel_bound * opts.fps * opts.fps / opts.fps + 1e-6, "frame {f} bird {i}: speed jump {dv}");
+        }
+    }
+}
+
+fn case(params: &FormationParams, birds: usize) {
+    let opts = SteadyOptions {
+        birds,
+        frames: 181,
+        fps: 30.0,
+        key_every_s: 1.0,
+        ..SteadyOptions::default()
+    };
+    let (anim, rep) = steady_flight_report(params, &opts, &mut seeded(7), &Silent).unwrap();
+    eprintln!("{birds} birds: {:?}", rep.keys);
+    eprintln!("  frames outside range {} max excess {:.2e}", rep.frames_outside_range, rep.max_frame_excess);
+    check(&anim, &rep, &opts);
+}
+
+#[test]
+fn v9_same_number_of_birds() {
+    case(&steady_support::v9(), 9);
+}
+
+#[test]
+fn v9_to_14_birds() {
+    case(&steady_support::v9(), 14);
+}
+
+#[test]
+fn j16_to_28_birds() {
+    case(&steady_support::j16(), 28);
+}
+
+#[test]
+fn j16_to_16_birds() {
+    case(&steady_support::j16(), 16);
+}
+
+#[test]
+fn fewer_birds_than_the_movie() {
+    case(&steady_support::j16(), 7);
+    case(&steady_support::v9(), 5);
+}
+
+#[test]
+fn same_seed_same_bytes() {
+    let p = steady_support::v9();
+    let a = serde_json::to_vec(&run(&p, 12, 60, 3).0).unwrap();
+    let b = serde_json::to_vec(&run(&p, 12, 60, 3).0).unwrap();
+    let c = serde_json::to_vec(&run(&p, 12, 60, 4).0).unwrap();
+    assert_eq!(a, b);
+    assert_ne!(a, c);
+}
+
+#[test]
+fn steady_flight_matches_report_variant() {
+    let p = steady_support::v9();
+    let opts = SteadyOptions {
+        birds: 9,
+        frames: 40,
+        ..SteadyOptions::default()
+    };
+    let a = steady_flight(&p, &opts, &mut seeded(1), &Silent).unwrap();
+    let b = steady_flight_report(&p, &opts, &mut seeded(1), &Silent).unwrap().0;
+    assert_eq!(a, b);
+}
+
+/// Writes the fixtures under tests/data/ (run explicitly with `--ignored`).
+#[test]
+#[ignore]
+fn write_fixtures() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data");
+    for (name, p) in [("steady_v9_params.json", steady_support::v9()), ("steady_j16_params.json", steady_support::j16())] {
+        formation::io::write_json_atomic(&dir.join(name), &p).unwrap();
+    }
+}
