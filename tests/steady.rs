@@ -11,7 +11,12 @@ use formation::progress::Silent;
 use formation::rng::seeded;
 use formation::Animation;
 
-fn run(params: &FormationParams, birds: usize, frames: usize, seed: u64) -> (Animation, SteadyReport) {
+fn run(
+    params: &FormationParams,
+    birds: usize,
+    frames: usize,
+    seed: u64,
+) -> (Animation, SteadyReport) {
     let opts = SteadyOptions {
         birds,
         frames,
@@ -26,7 +31,10 @@ fn check(anim: &Animation, rep: &SteadyReport, opts: &SteadyOptions) {
     let n = opts.birds;
     assert_eq!(anim.birds, n);
     assert_eq!(anim.frames.len(), opts.frames);
-    assert_eq!(anim.stage("steady").map(|s| (s.start, s.end)), Some((0, opts.frames)));
+    assert_eq!(
+        anim.stage("steady").map(|s| (s.start, s.end)),
+        Some((0, opts.frames))
+    );
     assert_eq!(anim.key_shapes.len(), rep.key_frames.len());
     assert!(anim.key_shapes.len() >= 2);
     let ranges = anim.xi_ranges.as_ref().expect("xi_ranges");
@@ -34,13 +42,20 @@ fn check(anim: &Animation, rep: &SteadyReport, opts: &SteadyOptions) {
 
     // Every key shape solved (residual bound), its ξ consistent with its positions and inside the
     // feasible ranges; no pair inside the downwash.
-    assert!(rep.keys.max_residual <= 1e-6, "max residual {}", rep.keys.max_residual);
+    assert!(
+        rep.keys.max_residual <= 1e-6,
+        "max residual {}",
+        rep.keys.max_residual
+    );
     for (k, ks) in anim.key_shapes.iter().enumerate() {
         let x: Vec<f64> = ks.birds.iter().map(|b| b.x).collect();
         let y: Vec<f64> = ks.birds.iter().map(|b| b.y).collect();
         let p = power_reduction(&x, &y).expect("key shape out of downwash");
         for (i, b) in ks.birds.iter().enumerate() {
-            assert!((p.xi[i] - b.xi).abs() < 1e-9, "key {k} bird {i}: stored ξ differs");
+            assert!(
+                (p.xi[i] - b.xi).abs() < 1e-9,
+                "key {k} bird {i}: stored ξ differs"
+            );
             let [lo, hi] = ranges[i];
             assert!(
                 b.xi >= lo - 1e-6 && b.xi <= hi + 1e-6,
@@ -50,10 +65,16 @@ fn check(anim: &Animation, rep: &SteadyReport, opts: &SteadyOptions) {
         }
         let mut xs = x.clone();
         xs.sort_by(f64::total_cmp);
-        assert!(xs.windows(2).all(|w| w[1] - w[0] > VORTEX_SPAN), "key {k}: downwash pair");
+        assert!(
+            xs.windows(2).all(|w| w[1] - w[0] > VORTEX_SPAN),
+            "key {k}: downwash pair"
+        );
         // Leader front-most.
         let lead = rep.leader;
-        assert!(y.iter().enumerate().all(|(i, &v)| i == lead || v > y[lead]), "key {k}");
+        assert!(
+            y.iter().enumerate().all(|(i, &v)| i == lead || v > y[lead]),
+            "key {k}"
+        );
     }
 
     // Motion relative to the flock (formation-frame y = leader's north − bird's north) is smooth:
@@ -71,7 +92,10 @@ fn check(anim: &Animation, rep: &SteadyReport, opts: &SteadyOptions) {
         let (a, b) = (rel(f - 1), rel(f));
         let step: Vec<f64> = a.iter().zip(&b).map(|(p, q)| q - p).collect();
         for (i, s) in step.iter().enumerate() {
-            assert!(s.abs() <= step_bound, "frame {f} bird {i}: step {s} > {step_bound}");
+            assert!(
+                s.abs() <= step_bound,
+                "frame {f} bird {i}: step {s} > {step_bound}"
+            );
         }
         if let Some(ps) = &prev_step {
             for (i, (s, p)) in step.iter().zip(ps).enumerate() {
@@ -90,7 +114,10 @@ fn check(anim: &Animation, rep: &SteadyReport, opts: &SteadyOptions) {
     for f in 1..anim.frames.len() {
         for i in 0..n {
             let dv = (anim.frames[f].speed[i] - anim.frames[f - 1].speed[i]).abs();
-            assert!(dv <= accel_bound * opts.fps * opts.fps / opts.fps + 1e-6, "frame {f} bird {i}: speed jump {dv}");
+            assert!(
+                dv <= accel_bound * opts.fps * opts.fps / opts.fps + 1e-6,
+                "frame {f} bird {i}: speed jump {dv}"
+            );
         }
     }
 }
@@ -105,7 +132,11 @@ fn case(params: &FormationParams, birds: usize) {
     };
     let (anim, rep) = steady_flight_report(params, &opts, &mut seeded(7), &Silent).unwrap();
     eprintln!("{birds} birds: {:?}", rep.keys);
-    eprintln!("  frames outside range {} max excess {:.2e}", rep.frames_outside_range, rep.max_frame_excess);
+    assert_eq!(rep.keys.held, 0, "a key shape was held instead of solved");
+    eprintln!(
+        "  frames outside range {} max excess {:.2e}",
+        rep.frames_outside_range, rep.max_frame_excess
+    );
     check(&anim, &rep, &opts);
 }
 
@@ -154,7 +185,9 @@ fn steady_flight_matches_report_variant() {
         ..SteadyOptions::default()
     };
     let a = steady_flight(&p, &opts, &mut seeded(1), &Silent).unwrap();
-    let b = steady_flight_report(&p, &opts, &mut seeded(1), &Silent).unwrap().0;
+    let b = steady_flight_report(&p, &opts, &mut seeded(1), &Silent)
+        .unwrap()
+        .0;
     assert_eq!(a, b);
 }
 
@@ -163,7 +196,10 @@ fn steady_flight_matches_report_variant() {
 #[ignore]
 fn write_fixtures() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data");
-    for (name, p) in [("steady_v9_params.json", steady_support::v9()), ("steady_j16_params.json", steady_support::j16())] {
+    for (name, p) in [
+        ("steady_v9_params.json", steady_support::v9()),
+        ("steady_j16_params.json", steady_support::j16()),
+    ] {
         formation::io::write_json_atomic(&dir.join(name), &p).unwrap();
     }
 }

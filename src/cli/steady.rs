@@ -33,28 +33,40 @@ pub struct SteadyArgs {
     #[arg(short = 'o', long = "output", required = true)]
     pub output: Vec<PathBuf>,
     /// Frames per second.
-    #[arg(long, default_value_t = 30.0)]
+    #[arg(long, default_value_t = 30.0, allow_negative_numbers = true)]
     pub fps: f64,
     /// Time between key shapes, seconds.
-    #[arg(long = "key-every", default_value_t = 3.0)]
+    #[arg(
+        long = "key-every",
+        default_value_t = 3.0,
+        allow_negative_numbers = true
+    )]
     pub key_every: f64,
     /// Cruise speed of the flock, wingspans per second.
-    #[arg(long, default_value_t = 10.0)]
+    #[arg(long, default_value_t = 10.0, allow_negative_numbers = true)]
     pub speed: f64,
     /// ε of eq. (2): widening of each bird's ξ range, in [0, 0.5].
-    #[arg(long, default_value_t = 0.1)]
+    #[arg(long, default_value_t = 0.1, allow_negative_numbers = true)]
     pub epsilon: f64,
     /// C1 of eq. (2): smallest step ratio of ξ between key shapes, in [0.5, 1].
-    #[arg(long, default_value_t = 0.85)]
+    #[arg(long, default_value_t = 0.85, allow_negative_numbers = true)]
     pub c1: f64,
     /// C2 of eq. (2): largest step ratio of ξ between key shapes, in [1, 2].
-    #[arg(long, default_value_t = 1.15)]
+    #[arg(long, default_value_t = 1.15, allow_negative_numbers = true)]
     pub c2: f64,
     /// Wingspan of one bird, metres (recorded for exports).
-    #[arg(long = "wingspan-m", default_value_t = 1.5)]
+    #[arg(
+        long = "wingspan-m",
+        default_value_t = 1.5,
+        allow_negative_numbers = true
+    )]
     pub wingspan_m: f64,
     /// Largest move of a bird between consecutive key shapes, wingspans.
-    #[arg(long = "max-jump", default_value_t = 0.5)]
+    #[arg(
+        long = "max-jump",
+        default_value_t = 0.5,
+        allow_negative_numbers = true
+    )]
     pub max_jump: f64,
     /// Also write the run's report (correspondence, ranges, solve statistics) as JSON here.
     #[arg(long)]
@@ -86,7 +98,7 @@ pub fn run(args: SteadyArgs, g: Global) -> Result<()> {
     if let Some(r) = &args.report {
         OutputKind::from_path(r, &[OutputKind::Json])?;
     }
-    let params = FormationParams::read(&args.params)?;
+    let params = read_params(&args.params)?;
     let mut rng = formation::rng::stream(g.seed, "steady");
     let progress = TermProgress::new(g.quiet);
     let (anim, report) = steady_flight_report(&params, &opts, &mut rng, &progress)?;
@@ -107,6 +119,27 @@ pub fn run(args: SteadyArgs, g: Global) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// Reads a params file, telling other `formation` files apart before serde's field errors.
+fn read_params(path: &Path) -> Result<FormationParams> {
+    let value: serde_json::Value = formation::io::read_json(path)?;
+    let tag = value.get("format").and_then(|f| f.as_str());
+    if tag != Some(formation::extract::params::PARAMS_FORMAT) {
+        let found = match tag {
+            Some(t) => format!("a \"{t}\" file"),
+            None if value.get("birds").is_some_and(|b| b.is_array()) => "a shape file".into(),
+            None => "no \"format\" field".into(),
+        };
+        return Err(Error::format(
+            path,
+            format!(
+                "not a formation params file ({found}, expected \"format\": \"{}\"); write one with `formation extract ANNOTATIONS -o params.json`",
+                formation::extract::params::PARAMS_FORMAT
+            ),
+        ));
+    }
+    FormationParams::read(path)
 }
 
 /// Long CSV of SPEC §4.4: `frame,t,bird,x,y,z,heading,speed,e,xi` (e, xi empty when undefined).

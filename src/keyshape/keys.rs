@@ -125,6 +125,9 @@ pub struct Structure {
     pub monotone_pairs: Vec<(usize, usize)>,
     /// Deepest allowed position, wingspans.
     pub max_depth: f64,
+    /// An outer bird may come this far ahead of its inner neighbour before the arm counts as
+    /// broken, wingspans (near-ties, e.g. around a J's vertex, would otherwise block every move).
+    pub monotone_tolerance: f64,
 }
 
 impl Structure {
@@ -151,6 +154,7 @@ impl Structure {
             leader,
             monotone_pairs: pairs,
             max_depth,
+            monotone_tolerance: 0.1,
         }
     }
 
@@ -167,7 +171,7 @@ impl Structure {
         let ok_arms = self
             .monotone_pairs
             .iter()
-            .all(|&(inner, outer)| y[outer] >= y[inner]);
+            .all(|&(inner, outer)| y[outer] >= y[inner] - self.monotone_tolerance);
         ok_leader && ok_depth && ok_arms
     }
 }
@@ -403,6 +407,10 @@ mod tests {
             "bird ahead of leader"
         );
         assert!(!s.accepts(&[0.5, 0.7, 0.0, 0.7, 1.4]), "arm not monotone");
+        assert!(
+            s.accepts(&[0.65, 0.7, 0.0, 0.7, 1.4]),
+            "within the tolerance"
+        );
         assert!(!s.accepts(&[1.4, 0.7, 0.0, 0.7, 6.0]), "too deep");
     }
 }

@@ -287,6 +287,7 @@ pub fn steady_flight_report(
         leader: corr.leader,
         monotone_pairs: vec![],
         max_depth,
+        monotone_tolerance: 0.0,
     };
     let first_key_from = shapes.iter().position(|s| loose.accepts(&s.ys()));
     let y0: Vec<f64> = match first_key_from {

@@ -24,11 +24,10 @@ pub struct XiChart {
     pub key_times: Vec<f64>,
 }
 
-/// Blue → red through purple, `s` in [0, 1].
-fn ramp(s: f64) -> RGBColor {
+/// Blue → cyan → green → orange → red by hue, `s` in [0, 1].
+fn ramp(s: f64) -> HSLColor {
     let s = s.clamp(0.0, 1.0);
-    let lerp = |a: f64, b: f64| (a + (b - a) * s).round() as u8;
-    RGBColor(lerp(30.0, 215.0), lerp(90.0, 40.0), lerp(200.0, 40.0))
+    HSLColor((240.0 - 240.0 * s) / 360.0, 0.8, 0.42)
 }
 
 impl Chart for XiChart {
@@ -48,11 +47,10 @@ impl Chart for XiChart {
             .margin(16)
             .x_label_area_size(44)
             .y_label_area_size(70)
-            .right_y_label_area_size(if self.xi.len() <= 12 { 0 } else { 10 })
             .build_cartesian_2d(t0..t1, 0.0..top)?;
         chart
             .configure_mesh()
-            .x_desc("time (s)")
+            .x_desc("time (s)   ·   colour: lateral position, leftmost blue → rightmost red   ·   dashed: key shapes")
             .y_desc("relative power reduction ξ")
             .label_style((FONT_FAMILY, 14))
             .light_line_style(WHITE.mix(0.0))
