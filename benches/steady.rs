@@ -1,8 +1,45 @@
-//! Benchmarks of the steady stage (criterion). Results: docs/performance.md.
+//! Benchmarks of the steady stage (criterion): Algorithm 1 end to end with one frame per key shape
+//! (fps = 1, a key every second), so the time is that of steps 1–3 plus a few frames.
+//! Results: docs/performance.md.
 
 use criterion::{criterion_group, criterion_main, Criterion};
+use formation::keyshape::{steady_flight_report, SteadyOptions};
+use formation::progress::Silent;
+use formation::rng::seeded;
 
-fn placeholder(_c: &mut Criterion) {}
+#[path = "../tests/steady_support/mod.rs"]
+mod steady_support;
 
-criterion_group!(benches, placeholder);
+fn opts(birds: usize, keys: usize) -> SteadyOptions {
+    SteadyOptions {
+        birds,
+        frames: keys,
+        fps: 1.0,
+        key_every_s: 1.0,
+        ..SteadyOptions::default()
+    }
+}
+
+fn bench(c: &mut Criterion) {
+    let v9 = steady_support::v9();
+    let o = opts(40, 20);
+    // Print the solve statistics once (recorded in docs/performance.md).
+    let (_, rep) = steady_flight_report(&v9, &o, &mut seeded(0), &Silent).unwrap();
+    eprintln!("N = 40, 20 keys: {:?}", rep.keys);
+    c.bench_function("steady N=40 20 keys (v9 movie)", |b| {
+        b.iter(|| steady_flight_report(&v9, &o, &mut seeded(0), &Silent).unwrap())
+    });
+
+    let mut g = c.benchmark_group("steady large");
+    g.sample_size(10);
+    let o = opts(1000, 5);
+    let (_, rep) = steady_flight_report(&v9, &o, &mut seeded(0), &Silent).unwrap();
+    eprintln!("N = 1000, 5 keys: {:?}", rep.keys);
+    g.bench_function("steady N=1000 5 keys (v9 movie)", |b| {
+        b.iter(|| steady_flight_report(&v9, &o, &mut seeded(0), &Silent).unwrap())
+    });
+    g.finish();
+}
+
+criterion_group!(benches, bench);
 criterion_main!(benches);

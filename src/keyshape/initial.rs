@@ -121,16 +121,11 @@ fn match_side(
     if k > 1 {
         priority.push(k - 1);
     }
-    for r in 1..k.saturating_sub(1) {
-        if outliers.contains(&ids[r]) {
-            priority.push(r);
-        }
-    }
-    for r in 1..k.saturating_sub(1) {
-        if !outliers.contains(&ids[r]) {
-            priority.push(r);
-        }
-    }
+    let middle = 1..k.saturating_sub(1);
+    let (out_ranks, in_ranks): (Vec<usize>, Vec<usize>) =
+        middle.partition(|&r| outliers.contains(&ids[r]));
+    priority.extend(out_ranks);
+    priority.extend(in_ranks);
     for r in priority {
         let target = if k == 1 || slots == 0 {
             0

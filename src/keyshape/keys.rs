@@ -269,17 +269,33 @@ pub fn max_jump(a: &[f64], b: &[f64]) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// What every key shape of one flight shares.
+#[derive(Debug, Clone, Copy)]
+pub struct KeyContext<'a> {
+    /// Lateral positions, wingspans.
+    pub x: &'a [f64],
+    /// Feasible ranges of ξ (already widened by ε).
+    pub feasible: &'a XiRanges,
+    /// Leader, arms and depth to keep.
+    pub structure: &'a Structure,
+    /// Step-3 options.
+    pub opts: &'a KeyOptions,
+}
+
 /// The next key shape after `prev` (§5 step 3): redraws first, damping as the fallback, the
 /// previous shape held as the last resort (never an error for an unlucky draw).
 pub fn next_key(
-    x: &[f64],
+    ctx: &KeyContext,
     prev: &KeyShape,
-    feasible: &XiRanges,
-    structure: &Structure,
-    opts: &KeyOptions,
     rng: &mut impl Rng,
     stats: &mut KeyStats,
 ) -> Result<KeyShape> {
+    let KeyContext {
+        x,
+        feasible,
+        structure,
+        opts,
+    } = *ctx;
     let mut first_draw: Option<Vec<f64>> = None;
     let mut draws = 0;
     for _ in 0..opts.max_draws.max(1) {
@@ -337,12 +353,9 @@ pub fn next_key(
 
 /// `count` key shapes starting from `first` (already solved), each from the one before.
 pub fn key_shapes(
-    x: &[f64],
+    ctx: &KeyContext,
     first: KeyShape,
-    feasible: &XiRanges,
-    structure: &Structure,
     count: usize,
-    opts: &KeyOptions,
     rng: &mut impl Rng,
     mut on_key: impl FnMut(),
 ) -> Result<(Vec<KeyShape>, KeyStats)> {
@@ -358,7 +371,7 @@ pub fn key_shapes(
         let prev = keys
             .last()
             .ok_or_else(|| Error::Internal("no key".into()))?;
-        let k = next_key(x, prev, feasible, structure, opts, rng, &mut stats)?;
+        let k = next_key(ctx, prev, rng, &mut stats)?;
         stats.min_damping = stats.min_damping.min(k.damping);
         stats.max_residual = stats.max_residual.max(k.residual);
         stats.max_jump = stats.max_jump.max(max_jump(&prev.y, &k.y));

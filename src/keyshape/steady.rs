@@ -28,7 +28,7 @@ use crate::keyshape::initial::{
     InitialOptions,
 };
 use crate::keyshape::interpolate::Track;
-use crate::keyshape::keys::{key_shapes, KeyOptions, KeyShape, KeyStats, Structure};
+use crate::keyshape::keys::{key_shapes, KeyContext, KeyOptions, KeyShape, KeyStats, Structure};
 use crate::keyshape::ranges::{power_at, xi_ranges, XiRanges};
 use crate::keyshape::solve::SolveOptions;
 use crate::progress::Progress;
@@ -332,16 +332,13 @@ pub fn steady_flight_report(
         },
     };
     progress.start("steady: key shapes", key_frames.len() as u64);
-    let (keys, key_stats) = key_shapes(
-        &x,
-        key0,
-        &feasible,
-        &structure,
-        key_frames.len(),
-        &key_opts,
-        rng,
-        || progress.advance(1),
-    )?;
+    let ctx = KeyContext {
+        x: &x,
+        feasible: &feasible,
+        structure: &structure,
+        opts: &key_opts,
+    };
+    let (keys, key_stats) = key_shapes(&ctx, key0, key_frames.len(), rng, || progress.advance(1))?;
     progress.finish();
 
     // Step 4.

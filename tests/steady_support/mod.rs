@@ -71,7 +71,7 @@ pub fn movie(
         };
         let mut positions = Vec::new();
         let mut inlier_dev = Vec::new();
-        for i in 0..n_hat {
+        for (i, &xi) in x.iter().enumerate() {
             let mut d = if i == leader_rank {
                 0.0
             } else {
@@ -82,10 +82,10 @@ pub fn movie(
             } else if i != leader_rank {
                 inlier_dev.push(d);
             }
-            let y = shape.y_at(x[i]) + d;
+            let y = shape.y_at(xi) + d;
             positions.push(BirdPosition {
                 id: i,
-                x: x[i],
+                x: xi,
                 y,
                 dy: d,
             });
