@@ -40,6 +40,11 @@ pub struct InitialOptions {
     pub downwash_margin: f64,
     /// Redraws of one gap before it is clamped to π/4 + margin (or the mean, if larger).
     pub max_gap_draws: usize,
+    /// Every follower stays at least this far behind the leader, wingspans: the leader is the
+    /// front-most bird by definition (§4), so a Gaussian deviation that would put a follower
+    /// abreast of or ahead of it is redrawn (and, after `max_gap_draws` tries or for a carried
+    /// outlier deviation, clamped).
+    pub lead_margin: f64,
 }
 
 impl Default for InitialOptions {
@@ -47,6 +52,7 @@ impl Default for InitialOptions {
         InitialOptions {
             downwash_margin: 0.05,
             max_gap_draws: 64,
+            lead_margin: 0.05,
         }
     }
 }
@@ -215,7 +221,8 @@ pub fn curve_y(model: &ShapeModel, x: f64, scale_left: f64, scale_right: f64) ->
 
 /// One initial shape per movie frame (§5 step 1): lateral gaps from N(μ_x, σ_x), `y` on the
 /// frame's curve, the movie outliers' deviations carried over to their animated counterparts and
-/// N(μ_y, σ_y) deviations for every other follower. The leader sits at (0, 0).
+/// N(μ_y, σ_y) deviations for every other follower, which stay at least `lead_margin` behind the
+/// leader at (0, 0).
 pub fn initial_shapes(
     params: &FormationParams,
     corr: &Correspondence,
@@ -223,19 +230,7 @@ pub fn initial_shapes(
     opts: &InitialOptions,
 ) -> Vec<Shape> {
     let n = corr.birds;
-    let first = &params.frames[0];
-    let lead_pos = first
-        .order
-        .iter()
-        .position(|&id| id == first.leader)
-        .unwrap_or(0);
-    let movie_left = lead_pos as f64;
-    let movie_right = (first.order.len() - 1 - lead_pos) as f64;
-    let anim_left = corr.leader as f64;
-    let anim_right = (n - 1 - corr.leader) as f64;
-    let ratio = |m: f64, a: f64| if m > 0.0 && a > 0.0 { m / a } else { 1.0 };
-    let (scale_left, scale_right) = (ratio(movie_left, anim_left), ratio(movie_right, anim_right));
-
+    let (scale_left, scale_right) = side_scales(params, corr);
     params
         .frames
         .iter()
@@ -258,14 +253,45 @@ pub fn initial_shapes(
                             None
                         }
                     });
-                    // Always draw, so the random stream does not depend on the outlier pattern.
-                    let gauss = dev.as_ref().map_or(f.mu_y, |d| d.sample(rng));
-                    base + carried.unwrap_or(gauss)
+                    let y = match (carried, &dev) {
+                        (Some(d), _) => base + d,
+                        (None, None) => base + f.mu_y,
+                        (None, Some(dev)) => {
+                            let mut y = base + dev.sample(rng);
+                            for _ in 0..opts.max_gap_draws {
+                                if y >= opts.lead_margin {
+                                    break;
+                                }
+                                y = base + dev.sample(rng);
+                            }
+                            y
+                        }
+                    };
+                    y.max(opts.lead_margin)
                 })
                 .collect();
             Shape::from_xy(&x, &y)
         })
         .collect()
+}
+
+/// The factors that map animated lateral offsets onto the movie's curve for U and J shapes (see
+/// [`curve_y`]): movie birds per animated bird on the left and on the right of the leader.
+pub fn side_scales(params: &FormationParams, corr: &Correspondence) -> (f64, f64) {
+    let Some(first) = params.frames.first() else {
+        return (1.0, 1.0);
+    };
+    let lead_pos = first
+        .order
+        .iter()
+        .position(|&id| id == first.leader)
+        .unwrap_or(0);
+    let movie_left = lead_pos as f64;
+    let movie_right = (first.order.len() - 1 - lead_pos) as f64;
+    let anim_left = corr.leader as f64;
+    let anim_right = (corr.birds - 1 - corr.leader) as f64;
+    let ratio = |m: f64, a: f64| if m > 0.0 && a > 0.0 { m / a } else { 1.0 };
+    (ratio(movie_left, anim_left), ratio(movie_right, anim_right))
 }
 
 #[cfg(test)]
@@ -347,15 +373,17 @@ mod tests {
     #[test]
     fn fewer_birds_drop_inliers_first() {
         let f = frame(vec![0, 1, 2, 3, 4, 5, 6, 7, 8], 3, vec![6]);
-        let c = correspondence(&f, 5).unwrap();
+        let c = correspondence(&f, 7).unwrap();
         assert_eq!(c.movie[c.leader], Some(3));
         let m = matched(&c);
         assert!(m.contains(&6), "the outlier survives: {m:?}");
-        assert!(
-            m.contains(&8) && m.contains(&4),
-            "closest and farthest kept: {m:?}"
-        );
-        assert_eq!(m.len() + c.dropped.len(), 9);
+        for id in [0, 2, 4, 8] {
+            assert!(m.contains(&id), "closest and farthest kept: {m:?}");
+        }
+        assert_eq!(c.dropped, vec![1, 7], "inliers dropped");
+        // With only the two ends of each side left, closest and farthest win over the outlier.
+        let c = correspondence(&f, 5).unwrap();
+        assert_eq!(matched(&c), vec![0, 2, 3, 4, 8]);
     }
 
     #[test]

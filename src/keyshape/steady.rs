@@ -24,8 +24,8 @@ use crate::animation::{Animation, Frame, KeyBird, KeyShapeRecord, Stage};
 use crate::error::{Error, Result};
 use crate::extract::params::FormationParams;
 use crate::keyshape::initial::{
-    correspondence, curve_y, initial_shapes, lateral_gaps, positions_from_gaps, Correspondence,
-    InitialOptions,
+    correspondence, curve_y, initial_shapes, lateral_gaps, positions_from_gaps, side_scales,
+    Correspondence, InitialOptions,
 };
 use crate::keyshape::interpolate::Track;
 use crate::keyshape::keys::{key_shapes, KeyContext, KeyOptions, KeyShape, KeyStats, Structure};
@@ -292,17 +292,19 @@ pub fn steady_flight_report(
     let first_key_from = shapes.iter().position(|s| loose.accepts(&s.ys()));
     let y0: Vec<f64> = match first_key_from {
         Some(i) => shapes[i].ys(),
-        None => x
-            .iter()
-            .enumerate()
-            .map(|(i, &xi)| {
-                if i == corr.leader {
-                    0.0
-                } else {
-                    curve_y(&first.shape, xi, 1.0, 1.0).max(0.1)
-                }
-            })
-            .collect(),
+        None => {
+            let (sl, sr) = side_scales(params, &corr);
+            x.iter()
+                .enumerate()
+                .map(|(i, &xi)| {
+                    if i == corr.leader {
+                        0.0
+                    } else {
+                        curve_y(&first.shape, xi, sl, sr).max(init_opts.lead_margin)
+                    }
+                })
+                .collect()
+        }
     };
     let p0 = power_reduction(&x, &y0)?;
     let key0 = KeyShape {
@@ -337,6 +339,7 @@ pub fn steady_flight_report(
         feasible: &feasible,
         structure: &structure,
         opts: &key_opts,
+        total,
     };
     let (keys, key_stats) = key_shapes(&ctx, key0, key_frames.len(), rng, || progress.advance(1))?;
     progress.finish();
