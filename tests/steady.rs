@@ -137,6 +137,11 @@ fn case(params: &FormationParams, birds: usize) {
         "  frames outside range {} max excess {:.2e}",
         rep.frames_outside_range, rep.max_frame_excess
     );
+    assert!(
+        rep.max_frame_excess <= 1e-3,
+        "frame ξ leaves the ranges by {}",
+        rep.max_frame_excess
+    );
     check(&anim, &rep, &opts);
 }
 

@@ -16,7 +16,7 @@
 //! front-most, no bird falls further back than the depth limit, the arms keep the monotone steps of
 //! the first key shape (side structure), and no bird moves more than `max_jump` from the previous key.
 //! A rejected shape is never used as a starting point. Failing draws are redrawn (`max_draws`);
-//! when all fail, the first draw is damped toward ξ̂_{k−1} (ξ̂_{k−1} + λ (ξ̂ − ξ̂_{k−1})), whose
+//! when all fail, the draws are damped toward ξ̂_{k−1} (ξ̂_{k−1} + λ (ξ̂ − ξ̂_{k−1})), whose
 //! solution is the previous key shape at λ = 0, so the reachable set always contains a fallback.
 
 use rand::Rng;
@@ -350,7 +350,7 @@ impl Predictor {
 /// Each draw is first judged on its linear prediction (cheap): a draw whose predicted shape
 /// breaks the structure or jumps more than `max_jump` is redrawn without a solve; a promising
 /// one is solved starting from the prediction, so LM starts next to the answer. When every draw
-/// fails, the first one is damped: λ is halved until the prediction passes, then solved, and
+/// fails, the draws are damped in turn: λ is halved until the prediction passes, then solved, and
 /// halved again while the solve is rejected.
 pub fn next_key(
     ctx: &KeyContext,
@@ -367,7 +367,7 @@ pub fn next_key(
     } = *ctx;
     let predictor = Predictor::new(x, prev, structure.leader, total);
     let promising = |y: &[f64]| structure.accepts(y) && max_jump(&prev.y, y) <= opts.max_jump;
-    let mut first_draw: Option<Vec<f64>> = None;
+    let mut tried: Vec<Vec<f64>> = Vec::new();
     let mut draws = 0;
     for _ in 0..opts.max_draws.max(1) {
         let target = draw_target(&prev.xi_target, feasible, opts.c1, opts.c2, rng);
@@ -381,7 +381,7 @@ pub fn next_key(
             Some(y) if promising(y) => y.clone(),
             Some(_) => {
                 stats.rejected_predicted += 1;
-                first_draw.get_or_insert(target);
+                tried.push(target);
                 continue;
             }
             None => prev.y.clone(),
@@ -398,36 +398,38 @@ pub fn next_key(
                 draws,
             });
         }
-        first_draw.get_or_insert(target);
+        tried.push(target);
     }
-    let draw = first_draw.unwrap_or_else(|| prev.xi_target.clone());
-    let mut lambda = 1.0;
-    for _ in 0..opts.max_damping {
-        lambda *= 0.5;
-        let target: Vec<f64> = prev
-            .xi_target
-            .iter()
-            .zip(&draw)
-            .map(|(p, d)| p + lambda * (d - p))
-            .collect();
-        let predicted = predictor.as_ref().and_then(|p| p.predict(prev, &target));
-        let start = match &predicted {
-            Some(y) if promising(y) => y.clone(),
-            Some(_) => continue,
-            None => prev.y.clone(),
-        };
-        if let Attempt::Accepted(y, xi, residual) =
-            attempt(x, prev, &start, &target, structure, opts, stats)?
-        {
-            stats.damped += 1;
-            return Ok(KeyShape {
-                y,
-                xi_target: target,
-                xi,
-                residual,
-                damping: lambda,
-                draws,
-            });
+    // Damping: each draw in turn, λ halved until its prediction passes, then solved.
+    for draw in &tried {
+        let mut lambda = 1.0;
+        for _ in 0..opts.max_damping {
+            lambda *= 0.5;
+            let target: Vec<f64> = prev
+                .xi_target
+                .iter()
+                .zip(draw)
+                .map(|(p, d)| p + lambda * (d - p))
+                .collect();
+            let predicted = predictor.as_ref().and_then(|p| p.predict(prev, &target));
+            let start = match &predicted {
+                Some(y) if promising(y) => y.clone(),
+                Some(_) => continue,
+                None => prev.y.clone(),
+            };
+            if let Attempt::Accepted(y, xi, residual) =
+                attempt(x, prev, &start, &target, structure, opts, stats)?
+            {
+                stats.damped += 1;
+                return Ok(KeyShape {
+                    y,
+                    xi_target: target,
+                    xi,
+                    residual,
+                    damping: lambda,
+                    draws,
+                });
+            }
         }
     }
     stats.held += 1;
