@@ -339,9 +339,8 @@ impl BirdBeats {
 
     fn beat_strokes(&self, beat: &Beat) -> Strokes {
         if beat.glide {
-            let mut g = self.glide;
-            g.dihedral = Stroke::hold(g.dihedral.down + beat.offset);
-            g
+            // A glide is held steady: no per-wingbeat jitter, only the bird's own offset.
+            self.glide
         } else {
             scale_strokes(&self.strokes, beat.amp, beat.offset)
         }
@@ -445,7 +444,11 @@ fn draw_birds(seed: u64, birds: usize, opts: &WingbeatOptions) -> (Vec<BirdBeats
         out.push(BirdBeats {
             timing,
             strokes: scale_strokes(&preset.strokes, amp, offset),
-            glide: preset.glide_strokes(),
+            glide: {
+                let mut g = preset.glide_strokes();
+                g.dihedral = Stroke::hold(preset.glide_dihedral + offset);
+                g
+            },
             freq: preset.frequency_hz * (1.0 + v * BIRD_FREQ_SD * zf),
             phase0,
             bout_offset: match opts.phase_mode {
@@ -478,7 +481,7 @@ fn efforts(anim: &Animation, preset: &SpeciesPreset) -> Vec<f64> {
             continue;
         };
         let dt = fnx.t - fp.t;
-        if !(dt > 1e-9) {
+        if dt.is_nan() || dt <= 1e-9 {
             continue;
         }
         for i in 0..n {
@@ -508,7 +511,7 @@ pub fn bird_ahead(frame: &Frame, i: usize) -> Option<(usize, f64)> {
         let lateral = (dx * fy - dy * fx).abs();
         if along > AHEAD_MIN && lateral < AHEAD_MAX_LATERAL {
             let d2 = along * along + lateral * lateral;
-            if best.is_none_or(|(_, _, bd)| d2 < bd) {
+            if best.map_or(true, |(_, _, bd)| d2 < bd) {
                 best = Some((j, along, d2));
             }
         }
@@ -600,7 +603,7 @@ fn locked_rate(frame: &Frame, i: usize, phi: &[f64], last_rate: &[f64], own: f64
     let (Some(&pj), Some(&fj), Some(&pi)) = (phi.get(j), last_rate.get(j), phi.get(i)) else {
         return own;
     };
-    if !(speed >= LOCK_MIN_SPEED) {
+    if speed.is_nan() || speed < LOCK_MIN_SPEED {
         return own;
     }
     let target = pj - TAU * fj * dy / speed;

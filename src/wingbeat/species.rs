@@ -176,6 +176,6 @@ impl SpeciesPreset {
 }
 
 /// Degrees to radians.
-const fn deg(d: f64) -> f64 {
+fn deg(d: f64) -> f64 {
     d * std::f64::consts::PI / 180.0
 }
