@@ -7,8 +7,8 @@ use std::process::Command;
 
 use formation::animation::{Animation, Frame};
 use formation::wingbeat::{
-    assign_phases, bird_ahead, g1, g2, pose, probe, Flapper, Glide, PhaseMap, PhaseMode, Species,
-    WingbeatOptions,
+    assign_phases, bird_ahead, g1, g2, pose, probe, AheadIndex, Flapper, Glide, PhaseMap,
+    PhaseMode, Species, WingbeatOptions,
 };
 use proptest::prelude::*;
 
@@ -465,4 +465,24 @@ fn plot_wingbeat_writes_png_and_svg() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("heron"));
     assert!(!out.exists());
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+proptest! {
+    #[test]
+    fn the_grid_finds_the_same_bird_ahead(
+        pts in proptest::collection::vec((-20.0f64..20.0, -20.0f64..20.0, -0.5f64..0.5), 1..150),
+    ) {
+        let mut f = Frame::default();
+        for &(x, y, h) in &pts {
+            f.x.push(x);
+            f.y.push(y);
+            f.z.push(0.0);
+            f.heading.push(h);
+            f.speed.push(10.0);
+        }
+        let index = AheadIndex::new(&f);
+        for i in 0..pts.len() {
+            prop_assert_eq!(index.ahead(&f, i), bird_ahead(&f, i));
+        }
+    }
 }

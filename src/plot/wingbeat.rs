@@ -91,6 +91,7 @@ impl Chart for WingbeatChart {
             .x_desc("wingbeat phase φ / 2π (0 = start of downstroke)")
             .y_desc("joint angle, degrees")
             .label_style((FONT_FAMILY, 13))
+            .max_light_lines(2)
             .draw()?;
         shade(&mut chart, ua, mid, half, lo, hi)?;
         for (name, get, color) in ANGLES {
@@ -122,6 +123,7 @@ impl Chart for WingbeatChart {
             .x_desc("wingbeat phase φ / 2π")
             .y_desc("wing spread")
             .label_style((FONT_FAMILY, 13))
+            .max_light_lines(2)
             .draw()?;
         shade(&mut spread, ua, mid, half, 0.0, 1.1)?;
         let purple = RGBColor(148, 103, 189);

@@ -30,6 +30,18 @@ pub fn g1_basis(phi: f64) -> f64 {
     0.5 * (1.0 + phi.cos())
 }
 
+/// Reduces an angle into [0, 2π), cheaply when it already is or is one period off.
+#[inline]
+fn wrap(phi: f64) -> f64 {
+    if (0.0..TAU).contains(&phi) {
+        phi
+    } else if (-TAU..0.0).contains(&phi) && phi + TAU < TAU {
+        phi + TAU
+    } else {
+        phi.rem_euclid(TAU)
+    }
+}
+
 /// Composite function g2 (Wu & Popović §4.1), used for the arm sweep, arm and hand (forearm)
 /// twist and the wing spread: held at the downstroke value for the whole downstroke, then a
 /// raised cosine that reaches the upstroke value at mid-upstroke and returns by its end.
@@ -46,7 +58,7 @@ pub fn g2(down: f64, up: f64, phi: f64) -> f64 {
 /// The shape factor of [`g2`]: 0 on the downstroke, 1 at mid-upstroke.
 #[inline]
 pub fn g2_basis(phi: f64) -> f64 {
-    let p = phi.rem_euclid(TAU);
+    let p = wrap(phi);
     if p < PI {
         0.0
     } else {
@@ -110,7 +122,7 @@ impl PhaseMap {
     /// h(φ); φ is reduced modulo 2π, the result lies in [0, 2π).
     #[inline]
     pub fn eval(&self, phi: f64) -> f64 {
-        let p = phi.rem_euclid(TAU);
+        let p = wrap(phi);
         let (x0, y0, l, dy) = self.piece(p);
         let t = (p - x0) / l;
         let t2 = t * t;

@@ -232,10 +232,12 @@ const ACCEL_FREQ_GAIN: f64 = 0.2;
 const DECEL_AMP_CUT: f64 = 0.3;
 /// Half-width of the window over which the acceleration is measured, seconds.
 const ACCEL_WINDOW_S: f64 = 0.25;
-/// A bird j is "ahead" of i when it is at least this far ahead along i's heading (wingspans)...
+/// A bird j is "ahead" of i when it is more than this far ahead along i's heading (wingspans)...
 const AHEAD_MIN: f64 = 0.1;
 /// ...and at most this far to the side (wingspans).
 const AHEAD_MAX_LATERAL: f64 = 3.0;
+/// ...and at most this far ahead (wingspans): further ahead, its wake has decayed.
+const AHEAD_MAX_ALONG: f64 = 6.0;
 /// Below this ground speed (wingspans/s) the streamwise lag is meaningless and a bird flaps freely.
 const LOCK_MIN_SPEED: f64 = 0.5;
 
@@ -352,15 +354,15 @@ impl BirdBeats {
         a.freq + w * (b.freq - a.freq)
     }
 
-    /// Wing pose at unwrapped phase `s`.
-    fn pose_at(&self, s: f64) -> WingPose {
+    /// Wing pose at unwrapped phase `s`, whose value modulo 2π is `phi`.
+    fn pose_at(&self, s: f64, phi: f64) -> WingPose {
         let (a, b, w) = self.blend(s);
         let strokes = if w == 0.0 {
             self.beat_strokes(&a)
         } else {
             Strokes::lerp(&self.beat_strokes(&a), &self.beat_strokes(&b), w)
         };
-        pose(&strokes, &self.timing, s.rem_euclid(TAU))
+        pose(&strokes, &self.timing, phi)
     }
 
     /// Decides every wingbeat that phase `s` touches (including the next one once `s` enters the
@@ -496,27 +498,96 @@ fn efforts(anim: &Animation, preset: &SpeciesPreset) -> Vec<f64> {
 }
 
 /// The bird ahead of bird `i` in `frame` and the streamwise distance to it (wingspans, along
-/// bird i's heading): among birds at least 0.1 wingspans ahead and at most 3 wingspans to the
-/// side, the nearest one. `None` for a leader (or a bird index out of range).
+/// bird i's heading): among birds between 0.1 and 6 wingspans ahead and at most 3 wingspans to the
+/// side, the nearest one (ties: the lower index). `None` for a leader (or a bird index out of
+/// range). O(n); [`AheadIndex`] answers the same question for a whole frame in O(n).
 pub fn bird_ahead(frame: &Frame, i: usize) -> Option<(usize, f64)> {
+    ahead_among(frame, i, 0..frame.x.len())
+}
+
+/// [`bird_ahead`] restricted to the candidates `js`.
+fn ahead_among(
+    frame: &Frame,
+    i: usize,
+    js: impl IntoIterator<Item = usize>,
+) -> Option<(usize, f64)> {
     let (xi, yi, hd) = (*frame.x.get(i)?, *frame.y.get(i)?, *frame.heading.get(i)?);
     let (fx, fy) = (hd.sin(), hd.cos());
     let mut best: Option<(usize, f64, f64)> = None;
-    for (j, (&xj, &yj)) in frame.x.iter().zip(frame.y.iter()).enumerate() {
+    for j in js {
+        let (Some(&xj), Some(&yj)) = (frame.x.get(j), frame.y.get(j)) else {
+            continue;
+        };
         if j == i {
             continue;
         }
         let (dx, dy) = (xj - xi, yj - yi);
         let along = dx * fx + dy * fy;
         let lateral = (dx * fy - dy * fx).abs();
-        if along > AHEAD_MIN && lateral < AHEAD_MAX_LATERAL {
+        if along > AHEAD_MIN && along < AHEAD_MAX_ALONG && lateral < AHEAD_MAX_LATERAL {
             let d2 = along * along + lateral * lateral;
-            if best.map_or(true, |(_, _, bd)| d2 < bd) {
+            let better = match best {
+                None => true,
+                Some((bj, _, bd)) => d2 < bd || (d2 == bd && j < bj),
+            };
+            if better {
                 best = Some((j, along, d2));
             }
         }
     }
     best.map(|(j, along, _)| (j, along))
+}
+
+/// A uniform grid over one frame's positions (cells of 6.75 wingspans) that finds every bird's
+/// [`bird_ahead`] by looking only at nearby cells: O(n) per frame for a spread-out flock instead of
+/// O(n²).
+#[derive(Debug, Clone)]
+pub struct AheadIndex {
+    cells: std::collections::HashMap<(i64, i64), Vec<usize>>,
+}
+
+impl AheadIndex {
+    /// Cell size, wingspans: the farthest a bird ahead can be (√(6² + 3²) ≈ 6.71), so only the 3×3
+    /// cells around a bird hold candidates.
+    const CELL: f64 = 6.75;
+    /// Below this many birds a plain scan is faster than hashing.
+    const SCAN_BELOW: usize = 64;
+
+    fn key(x: f64, y: f64) -> (i64, i64) {
+        (
+            (x / Self::CELL).floor() as i64,
+            (y / Self::CELL).floor() as i64,
+        )
+    }
+
+    /// Indexes the birds of `frame`.
+    pub fn new(frame: &Frame) -> AheadIndex {
+        let mut cells: std::collections::HashMap<(i64, i64), Vec<usize>> =
+            std::collections::HashMap::new();
+        if frame.x.len() < Self::SCAN_BELOW {
+            return AheadIndex { cells };
+        }
+        for (j, (&x, &y)) in frame.x.iter().zip(frame.y.iter()).enumerate() {
+            cells.entry(Self::key(x, y)).or_default().push(j);
+        }
+        AheadIndex { cells }
+    }
+
+    /// Same answer as [`bird_ahead`]`(frame, i)`; `frame` must be the indexed frame.
+    pub fn ahead(&self, frame: &Frame, i: usize) -> Option<(usize, f64)> {
+        if frame.x.len() < Self::SCAN_BELOW {
+            return bird_ahead(frame, i);
+        }
+        let (xi, yi) = (*frame.x.get(i)?, *frame.y.get(i)?);
+        let (cx, cy) = Self::key(xi, yi);
+        let reach = 1;
+        let cand = (-reach..=reach)
+            .flat_map(|ox| (-reach..=reach).map(move |oy| (cx + ox, cy + oy)))
+            .filter_map(|k| self.cells.get(&k))
+            .flatten()
+            .copied();
+        ahead_among(frame, i, cand)
+    }
 }
 
 /// Wraps an angle into (−π, π].
@@ -567,11 +638,16 @@ fn simulate(anim: &Animation, opts: &WingbeatOptions) -> Run {
             break;
         };
         let dt = (next.t - frame.t).max(0.0);
+        let index = match opts.phase_mode {
+            PhaseMode::Locked => Some(AheadIndex::new(frame)),
+            PhaseMode::Independent => None,
+        };
         for i in 0..n {
-            rate[i] = match opts.phase_mode {
-                PhaseMode::Independent => own[i],
-                PhaseMode::Locked => {
-                    locked_rate(frame, i, &phi, &last_rate, own[i], opts.lock_time_s)
+            rate[i] = match &index {
+                None => own[i],
+                Some(index) => {
+                    let ahead = index.ahead(frame, i);
+                    locked_rate(frame, i, ahead, &phi, &last_rate, own[i], opts.lock_time_s)
                 }
             };
         }
@@ -595,9 +671,17 @@ fn simulate(anim: &Animation, opts: &WingbeatOptions) -> Run {
 
 /// Phase-locked frequency of bird `i` (Hz): the bird ahead's frequency plus a correction that
 /// pulls the phase towards the spatial-phasing target φ_ahead − 2π f Δy / U.
-fn locked_rate(frame: &Frame, i: usize, phi: &[f64], last_rate: &[f64], own: f64, tau: f64) -> f64 {
+fn locked_rate(
+    frame: &Frame,
+    i: usize,
+    ahead: Option<(usize, f64)>,
+    phi: &[f64],
+    last_rate: &[f64],
+    own: f64,
+    tau: f64,
+) -> f64 {
     let speed = frame.speed.get(i).copied().unwrap_or(0.0);
-    let Some((j, dy)) = bird_ahead(frame, i) else {
+    let Some((j, dy)) = ahead else {
         return own;
     };
     let (Some(&pj), Some(&fj), Some(&pi)) = (phi.get(j), last_rate.get(j), phi.get(i)) else {
@@ -747,9 +831,9 @@ impl Flapper {
         let (Some(k), Some(b)) = (self.index(frame, bird), self.birds.get(bird)) else {
             return WingPose::EXTENDED;
         };
-        match self.unwrapped.get(k) {
-            Some(&s) => b.pose_at(s),
-            None => WingPose::EXTENDED,
+        match (self.unwrapped.get(k), self.phase.get(k)) {
+            (Some(&s), Some(&phi)) => b.pose_at(s, phi),
+            _ => WingPose::EXTENDED,
         }
     }
 
@@ -776,7 +860,8 @@ impl Flapper {
             .and_then(|i| self.unwrapped.get(i))
             .copied()
             .unwrap_or(s0);
-        b.pose_at(s0 + w * (s1 - s0))
+        let s = s0 + w * (s1 - s0);
+        b.pose_at(s, s.rem_euclid(TAU))
     }
 }
 
@@ -822,7 +907,7 @@ pub mod probe {
                 })
                 .collect(),
         };
-        (b.pose_at(s), b.freq_at(s))
+        (b.pose_at(s, s.rem_euclid(TAU)), b.freq_at(s))
     }
 
     /// Unwrapped phases of every bird at every frame (frame-major) as the renderers see them.
