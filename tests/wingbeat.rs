@@ -486,3 +486,35 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn files_without_wingbeat_record_use_their_species_and_bad_files_are_rejected() {
+    let mut a = v_flock(3, 2.0, 30.0, |_| 10.0);
+    a.species = Some("pelican".into());
+    assert_eq!(WingbeatOptions::for_animation(&a).species, Species::Pelican);
+    // Without stored phases the flapper computes them as assign_phases would.
+    let computed = Flapper::from_animation(&a);
+    let mut b = a.clone();
+    assign_phases(
+        &mut b,
+        &WingbeatOptions {
+            species: Species::Pelican,
+            ..WingbeatOptions::default()
+        },
+    )
+    .unwrap();
+    assert_eq!(
+        computed.phase(30, 2),
+        b.frames[30].wing_phase.as_ref().unwrap()[2]
+    );
+
+    // One bird too few in a frame: an error naming the frame and field, not a panic.
+    let mut bad = v_flock(3, 1.0, 30.0, |_| 10.0);
+    bad.frames[5].speed.pop();
+    let e = assign_phases(&mut bad, &WingbeatOptions::default()).unwrap_err();
+    assert!(e.to_string().contains("frames[5].speed"), "{e}");
+    // The flapper never panics on it either.
+    let f = Flapper::from_animation(&bad);
+    let _ = f.pose(5, 2);
+    let _ = f.pose_at(5.5, 2);
+}
