@@ -393,6 +393,20 @@ fn finish(path: &Path, raw: RawAnnotations, opts: &ReadOptions) -> Result<Annota
                 forward: (b.x * d.0 + py * d.1) / scale,
             });
         }
+        if let Some((b, _)) = f
+            .birds
+            .iter()
+            .zip(&birds)
+            .find(|(_, m)| m.lateral.abs() > 1e6 || m.forward.abs() > 1e6)
+        {
+            return Err(Error::format(
+                path,
+                format!(
+                    "frame {}, {}: ({}, {}) px is more than a million wingspans ({scale} px each) from the image origin; check the coordinates and wingspan_px",
+                    f.index, b.at, b.x, b.y
+                ),
+            ));
+        }
         // Duplicate marks (same pixel, or the same id twice) cannot be two birds.
         for i in 0..birds.len() {
             for j in (i + 1)..birds.len() {

@@ -76,7 +76,7 @@ impl Default for SynthSpec {
 /// One bird of one generated frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SynthBird {
-    /// True id (lateral order in the first frame).
+    /// True id: the bird's lateral order in the first frame.
     pub id: usize,
     /// Lateral position relative to the frame's front-most bird, wingspans.
     pub x: f64,
@@ -122,7 +122,8 @@ fn curve(spec: &SynthSpec, x: f64) -> f64 {
     }
 }
 
-/// Generates a flock (see the module docs).
+/// Generates a flock (see the module docs). Outliers are displaced along the curve's normal by
+/// a distance drawn from `outlier_offset`.
 pub fn generate(spec: &SynthSpec, rng: &mut impl Rng) -> SynthFlock {
     let n = spec.birds.max(3);
     let gap = Normal::new(spec.spacing, spec.spacing_sd.max(0.0)).unwrap_or_else(|_| {
@@ -173,6 +174,27 @@ pub fn generate(spec: &SynthSpec, rng: &mut impl Rng) -> SynthFlock {
             }
         })
         .collect();
+    // Outliers move off the curve along its normal (−y', 1)/√(1 + y'²), so they are off the
+    // curve by the offset geometrically, not just along y.
+    let normals: Vec<(f64, f64)> = (0..n)
+        .map(|i| {
+            let x = base[i].0;
+            let h = 1e-6;
+            let s = if spec.kind == ShapeKind::Line && lead == n - 1 {
+                -spec.slope_left
+            } else if spec.kind == ShapeKind::V {
+                if x < 0.0 {
+                    -spec.slope_left
+                } else {
+                    spec.slope_right
+                }
+            } else {
+                (curve(spec, x + h) - curve(spec, x - h)) / (2.0 * h)
+            };
+            let len = (1.0 + s * s).sqrt();
+            (-s / len, 1.0 / len)
+        })
+        .collect();
     let theta = spec.heading_deg.to_radians();
     let (d, r) = ((theta.sin(), -theta.cos()), (theta.cos(), theta.sin()));
     let mut walk = vec![(0.0f64, 0.0f64); n];
@@ -185,8 +207,10 @@ pub fn generate(spec: &SynthSpec, rng: &mut impl Rng) -> SynthFlock {
             // The walk is pulled back so birds keep their places over long movies.
             walk[i].0 *= 0.9;
             walk[i].1 *= 0.9;
-            let x = base[i].0 + walk[i].0 + spec.noise * unit.sample(rng);
-            let y = base[i].1 + offsets[i] + walk[i].1 + spec.noise * unit.sample(rng);
+            let x =
+                base[i].0 + offsets[i] * normals[i].0 + walk[i].0 + spec.noise * unit.sample(rng);
+            let y =
+                base[i].1 + offsets[i] * normals[i].1 + walk[i].1 + spec.noise * unit.sample(rng);
             raw.push((x, y));
         }
         let leader = (0..n)
@@ -211,6 +235,22 @@ pub fn generate(spec: &SynthSpec, rng: &mut impl Rng) -> SynthFlock {
             })
             .collect();
         frames.push(SynthFrame { birds, leader });
+    }
+    // True ids are the lateral order in the first frame (§4 step 1), after noise and offsets.
+    if let Some(f0) = frames.first() {
+        let mut by_x: Vec<usize> = (0..n).collect();
+        by_x.sort_by(|&a, &b| f0.birds[a].x.total_cmp(&f0.birds[b].x));
+        let mut rank = vec![0usize; n];
+        for (r, &i) in by_x.iter().enumerate() {
+            rank[i] = r;
+        }
+        for f in &mut frames {
+            for b in &mut f.birds {
+                b.id = rank[b.id];
+            }
+            f.leader = rank[f.leader];
+            f.birds.sort_by_key(|b| b.id);
+        }
     }
     SynthFlock {
         spec: spec.clone(),

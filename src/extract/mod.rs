@@ -20,13 +20,15 @@
 //! \qquad \sigma = T / 2
 //! ```
 //!
-//! with r_i = y_i − curve(x_i), T the inlier threshold (`ExtractOptions::inlier_threshold`,
+//! with r_i = (y_i − curve(x_i)) / √(1 + curve'(x_i)²) the first-order distance of bird i
+//! from the curve (so that image noise on a steep arm is not taken for an outlier), T the inlier threshold (`ExtractOptions::inlier_threshold`,
 //! wingspans), n the birds in the frame and k_M the parameter count (line 2, parabola 3, V 4).
 //! A bad point costs at most (T/σ)² = 4, so an outlier cannot pull the choice; a more complex
 //! model must buy its extra parameters with a residual drop of ln n each. The lowest S wins. A
 //! parabola is a **J** when its vertex x_v = −b/(2a) lies more than `j_offset` half-widths from
 //! the centre of the inliers' lateral extent (one arm clearly longer), else a **U**. Birds with
-//! |r| ≤ T are inliers; μ_y, σ_y are the mean and sample standard deviation of the inliers' r.
+//! |r| ≤ T are inliers; μ_y, σ_y are the mean and sample standard deviation of the inliers'
+//! vertical deviations dy = y − curve(x) (the paper's y-deviations).
 
 pub mod params;
 pub mod ransac;
@@ -227,6 +229,29 @@ pub fn extract_with_report(
     ))
 }
 
+/// Slope dy/dx of a fitted curve at x (a V uses the arm of x's side).
+pub fn slope_at(m: &ShapeModel, x: f64) -> f64 {
+    match *m {
+        ShapeModel::V { left, right } => {
+            if x < 0.0 {
+                left.slope
+            } else {
+                right.slope
+            }
+        }
+        ShapeModel::Line { slope, .. } => slope,
+        ShapeModel::U { a, b, .. } | ShapeModel::J { a, b, .. } => 2.0 * a * x + b,
+    }
+}
+
+/// Squared first-order (Sampson) distance of (x, y) from the curve, wingspans²:
+/// r² / (1 + y'(x)²) with r = y − curve(x).
+pub fn dist2(m: &ShapeModel, x: f64, y: f64) -> f64 {
+    let r = y - m.y_at(x);
+    let s = slope_at(m, x);
+    r * r / (1.0 + s * s)
+}
+
 fn mean_sd(v: &[f64]) -> (f64, f64) {
     if v.is_empty() {
         return (0.0, 0.0);
@@ -287,7 +312,7 @@ pub fn extract_frame(
     for &(id, x, y) in &pos {
         let dy = y - shape.y_at(x);
         positions.push(BirdPosition { id, x, y, dy });
-        if dy.abs() <= t {
+        if dist2(&shape, x, y) <= t * t {
             inliers.push(id);
             dys.push(dy);
         } else {
@@ -340,7 +365,7 @@ fn choose_model(
     };
     let cost_of = |m: &ShapeModel| -> f64 {
         pts.iter()
-            .map(|&(x, y)| (y - m.y_at(x)).powi(2).min(t2))
+            .map(|&(x, y)| dist2(m, x, y).min(t2))
             .sum::<f64>()
     };
     let mut cands: Vec<(ShapeModel, f64)> = Vec::new();
@@ -358,7 +383,7 @@ fn choose_model(
             // J or U by where the vertex lies within the inliers' lateral extent.
             let inl: Vec<f64> = pts
                 .iter()
-                .filter(|&&(x, y)| (y - p.y_at(x)).powi(2) <= t2)
+                .filter(|&&(x, y)| p.dist2(x, y) <= t2)
                 .map(|p| p.0)
                 .collect();
             let (lo, hi) = inl

@@ -1,12 +1,12 @@
 //! Robust curve fits for §4 step 2: RANSAC with the MSAC cost, exhaustive minimal samples when
 //! they are few, and local optimisation (least squares on the inliers, repeated).
 //!
-//! Points are `(x, y)` in the formation frame (wingspans); residuals are vertical,
-//! r = y − curve(x), the same deviation the params file records as `dy`. A fit's cost is MSAC's
-//! truncated quadratic
+//! Points are `(x, y)` in the formation frame (wingspans). A point's distance from a curve is
+//! taken to first order (Sampson): d = r / √(1 + y'(x)²) with r = y − curve(x) the vertical
+//! deviation the params file records as `dy`. A fit's cost is MSAC's truncated quadratic
 //!
 //! ```math
-//! C = \sum_i \min(r_i^2, T^2)
+//! C = \sum_i \min(d_i^2, T^2)
 //! ```
 //!
 //! with T the inlier threshold (wingspans). Minimal samples: 2 points for a line, 3 for a
@@ -45,6 +45,16 @@ pub trait Model: Copy {
     fn fit(pts: &[(f64, f64)]) -> Option<Self>;
     /// The curve's y at x.
     fn y_at(&self, x: f64) -> f64;
+    /// The curve's slope dy/dx at x.
+    fn slope_at(&self, x: f64) -> f64;
+    /// Squared distance of a point from the curve to first order (the Sampson approximation
+    /// r² / (1 + y'(x)²), r = y − curve(x)): isotropic image noise on a steep arm is not
+    /// mistaken for an outlier.
+    fn dist2(&self, x: f64, y: f64) -> f64 {
+        let r = y - self.y_at(x);
+        let s = self.slope_at(x);
+        r * r / (1.0 + s * s)
+    }
     /// Whether the model is admissible (a U/J parabola must open backward, `a > 0`).
     fn valid(&self) -> bool {
         true
@@ -71,6 +81,9 @@ impl Model for Line {
     }
     fn y_at(&self, x: f64) -> f64 {
         self.c + self.s * x
+    }
+    fn slope_at(&self, _x: f64) -> f64 {
+        self.s
     }
 }
 
@@ -111,6 +124,9 @@ impl Model for Parabola {
     fn y_at(&self, x: f64) -> f64 {
         (self.a * x + self.b) * x + self.c
     }
+    fn slope_at(&self, x: f64) -> f64 {
+        2.0 * self.a * x + self.b
+    }
     fn valid(&self) -> bool {
         self.a > 0.0
     }
@@ -129,9 +145,7 @@ pub struct RansacOptions {
 
 /// MSAC cost of a model over points.
 pub fn msac_cost<M: Model>(m: &M, pts: &[(f64, f64)], t2: f64) -> f64 {
-    pts.iter()
-        .map(|&(x, y)| (y - m.y_at(x)).powi(2).min(t2))
-        .sum()
+    pts.iter().map(|&(x, y)| m.dist2(x, y).min(t2)).sum()
 }
 
 fn binomial(n: usize, k: usize) -> u128 {
@@ -214,10 +228,7 @@ pub fn ransac<M: Model>(
             if let Some(m) = M::fit(&sample[..k]) {
                 consider(m, &mut best);
                 if let Some((bm, _)) = &best {
-                    let inl = pts
-                        .iter()
-                        .filter(|&&(x, y)| (y - bm.y_at(x)).powi(2) <= t2)
-                        .count() as f64
+                    let inl = pts.iter().filter(|&&(x, y)| bm.dist2(x, y) <= t2).count() as f64
                         / n as f64;
                     let wk = inl.powi(k as i32);
                     needed = if wk >= 1.0 - 1e-12 {
@@ -234,7 +245,7 @@ pub fn ransac<M: Model>(
     let mut inl: Vec<(f64, f64)> = Vec::with_capacity(n);
     for _ in 0..opts.refine_rounds {
         inl.clear();
-        inl.extend(pts.iter().filter(|&&(x, y)| (y - m.y_at(x)).powi(2) <= t2));
+        inl.extend(pts.iter().filter(|&&(x, y)| m.dist2(x, y) <= t2));
         let Some(m2) = M::fit(&inl).filter(|m| m.valid()) else {
             break;
         };
