@@ -122,8 +122,8 @@ fn curve(spec: &SynthSpec, x: f64) -> f64 {
     }
 }
 
-/// Generates a flock (see the module docs). Outliers are displaced along the curve's normal by
-/// a distance drawn from `outlier_offset`.
+/// Generates a flock (see the module docs). Outliers are displaced along y so that their distance
+/// from the curve is drawn from `outlier_offset`.
 pub fn generate(spec: &SynthSpec, rng: &mut impl Rng) -> SynthFlock {
     let n = spec.birds.max(3);
     let gap = Normal::new(spec.spacing, spec.spacing_sd.max(0.0)).unwrap_or_else(|_| {
@@ -159,23 +159,8 @@ pub fn generate(spec: &SynthSpec, rng: &mut impl Rng) -> SynthFlock {
         out_ids.push(candidates.remove(k));
     }
     out_ids.sort_unstable();
-    let offsets: Vec<f64> = (0..n)
-        .map(|i| {
-            if !out_ids.contains(&i) {
-                return 0.0;
-            }
-            let (lo, hi) = spec.outlier_offset;
-            let mag = lo + (hi - lo) * rng.random::<f64>();
-            // Forward offsets only where the bird stays well behind the leader.
-            if rng.random::<bool>() && base[i].1 > mag + 0.8 {
-                -mag
-            } else {
-                mag
-            }
-        })
-        .collect();
-    // Outliers move off the curve along its normal (−y', 1)/√(1 + y'²), so they are off the
-    // curve by the offset geometrically, not just along y.
+    // Outliers move along y (their lateral places are kept) by offset·√(1 + y'²), which puts
+    // them `offset` wingspans off the curve geometrically, also on a steep arm.
     let normals: Vec<(f64, f64)> = (0..n)
         .map(|i| {
             let x = base[i].0;
@@ -191,8 +176,22 @@ pub fn generate(spec: &SynthSpec, rng: &mut impl Rng) -> SynthFlock {
             } else {
                 (curve(spec, x + h) - curve(spec, x - h)) / (2.0 * h)
             };
-            let len = (1.0 + s * s).sqrt();
-            (-s / len, 1.0 / len)
+            (0.0, (1.0 + s * s).sqrt())
+        })
+        .collect();
+    let offsets: Vec<f64> = (0..n)
+        .map(|i| {
+            if !out_ids.contains(&i) {
+                return 0.0;
+            }
+            let (lo, hi) = spec.outlier_offset;
+            let mag = lo + (hi - lo) * rng.random::<f64>();
+            // Forward offsets only where the bird stays well behind the leader.
+            if rng.random::<bool>() && base[i].1 > mag * normals[i].1 + 0.8 {
+                -mag
+            } else {
+                mag
+            }
         })
         .collect();
     let theta = spec.heading_deg.to_radians();
