@@ -356,3 +356,48 @@ fn same_seed_same_params_and_exhaustive_fits_do_not_depend_on_it() {
     assert_eq!(a, b);
     let _ = fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn params_do_not_depend_on_heading_or_scale() {
+    // The same flock filmed flying another way at another zoom gives the same parameters.
+    let base = SynthSpec {
+        kind: ShapeKind::J,
+        birds: 16,
+        frames: 6,
+        leader_at: 0.1,
+        outliers: 2,
+        ..SynthSpec::default()
+    };
+    let dir = tmpdir("invariance");
+    let mut results = Vec::new();
+    for (heading, scale) in [(0.0, 40.0), (123.0, 17.0), (270.0, 95.0)] {
+        let spec = SynthSpec {
+            heading_deg: heading,
+            wingspan_px: scale,
+            ..base.clone()
+        };
+        let flock = generate(&spec, &mut stream(9, "inv"));
+        let p = dir.join("a.json");
+        fs::write(&p, flock.native_json("t", true, &mut stream(9, "w"))).unwrap();
+        let ann = read(&p, &ReadOptions::default()).unwrap();
+        results.push(extract(&ann, &ExtractOptions::default(), &mut stream(0, "e")).unwrap());
+    }
+    for r in &results[1..] {
+        for (a, b) in results[0].frames.iter().zip(&r.frames) {
+            assert_eq!(a.shape.kind(), b.shape.kind());
+            assert_eq!(
+                (&a.order, a.leader, &a.outliers),
+                (&b.order, b.leader, &b.outliers)
+            );
+            // Pixel coordinates are rounded to 0.01 px: allow that much.
+            assert!((a.mu_x - b.mu_x).abs() < 2e-3, "{} {}", a.mu_x, b.mu_x);
+            assert!(
+                (a.sigma_y - b.sigma_y).abs() < 2e-3,
+                "{} {}",
+                a.sigma_y,
+                b.sigma_y
+            );
+        }
+    }
+    let _ = fs::remove_dir_all(&dir);
+}

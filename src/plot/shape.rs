@@ -6,7 +6,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::{Chart, DrawResult, FONT_FAMILY};
-use crate::extract::{FrameParams, ShapeModel};
+use crate::extract::{slope_at, FrameParams, ShapeModel};
 
 /// The chart of one frame's fit.
 #[derive(Debug, Clone)]
@@ -25,23 +25,28 @@ const LEADER: RGBColor = RGBColor(44, 160, 44);
 const CURVE: RGBColor = RGBColor(60, 60, 60);
 
 impl ShapeChart {
-    /// Curve segments to draw (a V is drawn as its two arms meeting at x = 0).
+    /// Curve segments to draw (a V is drawn as its two arms meeting at x = 0), shifted by
+    /// `offset` wingspans along the curve's normal to first order (vertically
+    /// offset·√(1 + y'²)), which is how far the inlier test reaches.
     fn curve_pieces(&self, x0: f64, x1: f64, offset: f64) -> Vec<Vec<(f64, f64)>> {
         let m = self.frame.shape;
+        let y = |x: f64, s: f64| m.y_at(x) + offset * (1.0 + s * s).sqrt();
         let sample = |a: f64, b: f64| -> Vec<(f64, f64)> {
             (0..=200)
                 .map(|i| {
                     let x = a + (b - a) * i as f64 / 200.0;
-                    (x, m.y_at(x) + offset)
+                    (x, y(x, slope_at(&m, x)))
                 })
                 .collect()
         };
         match m {
             ShapeModel::V { left, right } => {
                 let (a, b) = (x0.min(0.0), x1.max(0.0));
+                let l = |x: f64| left.y_at(x) + offset * (1.0 + left.slope.powi(2)).sqrt();
+                let r = |x: f64| right.y_at(x) + offset * (1.0 + right.slope.powi(2)).sqrt();
                 vec![
-                    vec![(a, left.y_at(a) + offset), (0.0, left.y_at(0.0) + offset)],
-                    vec![(0.0, right.y_at(0.0) + offset), (b, right.y_at(b) + offset)],
+                    vec![(a, l(a)), (0.0, l(0.0))],
+                    vec![(0.0, r(0.0)), (b, r(b))],
                 ]
             }
             _ => vec![sample(x0, x1)],
@@ -127,9 +132,18 @@ impl Chart for ShapeChart {
             .draw()?;
 
         if let Some(t) = self.threshold {
+            let mut labelled = false;
             for off in [-t, t] {
                 for piece in self.curve_pieces(cx0, cx1, off) {
-                    chart.draw_series(LineSeries::new(piece, CURVE.mix(0.35).stroke_width(1)))?;
+                    let s = chart
+                        .draw_series(LineSeries::new(piece, CURVE.mix(0.35).stroke_width(1)))?;
+                    if !labelled {
+                        s.label(format!("inlier band (±{t} wingspans from the curve)"))
+                            .legend(|(x, y)| {
+                                PathElement::new(vec![(x, y), (x + 18, y)], CURVE.mix(0.35))
+                            });
+                        labelled = true;
+                    }
                 }
             }
         }
