@@ -357,3 +357,42 @@ fn parse_dltdv(path: &Path, rdr: &mut csv::Reader<&[u8]>, hdr: &[String]) -> Res
     }
     Ok(frames)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn long_csv_with_metadata_and_per_frame_scale() {
+        let text = "# source: test clip\n# heading: 45\nframe,bird,x,y,wingspan_px,note\n0,1,1,2,30,a\n0,2,3,4,30,b\n1,1,5,6,31,c\n";
+        let raw = parse(Path::new("t.csv"), text, Format::LongCsv).unwrap();
+        assert_eq!(raw.source.as_deref(), Some("test clip"));
+        assert_eq!(raw.heading, Some(Heading::Degrees(45.0)));
+        assert_eq!(raw.frames.len(), 2);
+        assert_eq!(raw.frames[1].wingspan_px, Some(31.0));
+        assert_eq!(raw.frames[0].birds[1].id, Some(2));
+        assert!(!raw.y_up);
+    }
+
+    #[test]
+    fn dltdv_picks_the_first_camera_and_skips_empty_rows() {
+        let text = "pt1_cam1_X,pt1_cam1_Y,pt1_cam2_X,pt1_cam2_Y,pt2_cam1_X,pt2_cam1_Y\nNaN,NaN,1,1,NaN,NaN\n1,2,9,9,3,4\n";
+        assert_eq!(detect_csv(Path::new("d.csv"), text).unwrap(), Format::Dltdv);
+        let raw = parse(Path::new("d.csv"), text, Format::Dltdv).unwrap();
+        assert_eq!(raw.frames.len(), 1);
+        assert_eq!(raw.frames[0].index, 1);
+        let b = &raw.frames[0].birds;
+        assert_eq!((b[0].id, b[0].x, b[0].y), (Some(0), 1.0, 2.0));
+        assert_eq!((b[1].id, b[1].x), (Some(1), 3.0));
+        assert!(raw.y_up);
+    }
+
+    #[test]
+    fn conflicting_frame_scales_are_an_error() {
+        let text = "frame,x,y,wingspan_px\n0,1,2,30\n0,3,4,31\n";
+        let e = parse(Path::new("t.csv"), text, Format::LongCsv)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("row 2") && e.contains("wingspan_px"), "{e}");
+    }
+}

@@ -246,3 +246,35 @@ pub(crate) fn read_dir(dir: &Path) -> Result<RawAnnotations> {
         frames,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const FILE: &str = r#"{"shapes": [
+        {"label": "bird", "group_id": 4, "shape_type": "point", "points": [[10, 20]]},
+        {"label": "bird", "group_id": 2, "shape_type": "point", "points": [[30, 40]]},
+        {"label": "bird", "group_id": 9, "shape_type": "point", "points": [[50, 45]]},
+        {"label": "wingspan", "shape_type": "line", "points": [[0, 0], [30, 40]]},
+        {"label": "tree", "shape_type": "polygon", "points": [[0, 0], [1, 1], [2, 0]]}
+    ], "imagePath": "f.jpg"}"#;
+
+    #[test]
+    fn group_ids_and_wingspan_line() {
+        let raw = parse_file(Path::new("f.json"), FILE).unwrap();
+        let f = &raw.frames[0];
+        assert_eq!(
+            f.birds.iter().map(|b| b.id).collect::<Vec<_>>(),
+            vec![Some(4), Some(2), Some(9)]
+        );
+        assert_eq!(f.wingspan_px, Some(50.0));
+        assert_eq!(f.image.as_deref(), Some("f.jpg"));
+    }
+
+    #[test]
+    fn frame_numbers_come_from_file_names() {
+        assert_eq!(trailing_number("frame_0012.json"), Some(12));
+        assert_eq!(trailing_number("clip3_f7.json"), Some(7));
+        assert_eq!(trailing_number("a.json"), None);
+    }
+}
