@@ -460,3 +460,39 @@ fn plot_shape_writes_png_and_svg() {
     assert!(!none.exists());
     let _ = fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn params_from_path_reads_params_or_extracts_annotations() {
+    use formation::annotations::ReadOptions;
+    use formation::extract::{params_from_path, ExtractOptions};
+    use formation::rng::stream;
+    let dir = tmpdir("from_path");
+    let ann = examples().join("barnacle_geese_v.json");
+    let from_ann = params_from_path(
+        &ann,
+        &ReadOptions::default(),
+        &ExtractOptions::default(),
+        &mut stream(0, "extract"),
+    )
+    .unwrap();
+    let p = dir.join("p.json");
+    assert!(
+        run(&["extract", ann.to_str().unwrap(), "-o", p.to_str().unwrap()])
+            .status
+            .success()
+    );
+    let from_params = params_from_path(
+        &p,
+        &ReadOptions::default(),
+        &ExtractOptions::default(),
+        &mut stream(9, "x"),
+    )
+    .unwrap();
+    assert_eq!(from_ann.frames.len(), from_params.frames.len());
+    assert_eq!(from_ann.frames[0].order, from_params.frames[0].order);
+    assert_eq!(
+        from_ann.frames[0].shape.kind(),
+        from_params.frames[0].shape.kind()
+    );
+    let _ = fs::remove_dir_all(&dir);
+}

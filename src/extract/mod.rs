@@ -186,6 +186,27 @@ pub fn is_params_file(text: &str) -> bool {
         .unwrap_or(false)
 }
 
+/// Formation parameters from `path`, whatever it holds: a params file written by `extract` is
+/// read and validated; anything else is read as annotations (with `read`) and extracted (with
+/// `opts` and `rng`). This is what `formation animate INPUT` needs.
+pub fn params_from_path(
+    path: &std::path::Path,
+    read: &crate::annotations::ReadOptions,
+    opts: &ExtractOptions,
+    rng: &mut impl Rng,
+) -> Result<FormationParams> {
+    if !path.is_dir() {
+        let text = crate::io::read_text(path)?;
+        if is_params_file(&text) {
+            let p: FormationParams = crate::io::parse_json(path, &text)?;
+            p.validate(path)?;
+            return Ok(p);
+        }
+    }
+    let ann = crate::annotations::read(path, read)?;
+    extract(&ann, opts, rng)
+}
+
 /// §4 steps 1 and 2 over every frame.
 pub fn extract(
     ann: &Annotations,
