@@ -26,6 +26,10 @@ pub struct Animation {
     /// Species preset used for wingbeats and drawing, if any.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub species: Option<String>,
+    /// Options the wingbeats were assigned with (`wingbeat::assign_phases`), if any; renderers
+    /// rebuild the same wingbeats from them.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub wingbeat: Option<crate::wingbeat::WingbeatOptions>,
     /// Named frame ranges, `start` inclusive, `end` exclusive.
     pub stages: Vec<Stage>,
     /// Key shapes of the steady flight, formation frame.
@@ -106,6 +110,7 @@ impl Animation {
             wingspan_m,
             birds,
             species: None,
+            wingbeat: None,
             stages: Vec::new(),
             key_shapes: Vec::new(),
             xi_ranges: None,

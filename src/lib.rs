@@ -24,6 +24,9 @@
 //! Conventions (SPEC §2): lengths in wingspans; formation frame `x` right of the flight direction,
 //! `y` behind the leader; world frame `x` east, `y` north, `z` up, cruise heading +y.
 
+// `!(a > b)` is used on purpose: it also rejects NaN, which `a <= b` would let through.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 pub mod aero;
 pub mod animation;
 pub mod annotations;

@@ -28,7 +28,14 @@ fn main() -> ExitCode {
                     // clap's message is several lines (usage, tip); keep the first, which says
                     // what is wrong, and point at --help.
                     let rendered = e.render().to_string();
-                    let first = rendered.lines().next().unwrap_or("error: invalid usage");
+                    let mut lines = rendered.lines().map(str::trim).filter(|l| !l.is_empty());
+                    let mut first = lines.next().unwrap_or("error: invalid usage").to_string();
+                    if first.ends_with(':') {
+                        // "the following required arguments were not provided:" + the list.
+                        if let Some(next) = lines.next() {
+                            first = format!("{first} {next}");
+                        }
+                    }
                     eprintln!("{first} (see `formation --help`)");
                     ExitCode::from(2)
                 }

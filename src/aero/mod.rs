@@ -87,9 +87,11 @@ fn pair(x: f64, y: f64) -> Pair {
     } else {
         (dp + dm) / y2
     };
-    let sigma_over_y = sigma_over_y2 * yy;
+    let sigma = sigma_over_y2 * y2;
     let q = yy + r0;
-    let d_term = -(dm / q).ln_1p() - (dp / q).ln_1p() + sigma_over_y;
+    // −ln1p(δ₋/q) − ln1p(δ₊/q) as one logarithm: −ln1p((δ₊ + δ₋)/q + δ₊δ₋/q²), with δ₊ + δ₋ = Σ
+    // taken from its cancellation-free form.
+    let d_term = -(sigma / q + dp * dm / (q * q)).ln_1p() + sigma_over_y2 * yy;
     let a_term = -(-(A / x) * (A / x)).ln_1p();
     Pair {
         a_term,

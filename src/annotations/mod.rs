@@ -1,1 +1,630 @@
 //! Reading annotated frames (SPEC §4.1) from every supported format into one type (issue 3).
+//!
+//! Takes a file or directory of annotations in pixels: the native JSON, a long CSV
+//! (`frame,bird,x,y`), a DLTdv digitizer CSV (`ptN_camM_X/Y`) or Labelme JSON (a file or a directory
+//! of files). The format is detected by content ([`detect`]), never by extension. Gives
+//! [`Annotations`]: every frame with its birds in the image (pixels, y down) and in wingspans along
+//! the flight direction (`lateral` to the right of it, `forward` along it), and a stable bird id per
+//! bird across frames — the annotation's own ids, or, when the format carries none, §4 step 1's
+//! order by lateral position in the first frame, with later frames matched by an optimal assignment
+//! after aligning the leaders ([`assign_ids`]).
+//!
+//! Heading (SPEC §2): θ clockwise from image-up, so the flight direction in the image (x right,
+//! y down) is d = (sin θ, −cos θ) and the right-hand side of the flight is r = (cos θ, sin θ).
+//! With the scale s = `wingspan_px`, a pixel point p maps to `lateral = p·r / s`,
+//! `forward = p·d / s` (wingspans).
+
+mod csv_formats;
+mod labelme;
+mod native;
+pub mod synth;
+
+use std::path::{Path, PathBuf};
+use std::str::FromStr;
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Error, Result};
+
+/// Flight direction of the flock in the image.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub enum Heading {
+    /// Toward smaller pixel y (the top of the image), 0°.
+    Up,
+    /// Toward larger pixel x, 90°.
+    Right,
+    /// Toward larger pixel y, 180°.
+    Down,
+    /// Toward smaller pixel x, 270°.
+    Left,
+    /// Degrees clockwise from image-up.
+    Degrees(f64),
+}
+
+impl Heading {
+    /// The heading in degrees clockwise from image-up.
+    pub fn degrees(self) -> f64 {
+        match self {
+            Heading::Up => 0.0,
+            Heading::Right => 90.0,
+            Heading::Down => 180.0,
+            Heading::Left => 270.0,
+            Heading::Degrees(d) => d,
+        }
+    }
+
+    /// Parses `up|down|left|right` or a number of degrees; `None` with a message otherwise.
+    pub fn parse(s: &str) -> std::result::Result<Heading, String> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "up" => Ok(Heading::Up),
+            "down" => Ok(Heading::Down),
+            "left" => Ok(Heading::Left),
+            "right" => Ok(Heading::Right),
+            t => match t.trim_end_matches("deg").trim().parse::<f64>() {
+                Ok(d) if d.is_finite() => Ok(Heading::Degrees(d)),
+                _ => Err(format!(
+                    "`{s}` is not a heading; use up, down, left, right or degrees clockwise from image-up (e.g. 30)"
+                )),
+            },
+        }
+    }
+}
+
+impl FromStr for Heading {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Self, Self::Err> {
+        Heading::parse(s)
+    }
+}
+
+/// Where pixel y = 0 is in a CSV file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum YOrigin {
+    /// y = 0 is the top edge and y grows downward (image convention; long CSV default).
+    Top,
+    /// y = 0 is the bottom edge and y grows upward (DLTdv's convention and default).
+    Bottom,
+}
+
+impl FromStr for YOrigin {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Self, Self::Err> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "top" => Ok(YOrigin::Top),
+            "bottom" => Ok(YOrigin::Bottom),
+            _ => Err(format!("`{s}` is not a y origin; use top or bottom")),
+        }
+    }
+}
+
+/// Options of [`read`]; each `Some` overrides what the file says.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct ReadOptions {
+    /// Flight direction in the image (default: the file's, else up).
+    pub heading: Option<Heading>,
+    /// Wingspan in pixels, for every frame (default: the file's per-frame or per-file value).
+    pub wingspan_px: Option<f64>,
+    /// Origin of pixel y in CSV files (default: top for long CSV, bottom for DLTdv).
+    pub y_origin: Option<YOrigin>,
+}
+
+/// The input formats of SPEC §4.1.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Format {
+    /// `{"frames": [{"birds": [[x, y], ...]}]}`.
+    Native,
+    /// CSV with header `frame,bird,x,y` (`bird` optional).
+    LongCsv,
+    /// DLTdv digitizer CSV, `pt1_cam1_X,pt1_cam1_Y,...`, one row per frame.
+    Dltdv,
+    /// One Labelme JSON file (`point` shapes are birds).
+    Labelme,
+    /// A directory of Labelme JSON files, one per frame.
+    LabelmeDir,
+}
+
+impl Format {
+    /// Human name of the format.
+    pub fn name(self) -> &'static str {
+        match self {
+            Format::Native => "native JSON",
+            Format::LongCsv => "long CSV",
+            Format::Dltdv => "DLTdv CSV",
+            Format::Labelme => "Labelme JSON",
+            Format::LabelmeDir => "Labelme directory",
+        }
+    }
+}
+
+/// One marked bird of a frame.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct MarkedBird {
+    /// Bird id, stable across frames.
+    pub id: usize,
+    /// Image x, pixels (right).
+    pub px: f64,
+    /// Image y, pixels, as in the file (downward from the top edge, or upward from the bottom edge
+    /// for DLTdv and `--y-origin bottom`).
+    pub py: f64,
+    /// Offset to the right of the flight direction from the image origin, wingspans.
+    pub lateral: f64,
+    /// Offset along the flight direction from the image origin, wingspans.
+    pub forward: f64,
+}
+
+/// One annotated frame.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AnnotatedFrame {
+    /// Frame index (from the file, else the position in it).
+    pub index: i64,
+    /// Image file name, when the format gives one.
+    pub image: Option<String>,
+    /// Flight direction, degrees clockwise from image-up.
+    pub heading_deg: f64,
+    /// Scale, pixels per wingspan.
+    pub wingspan_px: f64,
+    /// The marked birds, in file order.
+    pub birds: Vec<MarkedBird>,
+}
+
+/// Annotations of one movie, in any input format.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Annotations {
+    /// The file or directory read.
+    pub path: PathBuf,
+    /// Free text describing the footage (`source`), or the file name.
+    pub source: String,
+    /// Detected input format.
+    pub format: Format,
+    /// True when the file carried bird ids; false when they were assigned by [`assign_ids`].
+    pub ids_given: bool,
+    /// Frames in file order.
+    pub frames: Vec<AnnotatedFrame>,
+}
+
+impl Annotations {
+    /// Number of distinct bird ids over all frames (N̂).
+    pub fn bird_count(&self) -> usize {
+        let mut ids: Vec<usize> = self
+            .frames
+            .iter()
+            .flat_map(|f| f.birds.iter().map(|b| b.id))
+            .collect();
+        ids.sort_unstable();
+        ids.dedup();
+        ids.len()
+    }
+}
+
+/// A bird as parsed, before scale, heading and ids are resolved.
+#[derive(Debug, Clone)]
+pub(crate) struct RawBird {
+    pub id: Option<usize>,
+    pub x: f64,
+    pub y: f64,
+    /// Where it came from, for messages (`row 12`, `frames[3].birds[2]`, `shapes[4]`).
+    pub at: String,
+}
+
+/// A frame as parsed.
+#[derive(Debug, Clone)]
+pub(crate) struct RawFrame {
+    pub index: i64,
+    pub image: Option<String>,
+    pub wingspan_px: Option<f64>,
+    /// Where the frame's scale came from, for messages.
+    pub at: String,
+    pub birds: Vec<RawBird>,
+}
+
+/// A whole file as parsed.
+#[derive(Debug, Clone)]
+pub(crate) struct RawAnnotations {
+    pub format: Format,
+    pub source: Option<String>,
+    pub heading: Option<Heading>,
+    pub wingspan_px: Option<f64>,
+    /// Whether pixel y grows upward in the file (before any `--y-origin`).
+    pub y_up: bool,
+    /// Whether `--y-origin` applies (CSV formats).
+    pub is_csv: bool,
+    pub frames: Vec<RawFrame>,
+}
+
+/// What a path holds, judged by content.
+pub fn detect(path: &Path) -> Result<Format> {
+    if path.is_dir() {
+        return Ok(Format::LabelmeDir);
+    }
+    let text = crate::io::read_text(path)?;
+    detect_text(path, &text)
+}
+
+fn detect_text(path: &Path, text: &str) -> Result<Format> {
+    let t = text.trim_start_matches('\u{feff}').trim_start();
+    if t.is_empty() {
+        return Err(Error::format(
+            path,
+            "file is empty; expected annotations (native JSON, long CSV, DLTdv CSV or Labelme JSON)",
+        ));
+    }
+    if t.starts_with('{') || t.starts_with('[') {
+        let v: serde_json::Value = crate::io::parse_json(path, t)?;
+        let obj = v.as_object().ok_or_else(|| {
+            Error::format(
+                path,
+                "top level: expected a JSON object with \"frames\" (native) or \"shapes\" (Labelme)",
+            )
+        })?;
+        if obj.get("format").and_then(|f| f.as_str()) == Some(crate::extract::PARAMS_FORMAT) {
+            return Err(Error::format(
+                path,
+                "this is a params file written by `formation extract`, not annotations",
+            ));
+        }
+        if obj.contains_key("shapes") {
+            return Ok(Format::Labelme);
+        }
+        if obj.contains_key("frames") {
+            return Ok(Format::Native);
+        }
+        return Err(Error::format(
+            path,
+            "top level: no \"frames\" (native annotations) or \"shapes\" (Labelme) field",
+        ));
+    }
+    csv_formats::detect_csv(path, t)
+}
+
+/// Reads annotations from `path` (a file in any SPEC §4.1 format, or a Labelme directory),
+/// resolving heading, scale and bird ids.
+pub fn read(path: &Path, opts: &ReadOptions) -> Result<Annotations> {
+    if path.is_dir() {
+        let raw = labelme::read_dir(path)?;
+        return finish(path, raw, opts);
+    }
+    let text = crate::io::read_text(path)?;
+    parse_str(path, &text, opts)
+}
+
+/// Parses annotation text as if read from `path` (which only names the file in messages).
+pub fn parse_str(path: &Path, text: &str, opts: &ReadOptions) -> Result<Annotations> {
+    let format = detect_text(path, text)?;
+    let t = text.trim_start_matches('\u{feff}');
+    let raw = match format {
+        Format::Native => native::parse(path, t)?,
+        Format::Labelme => labelme::parse_file(path, t)?,
+        Format::LongCsv | Format::Dltdv => csv_formats::parse(path, t, format)?,
+        Format::LabelmeDir => return Err(Error::Internal("directory detected for text".into())),
+    };
+    finish(path, raw, opts)
+}
+
+fn check_scale(path: &Path, at: &str, v: f64) -> Result<f64> {
+    if !v.is_finite() || v <= 0.0 {
+        return Err(Error::format(
+            path,
+            format!("{at}: wingspan_px must be a positive number of pixels, got {v}"),
+        ));
+    }
+    Ok(v)
+}
+
+/// Resolves options, validates every frame and assigns ids.
+fn finish(path: &Path, raw: RawAnnotations, opts: &ReadOptions) -> Result<Annotations> {
+    if raw.frames.is_empty() {
+        return Err(Error::format(path, "no frames with marked birds"));
+    }
+    if let Some(w) = opts.wingspan_px {
+        if !w.is_finite() || w <= 0.0 {
+            return Err(Error::parameter(
+                "--wingspan-px",
+                format!("must be a positive number of pixels, got {w}"),
+            ));
+        }
+    }
+    if let Some(Heading::Degrees(d)) = opts.heading {
+        if !d.is_finite() {
+            return Err(Error::parameter("--heading", "must be a finite angle"));
+        }
+    }
+    let heading = opts.heading.or(raw.heading).unwrap_or(Heading::Up);
+    let theta = heading.degrees().to_radians();
+    let (d, r) = ((theta.sin(), -theta.cos()), (theta.cos(), theta.sin()));
+    let y_up = match (raw.is_csv, opts.y_origin) {
+        (true, Some(o)) => o == YOrigin::Bottom,
+        _ => raw.y_up,
+    };
+    let file_scale = match raw.wingspan_px {
+        Some(w) => Some(check_scale(path, "wingspan_px", w)?),
+        None => None,
+    };
+    let ids_given = raw
+        .frames
+        .iter()
+        .any(|f| f.birds.iter().any(|b| b.id.is_some()));
+    let mut frames = Vec::with_capacity(raw.frames.len());
+    for f in raw.frames {
+        let scale = match (opts.wingspan_px, f.wingspan_px, file_scale) {
+            (Some(w), _, _) => w,
+            (None, Some(w), _) => check_scale(path, &f.at, w)?,
+            (None, None, Some(w)) => w,
+            (None, None, None) => {
+                return Err(Error::format(
+                    path,
+                    format!(
+                        "frame {}: no scale; give --wingspan-px PIXELS, or \"wingspan_px\" in the file (per file or per frame; see docs/annotating.md)",
+                        f.index
+                    ),
+                ))
+            }
+        };
+        if f.birds.len() < 3 {
+            return Err(Error::format(
+                path,
+                format!(
+                    "frame {}: {} bird(s) marked, a line formation needs at least 3",
+                    f.index,
+                    f.birds.len()
+                ),
+            ));
+        }
+        if ids_given {
+            if let Some(b) = f.birds.iter().find(|b| b.id.is_none()) {
+                return Err(Error::format(
+                    path,
+                    format!(
+                        "frame {}, {}: bird has no id while other birds have one; give every bird an id or none",
+                        f.index, b.at
+                    ),
+                ));
+            }
+        }
+        let mut birds = Vec::with_capacity(f.birds.len());
+        for b in &f.birds {
+            // Pixel y measured downward (a y-up file's y negated: only differences matter).
+            let py = if y_up { -b.y } else { b.y };
+            birds.push(MarkedBird {
+                id: b.id.unwrap_or(usize::MAX),
+                px: b.x,
+                py: b.y,
+                lateral: (b.x * r.0 + py * r.1) / scale,
+                forward: (b.x * d.0 + py * d.1) / scale,
+            });
+        }
+        if let Some((b, _)) = f
+            .birds
+            .iter()
+            .zip(&birds)
+            .find(|(_, m)| m.lateral.abs() > 1e6 || m.forward.abs() > 1e6)
+        {
+            return Err(Error::format(
+                path,
+                format!(
+                    "frame {}, {}: ({}, {}) px is more than a million wingspans ({scale} px each) from the image origin; check the coordinates and wingspan_px",
+                    f.index, b.at, b.x, b.y
+                ),
+            ));
+        }
+        // Duplicate marks (same pixel, or the same id twice) cannot be two birds.
+        for i in 0..birds.len() {
+            for j in (i + 1)..birds.len() {
+                let (a, c) = (&f.birds[i], &f.birds[j]);
+                if a.x == c.x && a.y == c.y {
+                    return Err(Error::format(
+                        path,
+                        format!(
+                            "frame {}: {} and {} are the same point ({}, {}); remove the duplicate mark",
+                            f.index, a.at, c.at, a.x, a.y
+                        ),
+                    ));
+                }
+                if a.id.is_some() && a.id == c.id {
+                    return Err(Error::format(
+                        path,
+                        format!(
+                            "frame {}: bird id {} is marked twice ({} and {})",
+                            f.index,
+                            a.id.unwrap_or(0),
+                            a.at,
+                            c.at
+                        ),
+                    ));
+                }
+            }
+        }
+        frames.push(AnnotatedFrame {
+            index: f.index,
+            image: f.image,
+            heading_deg: heading.degrees(),
+            wingspan_px: scale,
+            birds,
+        });
+    }
+    if !ids_given {
+        assign_ids(&mut frames);
+    }
+    let source = raw.source.unwrap_or_else(|| {
+        path.file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default()
+    });
+    Ok(Annotations {
+        path: path.to_path_buf(),
+        source,
+        format: raw.format,
+        ids_given,
+        frames,
+    })
+}
+
+/// Index of the front-most bird (largest `forward`; ties to the first).
+pub(crate) fn front_most(birds: &[MarkedBird]) -> usize {
+    let mut best = 0;
+    for (i, b) in birds.iter().enumerate() {
+        if b.forward > birds[best].forward {
+            best = i;
+        }
+    }
+    best
+}
+
+/// Gives ids to birds of a movie whose format carries none.
+///
+/// Frame 0 follows §4 step 1: birds sorted by lateral position (left to right of the flight
+/// direction) get ids 0, 1, …. Every later frame is matched to the last known positions of the
+/// ids, both expressed relative to their frame's leader (front-most bird), by the assignment that
+/// minimises the sum of squared distances (Hungarian algorithm). Birds left over when a frame has
+/// more birds than ids seen so far get new ids in lateral order.
+pub fn assign_ids(frames: &mut [AnnotatedFrame]) {
+    // Last known leader-relative position of every id.
+    let mut known: Vec<(f64, f64)> = Vec::new();
+    for (k, f) in frames.iter_mut().enumerate() {
+        let n = f.birds.len();
+        if n == 0 {
+            continue;
+        }
+        let lead = front_most(&f.birds);
+        let (l0, f0) = (f.birds[lead].lateral, f.birds[lead].forward);
+        let rel: Vec<(f64, f64)> = f
+            .birds
+            .iter()
+            .map(|b| (b.lateral - l0, b.forward - f0))
+            .collect();
+        let mut ids = vec![usize::MAX; n];
+        if k > 0 && !known.is_empty() {
+            let m = known.len();
+            let cost = |i: usize, j: usize| {
+                let (a, b) = (rel[i], known[j]);
+                (a.0 - b.0).powi(2) + (a.1 - b.1).powi(2)
+            };
+            if n <= m {
+                let assign = hungarian(n, m, cost);
+                for (i, &j) in assign.iter().enumerate() {
+                    ids[i] = j;
+                }
+            } else {
+                let assign = hungarian(m, n, |j, i| cost(i, j));
+                for (j, &i) in assign.iter().enumerate() {
+                    ids[i] = j;
+                }
+            }
+        }
+        // Unmatched birds (all of frame 0) get fresh ids, left to right.
+        let mut fresh: Vec<usize> = (0..n).filter(|&i| ids[i] == usize::MAX).collect();
+        fresh.sort_by(|&a, &b| {
+            rel[a]
+                .0
+                .total_cmp(&rel[b].0)
+                .then(rel[b].1.total_cmp(&rel[a].1))
+        });
+        for i in fresh {
+            ids[i] = known.len();
+            known.push(rel[i]);
+        }
+        for (i, b) in f.birds.iter_mut().enumerate() {
+            b.id = ids[i];
+            known[ids[i]] = rel[i];
+        }
+    }
+}
+
+/// Minimum-cost assignment of `n` rows to distinct columns among `m ≥ n` (Kuhn–Munkres with
+/// potentials, O(n²m)). Returns the column of each row.
+pub fn hungarian(n: usize, m: usize, cost: impl Fn(usize, usize) -> f64) -> Vec<usize> {
+    // 1-based arrays as in the classical formulation; p[j] = row matched to column j.
+    let mut u = vec![0.0f64; n + 1];
+    let mut v = vec![0.0f64; m + 1];
+    let mut p = vec![0usize; m + 1];
+    let mut way = vec![0usize; m + 1];
+    for i in 1..=n {
+        p[0] = i;
+        let mut j0 = 0usize;
+        let mut minv = vec![f64::INFINITY; m + 1];
+        let mut used = vec![false; m + 1];
+        loop {
+            used[j0] = true;
+            let i0 = p[j0];
+            let mut delta = f64::INFINITY;
+            let mut j1 = 0usize;
+            for j in 1..=m {
+                if !used[j] {
+                    let cur = cost(i0 - 1, j - 1) - u[i0] - v[j];
+                    if cur < minv[j] {
+                        minv[j] = cur;
+                        way[j] = j0;
+                    }
+                    if minv[j] < delta {
+                        delta = minv[j];
+                        j1 = j;
+                    }
+                }
+            }
+            if j1 == 0 {
+                break; // only with non-finite costs; leaves the row unassigned
+            }
+            for j in 0..=m {
+                if used[j] {
+                    u[p[j]] += delta;
+                    v[j] -= delta;
+                } else {
+                    minv[j] -= delta;
+                }
+            }
+            j0 = j1;
+            if p[j0] == 0 {
+                break;
+            }
+        }
+        loop {
+            let j1 = way[j0];
+            p[j0] = p[j1];
+            j0 = j1;
+            if j0 == 0 {
+                break;
+            }
+        }
+    }
+    let mut ans = vec![0usize; n];
+    let mut taken = vec![false; m];
+    for j in 1..=m {
+        if p[j] > 0 {
+            ans[p[j] - 1] = j - 1;
+            taken[j - 1] = true;
+        }
+    }
+    ans
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hungarian_finds_the_optimum() {
+        let c = [[4.0, 1.0, 3.0], [2.0, 0.0, 5.0], [3.0, 2.0, 2.0]];
+        let a = hungarian(3, 3, |i, j| c[i][j]);
+        let total: f64 = a.iter().enumerate().map(|(i, &j)| c[i][j]).sum();
+        assert_eq!(total, 5.0);
+        let mut s = a.clone();
+        s.sort();
+        assert_eq!(s, vec![0, 1, 2]);
+    }
+
+    #[test]
+    fn hungarian_rectangular() {
+        let a = hungarian(2, 4, |i, j| ((i as f64 * 2.0) - j as f64).abs());
+        assert_eq!(a, vec![0, 2]);
+    }
+
+    #[test]
+    fn heading_maps_flight_direction_to_forward() {
+        let text = r#"{"wingspan_px": 10, "heading": "right", "frames": [{"birds": [[0,0],[10,0],[20,5]]}]}"#;
+        let a = parse_str(Path::new("t.json"), text, &ReadOptions::default()).unwrap();
+        let f = &a.frames[0];
+        // Flying right: larger pixel x is further forward; pixel y down is the right-hand side.
+        assert!((f.birds[1].forward - 1.0).abs() < 1e-12);
+        assert!((f.birds[2].lateral - 0.5).abs() < 1e-12);
+    }
+}

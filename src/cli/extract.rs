@@ -1,11 +1,72 @@
-//! `formation extract` and `formation plot shape` (issue 3).
+//! `formation extract` and `formation plot shape` (issue 3): flags → [`ReadOptions`] and
+//! [`ExtractOptions`], the per-frame summary table on stdout, the params file through an atomic
+//! write.
 
-use std::path::PathBuf;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
 
 use clap::Args;
-use formation::Result;
+use formation::annotations::{self, Heading, ReadOptions, YOrigin};
+use formation::extract::{self, ExtractOptions, FormationParams, FrameReport, ShapeKind};
+use formation::io::{write_json_atomic, OutputKind};
+use formation::{Error, Result};
 
 use super::Global;
+
+/// How to read annotations (shared by `extract` and `plot shape`).
+#[derive(Debug, Args, Clone)]
+pub struct ReadArgs {
+    /// Flight direction in the image: up, down, left, right, or degrees clockwise from image-up
+    /// (overrides the file's `heading`; default up).
+    #[arg(long, allow_hyphen_values = true, value_name = "DIR|DEG")]
+    pub heading: Option<Heading>,
+    /// Wingspan in pixels, for every frame (overrides the file's `wingspan_px`).
+    #[arg(long = "wingspan-px", value_name = "PX", allow_hyphen_values = true)]
+    pub wingspan_px: Option<f64>,
+    /// Where pixel y = 0 is in CSV input: top (long CSV default) or bottom (DLTdv default).
+    #[arg(long = "y-origin", value_name = "top|bottom")]
+    pub y_origin: Option<YOrigin>,
+}
+
+/// Fitting options (shared by `extract` and `plot shape`).
+#[derive(Debug, Args, Clone)]
+pub struct FitArgs {
+    /// Inlier threshold: birds farther than this from the fitted curve are outliers, wingspans.
+    #[arg(long, default_value_t = ExtractOptions::default().inlier_threshold, allow_hyphen_values = true)]
+    pub threshold: f64,
+    /// Fit only this shape family: v, u, j or line (default: chosen per frame).
+    #[arg(long)]
+    pub kind: Option<ShapeKind>,
+    /// Most RANSAC samples per model and frame (all subsets are tried when there are fewer).
+    #[arg(long = "max-samples", default_value_t = ExtractOptions::default().max_samples)]
+    pub max_samples: usize,
+    /// A parabola is a J when its vertex is more than this fraction of the flock's half-width
+    /// from its centre.
+    #[arg(long = "j-offset", default_value_t = ExtractOptions::default().j_offset, allow_hyphen_values = true)]
+    pub j_offset: f64,
+}
+
+impl ReadArgs {
+    fn options(&self) -> ReadOptions {
+        ReadOptions {
+            heading: self.heading,
+            wingspan_px: self.wingspan_px,
+            y_origin: self.y_origin,
+        }
+    }
+}
+
+impl FitArgs {
+    fn options(&self) -> ExtractOptions {
+        ExtractOptions {
+            inlier_threshold: self.threshold,
+            max_samples: self.max_samples,
+            j_offset: self.j_offset,
+            kind: self.kind,
+            ..ExtractOptions::default()
+        }
+    }
+}
 
 /// Arguments of `formation extract`.
 #[derive(Debug, Args)]
@@ -14,25 +75,199 @@ pub struct ExtractArgs {
     pub annotations: PathBuf,
     /// Output params file (.json).
     #[arg(short = 'o', long = "output")]
-    pub output: PathBuf,
+    pub output: Option<PathBuf>,
+    /// Print the params as JSON on stdout instead of the summary table.
+    #[arg(long)]
+    pub json: bool,
+    #[command(flatten)]
+    pub read: ReadArgs,
+    #[command(flatten)]
+    pub fit: FitArgs,
+}
+
+/// Reads annotations and extracts, with the seed's `extract` stream.
+fn read_and_extract(
+    path: &Path,
+    read: &ReadArgs,
+    fit: &FitArgs,
+    g: Global,
+) -> Result<(annotations::Annotations, FormationParams, Vec<FrameReport>)> {
+    let opts = fit.options();
+    opts.validate()?;
+    let ann = annotations::read(path, &read.options())?;
+    let mut rng = formation::rng::stream(g.seed, "extract");
+    let progress = super::progress::TermProgress::new(g.quiet);
+    let (params, reports) = extract::extract_with_report(&ann, &opts, &mut rng, &progress)?;
+    Ok((ann, params, reports))
 }
 
 /// Runs `formation extract`.
-pub fn run(_args: ExtractArgs, _g: Global) -> Result<()> {
-    Err(super::not_yet("extract"))
+pub fn run(args: ExtractArgs, g: Global) -> Result<()> {
+    if args.output.is_none() && !args.json {
+        return Err(Error::parameter(
+            "-o",
+            "give an output file (-o params.json) or --json to print the params on stdout",
+        ));
+    }
+    if let Some(o) = &args.output {
+        OutputKind::from_path(o, &[OutputKind::Json])?;
+    }
+    let (ann, params, reports) = read_and_extract(&args.annotations, &args.read, &args.fit, g)?;
+    if let Some(o) = &args.output {
+        write_json_atomic(o, &params)?;
+    }
+    if args.json {
+        let s = serde_json::to_string_pretty(&params)
+            .map_err(|e| Error::Internal(format!("serialising params: {e}")))?;
+        println!("{s}");
+    } else {
+        print!(
+            "{}",
+            summary_table(&ann, &params, &reports, args.output.as_deref())
+        );
+    }
+    Ok(())
+}
+
+fn id_list(ids: &[usize]) -> String {
+    if ids.is_empty() {
+        return "-".into();
+    }
+    let mut ids = ids.to_vec();
+    ids.sort_unstable();
+    let s: Vec<String> = ids.iter().map(|i| i.to_string()).collect();
+    let s = s.join(",");
+    if s.len() > 18 {
+        format!("{}…", &s[..s[..17].rfind(',').unwrap_or(17)])
+    } else {
+        s
+    }
+}
+
+/// The per-frame summary table.
+pub fn summary_table(
+    ann: &annotations::Annotations,
+    p: &FormationParams,
+    reports: &[FrameReport],
+    out: Option<&Path>,
+) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "{}: {} ({}), {} frames, {} birds, ids {}",
+        ann.path.display(),
+        p.source,
+        ann.format.name(),
+        p.frames.len(),
+        p.birds,
+        if ann.ids_given {
+            "from the file"
+        } else {
+            "assigned (lateral order in frame 0, then matched)"
+        }
+    );
+    s.push_str(
+        " frame birds  kind leader   mu_x sigma_x   mu_y sigma_y  inl  outliers           next best (ΔS)\n",
+    );
+    for (f, r) in p.frames.iter().zip(reports) {
+        let next = r
+            .margin()
+            .map(|(k, d)| format!("{} (+{:.1})", k.name(), d))
+            .unwrap_or_else(|| "-".into());
+        let _ = writeln!(
+            s,
+            "{:>6} {:>5} {:>5} {:>6} {:>6.3} {:>7.3} {:>6.3} {:>7.3} {:>4}  {:<18} {}",
+            f.index,
+            f.order.len(),
+            f.shape.kind(),
+            f.leader,
+            f.mu_x,
+            f.sigma_x,
+            f.mu_y,
+            f.sigma_y,
+            f.inliers.len(),
+            id_list(&f.outliers),
+            next
+        );
+    }
+    let mut counts: Vec<(&str, usize)> = Vec::new();
+    for f in &p.frames {
+        let k = f.shape.kind();
+        match counts.iter_mut().find(|c| c.0 == k) {
+            Some(c) => c.1 += 1,
+            None => counts.push((k, 1)),
+        }
+    }
+    let kinds: Vec<String> = counts
+        .iter()
+        .map(|(k, c)| format!("{k} in {c}/{}", p.frames.len()))
+        .collect();
+    let n_out: usize = p.frames.iter().map(|f| f.outliers.len()).sum();
+    let _ = write!(
+        s,
+        "kinds: {}; {} outlier marks; ΔS = criterion gap to the next best family (larger = clearer)",
+        kinds.join(", "),
+        n_out
+    );
+    match out {
+        Some(o) => {
+            let _ = writeln!(s, "\nwrote {}", o.display());
+        }
+        None => s.push('\n'),
+    }
+    s
 }
 
 /// Arguments of `formation plot shape`.
 #[derive(Debug, Args)]
 pub struct PlotShapeArgs {
-    /// A params file written by `formation extract`.
+    /// A params file written by `formation extract`, or annotations (extracted on the fly).
     pub input: PathBuf,
     /// Output chart (.png or .svg).
     #[arg(short = 'o', long = "output")]
     pub output: PathBuf,
+    /// Frame index to draw (as in the table's `frame` column; default: the first frame).
+    #[arg(long, allow_hyphen_values = true)]
+    pub frame: Option<i64>,
+    #[command(flatten)]
+    pub read: ReadArgs,
+    #[command(flatten)]
+    pub fit: FitArgs,
 }
 
 /// Runs `formation plot shape`.
-pub fn run_plot_shape(_args: PlotShapeArgs, _g: Global) -> Result<()> {
-    Err(super::not_yet("plot shape"))
+pub fn run_plot_shape(args: PlotShapeArgs, g: Global) -> Result<()> {
+    OutputKind::from_path(&args.output, &[OutputKind::Png, OutputKind::Svg])?;
+    let is_params = !args.input.is_dir()
+        && formation::io::read_text(&args.input)
+            .map(|t| extract::is_params_file(&t))
+            .unwrap_or(false);
+    let (params, threshold) = if is_params {
+        (FormationParams::read(&args.input)?, None)
+    } else {
+        let (_, p, _) = read_and_extract(&args.input, &args.read, &args.fit, g)?;
+        (p, Some(args.fit.threshold))
+    };
+    let frame = match args.frame {
+        None => params.frames.first(),
+        Some(k) => params.frames.iter().find(|f| f.index == k),
+    }
+    .ok_or_else(|| {
+        let lo = params.frames.first().map(|f| f.index).unwrap_or(0);
+        let hi = params.frames.last().map(|f| f.index).unwrap_or(0);
+        Error::parameter(
+            "--frame",
+            format!(
+                "no frame {} in {} (frames {lo}..={hi})",
+                args.frame.unwrap_or(0),
+                args.input.display()
+            ),
+        )
+    })?;
+    let chart = formation::plot::shape::ShapeChart {
+        frame: frame.clone(),
+        source: params.source.clone(),
+        threshold,
+    };
+    formation::plot::save(&chart, &args.output)
 }

@@ -78,7 +78,13 @@ pub fn run(cli: Cli) -> Result<()> {
 
 /// On Ctrl-C or SIGTERM, remove temporary output files before exiting (no partial outputs).
 pub fn install_signal_cleanup() {
-    // Installed by the hardening work (issue 8); temporaries are tracked in `formation::io`.
+    // Temporaries are tracked in `formation::io`; an existing output is never touched before the
+    // final rename, so removing the temporaries is all a clean interruption needs.
+    let _ = ctrlc::set_handler(|| {
+        formation::io::remove_open_temporaries();
+        eprintln!("error: interrupted; no output written");
+        std::process::exit(130);
+    });
 }
 
 /// The error for a command that is not built yet.

@@ -37,8 +37,15 @@ pub struct SolveOptions {
     pub tolerance: f64,
     /// LM's budget: at most `patience·N` model evaluations per attempt.
     pub patience: usize,
-    /// Check that the targets are reachable before solving (one minimum cut, O(N³) worst case).
+    /// Check that the targets are reachable before solving (one minimum cut). Done up front for
+    /// flocks up to [`SolveOptions::direct_limit`] birds; larger flocks are checked only when the
+    /// solve fails, to explain why.
     pub check_reachable: bool,
+    /// Largest flock solved with the `levenberg-marquardt` crate (MINPACK's pivoted-QR LM, the
+    /// paper's method). Beyond it, each of that method's trial steps costs a dense O(N³) QR and
+    /// O(N³) Givens updates (20 s for N = 1000), so the same Levenberg–Marquardt iteration runs
+    /// in the symmetric form of [`solve_symmetric`] (one Cholesky per trial step).
+    pub direct_limit: usize,
 }
 
 impl Default for SolveOptions {
@@ -47,6 +54,7 @@ impl Default for SolveOptions {
             tolerance: 1e-9,
             patience: 100,
             check_reachable: true,
+            direct_limit: 200,
         }
     }
 }
@@ -68,7 +76,7 @@ pub struct SolveReport {
     pub converged: bool,
     /// Total power reduction E (fixed by the lateral positions).
     pub total: f64,
-    /// LM's own termination reason of the last attempt, for diagnostics.
+    /// Which iteration produced the result and why it stopped, for diagnostics.
     pub termination: String,
 }
 
@@ -216,20 +224,31 @@ pub fn solve(
 ) -> Result<SolveReport> {
     let target = validate(x, xi_target, y0)?;
     let total = aero::munk_total_unchecked(x);
-    if opts.check_reachable {
+    let n = x.len();
+    let small = n <= opts.direct_limit;
+    if opts.check_reachable && small {
         reachability(x, &target, total)?;
     }
-    let n = x.len();
     let zeros = vec![0.0; n];
-    let mut best = attempt(x, &target, total, y0.unwrap_or(&zeros), opts);
+    let run = |start: &[f64]| {
+        if small {
+            attempt(x, &target, total, start, opts)
+        } else {
+            solve_symmetric(x, &target, total, start, opts)
+        }
+    };
+    let mut best = run(y0.unwrap_or(&zeros));
     if !best.converged && y0.is_some() {
         // A poor guess can strand LM on a plateau of g; the neutral start is the fallback.
-        let retry = attempt(x, &target, total, &zeros, opts);
+        let retry = run(&zeros);
         let evaluations = best.evaluations + retry.evaluations;
         if retry.residual < best.residual {
             best = retry;
         }
         best.evaluations = evaluations;
+    }
+    if !best.converged && opts.check_reachable && !small {
+        reachability(x, &target, total)?;
     }
     Ok(best)
 }
@@ -246,21 +265,36 @@ fn attempt(x: &[f64], target: &[f64], total: f64, y0: &[f64], opts: &SolveOption
         .with_xtol(1e-15)
         .with_gtol(1e-15)
         .with_patience(opts.patience.max(1));
-    let (problem, report) = lm.minimize(problem);
-    let mut y = problem.y;
-    let e = if y.iter().all(|v| v.is_finite()) {
-        aero::power_unchecked(x, &y)
+    let (problem, lm_report) = lm.minimize(problem);
+    let y = if problem.y.iter().all(|v| v.is_finite()) {
+        problem.y
     } else {
-        y = y0.to_vec();
-        aero::power_unchecked(x, &y)
+        y0.to_vec()
     };
+    report(
+        x,
+        target,
+        total,
+        y,
+        lm_report.number_of_evaluations,
+        opts.tolerance,
+        format!("levenberg-marquardt crate: {:?}", lm_report.termination),
+    )
+}
+
+/// Builds the report for positions `y` (shifted so that the front-most bird is at 0).
+fn report(
+    x: &[f64],
+    target: &[f64],
+    total: f64,
+    mut y: Vec<f64>,
+    evaluations: usize,
+    tolerance: f64,
+    termination: String,
+) -> SolveReport {
+    let e = aero::power_unchecked(x, &y);
     let xi: Vec<f64> = e.iter().map(|v| v / total).collect();
-    let residual = xi
-        .iter()
-        .zip(target)
-        .map(|(a, b)| (a - b) * (a - b))
-        .sum::<f64>()
-        .sqrt();
+    let residual = norm_diff(&xi, target);
     let front = y.iter().copied().fold(f64::INFINITY, f64::min);
     for v in &mut y {
         *v -= front;
@@ -270,11 +304,117 @@ fn attempt(x: &[f64], target: &[f64], total: f64, y0: &[f64], opts: &SolveOption
         xi,
         target: target.to_vec(),
         residual,
-        evaluations: report.number_of_evaluations,
-        converged: residual.is_finite() && residual <= opts.tolerance,
+        evaluations,
+        converged: residual.is_finite() && residual <= tolerance,
         total,
-        termination: format!("{:?}", report.termination),
+        termination,
     }
+}
+
+fn norm_diff(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(p, q)| (p - q) * (p - q))
+        .sum::<f64>()
+        .sqrt()
+}
+
+/// Levenberg–Marquardt for large flocks, in the form the problem's symmetry allows.
+///
+/// The Jacobian J = (1/E)·∂e/∂y is a weighted graph Laplacian: symmetric, and positive definite
+/// once the fixed bird's row and column are removed. So the LM step
+/// ```math
+/// (J + \lambda\,\bar d\,I)\,\delta = -r
+/// ```
+/// (d̄ the mean diagonal of J; r and J restricted to the free birds) is a descent direction of
+/// ‖r‖² for every λ ≥ 0, is found with one
+/// Cholesky factorisation of an (N−1)×(N−1) matrix, and λ follows Marquardt's rule: divided by
+/// 10 after a step that lowers ‖r‖, multiplied by 10 (and the step retried) after one that does
+/// not. Stops at the tolerance, after `patience` Jacobians, or when λ exceeds 10¹².
+pub fn solve_symmetric(
+    x: &[f64],
+    target: &[f64],
+    total: f64,
+    y0: &[f64],
+    opts: &SolveOptions,
+) -> SolveReport {
+    let n = x.len();
+    let fixed = (0..n)
+        .min_by(|&a, &b| y0[a].total_cmp(&y0[b]).then(a.cmp(&b)))
+        .unwrap_or(0);
+    let free: Vec<usize> = (0..n).filter(|&i| i != fixed).collect();
+    let m = free.len();
+    let residuals = |y: &[f64]| -> Vec<f64> {
+        aero::power_unchecked(x, y)
+            .iter()
+            .zip(target)
+            .map(|(e, t)| e / total - t)
+            .collect()
+    };
+    // Merit: the free birds' residuals (the fixed bird's is minus their sum, since Σξ = Σξ̂ = 1);
+    // in this norm the damped step is a descent direction for every λ.
+    let merit = |r: &[f64]| -> f64 { free.iter().map(|&i| r[i] * r[i]).sum::<f64>().sqrt() };
+    let mut y = y0.to_vec();
+    let mut r = residuals(&y);
+    let mut norm = merit(&r);
+    let mut evaluations = 1;
+    let mut lambda = 1e-3;
+    let mut why = "iteration budget exhausted";
+    let stop = opts.tolerance * 1e-3;
+    'outer: for _ in 0..opts.patience.max(1) {
+        if norm <= stop {
+            why = "residual below tolerance";
+            break;
+        }
+        let full = aero::power_jacobian_unchecked(x, &y);
+        let inv = 1.0 / total;
+        let jac = DMatrix::from_fn(m, m, |a, b| full[free[a] * n + free[b]] * inv);
+        let mean_diag = (0..m).map(|a| jac[(a, a)]).sum::<f64>() / m as f64;
+        let rhs = DVector::from_iterator(m, free.iter().map(|&i| -r[i]));
+        loop {
+            let mut damped = jac.clone();
+            for a in 0..m {
+                damped[(a, a)] += lambda * mean_diag;
+            }
+            let Some(chol) = damped.cholesky() else {
+                lambda *= 10.0;
+                if lambda > 1e12 {
+                    why = "damped Jacobian not positive definite";
+                    break 'outer;
+                }
+                continue;
+            };
+            let step = chol.solve(&rhs);
+            let mut trial = y.clone();
+            for (a, &i) in free.iter().enumerate() {
+                trial[i] += step[a];
+            }
+            let tr = residuals(&trial);
+            evaluations += 1;
+            let tnorm = merit(&tr);
+            if tnorm.is_finite() && tnorm < norm {
+                y = trial;
+                r = tr;
+                norm = tnorm;
+                lambda = (lambda / 10.0).max(1e-15);
+                break;
+            }
+            lambda *= 10.0;
+            if lambda > 1e12 {
+                why = "no step lowers the residual";
+                break 'outer;
+            }
+        }
+    }
+    report(
+        x,
+        target,
+        total,
+        y,
+        evaluations,
+        opts.tolerance,
+        format!("symmetric Levenberg–Marquardt: {why}"),
+    )
 }
 
 /// Decides whether renormalised targets `target` (Σ = 1) are reachable for lateral positions

@@ -6,6 +6,7 @@ use std::path::Path;
 use std::sync::Once;
 
 pub mod power;
+pub mod shape;
 pub mod xi;
 
 use plotters::coord::Shift;
@@ -90,3 +91,5 @@ pub fn encode_png_rgb(buf: &[u8], w: u32, h: u32) -> Result<Vec<u8>> {
 }
 
 use image::ImageEncoder as _;
+
+pub mod wingbeat;

@@ -1,13 +1,47 @@
-//! Kinematic flapping after Wu & Popović (issue 7).
+//! Kinematic flapping after Wu & Popović, "Realistic Modeling of Bird Flight Animations"
+//! (SIGGRAPH 2003, §4.1–4.3), cheap enough for a thousand birds.
 //!
-//! Interface used by the renderers: [`Flapper::from_animation`] rebuilds every bird's wingbeat
-//! from an animation file (its seed, species and per-frame `wing_phase`), and [`Flapper::pose`]
-//! gives the joint angles of one bird at one frame. The placeholder below is a plain sinusoid;
-//! the wingbeat work replaces the internals, not the interface.
+//! Takes an [`Animation`] (world frame, speeds in wingspans/s, headings clockwise from +y) and gives
+//! every bird a wingbeat phase per frame ([`assign_phases`] fills `Frame::wing_phase`, radians in
+//! [0, 2π), 0 = start of the downstroke) and a wing pose per frame ([`Flapper::pose`], joint angles
+//! in radians, see [`WingPose`]). The pieces:
+//! - [`kinematics`]: the composite functions g1/g2, the phase transformation h (downstroke
+//!   fractions u_α, u_β), the stroke-midpoint alignment and the blending weight;
+//! - [`species`]: goose, crane and pelican presets (frequency, amplitudes, downstroke fraction);
+//! - this file: per-bird variation drawn from the animation's seed, one parameter set per
+//!   wingbeat (changing only at mid-upstroke and blended over a short window, §4.3), faster and
+//!   deeper beats while a bird accelerates, gliding, and phase relations between birds
+//!   (independent, or locked to the bird ahead with the spatial phasing of Portugal et al. 2014).
+//!
+//! Determinism: everything is drawn from `rng::stream(anim.seed, "wingbeat")`, one generator per
+//! bird, consumed one wingbeat at a time. [`Flapper::from_animation`] replays the same decisions
+//! from the stored phases, so renderers see exactly the wingbeats [`assign_phases`] produced.
 
-use crate::animation::Animation;
+pub mod kinematics;
+pub mod species;
+
+use std::f64::consts::{PI, TAU};
+use std::fmt;
+use std::path::Path;
+use std::str::FromStr;
+
+use rand::{Rng, RngCore, SeedableRng};
+use rand_distr::StandardNormal;
+use serde::{Deserialize, Serialize};
+
+use crate::animation::{Animation, Frame};
+use crate::error::{Error, Result};
+use crate::rng::{stream, FlockRng};
+
+pub use kinematics::{blend_weight, g1, g2, pose, PhaseMap, Stroke, Strokes, Timing};
+pub use species::{Species, SpeciesPreset};
 
 /// Joint angles of one wing (both wings mirror each other), radians.
+///
+/// Bird frame: x to the bird's right (along the right wing), y forward, z up. Angles of the right
+/// wing; the left wing is its mirror image in the bird's symmetry plane (same values, mirrored
+/// rotation axes). All angles are 0 for a wing stretched straight out sideways, horizontal and
+/// untwisted.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct WingPose {
     /// Shoulder elevation (dihedral) of the upper arm above the horizontal, up positive.
@@ -26,45 +60,858 @@ pub struct WingPose {
     pub tail_bend: f64,
 }
 
+impl WingPose {
+    /// A wing held straight out, horizontal and fully spread (the pose used outside the animation).
+    pub const EXTENDED: WingPose = WingPose {
+        dihedral: 0.0,
+        hand_dihedral: 0.0,
+        sweep: 0.0,
+        arm_twist: 0.0,
+        hand_twist: 0.0,
+        spread: 1.0,
+        tail_bend: 0.0,
+    };
+}
+
+/// How the wingbeat phases of different birds relate.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum PhaseMode {
+    /// Followers lock their phase to the bird ahead with a lag that tracks the streamwise distance
+    /// (spatial phasing, Portugal et al. 2014). The default.
+    #[default]
+    Locked,
+    /// Every bird flaps at its own frequency from a random initial phase.
+    Independent,
+}
+
+impl FromStr for PhaseMode {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<PhaseMode> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "locked" => Ok(PhaseMode::Locked),
+            "independent" => Ok(PhaseMode::Independent),
+            _ => Err(Error::parameter(
+                "--phase",
+                format!("unknown phase mode \"{s}\": expected locked or independent"),
+            )),
+        }
+    }
+}
+
+impl fmt::Display for PhaseMode {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            PhaseMode::Locked => "locked",
+            PhaseMode::Independent => "independent",
+        })
+    }
+}
+
+/// Gliding.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Glide {
+    /// Continuous flapping (the default).
+    #[default]
+    Off,
+    /// Flap-gliding: bouts of the species' `flap_beats` wingbeats followed by `glide_beats` wingbeat
+    /// periods of gliding; a bird that decelerates hard also glides.
+    Bouts,
+    /// Pure gliding: wings held in the glide pose throughout.
+    Always,
+}
+
+impl FromStr for Glide {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Glide> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "off" | "none" => Ok(Glide::Off),
+            "bouts" | "on" => Ok(Glide::Bouts),
+            "always" => Ok(Glide::Always),
+            _ => Err(Error::parameter(
+                "--glide",
+                format!("unknown glide mode \"{s}\": expected off, bouts or always"),
+            )),
+        }
+    }
+}
+
+impl fmt::Display for Glide {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Glide::Off => "off",
+            Glide::Bouts => "bouts",
+            Glide::Always => "always",
+        })
+    }
+}
+
+/// Options of the wingbeat stage. Stored in the animation file (`"wingbeat"`) by
+/// [`assign_phases`] so that renderers rebuild the same wingbeats.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct WingbeatOptions {
+    /// Species preset.
+    pub species: Species,
+    /// Phase relation between birds (default: locked to the bird ahead).
+    pub phase_mode: PhaseMode,
+    /// Gliding mode (default: off).
+    pub glide: Glide,
+    /// Scale of the random per-bird and per-wingbeat variation, dimensionless: 0 = identical
+    /// birds and wingbeats, 1 = the documented default spread.
+    pub variation: f64,
+    /// Time constant of phase locking, seconds: a phase error decays as e^{−t/τ}.
+    pub lock_time_s: f64,
+}
+
+impl Default for WingbeatOptions {
+    fn default() -> Self {
+        WingbeatOptions {
+            species: Species::Goose,
+            phase_mode: PhaseMode::Locked,
+            glide: Glide::Off,
+            variation: 1.0,
+            lock_time_s: 0.6,
+        }
+    }
+}
+
+impl WingbeatOptions {
+    /// Checks the numeric options.
+    pub fn validate(&self) -> Result<()> {
+        if !(self.variation.is_finite() && (0.0..=5.0).contains(&self.variation)) {
+            return Err(Error::parameter(
+                "variation",
+                format!("{}: must be between 0 and 5", self.variation),
+            ));
+        }
+        if !(self.lock_time_s.is_finite() && self.lock_time_s >= 0.05 && self.lock_time_s <= 60.0) {
+            return Err(Error::parameter(
+                "lock_time_s",
+                format!("{}: must be between 0.05 and 60 seconds", self.lock_time_s),
+            ));
+        }
+        Ok(())
+    }
+
+    /// The options an animation was made with: its `wingbeat` record if present, else the
+    /// defaults with the animation's `species` (goose if absent or unknown).
+    pub fn for_animation(anim: &Animation) -> WingbeatOptions {
+        if let Some(o) = &anim.wingbeat {
+            if o.validate().is_ok() {
+                return o.clone();
+            }
+        }
+        let species = anim
+            .species
+            .as_deref()
+            .and_then(|s| s.parse().ok())
+            .unwrap_or_default();
+        WingbeatOptions {
+            species,
+            ..WingbeatOptions::default()
+        }
+    }
+}
+
+/// Per-bird variation: standard deviations (at `variation` = 1) of the amplitude scale, the
+/// frequency scale, the dihedral offset (radians) and the downstroke fractions.
+const BIRD_AMP_SD: f64 = 0.06;
+const BIRD_FREQ_SD: f64 = 0.04;
+const BIRD_OFFSET_SD: f64 = 2.0 * PI / 180.0;
+const BIRD_FRACTION_SD: f64 = 0.015;
+/// Per-wingbeat variation (Ju et al.'s scale / offset / timewarp), standard deviations.
+const BEAT_AMP_SD: f64 = 0.04;
+const BEAT_FREQ_SD: f64 = 0.015;
+const BEAT_OFFSET_SD: f64 = 1.0 * PI / 180.0;
+/// Response to the effort e ∈ [−1, 1] (forward acceleration / the species' reference): amplitude
+/// ×(1 + 0.3e) and frequency ×(1 + 0.2e) when accelerating, amplitude ×(1 + 0.3e) when slowing.
+const ACCEL_AMP_GAIN: f64 = 0.3;
+const ACCEL_FREQ_GAIN: f64 = 0.2;
+const DECEL_AMP_CUT: f64 = 0.3;
+/// Half-width of the window over which the acceleration is measured, seconds.
+const ACCEL_WINDOW_S: f64 = 0.25;
+/// A bird j is "ahead" of i when it is more than this far ahead along i's heading (wingspans)...
+const AHEAD_MIN: f64 = 0.1;
+/// ...and at most this far to the side (wingspans).
+const AHEAD_MAX_LATERAL: f64 = 3.0;
+/// ...and at most this far ahead (wingspans): further ahead, its wake has decayed.
+const AHEAD_MAX_ALONG: f64 = 6.0;
+/// Below this ground speed (wingspans/s) the streamwise lag is meaningless and a bird flaps freely.
+const LOCK_MIN_SPEED: f64 = 0.5;
+
+/// A standard normal draw clamped to ±2.5 (no outlandish birds).
+fn normal(rng: &mut impl Rng) -> f64 {
+    let z: f64 = rng.sample(StandardNormal);
+    z.clamp(-2.5, 2.5)
+}
+
+/// One wingbeat's deviation from its bird's base wingbeat.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Beat {
+    /// Amplitude scale of every DOF's excursion.
+    amp: f64,
+    /// Dihedral offset, radians.
+    offset: f64,
+    /// Wingbeat frequency, Hz.
+    freq: f64,
+    /// Held in the glide pose.
+    glide: bool,
+}
+
+/// Scales a g1 stroke about its mean by `amp` and shifts it by `offset`.
+fn scale_g1(s: Stroke, amp: f64, offset: f64) -> Stroke {
+    let mean = 0.5 * (s.up + s.down) + offset;
+    let half = 0.5 * (s.up - s.down) * amp;
+    Stroke::new(mean - half, mean + half)
+}
+
+/// Scales a g2 stroke's excursion from its downstroke value by `amp`.
+fn scale_g2(s: Stroke, amp: f64) -> Stroke {
+    Stroke::new(s.down, s.down + amp * (s.up - s.down))
+}
+
+fn scale_strokes(s: &Strokes, amp: f64, offset: f64) -> Strokes {
+    let spread = scale_g2(s.spread, amp);
+    Strokes {
+        dihedral: scale_g1(s.dihedral, amp, offset),
+        hand_dihedral: scale_g1(s.hand_dihedral, amp, 0.0),
+        tail_bend: scale_g1(s.tail_bend, amp, 0.0),
+        sweep: scale_g2(s.sweep, amp),
+        arm_twist: scale_g2(s.arm_twist, amp),
+        hand_twist: scale_g2(s.hand_twist, amp),
+        spread: Stroke::new(spread.down.clamp(0.0, 1.0), spread.up.clamp(0.1, 1.0)),
+    }
+}
+
+/// A bird's own wingbeat and its wingbeats so far.
+#[derive(Debug, Clone)]
+struct BirdBeats {
+    timing: Timing,
+    strokes: Strokes,
+    glide: Strokes,
+    /// Own cruising frequency, Hz.
+    freq: f64,
+    /// Initial phase, radians.
+    phase0: f64,
+    /// Position of wingbeat 0 in the flap-glide cycle.
+    bout_offset: i64,
+    flap_beats: i64,
+    glide_beats: i64,
+    /// Index of `beats[0]`.
+    first: i64,
+    beats: Vec<Beat>,
+}
+
+impl BirdBeats {
+    /// Index of the wingbeat at unwrapped phase `s`: wingbeat n starts its downstroke at 2πn and
+    /// runs from the mid-upstroke before it to the mid-upstroke after it (§4.3).
+    fn beat_index(&self, s: f64) -> i64 {
+        ((s - self.timing.mid_upstroke()) / TAU).floor() as i64 + 1
+    }
+
+    fn beat(&self, n: i64) -> Beat {
+        let last = self.beats.len().saturating_sub(1) as i64;
+        let k = (n - self.first).clamp(0, last) as usize;
+        self.beats.get(k).copied().unwrap_or(Beat {
+            amp: 1.0,
+            offset: 0.0,
+            freq: self.freq,
+            glide: false,
+        })
+    }
+
+    /// The two wingbeats and the blend weight at unwrapped phase `s`.
+    fn blend(&self, s: f64) -> (Beat, Beat, f64) {
+        let n = self.beat_index(s);
+        let b = self.timing.blend_half_width();
+        let end = TAU * n as f64 + self.timing.mid_upstroke();
+        if s >= end - b {
+            let w = blend_weight((s - (end - b)) / (2.0 * b));
+            (self.beat(n), self.beat(n + 1), w)
+        } else if s < end - TAU + b {
+            let w = blend_weight((s - (end - TAU - b)) / (2.0 * b));
+            (self.beat(n - 1), self.beat(n), w)
+        } else {
+            let bt = self.beat(n);
+            (bt, bt, 0.0)
+        }
+    }
+
+    fn beat_strokes(&self, beat: &Beat) -> Strokes {
+        if beat.glide {
+            // A glide is held steady: no per-wingbeat jitter, only the bird's own offset.
+            self.glide
+        } else {
+            scale_strokes(&self.strokes, beat.amp, beat.offset)
+        }
+    }
+
+    /// Own (unlocked) wingbeat frequency at unwrapped phase `s`, Hz, blended like the strokes.
+    fn freq_at(&self, s: f64) -> f64 {
+        let (a, b, w) = self.blend(s);
+        a.freq + w * (b.freq - a.freq)
+    }
+
+    /// Wing pose at unwrapped phase `s`, whose value modulo 2π is `phi`.
+    fn pose_at(&self, s: f64, phi: f64) -> WingPose {
+        let (a, b, w) = self.blend(s);
+        let strokes = if w == 0.0 {
+            self.beat_strokes(&a)
+        } else {
+            Strokes::lerp(&self.beat_strokes(&a), &self.beat_strokes(&b), w)
+        };
+        pose(&strokes, &self.timing, phi)
+    }
+
+    /// Decides every wingbeat that phase `s` touches (including the next one once `s` enters the
+    /// blending window before it) from the bird's generator and its current `effort`.
+    fn ensure(&mut self, s: f64, effort: f64, rng: &mut FlockRng, glide: Glide, variation: f64) {
+        let b = self.timing.blend_half_width();
+        let lo = self.beat_index(s - b);
+        let hi = self.beat_index(s + b);
+        let start = if self.beats.is_empty() {
+            self.first = lo;
+            lo
+        } else {
+            self.first + self.beats.len() as i64
+        };
+        // At most 2π of phase passes per frame, so only a few wingbeats can be new; the cap guards
+        // against absurd stored phases.
+        let stop = hi.min(start + 4);
+        for n in start..=stop {
+            let beat = self.decide(n, effort, rng, glide, variation);
+            self.beats.push(beat);
+        }
+    }
+
+    fn decide(
+        &self,
+        n: i64,
+        effort: f64,
+        rng: &mut FlockRng,
+        glide: Glide,
+        variation: f64,
+    ) -> Beat {
+        let (z1, z2, z3) = (normal(rng), normal(rng), normal(rng));
+        let e = effort.clamp(-1.0, 1.0);
+        let (acc, dec) = (e.max(0.0), (-e).max(0.0));
+        let amp = (1.0 + variation * BEAT_AMP_SD * z1)
+            * (1.0 + ACCEL_AMP_GAIN * acc)
+            * (1.0 - DECEL_AMP_CUT * dec);
+        let freq =
+            self.freq * (1.0 + variation * BEAT_FREQ_SD * z2) * (1.0 + ACCEL_FREQ_GAIN * acc);
+        let offset = variation * BEAT_OFFSET_SD * z3;
+        let glide = match glide {
+            Glide::Off => false,
+            Glide::Always => true,
+            Glide::Bouts => {
+                let cycle = (self.flap_beats + self.glide_beats).max(1);
+                (n + self.bout_offset).rem_euclid(cycle) >= self.flap_beats || e < -0.5
+            }
+        };
+        Beat {
+            amp,
+            offset,
+            freq,
+            glide,
+        }
+    }
+}
+
+/// Draws every bird's own wingbeat from the seed; returns the birds and their generators.
+fn draw_birds(seed: u64, birds: usize, opts: &WingbeatOptions) -> (Vec<BirdBeats>, Vec<FlockRng>) {
+    let preset = opts.species.preset();
+    let v = opts.variation;
+    let mut master = stream(seed, "wingbeat");
+    let cycle = i64::from(preset.flap_beats + preset.glide_beats).max(1);
+    let mut out = Vec::with_capacity(birds);
+    let mut rngs = Vec::with_capacity(birds);
+    for _ in 0..birds {
+        let mut r = FlockRng::seed_from_u64(master.next_u64());
+        let (za, zf, zo, zu) = (
+            normal(&mut r),
+            normal(&mut r),
+            normal(&mut r),
+            normal(&mut r),
+        );
+        let phase0 = r.random::<f64>() * TAU;
+        let bout = r.random_range(0..cycle);
+        let mut timing = preset.timing;
+        timing.u_alpha = (timing.u_alpha + v * BIRD_FRACTION_SD * zu).clamp(0.3, 0.7);
+        timing.u_beta = (timing.u_beta + v * BIRD_FRACTION_SD * zu).clamp(0.3, 0.7);
+        let amp = 1.0 + v * BIRD_AMP_SD * za;
+        let offset = v * BIRD_OFFSET_SD * zo;
+        out.push(BirdBeats {
+            timing,
+            strokes: scale_strokes(&preset.strokes, amp, offset),
+            glide: {
+                let mut g = preset.glide_strokes();
+                g.dihedral = Stroke::hold(preset.glide_dihedral + offset);
+                g
+            },
+            freq: preset.frequency_hz * (1.0 + v * BIRD_FREQ_SD * zf),
+            phase0,
+            bout_offset: match opts.phase_mode {
+                PhaseMode::Independent => bout,
+                // Locked birds share the bout clock, so glides travel down the line with the
+                // phase lag.
+                PhaseMode::Locked => 0,
+            },
+            flap_beats: i64::from(preset.flap_beats),
+            glide_beats: i64::from(preset.glide_beats),
+            first: 0,
+            beats: Vec::new(),
+        });
+        rngs.push(r);
+    }
+    (out, rngs)
+}
+
+/// Effort of every bird at every frame (frame-major): forward acceleration (m/s², from the speed
+/// change over ±0.25 s) over the species' reference, clamped into [−1, 1].
+fn efforts(anim: &Animation, preset: &SpeciesPreset) -> Vec<f64> {
+    let n = anim.birds;
+    let nf = anim.frames.len();
+    let half = ((ACCEL_WINDOW_S * anim.fps).round() as usize).max(1);
+    let mut out = vec![0.0; n * nf];
+    for k in 0..nf {
+        let kp = k.saturating_sub(half);
+        let kn = (k + half).min(nf.saturating_sub(1));
+        let (Some(fp), Some(fnx)) = (anim.frames.get(kp), anim.frames.get(kn)) else {
+            continue;
+        };
+        let dt = fnx.t - fp.t;
+        if dt.is_nan() || dt <= 1e-9 {
+            continue;
+        }
+        for i in 0..n {
+            let v0 = fp.speed.get(i).copied().unwrap_or(0.0);
+            let v1 = fnx.speed.get(i).copied().unwrap_or(0.0);
+            let accel = (v1 - v0) / dt * anim.wingspan_m;
+            let e = (accel / preset.accel_ref_mps2).clamp(-1.0, 1.0);
+            out[k * n + i] = if e.is_finite() { e } else { 0.0 };
+        }
+    }
+    out
+}
+
+/// The bird ahead of bird `i` in `frame` and the streamwise distance to it (wingspans, along
+/// bird i's heading): among birds between 0.1 and 6 wingspans ahead and at most 3 wingspans to the
+/// side, the nearest one (ties: the lower index). `None` for a leader (or a bird index out of
+/// range). O(n); [`AheadIndex`] answers the same question for a whole frame in O(n).
+pub fn bird_ahead(frame: &Frame, i: usize) -> Option<(usize, f64)> {
+    ahead_among(frame, i, 0..frame.x.len())
+}
+
+/// [`bird_ahead`] restricted to the candidates `js`.
+fn ahead_among(
+    frame: &Frame,
+    i: usize,
+    js: impl IntoIterator<Item = usize>,
+) -> Option<(usize, f64)> {
+    let (xi, yi, hd) = (*frame.x.get(i)?, *frame.y.get(i)?, *frame.heading.get(i)?);
+    let (fx, fy) = (hd.sin(), hd.cos());
+    let mut best: Option<(usize, f64, f64)> = None;
+    for j in js {
+        let (Some(&xj), Some(&yj)) = (frame.x.get(j), frame.y.get(j)) else {
+            continue;
+        };
+        if j == i {
+            continue;
+        }
+        let (dx, dy) = (xj - xi, yj - yi);
+        let along = dx * fx + dy * fy;
+        let lateral = (dx * fy - dy * fx).abs();
+        if along > AHEAD_MIN && along < AHEAD_MAX_ALONG && lateral < AHEAD_MAX_LATERAL {
+            let d2 = along * along + lateral * lateral;
+            let better = match best {
+                None => true,
+                Some((bj, _, bd)) => d2 < bd || (d2 == bd && j < bj),
+            };
+            if better {
+                best = Some((j, along, d2));
+            }
+        }
+    }
+    best.map(|(j, along, _)| (j, along))
+}
+
+/// A uniform grid over one frame's positions (cells of 6.75 wingspans) that finds every bird's
+/// [`bird_ahead`] by looking only at nearby cells: O(n) per frame for a spread-out flock instead of
+/// O(n²).
+#[derive(Debug, Clone)]
+pub struct AheadIndex {
+    cells: std::collections::HashMap<(i64, i64), Vec<usize>>,
+}
+
+impl AheadIndex {
+    /// Cell size, wingspans: the farthest a bird ahead can be (√(6² + 3²) ≈ 6.71), so only the 3×3
+    /// cells around a bird hold candidates.
+    const CELL: f64 = 6.75;
+    /// Below this many birds a plain scan is faster than hashing.
+    const SCAN_BELOW: usize = 64;
+
+    fn key(x: f64, y: f64) -> (i64, i64) {
+        (
+            (x / Self::CELL).floor() as i64,
+            (y / Self::CELL).floor() as i64,
+        )
+    }
+
+    /// Indexes the birds of `frame`.
+    pub fn new(frame: &Frame) -> AheadIndex {
+        let mut cells: std::collections::HashMap<(i64, i64), Vec<usize>> =
+            std::collections::HashMap::new();
+        if frame.x.len() < Self::SCAN_BELOW {
+            return AheadIndex { cells };
+        }
+        for (j, (&x, &y)) in frame.x.iter().zip(frame.y.iter()).enumerate() {
+            cells.entry(Self::key(x, y)).or_default().push(j);
+        }
+        AheadIndex { cells }
+    }
+
+    /// Same answer as [`bird_ahead`]`(frame, i)`; `frame` must be the indexed frame.
+    pub fn ahead(&self, frame: &Frame, i: usize) -> Option<(usize, f64)> {
+        if frame.x.len() < Self::SCAN_BELOW {
+            return bird_ahead(frame, i);
+        }
+        let (xi, yi) = (*frame.x.get(i)?, *frame.y.get(i)?);
+        let (cx, cy) = Self::key(xi, yi);
+        let reach = 1;
+        let cand = (-reach..=reach)
+            .flat_map(|ox| (-reach..=reach).map(move |oy| (cx + ox, cy + oy)))
+            .filter_map(|k| self.cells.get(&k))
+            .flatten()
+            .copied();
+        ahead_among(frame, i, cand)
+    }
+}
+
+/// Wraps an angle into (−π, π].
+fn wrap_pi(a: f64) -> f64 {
+    let r = (a + PI).rem_euclid(TAU) - PI;
+    if r <= -PI {
+        r + TAU
+    } else {
+        r
+    }
+}
+
+/// Everything the wingbeat stage derives for an animation.
+struct Run {
+    birds: Vec<BirdBeats>,
+    /// Wrapped phase per frame and bird (frame-major), radians in [0, 2π).
+    phase: Vec<f64>,
+    /// Unwrapped phase per frame and bird (frame-major), radians.
+    unwrapped: Vec<f64>,
+}
+
+/// Integrates every bird's phase through the animation (what [`assign_phases`] stores).
+fn simulate(anim: &Animation, opts: &WingbeatOptions) -> Run {
+    let n = anim.birds;
+    let nf = anim.frames.len();
+    let preset = opts.species.preset();
+    let eff = efforts(anim, &preset);
+    let (mut birds, mut rngs) = draw_birds(anim.seed, n, opts);
+    let mut phi: Vec<f64> = birds.iter().map(|b| b.phase0).collect();
+    let mut cycles = vec![0u64; n];
+    let mut own = vec![0.0; n];
+    let mut rate = vec![0.0; n];
+    let mut last_rate = vec![0.0; n];
+    let mut phase = vec![0.0; n * nf];
+    let mut unwrapped = vec![0.0; n * nf];
+    for k in 0..nf {
+        for i in 0..n {
+            let s = TAU * cycles[i] as f64 + phi[i];
+            phase[k * n + i] = phi[i];
+            unwrapped[k * n + i] = s;
+            birds[i].ensure(s, eff[k * n + i], &mut rngs[i], opts.glide, opts.variation);
+            own[i] = birds[i].freq_at(s);
+        }
+        if k == 0 {
+            last_rate.copy_from_slice(&own);
+        }
+        let (Some(frame), Some(next)) = (anim.frames.get(k), anim.frames.get(k + 1)) else {
+            break;
+        };
+        let dt = (next.t - frame.t).max(0.0);
+        let index = match opts.phase_mode {
+            PhaseMode::Locked => Some(AheadIndex::new(frame)),
+            PhaseMode::Independent => None,
+        };
+        for i in 0..n {
+            rate[i] = match &index {
+                None => own[i],
+                Some(index) => {
+                    let ahead = index.ahead(frame, i);
+                    locked_rate(frame, i, ahead, &phi, &last_rate, own[i], opts.lock_time_s)
+                }
+            };
+        }
+        for i in 0..n {
+            let step = (TAU * rate[i] * dt).clamp(0.0, PI);
+            let mut p = phi[i] + step;
+            if p >= TAU {
+                p -= TAU;
+                cycles[i] += 1;
+            }
+            phi[i] = p.clamp(0.0, TAU - f64::EPSILON * TAU);
+            last_rate[i] = rate[i];
+        }
+    }
+    Run {
+        birds,
+        phase,
+        unwrapped,
+    }
+}
+
+/// Phase-locked frequency of bird `i` (Hz): the bird ahead's frequency plus a correction that
+/// pulls the phase towards the spatial-phasing target φ_ahead − 2π f Δy / U.
+fn locked_rate(
+    frame: &Frame,
+    i: usize,
+    ahead: Option<(usize, f64)>,
+    phi: &[f64],
+    last_rate: &[f64],
+    own: f64,
+    tau: f64,
+) -> f64 {
+    let speed = frame.speed.get(i).copied().unwrap_or(0.0);
+    let Some((j, dy)) = ahead else {
+        return own;
+    };
+    let (Some(&pj), Some(&fj), Some(&pi)) = (phi.get(j), last_rate.get(j), phi.get(i)) else {
+        return own;
+    };
+    if speed.is_nan() || speed < LOCK_MIN_SPEED {
+        return own;
+    }
+    let target = pj - TAU * fj * dy / speed;
+    let err = wrap_pi(target - pi);
+    (fj + err / (TAU * tau)).clamp(0.5 * own, 1.5 * own)
+}
+
+/// Rebuilds the wingbeat decisions from phases stored in the animation (what the renderers see).
+fn replay(anim: &Animation, opts: &WingbeatOptions) -> Run {
+    let n = anim.birds;
+    let nf = anim.frames.len();
+    let preset = opts.species.preset();
+    let eff = efforts(anim, &preset);
+    let (mut birds, mut rngs) = draw_birds(anim.seed, n, opts);
+    let mut cycles = vec![0u64; n];
+    let mut prev = vec![0.0; n];
+    let mut phase = vec![0.0; n * nf];
+    let mut unwrapped = vec![0.0; n * nf];
+    for (k, frame) in anim.frames.iter().enumerate() {
+        let stored = frame.wing_phase.as_deref().unwrap_or(&[]);
+        for i in 0..n {
+            let raw = stored.get(i).copied().unwrap_or(0.0);
+            let p = if raw.is_finite() {
+                raw.rem_euclid(TAU)
+            } else {
+                0.0
+            };
+            if k > 0 && p < prev[i] {
+                cycles[i] += 1;
+            }
+            prev[i] = p;
+            let s = TAU * cycles[i] as f64 + p;
+            phase[k * n + i] = p;
+            unwrapped[k * n + i] = s;
+            birds[i].ensure(s, eff[k * n + i], &mut rngs[i], opts.glide, opts.variation);
+        }
+    }
+    Run {
+        birds,
+        phase,
+        unwrapped,
+    }
+}
+
+/// Fills `Frame::wing_phase` of every frame (radians in [0, 2π), 0 = start of the downstroke) and
+/// records the species and options in the animation (`species`, `wingbeat`), so that
+/// [`Flapper::from_animation`] rebuilds the same wingbeats. Seeded from `anim.seed`: equal seeds,
+/// inputs and options give equal phases.
+///
+/// Phase integration per bird, from frame k to k + 1 (Δt = t_{k+1} − t_k):
+/// ```math
+/// \varphi_{k+1} = \varphi_k + 2\pi f_k \Delta t, \qquad
+/// f_k = \begin{cases} f^{\text{own}}_k & \text{independent, or no bird ahead}\\
+///   f_{j} + \dfrac{\operatorname{wrap}(\varphi_j - 2\pi f_j \Delta y / U - \varphi_k)}{2\pi\tau}
+///   & \text{locked to bird } j \text{ ahead} \end{cases}
+/// ```
+/// with f^own the bird's blended wingbeat frequency, Δy the streamwise distance to the bird ahead
+/// (wingspans), U the bird's speed (wingspans/s) and τ = `lock_time_s` (Portugal et al. 2014).
+pub fn assign_phases(anim: &mut Animation, opts: &WingbeatOptions) -> Result<()> {
+    opts.validate()?;
+    anim.validate(Path::new("<animation>"))?;
+    let run = simulate(anim, opts);
+    let n = anim.birds;
+    for (k, frame) in anim.frames.iter_mut().enumerate() {
+        frame.wing_phase = Some(run.phase[k * n..(k + 1) * n].to_vec());
+    }
+    anim.species = Some(opts.species.name().to_string());
+    anim.wingbeat = Some(opts.clone());
+    Ok(())
+}
+
 /// Per-bird wingbeats of a whole animation.
 #[derive(Debug, Clone)]
 pub struct Flapper {
-    phases: Vec<Vec<f64>>,
+    birds: Vec<BirdBeats>,
+    /// Wrapped phase per frame and bird (frame-major).
+    phase: Vec<f64>,
+    /// Unwrapped phase per frame and bird (frame-major).
+    unwrapped: Vec<f64>,
+    nbirds: usize,
+    nframes: usize,
 }
 
 impl Flapper {
-    /// Rebuilds the wingbeats of `anim`.
+    /// Rebuilds the wingbeats of `anim`: from its stored `wing_phase` (as written by
+    /// [`assign_phases`]) when every frame has one, otherwise by computing the phases with the
+    /// options recorded in the file (or the defaults for its species). Never fails; a malformed
+    /// animation gives neutral poses where data is missing.
     pub fn from_animation(anim: &Animation) -> Flapper {
-        let freq = 3.0; // Hz, placeholder
-        let phases = anim
-            .frames
-            .iter()
-            .map(|f| match &f.wing_phase {
-                Some(p) => p.clone(),
-                None => (0..anim.birds)
-                    .map(|i| {
-                        (std::f64::consts::TAU * freq * f.t + i as f64)
-                            .rem_euclid(std::f64::consts::TAU)
-                    })
-                    .collect(),
-            })
-            .collect();
-        Flapper { phases }
+        Flapper::with_options(anim, &WingbeatOptions::for_animation(anim))
     }
 
-    /// Pose of `bird` at `frame`.
-    pub fn pose(&self, frame: usize, bird: usize) -> WingPose {
-        let phase = self
-            .phases
-            .get(frame)
-            .and_then(|p| p.get(bird))
-            .copied()
-            .unwrap_or(0.0);
-        WingPose {
-            dihedral: 0.5 * phase.cos(),
-            hand_dihedral: 0.2 * phase.cos(),
-            spread: 1.0,
-            ..WingPose::default()
+    /// Like [`Flapper::from_animation`] with explicit options (which must be those the phases were
+    /// assigned with for the per-wingbeat variation to match).
+    pub fn with_options(anim: &Animation, opts: &WingbeatOptions) -> Flapper {
+        let n = anim.birds;
+        let stored = !anim.frames.is_empty()
+            && anim
+                .frames
+                .iter()
+                .all(|f| f.wing_phase.as_ref().is_some_and(|p| p.len() == n));
+        let run = if stored {
+            replay(anim, opts)
+        } else {
+            simulate(anim, opts)
+        };
+        Flapper {
+            birds: run.birds,
+            phase: run.phase,
+            unwrapped: run.unwrapped,
+            nbirds: n,
+            nframes: anim.frames.len(),
         }
+    }
+
+    /// Number of birds.
+    pub fn birds(&self) -> usize {
+        self.nbirds
+    }
+
+    /// Number of frames.
+    pub fn frames(&self) -> usize {
+        self.nframes
+    }
+
+    /// Wingbeat phase of `bird` at `frame`, radians in [0, 2π), 0 = start of the downstroke
+    /// (0 outside the animation).
+    pub fn phase(&self, frame: usize, bird: usize) -> f64 {
+        self.index(frame, bird)
+            .and_then(|k| self.phase.get(k))
+            .copied()
+            .unwrap_or(0.0)
+    }
+
+    fn index(&self, frame: usize, bird: usize) -> Option<usize> {
+        (frame < self.nframes && bird < self.nbirds).then(|| frame * self.nbirds + bird)
+    }
+
+    /// Pose of `bird` at `frame` ([`WingPose::EXTENDED`] outside the animation).
+    pub fn pose(&self, frame: usize, bird: usize) -> WingPose {
+        let (Some(k), Some(b)) = (self.index(frame, bird), self.birds.get(bird)) else {
+            return WingPose::EXTENDED;
+        };
+        match (self.unwrapped.get(k), self.phase.get(k)) {
+            (Some(&s), Some(&phi)) => b.pose_at(s, phi),
+            _ => WingPose::EXTENDED,
+        }
+    }
+
+    /// Poses of every bird at `frame`, written into `out` (cleared first).
+    pub fn poses_into(&self, frame: usize, out: &mut Vec<WingPose>) {
+        out.clear();
+        out.extend((0..self.nbirds).map(|i| self.pose(frame, i)));
+    }
+
+    /// Pose of `bird` at a fractional frame position (linear interpolation of the unwrapped
+    /// phase between frames), for renderers that sample between frames (e.g. glTF keyframes).
+    pub fn pose_at(&self, frame: f64, bird: usize) -> WingPose {
+        if !(frame.is_finite() && frame >= 0.0) || self.nframes == 0 {
+            return self.pose(0, bird);
+        }
+        let k = (frame.floor() as usize).min(self.nframes - 1);
+        let w = (frame - k as f64).clamp(0.0, 1.0);
+        let (Some(a), Some(b)) = (self.index(k, bird), self.birds.get(bird)) else {
+            return WingPose::EXTENDED;
+        };
+        let s0 = self.unwrapped.get(a).copied().unwrap_or(0.0);
+        let s1 = self
+            .index(k + 1, bird)
+            .and_then(|i| self.unwrapped.get(i))
+            .copied()
+            .unwrap_or(s0);
+        let s = s0 + w * (s1 - s0);
+        b.pose_at(s, s.rem_euclid(TAU))
+    }
+}
+
+/// One wingbeat of the average bird of `species`: `samples` poses at phases 0..2π (inclusive).
+pub fn wingbeat_curve(species: Species, samples: usize) -> Vec<(f64, WingPose)> {
+    let preset = species.preset();
+    let m = samples.max(2);
+    (0..m)
+        .map(|k| {
+            let phi = TAU * k as f64 / (m - 1) as f64;
+            (phi, pose(&preset.strokes, &preset.timing, phi))
+        })
+        .collect()
+}
+
+#[doc(hidden)]
+/// Unwrapped phase and own-frequency access for tests of the blending (not a stable API).
+pub mod probe {
+    use super::*;
+
+    /// The pose and own frequency of a synthetic bird with the given wingbeats at unwrapped
+    /// phase `s`: wingbeat n (n = 0, 1, ...) has amplitude `amps[n]` and frequency `freqs[n]`.
+    pub fn blended(species: Species, amps: &[f64], freqs: &[f64], s: f64) -> (WingPose, f64) {
+        let preset = species.preset();
+        let b = BirdBeats {
+            timing: preset.timing,
+            strokes: preset.strokes,
+            glide: preset.glide_strokes(),
+            freq: preset.frequency_hz,
+            phase0: 0.0,
+            bout_offset: 0,
+            flap_beats: 1,
+            glide_beats: 0,
+            first: 0,
+            beats: amps
+                .iter()
+                .zip(freqs)
+                .map(|(&amp, &freq)| Beat {
+                    amp,
+                    offset: 0.0,
+                    freq,
+                    glide: false,
+                })
+                .collect(),
+        };
+        (b.pose_at(s, s.rem_euclid(TAU)), b.freq_at(s))
+    }
+
+    /// Unwrapped phases of every bird at every frame (frame-major) as the renderers see them.
+    pub fn unwrapped(f: &Flapper) -> &[f64] {
+        &f.unwrapped
     }
 }

@@ -1,0 +1,182 @@
+//! The native annotation JSON (SPEC §4.1): `{"source", "heading", "wingspan_px", "frames":
+//! [{"index", "image", "wingspan_px", "birds": [[x, y], ...]}]}` in pixels. A bird may also be an
+//! object `{"id": 3, "x": .., "y": ..}`, which carries its identity across frames.
+
+use std::path::Path;
+
+use serde_json::Value;
+
+use super::{Format, Heading, RawAnnotations, RawBird, RawFrame};
+use crate::error::{Error, Result};
+
+/// Reads a number field, naming it when it is not a finite number.
+pub(crate) fn number(path: &Path, at: &str, v: &Value) -> Result<f64> {
+    match v.as_f64() {
+        Some(x) if x.is_finite() => Ok(x),
+        _ => Err(Error::format(
+            path,
+            format!("{at}: expected a number, found {}", short(v)),
+        )),
+    }
+}
+
+/// A short rendering of a JSON value for messages.
+pub(crate) fn short(v: &Value) -> String {
+    let s = v.to_string();
+    if s.chars().count() > 40 {
+        format!("{}…", s.chars().take(40).collect::<String>())
+    } else {
+        s
+    }
+}
+
+/// Reads an id: a non-negative integer.
+pub(crate) fn id(path: &Path, at: &str, v: &Value) -> Result<usize> {
+    v.as_u64()
+        .and_then(|u| usize::try_from(u).ok())
+        .ok_or_else(|| {
+            Error::format(
+                path,
+                format!(
+                    "{at}: expected a non-negative integer id, found {}",
+                    short(v)
+                ),
+            )
+        })
+}
+
+/// Parses a heading value: a string or degrees.
+pub(crate) fn heading(path: &Path, at: &str, v: &Value) -> Result<Heading> {
+    match v {
+        Value::String(s) => {
+            Heading::parse(s).map_err(|m| Error::format(path, format!("{at}: {m}")))
+        }
+        Value::Number(_) => Ok(Heading::Degrees(number(path, at, v)?)),
+        _ => Err(Error::format(
+            path,
+            format!(
+                "{at}: expected \"up\", \"down\", \"left\", \"right\" or degrees, found {}",
+                short(v)
+            ),
+        )),
+    }
+}
+
+pub(crate) fn parse(path: &Path, text: &str) -> Result<RawAnnotations> {
+    let v: Value = crate::io::parse_json(path, text)?;
+    let obj = v
+        .as_object()
+        .ok_or_else(|| Error::format(path, "top level: expected a JSON object"))?;
+    let source = match obj.get("source") {
+        None | Some(Value::Null) => None,
+        Some(Value::String(s)) => Some(s.clone()),
+        Some(other) => {
+            return Err(Error::format(
+                path,
+                format!("source: expected text, found {}", short(other)),
+            ))
+        }
+    };
+    let heading = match obj.get("heading") {
+        None | Some(Value::Null) => None,
+        Some(h) => Some(heading(path, "heading", h)?),
+    };
+    let wingspan_px = match obj.get("wingspan_px") {
+        None | Some(Value::Null) => None,
+        Some(w) => Some(number(path, "wingspan_px", w)?),
+    };
+    let frames_v = obj
+        .get("frames")
+        .and_then(|f| f.as_array())
+        .ok_or_else(|| Error::format(path, "frames: expected an array of frames"))?;
+    if frames_v.is_empty() {
+        return Err(Error::format(
+            path,
+            "frames: the array is empty, no frame to read",
+        ));
+    }
+    let mut frames = Vec::with_capacity(frames_v.len());
+    for (k, fv) in frames_v.iter().enumerate() {
+        let at = format!("frames[{k}]");
+        let fo = fv.as_object().ok_or_else(|| {
+            Error::format(path, format!("{at}: expected an object with \"birds\""))
+        })?;
+        let index = match fo.get("index") {
+            None | Some(Value::Null) => k as i64,
+            Some(i) => i.as_i64().ok_or_else(|| {
+                Error::format(
+                    path,
+                    format!("{at}.index: expected an integer, found {}", short(i)),
+                )
+            })?,
+        };
+        let image = match fo.get("image") {
+            Some(Value::String(s)) => Some(s.clone()),
+            _ => None,
+        };
+        let fw = match fo.get("wingspan_px") {
+            None | Some(Value::Null) => None,
+            Some(w) => Some(number(path, &format!("{at}.wingspan_px"), w)?),
+        };
+        let birds_v = fo.get("birds").and_then(|b| b.as_array()).ok_or_else(|| {
+            Error::format(
+                path,
+                format!("{at}.birds: expected an array of [x, y] points"),
+            )
+        })?;
+        let mut birds = Vec::with_capacity(birds_v.len());
+        for (j, bv) in birds_v.iter().enumerate() {
+            let bat = format!("{at}.birds[{j}]");
+            let bird = match bv {
+                Value::Array(a) if a.len() == 2 => RawBird {
+                    id: None,
+                    x: number(path, &format!("{bat}[0] (x)"), &a[0])?,
+                    y: number(path, &format!("{bat}[1] (y)"), &a[1])?,
+                    at: bat,
+                },
+                Value::Object(o) => {
+                    let get = |name: &str| {
+                        o.get(name).ok_or_else(|| {
+                            Error::format(path, format!("{bat}: missing field \"{name}\""))
+                        })
+                    };
+                    RawBird {
+                        id: match o.get("id") {
+                            None | Some(Value::Null) => None,
+                            Some(i) => Some(id(path, &format!("{bat}.id"), i)?),
+                        },
+                        x: number(path, &format!("{bat}.x"), get("x")?)?,
+                        y: number(path, &format!("{bat}.y"), get("y")?)?,
+                        at: bat,
+                    }
+                }
+                other => {
+                    return Err(Error::format(
+                        path,
+                        format!(
+                            "{bat}: expected [x, y] or {{\"id\", \"x\", \"y\"}}, found {}",
+                            short(other)
+                        ),
+                    ))
+                }
+            };
+            birds.push(bird);
+        }
+        frames.push(RawFrame {
+            index,
+            image,
+            wingspan_px: fw,
+            at: format!("{at}.wingspan_px"),
+            birds,
+        });
+    }
+    Ok(RawAnnotations {
+        format: Format::Native,
+        source,
+        heading,
+        wingspan_px,
+        y_up: false,
+        is_csv: false,
+        frames,
+    })
+}

@@ -1,0 +1,248 @@
+//! `formation plot shape`: one frame of a params file in the formation frame (wingspans, equal
+//! axis scales, flight direction up, so the leader is at the top): inlier birds, outliers with
+//! their deviation from the curve, the leader, the fitted curve, and bird ids.
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use super::{Chart, DrawResult, FONT_FAMILY};
+use crate::extract::{slope_at, FrameParams, ShapeModel};
+
+/// The chart of one frame's fit.
+#[derive(Debug, Clone)]
+pub struct ShapeChart {
+    /// The frame to draw.
+    pub frame: FrameParams,
+    /// Source text of the params file, for the title.
+    pub source: String,
+    /// Inlier threshold, wingspans, when known: drawn as a band around the curve.
+    pub threshold: Option<f64>,
+}
+
+const INLIER: RGBColor = RGBColor(31, 119, 180);
+const OUTLIER: RGBColor = RGBColor(214, 39, 40);
+const LEADER: RGBColor = RGBColor(44, 160, 44);
+const CURVE: RGBColor = RGBColor(60, 60, 60);
+
+impl ShapeChart {
+    /// Curve segments to draw (a V is drawn as its two arms meeting at x = 0), shifted by
+    /// `offset` wingspans along the curve's normal to first order (vertically
+    /// offset·√(1 + y'²)), which is how far the inlier test reaches.
+    fn curve_pieces(&self, x0: f64, x1: f64, offset: f64) -> Vec<Vec<(f64, f64)>> {
+        let m = self.frame.shape;
+        let y = |x: f64, s: f64| m.y_at(x) + offset * (1.0 + s * s).sqrt();
+        let sample = |a: f64, b: f64| -> Vec<(f64, f64)> {
+            (0..=200)
+                .map(|i| {
+                    let x = a + (b - a) * i as f64 / 200.0;
+                    (x, y(x, slope_at(&m, x)))
+                })
+                .collect()
+        };
+        match m {
+            ShapeModel::V { left, right } => {
+                let (a, b) = (x0.min(0.0), x1.max(0.0));
+                let l = |x: f64| left.y_at(x) + offset * (1.0 + left.slope.powi(2)).sqrt();
+                let r = |x: f64| right.y_at(x) + offset * (1.0 + right.slope.powi(2)).sqrt();
+                vec![
+                    vec![(a, l(a)), (0.0, l(0.0))],
+                    vec![(0.0, r(0.0)), (b, r(b))],
+                ]
+            }
+            _ => vec![sample(x0, x1)],
+        }
+    }
+}
+
+/// The source text, shortened for a title.
+fn short_source(s: &str) -> String {
+    let s = s.trim();
+    if s.is_empty() {
+        return "flock".into();
+    }
+    if s.chars().count() > 48 {
+        format!("{}…", s.chars().take(47).collect::<String>())
+    } else {
+        s.to_string()
+    }
+}
+
+impl Chart for ShapeChart {
+    fn size(&self) -> (u32, u32) {
+        (1000, 720)
+    }
+
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult<DB> {
+        let f = &self.frame;
+        let pos = &f.positions;
+        let (mut xmin, mut xmax, mut ymin, mut ymax) = (-1.0f64, 1.0f64, -0.5f64, 1.0f64);
+        for p in pos {
+            xmin = xmin.min(p.x);
+            xmax = xmax.max(p.x);
+            ymin = ymin.min(p.y);
+            ymax = ymax.max(p.y);
+        }
+        let (cx0, cx1) = (xmin - 0.3, xmax + 0.3);
+        for i in 0..=20 {
+            let x = cx0 + (cx1 - cx0) * i as f64 / 20.0;
+            let y = f.shape.y_at(x);
+            if y.is_finite() {
+                ymin = ymin.min(y);
+                ymax = ymax.max(y);
+            }
+        }
+        // Margins, then widen one axis so that a wingspan is as long across as along.
+        let (mut x0, mut x1) = (xmin - 1.0, xmax + 1.0);
+        let (mut y0, mut y1) = (ymin - 1.0, ymax + 1.0);
+        let (w, h) = self.size();
+        let (pw, ph) = (w as f64 - 110.0, h as f64 - 130.0);
+        let (sx, sy) = ((x1 - x0) / pw, (y1 - y0) / ph);
+        if sx > sy {
+            let extra = (sx * ph - (y1 - y0)) / 2.0;
+            y0 -= extra;
+            y1 += extra;
+        } else {
+            let extra = (sy * pw - (x1 - x0)) / 2.0;
+            x0 -= extra;
+            x1 += extra;
+        }
+        let n_out = f.outliers.len();
+        let caption = format!(
+            "{} — frame {}: {} birds, kind {}, {} outlier{}",
+            short_source(&self.source),
+            f.index,
+            f.order.len(),
+            f.shape.kind().to_uppercase(),
+            n_out,
+            if n_out == 1 { "" } else { "s" }
+        );
+        let mut chart = ChartBuilder::on(root)
+            .caption(caption, (FONT_FAMILY, 22))
+            .margin(12)
+            .x_label_area_size(42)
+            .y_label_area_size(56)
+            // y grows downward: behind the leader is lower on the page, flight is up.
+            .build_cartesian_2d(x0..x1, y1..y0)?;
+        chart
+            .configure_mesh()
+            .x_desc("x: lateral offset right of the flight direction (wingspans)")
+            .y_desc("y: distance behind the leader (wingspans)")
+            .label_style((FONT_FAMILY, 14))
+            .light_line_style(RGBColor(235, 235, 235))
+            .draw()?;
+
+        if let Some(t) = self.threshold {
+            let mut labelled = false;
+            for off in [-t, t] {
+                for piece in self.curve_pieces(cx0, cx1, off) {
+                    let s = chart
+                        .draw_series(LineSeries::new(piece, CURVE.mix(0.35).stroke_width(1)))?;
+                    if !labelled {
+                        s.label(format!("inlier band (±{t} wingspans from the curve)"))
+                            .legend(|(x, y)| {
+                                PathElement::new(vec![(x, y), (x + 18, y)], CURVE.mix(0.35))
+                            });
+                        labelled = true;
+                    }
+                }
+            }
+        }
+        let mut first = true;
+        for piece in self.curve_pieces(cx0, cx1, 0.0) {
+            let s = chart.draw_series(LineSeries::new(piece, CURVE.stroke_width(2)))?;
+            if first {
+                let label = match f.shape {
+                    ShapeModel::V { left, right } => format!(
+                        "V: left y = {:.2} {:+.2}x, right y = {:.2} {:+.2}x",
+                        left.intercept, left.slope, right.intercept, right.slope
+                    ),
+                    ShapeModel::Line { intercept, slope } => {
+                        format!("line: y = {intercept:.2} {slope:+.2}x")
+                    }
+                    ShapeModel::U { a, b, c } | ShapeModel::J { a, b, c } => format!(
+                        "{}: y = {a:.3}x² {b:+.3}x {c:+.2}",
+                        f.shape.kind().to_uppercase()
+                    ),
+                };
+                s.label(label).legend(|(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 18, y)], CURVE.stroke_width(2))
+                });
+                first = false;
+            }
+        }
+        // Outliers' deviations from the curve.
+        for p in pos.iter().filter(|p| f.outliers.contains(&p.id)) {
+            chart.draw_series(std::iter::once(PathElement::new(
+                vec![(p.x, p.y), (p.x, p.y - p.dy)],
+                OUTLIER.mix(0.6).stroke_width(1),
+            )))?;
+        }
+        chart
+            .draw_series(
+                pos.iter()
+                    .filter(|p| f.inliers.contains(&p.id) && p.id != f.leader)
+                    .map(|p| Circle::new((p.x, p.y), 6, INLIER.filled())),
+            )?
+            .label(format!("inliers ({})", f.inliers.len()))
+            .legend(|(x, y)| Circle::new((x + 9, y), 5, INLIER.filled()));
+        chart
+            .draw_series(
+                pos.iter()
+                    .filter(|p| f.outliers.contains(&p.id))
+                    .map(|p| Cross::new((p.x, p.y), 7, OUTLIER.stroke_width(3))),
+            )?
+            .label(format!("outliers ({n_out}), line = deviation from curve"))
+            .legend(|(x, y)| Cross::new((x + 9, y), 5, OUTLIER.stroke_width(3)));
+        chart
+            .draw_series(
+                pos.iter()
+                    .filter(|p| p.id == f.leader)
+                    .map(|p| TriangleMarker::new((p.x, p.y), 11, LEADER.filled())),
+            )?
+            .label(format!("leader (bird {})", f.leader))
+            .legend(|(x, y)| TriangleMarker::new((x + 9, y), 6, LEADER.filled()));
+        chart.draw_series(pos.iter().map(|p| {
+            EmptyElement::at((p.x, p.y))
+                + Text::new(
+                    p.id.to_string(),
+                    (7, 2),
+                    (FONT_FAMILY, 12).into_font().color(&RGBColor(40, 40, 40)),
+                )
+        }))?;
+        // The legend goes in the corner with the fewest birds.
+        let (mx, my) = ((x0 + x1) / 2.0, (y0 + y1) / 2.0);
+        let corners = [
+            (SeriesLabelPosition::UpperRight, true, false),
+            (SeriesLabelPosition::UpperLeft, false, false),
+            (SeriesLabelPosition::LowerRight, true, true),
+            (SeriesLabelPosition::LowerLeft, false, true),
+        ];
+        let crowd = |right: bool, low: bool| {
+            pos.iter()
+                .filter(|p| (p.x > mx) == right && (p.y > my) == low)
+                .count()
+        };
+        let corner = corners
+            .iter()
+            .min_by_key(|c| crowd(c.1, c.2))
+            .map(|c| c.0.clone())
+            .unwrap_or(SeriesLabelPosition::LowerRight);
+        chart
+            .configure_series_labels()
+            .position(corner)
+            .background_style(WHITE.mix(0.85))
+            .border_style(RGBColor(180, 180, 180))
+            .label_font((FONT_FAMILY, 14))
+            .draw()?;
+        let stats = format!(
+            "μx = {:.3}  σx = {:.3}  μy = {:.3}  σy = {:.3} (wingspans)   ↑ flight direction",
+            f.mu_x, f.sigma_x, f.mu_y, f.sigma_y
+        );
+        root.draw(&Text::new(
+            stats,
+            (70, 40),
+            (FONT_FAMILY, 15).into_font().color(&RGBColor(80, 80, 80)),
+        ))?;
+        Ok(())
+    }
+}

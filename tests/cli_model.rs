@@ -1,0 +1,232 @@
+//! `formation power` and `formation solve` through the binary: outputs and every bad input
+//! (exit 2, one line naming the file and field, no output file left behind).
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_formation"))
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir =
+        std::env::temp_dir().join(format!("formation-cli-model-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn run(args: &[&str]) -> (i32, String, String) {
+    let out = bin().args(args).output().unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn example(name: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("examples_data")
+        .join(name)
+        .to_string_lossy()
+        .into_owned()
+}
+
+#[test]
+fn power_table_and_json() {
+    let (code, out, err) = run(&["power", &example("v9_shape.json")]);
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("leader"));
+    assert!(out.contains("total E"));
+    let (code, out, _) = run(&["power", &example("v9_shape.json"), "--json"]);
+    assert_eq!(code, 0);
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let birds = v["birds"].as_array().unwrap();
+    assert_eq!(birds.len(), 9);
+    let total = v["total"].as_f64().unwrap();
+    let sum_e: f64 = birds.iter().map(|b| b["e"].as_f64().unwrap()).sum();
+    let sum_xi: f64 = birds.iter().map(|b| b["xi"].as_f64().unwrap()).sum();
+    assert!((sum_e - total).abs() < 1e-12 * total);
+    assert!((sum_xi - 1.0).abs() < 1e-12);
+    assert_eq!(birds[4]["y"].as_f64().unwrap(), 0.0);
+}
+
+#[test]
+fn solve_writes_a_shape_that_power_reads_back() {
+    let dir = scratch("solve");
+    let out = dir.join("u.json");
+    let (code, _, err) = run(&[
+        "solve",
+        &example("equal_savings_target.json"),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    assert_eq!(v["converged"], true);
+    assert!(v["residual"].as_f64().unwrap() < 1e-9);
+    let ys: Vec<f64> = v["birds"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|b| b["y"].as_f64().unwrap())
+        .collect();
+    assert_eq!(
+        ys.iter().copied().fold(f64::INFINITY, f64::min),
+        0.0,
+        "leader at y = 0"
+    );
+    let (code, json, _) = run(&["power", out.to_str().unwrap(), "--json"]);
+    assert_eq!(code, 0);
+    let p: serde_json::Value = serde_json::from_str(&json).unwrap();
+    for b in p["birds"].as_array().unwrap() {
+        assert!((b["xi"].as_f64().unwrap() - 1.0 / 9.0).abs() < 1e-9);
+    }
+}
+
+/// Runs a command on a file with `content`, expects exit 2, one stderr line containing every
+/// `needle`, and no output file.
+fn bad(cmd: &str, content: &str, needles: &[&str]) {
+    let dir = scratch(&format!(
+        "bad-{cmd}-{}",
+        needles
+            .join("-")
+            .replace(['/', ' ', '[', ']', '.', '"'], "_")
+    ));
+    let input = dir.join("input.json");
+    std::fs::write(&input, content).unwrap();
+    let out = dir.join("out.json");
+    let mut args = vec![cmd, input.to_str().unwrap()];
+    if cmd == "solve" {
+        args.extend(["-o", out.to_str().unwrap()]);
+    }
+    let (code, _, err) = run(&args);
+    assert_eq!(code, 2, "{cmd} on {content:?}: exit {code}, stderr {err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "one line: {err}");
+    for n in needles {
+        assert!(
+            err.contains(n),
+            "{cmd} on {content:?}: expected {n:?} in {err}"
+        );
+    }
+    assert!(!out.exists(), "no output after a failure");
+    let leftovers: Vec<_> = std::fs::read_dir(&dir).unwrap().collect();
+    assert_eq!(leftovers.len(), 1, "no temporary files left behind");
+}
+
+#[test]
+fn power_bad_inputs() {
+    bad("power", "", &["input.json", "empty"]);
+    bad(
+        "power",
+        "{\"birds\": [{\"x\": 0, \"y\": 0}, {\"x\": 1",
+        &["input.json", "line 1", "truncated"],
+    );
+    bad(
+        "power",
+        "[1, 2]",
+        &["input.json", "unexpected JSON structure"],
+    );
+    bad(
+        "power",
+        "{\"birds\": [{\"x\": NaN, \"y\": 0}, {\"x\": 1, \"y\": 1}]}",
+        &["input.json", "invalid JSON"],
+    );
+    bad(
+        "power",
+        "{\"birds\": [{\"x\": 1e999, \"y\": 0}, {\"x\": 1, \"y\": 1}]}",
+        &["input.json"],
+    );
+    bad(
+        "power",
+        "{\"birds\": [{\"x\": 0, \"y\": 0}]}",
+        &["input.json", "at least 2"],
+    );
+    bad(
+        "power",
+        "{\"birds\": [{\"x\": 0, \"y\": 0}, {\"x\": 0.5, \"y\": 1}]}",
+        &["input.json", "birds 0 and 1", "downwash"],
+    );
+    bad(
+        "power",
+        "{\"birds\": [{\"x\": \"a\", \"y\": 0}, {\"x\": 1, \"y\": 1}]}",
+        &["input.json", "line 1"],
+    );
+}
+
+#[test]
+fn solve_bad_inputs() {
+    bad(
+        "solve",
+        "{\"x\": [0, 1, 2], \"xi\": [1, 1]}",
+        &["input.json", "xi", "2 targets for 3"],
+    );
+    bad(
+        "solve",
+        "{\"x\": [0], \"xi\": [1]}",
+        &["input.json", "at least 2"],
+    );
+    bad(
+        "solve",
+        "{\"x\": [0, 1, 2], \"xi\": [1, -1, 1]}",
+        &["input.json", "xi[1]", "negative"],
+    );
+    bad(
+        "solve",
+        "{\"x\": [0, 1, 2], \"xi\": [0, 0, 0]}",
+        &["input.json", "all targets are zero"],
+    );
+    bad(
+        "solve",
+        "{\"x\": [0, 1, 1.5], \"xi\": [1, 1, 1]}",
+        &["input.json", "birds 1 and 2", "downwash"],
+    );
+    bad(
+        "solve",
+        "{\"x\": [0, 1, 2], \"xi\": [1, 1, 1], \"y\": [0, 1]}",
+        &["input.json", "initial positions"],
+    );
+    bad(
+        "solve",
+        "{\"x\": [0, 1, 2], \"xi\": [1, 1, 1], \"typo\": 1}",
+        &["input.json", "unknown field"],
+    );
+    bad(
+        "solve",
+        "{\"x\": [-2, -1, 0, 1, 2], \"xi\": [0.1, 0.1, 0.6, 0.1, 0.1]}",
+        &["input.json", "bird 2"],
+    );
+    bad(
+        "solve",
+        "{\"x\": [0, 1, 2], \"xi\": [1, 1e999, 1]}",
+        &["input.json"],
+    );
+}
+
+#[test]
+fn usage_errors_and_missing_files() {
+    let (code, _, err) = run(&["power", "/nonexistent/shape.json"]);
+    assert_eq!(code, 2);
+    assert!(err.contains("/nonexistent/shape.json"));
+    let (code, _, err) = run(&[
+        "solve",
+        &example("equal_savings_target.json"),
+        "-o",
+        "/tmp/x.txt",
+    ]);
+    assert_eq!(code, 2);
+    assert!(err.contains("x.txt"), "{err}");
+    let (code, _, err) = run(&[
+        "solve",
+        &example("equal_savings_target.json"),
+        "-o",
+        "/nonexistent-dir/u.json",
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("/nonexistent-dir/u.json"), "{err}");
+    let (code, _, err) = run(&["power", "--bogus"]);
+    assert_eq!(code, 2);
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+}

@@ -1,0 +1,155 @@
+//! The key-shape solve (eq. 4): round trips shape → ξ → solved shape → same ξ, Hummel's
+//! equal-savings U, and unreachable targets named.
+
+use formation::aero::power_reduction;
+use formation::keyshape::{solve, SolveOptions};
+use formation::Error;
+use proptest::prelude::*;
+
+/// A V: leader at x = 0, `left` birds to the left and `right` to the right, lateral gaps and
+/// per-bird depth increments given.
+fn v_shape(
+    gaps_l: &[f64],
+    gaps_r: &[f64],
+    depth_l: &[f64],
+    depth_r: &[f64],
+) -> (Vec<f64>, Vec<f64>) {
+    let (mut x, mut y) = (vec![0.0], vec![0.0]);
+    let (mut ax, mut ay) = (0.0, 0.0);
+    for (g, d) in gaps_l.iter().zip(depth_l) {
+        ax -= g;
+        ay += d;
+        x.push(ax);
+        y.push(ay);
+    }
+    let (mut ax, mut ay) = (0.0, 0.0);
+    for (g, d) in gaps_r.iter().zip(depth_r) {
+        ax += g;
+        ay += d;
+        x.push(ax);
+        y.push(ay);
+    }
+    (x, y)
+}
+
+fn v_strategy() -> impl Strategy<Value = (Vec<f64>, Vec<f64>, Vec<f64>)> {
+    (1usize..12, 1usize..12).prop_flat_map(|(l, r)| {
+        (
+            prop::collection::vec(0.85f64..1.6, l),
+            prop::collection::vec(0.85f64..1.6, r),
+            prop::collection::vec(0.1f64..1.5, l),
+            prop::collection::vec(0.1f64..1.5, r),
+            prop::collection::vec(-0.3f64..0.3, l + r + 1),
+        )
+            .prop_map(|(gl, gr, dl, dr, noise)| {
+                let (x, y) = v_shape(&gl, &gr, &dl, &dr);
+                let guess: Vec<f64> = y.iter().zip(&noise).map(|(a, b)| a + b).collect();
+                (x, y, guess)
+            })
+    })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    /// Random V → ξ → solve from a perturbed guess → the same ξ (and the same shape).
+    #[test]
+    fn round_trip((x, y, guess) in v_strategy()) {
+        let xi = power_reduction(&x, &y).unwrap().xi;
+        let rep = solve(&x, &xi, Some(&guess), &SolveOptions::default()).unwrap();
+        prop_assert!(rep.converged, "residual {}", rep.residual);
+        let again = power_reduction(&x, &rep.y).unwrap().xi;
+        for (a, b) in again.iter().zip(&xi) {
+            prop_assert!((a - b).abs() < 1e-8);
+        }
+        // Unique up to a shift: the same positions (leader at 0 in both).
+        for (a, b) in rep.y.iter().zip(&y) {
+            prop_assert!((a - b).abs() < 1e-5, "{} vs {}", a, b);
+        }
+    }
+}
+
+#[test]
+fn round_trip_from_the_neutral_start_for_large_flocks() {
+    // 11 and 41 birds go through the LM crate, 301 through the symmetric LM.
+    for n_side in [5usize, 20, 150] {
+        let gaps = vec![1.05; n_side];
+        let depth: Vec<f64> = (0..n_side).map(|k| 0.5 + 0.02 * k as f64).collect();
+        let (x, y) = v_shape(&gaps, &gaps, &depth, &depth);
+        let xi = power_reduction(&x, &y).unwrap().xi;
+        let rep = solve(&x, &xi, None, &SolveOptions::default()).unwrap();
+        assert!(rep.converged, "N = {}: residual {}", x.len(), rep.residual);
+    }
+}
+
+/// Equal targets ξ_i = 1/N give Hummel's equal-savings formation: a mirror-symmetric U whose
+/// outer birds fly farthest behind.
+#[test]
+fn equal_targets_give_a_symmetric_u() {
+    for n in [5usize, 9, 15] {
+        let x: Vec<f64> = (0..n).map(|i| i as f64 - (n as f64 - 1.0) / 2.0).collect();
+        let rep = solve(&x, &vec![1.0; n], None, &SolveOptions::default()).unwrap();
+        assert!(rep.converged);
+        let mid = n / 2;
+        assert!(rep.y[mid].abs() < 1e-9, "the middle bird leads");
+        for i in 0..n {
+            assert!(
+                (rep.y[i] - rep.y[n - 1 - i]).abs() < 1e-7,
+                "mirror symmetric"
+            );
+        }
+        for i in mid..n - 1 {
+            assert!(rep.y[i + 1] > rep.y[i], "further out is further back");
+        }
+        // U, not V: depth grows faster than linearly towards the tips.
+        let d1 = rep.y[mid + 1] - rep.y[mid];
+        let d_last = rep.y[n - 1] - rep.y[n - 2];
+        assert!(
+            d_last > 2.0 * d1,
+            "U: {d1} at the centre, {d_last} at the tip"
+        );
+        for v in &rep.xi {
+            assert!((v - 1.0 / n as f64).abs() < 1e-9);
+        }
+    }
+}
+
+#[test]
+fn targets_are_renormalised() {
+    let (x, y) = v_shape(&[1.0, 1.1], &[1.0, 1.2], &[0.5, 0.6], &[0.4, 0.7]);
+    let xi = power_reduction(&x, &y).unwrap().xi;
+    let scaled: Vec<f64> = xi.iter().map(|v| v * 7.5).collect();
+    let rep = solve(&x, &scaled, None, &SolveOptions::default()).unwrap();
+    assert!(rep.converged);
+    assert!((rep.target.iter().sum::<f64>() - 1.0).abs() < 1e-15);
+}
+
+#[test]
+fn unreachable_targets_name_the_birds() {
+    // The leader of a 5-bird line abreast asking for 60 % of the savings: only possible if the
+    // others flew infinitely far ahead, and more than that is impossible.
+    let x = [-2.0, -1.0, 0.0, 1.0, 2.0];
+    let err = solve(
+        &x,
+        &[0.1, 0.1, 0.6, 0.1, 0.1],
+        None,
+        &SolveOptions::default(),
+    )
+    .unwrap_err();
+    assert!(matches!(err, Error::Unreachable(_)), "{err}");
+    let msg = err.to_string();
+    assert!(msg.contains("bird 2") || msg.contains("birds 2"), "{msg}");
+    assert_eq!(err.exit_code(), 2);
+}
+
+#[test]
+fn bad_inputs_are_typed_errors() {
+    let o = SolveOptions::default();
+    assert!(solve(&[0.0], &[1.0], None, &o).is_err());
+    assert!(solve(&[0.0, 1.0], &[1.0], None, &o).is_err());
+    assert!(solve(&[0.0, 1.0], &[1.0, -0.5], None, &o).is_err());
+    assert!(solve(&[0.0, 1.0], &[0.0, 0.0], None, &o).is_err());
+    assert!(solve(&[0.0, 1.0], &[f64::NAN, 0.5], None, &o).is_err());
+    assert!(solve(&[0.0, 0.5], &[0.5, 0.5], None, &o).is_err());
+    assert!(solve(&[0.0, 1.0], &[0.5, 0.5], Some(&[0.0]), &o).is_err());
+}
