@@ -208,3 +208,45 @@ fn write_fixtures() {
         formation::io::write_json_atomic(&dir.join(name), &p).unwrap();
     }
 }
+
+/// Odd movies: an echelon (leader at the left end, a line), a 2-bird movie, two animated birds,
+/// no positions, zero deviations and a mean gap inside the downwash (a wrong scale).
+#[test]
+fn odd_movies_still_give_valid_flights() {
+    use formation::extract::params::ShapeModel;
+    let mut echelon = steady_support::v9();
+    for f in &mut echelon.frames {
+        f.leader = 0;
+        f.shape = ShapeModel::Line {
+            intercept: 0.0,
+            slope: 0.6,
+        };
+        f.outliers.clear();
+        f.inliers = (0..9).collect();
+        f.positions.clear();
+    }
+    let mut two = steady_support::v9();
+    for f in &mut two.frames {
+        f.order = vec![3, 4];
+        f.outliers.clear();
+        f.inliers = vec![3, 4];
+    }
+    let mut tiny = steady_support::v9();
+    for f in &mut tiny.frames {
+        f.mu_x = 0.3;
+        f.sigma_x = 0.0;
+        f.sigma_y = 0.0;
+    }
+    for p in [&echelon, &two, &tiny] {
+        for birds in [2, 3, 17] {
+            let opts = SteadyOptions {
+                birds,
+                frames: 121,
+                key_every_s: 1.0,
+                ..SteadyOptions::default()
+            };
+            let (anim, rep) = steady_flight_report(p, &opts, &mut seeded(2), &Silent).unwrap();
+            check(&anim, &rep, &opts);
+        }
+    }
+}

@@ -139,9 +139,17 @@ fn match_side(
             ((r as f64) * ((slots - 1) as f64) / ((k - 1) as f64)).round() as usize
         };
         match nearest_free(&out, target) {
-            Some(s) => out[s] = Some(ids[r]),
+            Some(s) => out[s] = Some(r),
             None => dropped.push(ids[r]),
         }
+    }
+    // Collisions can swap neighbours; keep the movie's lateral order on the occupied slots (the
+    // priority decided which birds survive and which slots they occupy, not their order).
+    let mut ranks: Vec<usize> = out.iter().flatten().copied().collect();
+    ranks.sort_unstable();
+    let mut ranks = ranks.into_iter();
+    for slot in out.iter_mut().filter(|s| s.is_some()) {
+        *slot = ranks.next().map(|r| ids[r]);
     }
     out
 }
@@ -384,6 +392,33 @@ mod tests {
         // With only the two ends of each side left, closest and farthest win over the outlier.
         let c = correspondence(&f, 5).unwrap();
         assert_eq!(matched(&c), vec![0, 2, 3, 4, 8]);
+    }
+
+    proptest::proptest! {
+        #[test]
+        fn correspondence_is_a_partial_bijection(
+            n_hat in 2usize..30,
+            n in 2usize..60,
+            lead_frac in 0.0f64..1.0,
+            out_mask in proptest::collection::vec(proptest::bool::weighted(0.2), 30),
+        ) {
+            let lead = ((n_hat - 1) as f64 * lead_frac).round() as usize;
+            let outliers: Vec<usize> = (0..n_hat).filter(|&i| i != lead && out_mask[i]).collect();
+            let f = frame((0..n_hat).collect(), lead, outliers);
+            let c = correspondence(&f, n).unwrap();
+            proptest::prop_assert_eq!(c.movie.len(), n);
+            proptest::prop_assert_eq!(c.movie[c.leader], Some(lead));
+            let m = matched(&c);
+            let mut all: Vec<usize> = m.iter().chain(&c.dropped).copied().collect();
+            all.sort_unstable();
+            proptest::prop_assert_eq!(all, (0..n_hat).collect::<Vec<_>>(), "each movie bird once");
+            proptest::prop_assert!(c.dropped.len() == n_hat.saturating_sub(n) || n < n_hat);
+            if n >= n_hat {
+                proptest::prop_assert!(c.dropped.is_empty());
+            }
+            // Movie side order is kept: matched ids increase left to right.
+            proptest::prop_assert!(c.movie.iter().flatten().collect::<Vec<_>>().windows(2).all(|w| w[0] < w[1]));
+        }
     }
 
     #[test]
