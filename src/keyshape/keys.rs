@@ -1,13 +1,13 @@
 //! §5 step 3: new key shapes. Each key k draws relative power reductions ξ̂_k by eq. (2) inside the
 //! birds' feasible ranges and near ξ̂_{k−1}, and places the birds fore and aft by the
-//! Levenberg–Marquardt solve of eq. (4) ([`crate::keyshape::solve`]) with the lateral positions
+//! Levenberg–Marquardt solve of eq. (4) ([`crate::keyshape::solve()`]) with the lateral positions
 //! fixed. Formation frame, wingspans; ξ dimensionless.
 //!
 //! ```math
 //! \hat\xi_{i,k} \in [(1-\varepsilon)\,p_i,\ (1+\varepsilon)\,P_i] \cap [C_1\,\hat\xi_{i,k-1},\ C_2\,\hat\xi_{i,k-1}]
 //! \qquad \text{(Klotsman \& Tal, eq. 2)}
 //! ```
-//! (`p_i, P_i` = [`XiRanges`], `ε, C_1, C_2` = [`KeyOptions::epsilon`, `c1`, `c2`]).
+//! (`p_i, P_i` = [`XiRanges`]; `ε, C_1, C_2` = [`KeyOptions`] `epsilon`, `c1`, `c2`).
 //! Munk's stagger theorem fixes E = Σ e_i by the lateral positions alone, so eq. (3)–(4) reduce to
 //! ξ(x, y) = ξ̂ with Σ ξ̂ = 1: a draw is renormalised, clipped back into its range and renormalised
 //! again, which keeps the system consistent.
