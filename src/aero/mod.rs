@@ -225,8 +225,23 @@ pub fn power_reduction(x: &[f64], y: &[f64]) -> Result<PowerReduction> {
 
 /// e_i without validation (the caller guarantees N ≥ 2, finite values, no downwash pair).
 pub fn power_unchecked(x: &[f64], y: &[f64]) -> Vec<f64> {
+    let mut e = vec![0.0; x.len()];
+    accumulate(x, y, &mut e, None);
+    e
+}
+
+/// e_i and the Jacobian ∂e_i/∂y_k (row-major N×N, see [`power_jacobian_unchecked`]) in one pass
+/// over the pairs, which share their square roots. No validation.
+pub fn power_and_jacobian_unchecked(x: &[f64], y: &[f64]) -> (Vec<f64>, Vec<f64>) {
     let n = x.len();
     let mut e = vec![0.0; n];
+    let mut jac = vec![0.0; n * n];
+    accumulate(x, y, &mut e, Some(&mut jac));
+    (e, jac)
+}
+
+fn accumulate(x: &[f64], y: &[f64], e: &mut [f64], mut jac: Option<&mut [f64]>) {
+    let n = x.len();
     for i in 0..n {
         for j in (i + 1)..n {
             let dx = (x[i] - x[j]).abs();
@@ -241,12 +256,18 @@ pub fn power_unchecked(x: &[f64], y: &[f64]) -> Vec<f64> {
                 e[i] += front;
                 e[j] += back;
             }
+            if let Some(jac) = jac.as_deref_mut() {
+                let s = TWO_OVER_PI2 * p.slope;
+                jac[i * n + j] = -s;
+                jac[j * n + i] = -s;
+                jac[i * n + i] += s;
+                jac[j * n + j] += s;
+            }
         }
     }
-    for v in &mut e {
+    for v in e.iter_mut() {
         *v *= TWO_OVER_PI2;
     }
-    e
 }
 
 /// E from the lateral positions only (Munk's stagger theorem): Σ over pairs of 2·g(|Δx|, 0).

@@ -10,7 +10,8 @@
 //! it is computed once ([`crate::aero::munk_total`]) and the targets are renormalised to Σξ̂ = 1.
 //! Unknowns: the N − 1 longitudinal positions of every bird but one (held fixed, since only
 //! differences matter); residuals: r_i = ξ_i(y) − ξ̂_i for all N birds; Jacobian
-//! ∂r_i/∂y_k = (1/E)·∂e_i/∂y_k from [`crate::aero::power_jacobian_unchecked`].
+//! ∂r_i/∂y_k = (1/E)·∂e_i/∂y_k, computed with e in one pass over the pairs
+//! ([`crate::aero::power_and_jacobian_unchecked`]).
 //!
 //! e(y) is the gradient of the convex potential Σ_{i<j} G(x_ij, y_i − y_j) with ∂G/∂y = g, so
 //! the system has a solution (unique up to a common shift) exactly when ξ̂·E lies in the interior
@@ -91,12 +92,14 @@ struct KeyShapeProblem<'a> {
     y: Vec<f64>,
     /// e_i at `y`.
     e: Vec<f64>,
+    /// ∂e_i/∂y_k at `y`, row-major N×N (computed with `e`: the pairs share their square roots).
+    jac: Vec<f64>,
 }
 
 impl<'a> KeyShapeProblem<'a> {
     fn new(x: &'a [f64], target: &'a [f64], total: f64, y0: &[f64], fixed: usize) -> Self {
         let y = y0.to_vec();
-        let e = aero::power_unchecked(x, &y);
+        let (e, jac) = aero::power_and_jacobian_unchecked(x, &y);
         KeyShapeProblem {
             x,
             target,
@@ -104,6 +107,7 @@ impl<'a> KeyShapeProblem<'a> {
             fixed,
             y,
             e,
+            jac,
         }
     }
 
@@ -127,7 +131,7 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for KeyShapeProblem<'_> {
             let b = self.bird(k);
             self.y[b] = p[k];
         }
-        self.e = aero::power_unchecked(self.x, &self.y);
+        (self.e, self.jac) = aero::power_and_jacobian_unchecked(self.x, &self.y);
     }
 
     fn params(&self) -> DVector<f64> {
@@ -148,9 +152,8 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for KeyShapeProblem<'_> {
 
     fn jacobian(&self) -> Option<DMatrix<f64>> {
         let n = self.y.len();
-        let full = aero::power_jacobian_unchecked(self.x, &self.y);
         let inv = 1.0 / self.total;
-        let jac = DMatrix::from_fn(n, n - 1, |i, k| full[i * n + self.bird(k)] * inv);
+        let jac = DMatrix::from_fn(n, n - 1, |i, k| self.jac[i * n + self.bird(k)] * inv);
         jac.iter().all(|v| v.is_finite()).then_some(jac)
     }
 }
@@ -344,18 +347,16 @@ pub fn solve_symmetric(
         .unwrap_or(0);
     let free: Vec<usize> = (0..n).filter(|&i| i != fixed).collect();
     let m = free.len();
-    let residuals = |y: &[f64]| -> Vec<f64> {
-        aero::power_unchecked(x, y)
-            .iter()
-            .zip(target)
-            .map(|(e, t)| e / total - t)
-            .collect()
+    let evaluate = |y: &[f64]| -> (Vec<f64>, Vec<f64>) {
+        let (e, jac) = aero::power_and_jacobian_unchecked(x, y);
+        let r = e.iter().zip(target).map(|(e, t)| e / total - t).collect();
+        (r, jac)
     };
     // Merit: the free birds' residuals (the fixed bird's is minus their sum, since Σξ = Σξ̂ = 1);
     // in this norm the damped step is a descent direction for every λ.
     let merit = |r: &[f64]| -> f64 { free.iter().map(|&i| r[i] * r[i]).sum::<f64>().sqrt() };
     let mut y = y0.to_vec();
-    let mut r = residuals(&y);
+    let (mut r, mut full) = evaluate(&y);
     let mut norm = merit(&r);
     let mut evaluations = 1;
     let mut lambda = 1e-3;
@@ -366,7 +367,6 @@ pub fn solve_symmetric(
             why = "residual below tolerance";
             break;
         }
-        let full = aero::power_jacobian_unchecked(x, &y);
         let inv = 1.0 / total;
         let jac = DMatrix::from_fn(m, m, |a, b| full[free[a] * n + free[b]] * inv);
         let mean_diag = (0..m).map(|a| jac[(a, a)]).sum::<f64>() / m as f64;
@@ -389,12 +389,13 @@ pub fn solve_symmetric(
             for (a, &i) in free.iter().enumerate() {
                 trial[i] += step[a];
             }
-            let tr = residuals(&trial);
+            let (tr, tjac) = evaluate(&trial);
             evaluations += 1;
             let tnorm = merit(&tr);
             if tnorm.is_finite() && tnorm < norm {
                 y = trial;
                 r = tr;
+                full = tjac;
                 norm = tnorm;
                 lambda = (lambda / 10.0).max(1e-15);
                 break;
