@@ -193,7 +193,7 @@ fn the_drawn_birds_are_inside_the_picture_and_dark_against_the_sky() {
     let mut canvas = formation::export::raster::Canvas::new(320, 180);
     let mut mask = formation::export::raster::Mask::new();
     for k in 0..film.len() {
-        film.draw(k, &mut canvas, &mut mask);
+        film.draw(k, &mut canvas, &mut mask, false);
         let mut dark = 0;
         for y in 0..180 {
             for x in 0..320 {
@@ -301,4 +301,58 @@ fn write_demo_animation() {
     };
     let anim = synthetic_flock(&mut formation::rng::seeded(0), &SyntheticParams::default());
     formation::io::write_json_atomic(Path::new(&path), &anim).unwrap();
+}
+
+/// Decodes frame `$FORMATION_GIF_FRAME` of `$FORMATION_GIF` into `$FORMATION_GIF.png`, to look
+/// at what the fixed palette makes of a picture.
+#[test]
+#[ignore]
+fn dump_gif_frame() {
+    let (Ok(path), Ok(k)) = (
+        std::env::var("FORMATION_GIF"),
+        std::env::var("FORMATION_GIF_FRAME"),
+    ) else {
+        return;
+    };
+    let f = std::fs::File::open(&path).unwrap();
+    let dec = image::codecs::gif::GifDecoder::new(std::io::BufReader::new(f)).unwrap();
+    let k: usize = k.parse().unwrap();
+    let frame = image::AnimationDecoder::into_frames(dec)
+        .nth(k)
+        .unwrap()
+        .unwrap();
+    frame.into_buffer().save(format!("{path}.png")).unwrap();
+}
+
+#[test]
+fn gif_frames_decode_to_exactly_the_drawn_pictures() {
+    // Frames after the first store only changed pixels; decoding must rebuild every picture.
+    let anim = flock(2.0, 20.0);
+    let d = tmpdir("exact");
+    let gif = d.join("a.gif");
+    write_outputs(&anim, std::slice::from_ref(&gif), &small(), &Silent).unwrap();
+    let dec = image::codecs::gif::GifDecoder::new(std::io::BufReader::new(
+        std::fs::File::open(&gif).unwrap(),
+    ))
+    .unwrap();
+    let frames = image::AnimationDecoder::into_frames(dec)
+        .collect_frames()
+        .unwrap();
+    let film = Film::new(&anim, 25.0, 240, 136);
+    let palette = film.palette();
+    let mut lookup = formation::export::palette::Lookup::new(&palette);
+    let mut canvas = formation::export::raster::Canvas::new(240, 136);
+    let mut mask = formation::export::raster::Mask::new();
+    let mut idx = Vec::new();
+    for k in [0, 1, 2, 17, film.len() - 1] {
+        film.draw(k, &mut canvas, &mut mask, true);
+        lookup.map_image(&canvas.rgb, &mut idx);
+        let got = frames[k].buffer();
+        for (i, &p) in idx.iter().enumerate() {
+            let want = palette.colours[p as usize];
+            let g = got.as_raw();
+            assert_eq!(&g[i * 4..i * 4 + 3], &want, "frame {k} pixel {i}");
+        }
+    }
+    std::fs::remove_dir_all(&d).unwrap();
 }

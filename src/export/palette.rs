@@ -3,13 +3,18 @@
 //! The palette is built once per render from the [`Style`]: it knows which colours a picture can
 //! contain (sky gradient, clouds blended over the sky, birds and their anti-aliased edges over sky
 //! and cloud), so it spends its entries there instead of quantising every frame (no NeuQuant).
+//! Cloud gradients are dithered by the renderer (see [`super::scene::Backdrop::paint`]).
 //! Lookups go through a table indexed by the colour's top 6 bits per channel, filled lazily with
 //! the nearest palette entry (perceptually weighted squared RGB distance), which makes mapping a
 //! 960×540 frame a few milliseconds and the result independent of frame order and thread count.
 
 use super::scene::Style;
 
-/// A palette of up to 256 RGB colours.
+/// Palette index reserved for "unchanged since the previous frame" (GIF transparency); the
+/// colours are entries `0..TRANSPARENT`.
+pub const TRANSPARENT: u8 = 255;
+
+/// A palette of 256 RGB colours, the last one reserved ([`TRANSPARENT`]).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Palette {
     /// The colours.
@@ -29,18 +34,18 @@ impl Palette {
     pub fn for_style(style: &Style) -> Palette {
         let mut c: Vec<[u8; 3]> = Vec::with_capacity(256);
         let sky = |v: f32| style.sky(v);
-        // 107 steps of the sky gradient (the rest of the table): about 1.5 levels per channel.
-        const SKY: usize = 107;
+        // 68 steps of the sky gradient (the rest of the table): about 2 levels per channel.
+        const SKY: usize = 68;
         for k in 0..SKY {
             let s = sky(k as f32 / (SKY - 1) as f32);
             c.push(mix(s, s, 0.0));
         }
-        // Clouds over the sky: 10 heights × 7 opacities.
+        // Clouds over the sky: 12 heights × 9 opacities.
         let cloud = f(style.cloud);
-        for k in 0..10 {
-            let s = sky(k as f32 / 9.0);
-            for a in 1..=7 {
-                c.push(mix(s, cloud, style.cloud_opacity * a as f32 / 7.0));
+        for k in 0..12 {
+            let s = sky(k as f32 / 11.0);
+            for a in 1..=9 {
+                c.push(mix(s, cloud, style.cloud_opacity * a as f32 / 9.0));
             }
         }
         // Birds: both tones solid and their shading in between.
@@ -66,7 +71,8 @@ impl Palette {
                 c.push(mix(s, wing, a));
             }
         }
-        c.truncate(256);
+        debug_assert_eq!(c.len(), TRANSPARENT as usize);
+        c.truncate(TRANSPARENT as usize);
         while c.len() < 256 {
             c.push([0, 0, 0]);
         }
@@ -102,7 +108,10 @@ impl<'a> Lookup<'a> {
         let g = (((cell >> 6) & 63) << 2 | 2) as i32;
         let b = ((cell & 63) << 2 | 2) as i32;
         let mut best = (i32::MAX, 0u8);
-        for (i, p) in self.palette.colours.iter().enumerate() {
+        for (i, p) in self.palette.colours[..TRANSPARENT as usize]
+            .iter()
+            .enumerate()
+        {
             let (dr, dg, db) = (r - p[0] as i32, g - p[1] as i32, b - p[2] as i32);
             let d = 3 * dr * dr + 4 * dg * dg + 2 * db * db;
             if d < best.0 {

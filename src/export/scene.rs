@@ -64,6 +64,14 @@ impl Style {
     }
 }
 
+/// 4×4 Bayer matrix, centred: values in −8..8.
+const BAYER: [[i32; 4]; 4] = [
+    [-8, 0, -6, 2],
+    [4, -4, 6, -2],
+    [-5, 3, -7, 1],
+    [7, -1, 5, -3],
+];
+
 /// Side of the square, tileable cloud texture, cells (a power of two).
 const TEX: usize = 256;
 
@@ -133,7 +141,7 @@ impl Backdrop {
                 }
                 let n = n / total;
                 // Puffy clouds over roughly a third of the sky, soft edges.
-                let t = ((n - 0.46) / 0.13).clamp(0.0, 1.0);
+                let t = ((n - 0.53) / 0.12).clamp(0.0, 1.0);
                 let a = t * t * (3.0 - 2.0 * t);
                 clouds[y * TEX + x] = (a * 255.0 + 0.5) as u8;
             }
@@ -152,8 +160,12 @@ impl Backdrop {
         &self.style
     }
 
-    /// Paints sky and clouds for the camera `view` into `canvas`.
-    pub fn paint(&self, view: &View, canvas: &mut Canvas) {
+    /// Paints sky and clouds for the camera `view` into `canvas`. With `dither`, cloud opacity
+    /// gets a 4×4 ordered (Bayer) dither of about one palette step, so that the GIF's fixed
+    /// palette shows soft clouds instead of contour bands, and the sky a fixed ±3-level dither
+    /// against banding (fixed on screen like the gradient, so it stays identical from frame to
+    /// frame and costs nothing after the first frame).
+    pub fn paint(&self, view: &View, canvas: &mut Canvas, dither: bool) {
         let (w, h) = (self.width, self.height);
         debug_assert_eq!(canvas.width, w);
         let st = &self.style;
@@ -177,17 +189,24 @@ impl Backdrop {
             let row0 = &self.clouds[y0 * TEX..(y0 + 1) * TEX];
             let row1 = &self.clouds[y1 * TEX..(y1 + 1) * TEX];
             let line = &mut canvas.rgb[r * w * 3..(r + 1) * w * 3];
+            let bayer = &BAYER[r & 3];
             let mut tx = ox;
-            for px in line.chunks_exact_mut(3) {
+            for (col, px) in line.chunks_exact_mut(3).enumerate() {
                 let txw = tx.rem_euclid(mask);
                 let (x0, fx) = ((txw >> 16) as usize, (txw & 0xFFFF) as i32 >> 8);
                 let x1 = (x0 + 1) & (TEX - 1);
                 let a0 = row0[x0] as i32 * (256 - fx) + row0[x1] as i32 * fx;
                 let a1 = row1[x0] as i32 * (256 - fx) + row1[x1] as i32 * fx;
                 // Opacity in 1/256 units.
-                let a = (((a0 * (256 - fy) + a1 * fy) >> 16) * amax) >> 8;
+                let mut a = (((a0 * (256 - fy) + a1 * fy) >> 16) * amax) >> 8;
+                if dither && a > 0 {
+                    // ±half a palette opacity step (the palette has 9 opacity levels).
+                    a = (a + bayer[col & 3] * amax / (9 * 16)).clamp(0, 256);
+                }
+                // Sky dither: ±3 levels, fixed on screen like the gradient itself.
+                let sd = if dither { bayer[col & 3] * 96 } else { 0 };
                 for k in 0..3 {
-                    let s = sky_i[k];
+                    let s = sky_i[k] + sd;
                     let v = s + ((((cloud[k] << 8) - s) * a) >> 8);
                     px[k] = ((v + 128) >> 8).clamp(0, 255) as u8;
                 }
@@ -263,7 +282,7 @@ mod tests {
             cy: 0.0,
             scale: 60.0,
         };
-        bd.paint(&view, &mut c);
+        bd.paint(&view, &mut c, false);
         let before = c.clone();
         let bird = BirdState {
             pose: crate::wingbeat::WingPose {
