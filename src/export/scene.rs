@@ -179,24 +179,36 @@ impl Backdrop {
         let oy = (oy.rem_euclid(TEX as f64) * 65536.0) as i64;
         let cloud = st.cloud.map(|c| c as i32);
         let amax = (st.cloud_opacity.clamp(0.0, 1.0) * 256.0) as i32;
-        let mask = (TEX as i64) << 16;
+        // Texture coordinates wrap at TEX cells = 2^24 in 16.16 fixed point.
+        const WRAP: u32 = ((TEX as u32) << 16) - 1;
+        let step = step.clamp(0, WRAP as i64) as u32;
         for r in 0..h {
-            let sky = self.sky_rows[r];
-            let sky_i = sky.map(|c| (c * 256.0) as i32);
-            let ty = (oy + step * r as i64).rem_euclid(mask);
-            let (y0, fy) = ((ty >> 16) as usize, (ty & 0xFFFF) as i32 >> 8);
+            let sky_i = self.sky_rows[r].map(|c| (c * 256.0) as i32);
+            let ty = ((oy + step as i64 * r as i64).rem_euclid(WRAP as i64 + 1)) as u32;
+            let (y0, fy) = ((ty >> 16) as usize, ((ty & 0xFFFF) >> 8) as i32);
             let y1 = (y0 + 1) & (TEX - 1);
             let row0 = &self.clouds[y0 * TEX..(y0 + 1) * TEX];
             let row1 = &self.clouds[y1 * TEX..(y1 + 1) * TEX];
             let line = &mut canvas.rgb[r * w * 3..(r + 1) * w * 3];
             let bayer = &BAYER[r & 3];
-            let mut tx = ox;
+            // Clear-sky pixels of this row, one per dither column.
+            let clear: [[u8; 3]; 4] = std::array::from_fn(|c| {
+                let sd = if dither { bayer[c] * 96 } else { 0 };
+                sky_i.map(|s| ((s + sd + 128) >> 8).clamp(0, 255) as u8)
+            });
+            let mut tx = ox as u32;
             for (col, px) in line.chunks_exact_mut(3).enumerate() {
-                let txw = tx.rem_euclid(mask);
-                let (x0, fx) = ((txw >> 16) as usize, (txw & 0xFFFF) as i32 >> 8);
+                let x0 = ((tx & WRAP) >> 16) as usize;
                 let x1 = (x0 + 1) & (TEX - 1);
-                let a0 = row0[x0] as i32 * (256 - fx) + row0[x1] as i32 * fx;
-                let a1 = row1[x0] as i32 * (256 - fx) + row1[x1] as i32 * fx;
+                let (c00, c01, c10, c11) = (row0[x0], row0[x1], row1[x0], row1[x1]);
+                tx = tx.wrapping_add(step);
+                if c00 | c01 | c10 | c11 == 0 {
+                    px.copy_from_slice(&clear[col & 3]);
+                    continue;
+                }
+                let fx = (((tx.wrapping_sub(step)) & 0xFFFF) >> 8) as i32;
+                let a0 = c00 as i32 * (256 - fx) + c01 as i32 * fx;
+                let a1 = c10 as i32 * (256 - fx) + c11 as i32 * fx;
                 // Opacity in 1/256 units.
                 let mut a = (((a0 * (256 - fy) + a1 * fy) >> 16) * amax) >> 8;
                 if dither && a > 0 {
@@ -210,7 +222,6 @@ impl Backdrop {
                     let v = s + ((((cloud[k] << 8) - s) * a) >> 8);
                     px[k] = ((v + 128) >> 8).clamp(0, 255) as u8;
                 }
-                tx += step;
             }
         }
     }
