@@ -53,7 +53,7 @@ impl Default for CameraParams {
         CameraParams {
             margin: 0.07,
             min_extent: 9.0,
-            smoothing_s: 0.8,
+            smoothing_s: 0.6,
         }
     }
 }
@@ -108,7 +108,7 @@ pub fn track(
         return Vec::new();
     }
     let sigma = (p.smoothing_s * fps).max(0.5);
-    let half = ((2.5 * sigma).ceil() as usize).min(n.max(1));
+    let half = ((2.0 * sigma).ceil() as usize).min(n.max(1));
     let kernel = gaussian(sigma, half);
     let bbox: Vec<(f64, f64, f64, f64)> = states
         .iter()
