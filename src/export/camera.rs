@@ -209,4 +209,40 @@ mod tests {
             }
         }
     }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(24))]
+        /// Any flock, any motion, any picture shape: every bird stays inside with the margin.
+        #[test]
+        fn containment_holds_for_random_flocks(
+            seed in 0u64..1000,
+            birds in 1usize..20,
+            frames in 1usize..80,
+            w in 32usize..1200,
+            h in 32usize..900,
+            spread in 0.0f64..60.0,
+        ) {
+            use rand::Rng;
+            let mut rng = crate::rng::seeded(seed);
+            let mut pos: Vec<(f64, f64)> = (0..birds).map(|_| (rng.random_range(-spread..=spread), rng.random_range(-spread..=spread))).collect();
+            let mut states = Vec::new();
+            for _ in 0..frames {
+                for p in pos.iter_mut() {
+                    p.0 += rng.random_range(-1.0..1.0);
+                    p.1 += rng.random_range(-0.5..2.0);
+                }
+                states.push(pos.iter().map(|&(x, y)| BirdState { x, y, ..Default::default() }).collect::<Vec<_>>());
+            }
+            let views = track(&states, 25.0, w, h, &CameraParams::default());
+            let m = 0.07 * w.min(h) as f64;
+            for (s, v) in states.iter().zip(&views) {
+                for b in s {
+                    let (px, py) = v.to_pixel(b.x, b.y, w, h);
+                    let r = BIRD_RADIUS * v.scale;
+                    proptest::prop_assert!(px - r >= m - 1e-6 && px + r <= w as f64 - m + 1e-6);
+                    proptest::prop_assert!(py - r >= m - 1e-6 && py + r <= h as f64 - m + 1e-6);
+                }
+            }
+        }
+    }
 }

@@ -127,13 +127,42 @@ impl Mask {
             for i in 0..n {
                 let a = c[i];
                 let b = c[(i + 1) % n];
-                // Clamping x to the box keeps the accumulated area of everything inside it exact.
-                let p0 = [(a[0] - fx).clamp(0.0, wmax), a[1] - fy];
-                let p1 = [(b[0] - fx).clamp(0.0, wmax), b[1] - fy];
-                self.line(p0, p1);
+                self.clipped_line([a[0] - fx, a[1] - fy], [b[0] - fx, b[1] - fy], wmax);
             }
         }
         true
+    }
+
+    /// Splits an edge where it crosses the box's left or right side; pieces outside are pressed
+    /// flat onto that side (a vertical edge there adds the same area to every pixel to its right,
+    /// or none), which keeps the coverage inside the box exact.
+    fn clipped_line(&mut self, p0: [f32; 2], p1: [f32; 2], wmax: f32) {
+        let mut cuts = [0.0f32, 1.0, 1.0, 1.0];
+        let mut n = 1;
+        let dx = p1[0] - p0[0];
+        if dx != 0.0 {
+            for edge in [0.0, wmax] {
+                let t = (edge - p0[0]) / dx;
+                if t > 0.0 && t < 1.0 {
+                    cuts[n] = t;
+                    n += 1;
+                }
+            }
+        }
+        cuts[n] = 1.0;
+        cuts[1..n].sort_by(f32::total_cmp);
+        let at = |t: f32| {
+            let x = if t == 1.0 { p1[0] } else { p0[0] + dx * t };
+            let y = if t == 1.0 {
+                p1[1]
+            } else {
+                p0[1] + (p1[1] - p0[1]) * t
+            };
+            [x.clamp(0.0, wmax), y]
+        };
+        for k in 0..n {
+            self.line(at(cuts[k]), at(cuts[k + 1]));
+        }
     }
 
     fn line(&mut self, p0: [f32; 2], p1: [f32; 2]) {
@@ -159,12 +188,14 @@ impl Mask {
             let xnext = x + dxdy * dy;
             let d = dy * dir;
             let (xa, xb) = if x < xnext { (x, xnext) } else { (xnext, x) };
+            // Rounding can leave an end a hair below 0; the cell maths needs xa ≥ 0.
+            let (xa, xb) = (xa.max(0.0), xb.max(0.0));
             let xa_floor = xa.floor();
             let xai = xa_floor.max(0.0) as usize;
             let xb_ceil = xb.ceil();
             let xbi = xb_ceil.max(0.0) as usize;
             if xbi <= xai + 1 {
-                let xmf = 0.5 * (x + xnext) - xa_floor;
+                let xmf = 0.5 * (xa + xb) - xa_floor;
                 self.cells[line + xai] += d - d * xmf;
                 self.cells[line + xai + 1] += d * xmf;
             } else {
@@ -246,5 +277,43 @@ mod tests {
         assert_eq!(&c.rgb[0..3], &[255; 3]);
         assert_eq!(&c.rgb[(4 * 5 + 1) * 3..(4 * 5 + 1) * 3 + 3], &[255; 3]);
         assert_eq!(&c.rgb[(4 * 5 + 2) * 3..(4 * 5 + 2) * 3 + 3], &[0; 3]);
+    }
+
+    proptest::proptest! {
+        /// Coverage of any triangle, even partly off the image, sums to its visible area.
+        #[test]
+        fn coverage_is_exact_for_random_triangles(
+            pts in proptest::collection::vec((-4.0f32..20.0, -4.0f32..20.0), 3)
+        ) {
+            let tri: Vec<[f32; 2]> = pts.iter().map(|&(x, y)| [x, y]).collect();
+            let mut m = Mask::new();
+            let total: f32 = if m.accumulate(&[tri.clone()], 16, 16) {
+                (0..16).flat_map(|y| (0..16).map(move |x| (x, y))).map(|(x, y)| m.coverage(x, y)).sum()
+            } else {
+                0.0
+            };
+            // Reference: Sutherland–Hodgman clip to the image square, then the shoelace area.
+            let mut poly = tri.clone();
+            for (axis, bound, keep_below) in [(0, 0.0f32, false), (0, 16.0, true), (1, 0.0, false), (1, 16.0, true)] {
+                let inside = |p: &[f32; 2]| if keep_below { p[axis] <= bound } else { p[axis] >= bound };
+                let mut out = Vec::new();
+                for i in 0..poly.len() {
+                    let (a, b) = (poly[i], poly[(i + 1) % poly.len()]);
+                    if inside(&a) {
+                        out.push(a);
+                    }
+                    if inside(&a) != inside(&b) {
+                        let t = (bound - a[axis]) / (b[axis] - a[axis]);
+                        out.push([a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t]);
+                    }
+                }
+                poly = out;
+                if poly.is_empty() {
+                    break;
+                }
+            }
+            let reference = if poly.len() < 3 { 0.0 } else { crate::export::rig::signed_area(&poly).abs() };
+            proptest::prop_assert!((total - reference).abs() < 2e-3 * reference.max(1.0), "{} vs {}", total, reference);
+        }
     }
 }
