@@ -287,7 +287,7 @@ mod tests {
         ) {
             let tri: Vec<[f32; 2]> = pts.iter().map(|&(x, y)| [x, y]).collect();
             let mut m = Mask::new();
-            let total: f32 = if m.accumulate(&[tri.clone()], 16, 16) {
+            let total: f32 = if m.accumulate(std::slice::from_ref(&tri), 16, 16) {
                 (0..16).flat_map(|y| (0..16).map(move |x| (x, y))).map(|(x, y)| m.coverage(x, y)).sum()
             } else {
                 0.0
