@@ -227,6 +227,14 @@ fn malformed_animation_exits_2_naming_the_file() {
     let out = formation(&["render", s(&bad), "-o", s(&out_gif)]);
     assert_usage_error(&out, &["bad.json", "fps"]);
     assert!(!out_gif.exists());
+    // Frame times that do not increase cannot be sampled or keyed.
+    let mut anim = formation::Animation::read(Path::new(FIXTURE)).unwrap();
+    anim.frames[3].t = anim.frames[2].t;
+    let stuck = d.join("stuck.json");
+    formation::io::write_json_atomic(&stuck, &anim).unwrap();
+    let out = formation(&["render", s(&stuck), "-o", s(&d.join("o.glb"))]);
+    assert_usage_error(&out, &["stuck.json", "frames[3].t"]);
+    assert!(!d.join("o.glb").exists());
     let out = formation(&["render", s(&d.join("missing.json")), "-o", s(&out_gif)]);
     assert_usage_error(&out, &["missing.json"]);
     std::fs::remove_dir_all(&d).unwrap();

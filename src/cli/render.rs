@@ -82,6 +82,7 @@ pub fn run(args: RenderArgs, g: Global) -> Result<()> {
     // Check the outputs before reading a possibly large animation.
     formation::export::plan_outputs(&args.output)?;
     let anim = Animation::read(&args.animation)?;
+    formation::export::sample::check_times(&anim, &args.animation)?;
     // `--seed` does not apply: rendering is deterministic, and the clouds take the animation's seed.
     let _ = g.seed;
     write_outputs(&anim, &args.output, &opts, &TermProgress::new(g.quiet))

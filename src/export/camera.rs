@@ -52,7 +52,7 @@ impl Default for CameraParams {
     fn default() -> Self {
         CameraParams {
             margin: 0.07,
-            min_extent: 9.0,
+            min_extent: 7.0,
             smoothing_s: 0.6,
         }
     }
