@@ -32,7 +32,7 @@ pub const ARM_FOLD: f32 = 0.5;
 /// Backward swing of the hand relative to the arm when the wing is fully folded, radians.
 pub const HAND_FOLD: f32 = 2.2;
 /// Radius of a disc around the bird's centre that contains every pose, wingspans.
-pub const BIRD_RADIUS: f64 = 0.55;
+pub const BIRD_RADIUS: f64 = 0.6;
 
 /// Body profile along the forward axis: `(z, half width, half height)`, wingspans, tail to bill
 /// (a goose: body about half the span long, long thin neck, small head).
@@ -279,15 +279,25 @@ mod tests {
 
     #[test]
     fn every_pose_fits_in_the_bird_radius() {
-        let pose = WingPose {
-            sweep: 0.5,
-            dihedral: -0.3,
-            spread: 1.0,
-            ..WingPose::default()
-        };
-        for o in top_view(&pose) {
-            for p in o {
-                assert!(((p[0] * p[0] + p[1] * p[1]).sqrt() as f64) < BIRD_RADIUS);
+        for sweep in [-1.2, -0.5, 0.0, 0.5, 1.2] {
+            for dihedral in [-1.0, 0.0, 1.0] {
+                for spread in [0.0, 0.5, 1.0] {
+                    let pose = WingPose {
+                        sweep,
+                        dihedral,
+                        hand_dihedral: -dihedral,
+                        arm_twist: 0.5,
+                        hand_twist: -0.5,
+                        spread,
+                        ..WingPose::default()
+                    };
+                    for o in top_view(&pose) {
+                        for p in o {
+                            let r = (p[0] * p[0] + p[1] * p[1]).sqrt() as f64;
+                            assert!(r < BIRD_RADIUS, "{pose:?}: {r}");
+                        }
+                    }
+                }
             }
         }
     }
