@@ -1,23 +1,89 @@
-//! `formation render`: outputs from an existing animation file (issue 6).
+//! `formation render`: outputs from an existing animation file (issue 6). Flags become a
+//! [`RenderOptions`]; everything else is [`formation::export::write_outputs`].
 
 use std::path::PathBuf;
 
 use clap::Args;
-use formation::Result;
+use formation::export::{write_outputs, RenderOptions};
+use formation::{Animation, Result};
 
+use super::progress::TermProgress;
 use super::Global;
 
 /// Arguments of `formation render`.
 #[derive(Debug, Args)]
 pub struct RenderArgs {
-    /// An animation file.
+    /// An animation file (SPEC §4.4).
     pub animation: PathBuf,
-    /// Outputs (.gif, DIR/, .glb, .csv, .json); may be repeated.
+    /// Outputs by extension: .gif, DIR/ (numbered PNG frames), .glb, .csv, .json; may be repeated.
     #[arg(short = 'o', long = "output", required = true)]
     pub output: Vec<PathBuf>,
+    #[command(flatten)]
+    pub picture: PictureArgs,
+}
+
+/// Picture and export flags shared by `render` and `animate`.
+#[derive(Debug, Clone, Args)]
+pub struct PictureArgs {
+    /// Picture size WIDTHxHEIGHT in pixels (GIF and PNG frames), each side 16..=7680.
+    #[arg(long, value_name = "WxH", default_value = "960x540", value_parser = parse_size)]
+    pub size: (u32, u32),
+    /// Frame rate of the pictures, frames per second [default: 25 for GIF (rounded to whole
+    /// 1/100 s per frame, at most 50), the animation's own rate for PNG frames]. JSON, CSV and glTF
+    /// keep the animation's frames.
+    #[arg(long, value_name = "FPS")]
+    pub fps: Option<f64>,
+    /// Bird wingspan in metres for the .glb (and recorded in the .json) [default: the
+    /// animation's, 1.5 for a goose].
+    #[arg(long, value_name = "M")]
+    pub wingspan_m: Option<f64>,
+}
+
+impl PictureArgs {
+    /// The library options for these flags.
+    pub fn options(&self) -> RenderOptions {
+        RenderOptions {
+            width: self.size.0,
+            height: self.size.1,
+            fps: self.fps,
+            wingspan_m: self.wingspan_m,
+            threads: 0,
+        }
+    }
+}
+
+/// Parses `960x540`.
+fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("expected WIDTHxHEIGHT like 960x540, got {s:?}"))?;
+    let parse = |v: &str| {
+        v.trim()
+            .parse::<u32>()
+            .map_err(|_| format!("expected WIDTHxHEIGHT like 960x540, got {s:?}"))
+    };
+    let (w, h) = (parse(w)?, parse(h)?);
+    let opts = RenderOptions {
+        width: w,
+        height: h,
+        ..RenderOptions::default()
+    };
+    opts.validate().map_err(|e| match e {
+        formation::Error::Parameter { message, .. } => message,
+        other => other.to_string(),
+    })?;
+    Ok((w, h))
 }
 
 /// Runs `formation render`.
-pub fn run(_args: RenderArgs, _g: Global) -> Result<()> {
-    Err(super::not_yet("render"))
+pub fn run(args: RenderArgs, g: Global) -> Result<()> {
+    let opts = args.picture.options();
+    opts.validate()?;
+    // Check the outputs before reading a possibly large animation.
+    formation::export::plan_outputs(&args.output)?;
+    let anim = Animation::read(&args.animation)?;
+    formation::export::sample::check_times(&anim, &args.animation)?;
+    // `--seed` does not apply: rendering is deterministic, and the clouds take the animation's seed.
+    let _ = g.seed;
+    write_outputs(&anim, &args.output, &opts, &TermProgress::new(g.quiet))
 }

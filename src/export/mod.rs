@@ -1,1 +1,301 @@
-//! Outputs of an animation: JSON, CSV, glTF (.glb), GIF and PNG frames (issue 6).
+//! Outputs of an animation (issue 6): the animation file (`.json`), the long CSV (`.csv`), an
+//! animated GIF (`.gif`), a directory of numbered PNG frames (`DIR/`) and a glTF 2.0 binary
+//! (`.glb`). [`write_outputs`] is the one entry point of `formation render` and
+//! `formation animate`: it checks every output path and option before doing any work, then writes
+//! each output atomically (no partial file on failure).
+//!
+//! Units: the animation is in wingspans (world frame `x` east, `y` north, `z` up); the `.glb` is in
+//! metres (`wingspan_m`) on glTF's Y-up axes (see [`gltf`]); the pictures are a top-down view,
+//! north up, that follows the flock (see [`camera`], [`scene`]).
+//!
+//! Frame rates: `.json`, `.csv` and `.glb` keep the animation's own frames. The GIF is sampled at
+//! [`pictures::GIF_FPS`] = 25 fps by default (GIF delays are whole 1/100 s); PNG frames at the
+//! animation's frame rate. [`RenderOptions::fps`] overrides both picture rates.
+
+pub mod camera;
+pub mod gltf;
+pub mod palette;
+pub mod pictures;
+pub mod raster;
+pub mod rig;
+pub mod sample;
+pub mod scene;
+pub mod synthetic;
+pub mod table;
+
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+
+use crate::animation::Animation;
+use crate::error::{Error, Result};
+use crate::io::{write_bytes_atomic, write_json_atomic, AtomicFile, OutputKind};
+use crate::progress::Progress;
+
+pub use pictures::{Film, GIF_FPS};
+
+/// Output kinds `render` and `animate` accept.
+pub const OUTPUT_KINDS: [OutputKind; 5] = [
+    OutputKind::Gif,
+    OutputKind::Directory,
+    OutputKind::Glb,
+    OutputKind::Csv,
+    OutputKind::Json,
+];
+
+/// Smallest image side, pixels.
+pub const MIN_SIDE: u32 = 16;
+/// Largest image side, pixels (8K UHD width; GIF itself allows 65535).
+pub const MAX_SIDE: u32 = 7680;
+/// Largest picture frame rate, frames per second.
+pub const MAX_FPS: f64 = 120.0;
+/// Largest GIF frame rate, frames per second: browsers slow down delays under 2/100 s.
+pub const MAX_GIF_FPS: f64 = 50.0;
+/// Largest number of picture frames one output may have.
+pub const MAX_FRAMES: usize = 200_000;
+
+/// How to render; every field is checked by [`RenderOptions::validate`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RenderOptions {
+    /// Picture width, pixels.
+    pub width: u32,
+    /// Picture height, pixels.
+    pub height: u32,
+    /// Frame rate of the pictures (GIF, PNG frames), frames per second; `None` = 25 for GIF, the
+    /// animation's own rate for PNG frames.
+    pub fps: Option<f64>,
+    /// Bird wingspan for the `.glb` and the written `.json`, metres; `None` = the animation's.
+    pub wingspan_m: Option<f64>,
+    /// Worker threads for pictures; 0 = one per core.
+    pub threads: usize,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        RenderOptions {
+            width: 960,
+            height: 540,
+            fps: None,
+            wingspan_m: None,
+            threads: 0,
+        }
+    }
+}
+
+impl RenderOptions {
+    /// Checks the size, frame rate and wingspan, naming the flag at fault.
+    pub fn validate(&self) -> Result<()> {
+        for (v, what) in [(self.width, "width"), (self.height, "height")] {
+            if !(MIN_SIDE..=MAX_SIDE).contains(&v) {
+                return Err(Error::parameter(
+                    "--size",
+                    format!("{what} {v} px is outside {MIN_SIDE}..={MAX_SIDE}; give e.g. --size 960x540"),
+                ));
+            }
+        }
+        if let Some(f) = self.fps {
+            if !(f.is_finite() && (1.0..=MAX_FPS).contains(&f)) {
+                return Err(Error::parameter(
+                    "--fps",
+                    format!("{f} frames per second is not a usable frame rate; give a number from 1 to {MAX_FPS}"),
+                ));
+            }
+        }
+        if let Some(w) = self.wingspan_m {
+            if !(w.is_finite() && w > 0.0 && w <= 100.0) {
+                return Err(Error::parameter(
+                    "--wingspan-m",
+                    format!("{w} m is not a wingspan; give metres between 0 and 100 (a goose is about 1.5)"),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// One checked output.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Output {
+    /// Where it goes (directories without the trailing slash).
+    pub path: PathBuf,
+    /// What it is.
+    pub kind: OutputKind,
+}
+
+/// Checks every output path: a known kind, no duplicates, an existing writable parent directory,
+/// and for a frames directory, one that is new, empty or holds only earlier frames (it is
+/// replaced as a whole). Creates and removes a probe file beside each output; writes nothing else.
+pub fn plan_outputs(outputs: &[PathBuf]) -> Result<Vec<Output>> {
+    if outputs.is_empty() {
+        return Err(Error::parameter(
+            "-o",
+            "no output given; add e.g. -o flock.gif",
+        ));
+    }
+    let mut seen = BTreeSet::new();
+    let mut plan = Vec::new();
+    for p in outputs {
+        let kind = OutputKind::from_path(p, &OUTPUT_KINDS)?;
+        let path = if kind == OutputKind::Directory {
+            let s = p.to_string_lossy();
+            let t = s.trim_end_matches(['/', std::path::MAIN_SEPARATOR]);
+            if t.is_empty() || p.file_name().is_none() || t.ends_with("..") {
+                return Err(Error::parameter(
+                    "-o",
+                    format!(
+                        "{}: name a frames directory to create or replace, e.g. -o frames/",
+                        p.display()
+                    ),
+                ));
+            }
+            PathBuf::from(t)
+        } else {
+            p.clone()
+        };
+        if !seen.insert(path.clone()) {
+            return Err(Error::parameter(
+                "-o",
+                format!("{}: given twice", path.display()),
+            ));
+        }
+        let parent = match path.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        if !parent.is_dir() {
+            return Err(Error::parameter(
+                "-o",
+                format!(
+                    "{}: directory {} does not exist; create it first",
+                    path.display(),
+                    parent.display()
+                ),
+            ));
+        }
+        if kind == OutputKind::Directory {
+            if path.exists() && !path.is_dir() {
+                return Err(Error::format(
+                    &path,
+                    "exists and is not a directory; choose another name for the frames",
+                ));
+            }
+            if path.is_dir() {
+                let entries = std::fs::read_dir(&path).map_err(|e| Error::io(&path, e))?;
+                for e in entries {
+                    let e = e.map_err(|e| Error::io(&path, e))?;
+                    let name = e.file_name().to_string_lossy().into_owned();
+                    let ours =
+                        name.starts_with("frame_") && name.ends_with(".png") && e.path().is_file();
+                    if !ours {
+                        return Err(Error::format(
+                            &path,
+                            format!("holds {name}, which is not a frame of ours; frames replace the whole directory, so give a new or empty one"),
+                        ));
+                    }
+                }
+            }
+        } else if path.is_dir() {
+            return Err(Error::format(&path, "is a directory, expected a file name"));
+        }
+        // Probe: can we create a file beside the target? (Dropped uncommitted: removed again.)
+        let probe = match kind {
+            OutputKind::Directory => path.with_extension("probe"),
+            _ => path.clone(),
+        };
+        drop(AtomicFile::create(&probe).map_err(|e| match e {
+            Error::Io { source, .. } => Error::io(&path, source),
+            other => other,
+        })?);
+        plan.push(Output { path, kind });
+    }
+    Ok(plan)
+}
+
+/// Frame rate used for a picture output of `kind`.
+fn picture_fps(anim: &Animation, kind: OutputKind, opts: &RenderOptions) -> f64 {
+    match (kind, opts.fps) {
+        (OutputKind::Gif, Some(f)) => 100.0 / (100.0 / f).round().max(2.0),
+        (OutputKind::Gif, None) => GIF_FPS,
+        (_, Some(f)) => f,
+        (_, None) => anim.fps.clamp(1.0, MAX_FPS),
+    }
+}
+
+/// Checks everything, then writes every output of `outputs` (kinds by extension, see
+/// [`OUTPUT_KINDS`]). Nothing is written when any path or option is invalid; each output is
+/// written atomically; outputs written before a later one fails stay in place.
+pub fn write_outputs(
+    anim: &Animation,
+    outputs: &[PathBuf],
+    opts: &RenderOptions,
+    progress: &dyn Progress,
+) -> Result<()> {
+    opts.validate()?;
+    let origin = Path::new("animation");
+    anim.validate(origin)?;
+    sample::check_times(anim, origin)?;
+    let plan = plan_outputs(outputs)?;
+    for o in &plan {
+        if o.kind == OutputKind::Gif {
+            if let Some(f) = opts.fps {
+                if f > MAX_GIF_FPS {
+                    return Err(Error::parameter(
+                        "--fps",
+                        format!("{f}: a GIF plays at most {MAX_GIF_FPS} frames per second (delays are whole 1/100 s, browsers slow shorter ones); give --fps 50 or less"),
+                    ));
+                }
+            }
+        }
+        if matches!(o.kind, OutputKind::Gif | OutputKind::Directory) {
+            let fps = picture_fps(anim, o.kind, opts);
+            let n = sample::output_times(anim, fps).len();
+            if n > MAX_FRAMES {
+                return Err(Error::parameter(
+                    "--fps",
+                    format!(
+                        "{}: {n} frames at {fps} fps is more than {MAX_FRAMES}; lower --fps",
+                        o.path.display()
+                    ),
+                ));
+            }
+        }
+    }
+    let wingspan_m = opts.wingspan_m.unwrap_or(anim.wingspan_m);
+    let threads = pictures::worker_count(opts.threads);
+    let (w, h) = (opts.width as usize, opts.height as usize);
+    for o in &plan {
+        match o.kind {
+            OutputKind::Json => {
+                let mut a = anim.clone();
+                a.wingspan_m = wingspan_m;
+                write_json_atomic(&o.path, &a)?;
+            }
+            OutputKind::Csv => {
+                let mut buf = Vec::new();
+                table::write_csv(anim, &mut buf).map_err(|e| Error::io(&o.path, e))?;
+                write_bytes_atomic(&o.path, &buf)?;
+            }
+            OutputKind::Glb => {
+                progress.start("glb", 1);
+                let bytes = gltf::glb_bytes(anim, wingspan_m)?;
+                write_bytes_atomic(&o.path, &bytes)?;
+                progress.advance(1);
+                progress.finish();
+            }
+            OutputKind::Gif => {
+                let film = Film::new(anim, picture_fps(anim, o.kind, opts), w, h);
+                pictures::write_gif(&film, &o.path, threads, progress)?;
+            }
+            OutputKind::Directory => {
+                let film = Film::new(anim, picture_fps(anim, o.kind, opts), w, h);
+                pictures::write_png_dir(&film, &o.path, threads, progress)?;
+            }
+            OutputKind::Png | OutputKind::Svg => {
+                return Err(Error::Internal(format!(
+                    "{}: not an animation output",
+                    o.path.display()
+                )));
+            }
+        }
+    }
+    Ok(())
+}
