@@ -46,10 +46,64 @@ fn rate(label: &str, shape: &[(f64, f64)], seeds: u64, opts: &InitiateOptions) {
 #[test]
 #[ignore]
 fn convergence_rates() {
-    let seeds: u64 = std::env::var("SEEDS").ok().and_then(|s| s.parse().ok()).unwrap_or(20);
+    let seeds: u64 = std::env::var("SEEDS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(20);
     let opts = InitiateOptions::default();
     for n in [9usize, 14, 41] {
         let s = if n == 41 { seeds / 2 } else { seeds };
-        rate(&format!("V{n}"), &initiate_support::v_shape(n, 1.0, 0.6), s, &opts);
+        rate(
+            &format!("V{n}"),
+            &initiate_support::v_shape(n, 1.0, 0.6),
+            s,
+            &opts,
+        );
+    }
+}
+
+#[test]
+#[ignore]
+fn diagnose() {
+    let n: usize = std::env::var("N")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(41);
+    let seed: u64 = std::env::var("SEED")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(1);
+    let opts = InitiateOptions::default();
+    let t = target(&initiate_support::v_shape(n, 1.0, 0.6));
+    let params = opts.step_params(30.0, 0.0, 10.0);
+    let mut r = rng::seeded(seed);
+    let region = match &opts.start {
+        initiate::Start::Random(r) => *r,
+        _ => unreachable!(),
+    };
+    let (p, h, v) = initiate::random_start(n, &region, &params, &mut r).unwrap();
+    let mut sim = initiate::Simulation::new(t, params, p, h, v);
+    for step in 0..9000 {
+        sim.step();
+        if step % 500 == 0 || sim.min_distance() < 0.3 {
+            let slots = sim.slot_positions();
+            let f = &sim.flock;
+            let matched = f.slot.iter().filter(|s| s.is_some()).count();
+            let mut errs: Vec<(usize, f64)> = (0..n)
+                .filter_map(|i| f.slot[i].map(|s| (i, (f.pos[i] - slots[s]).length())))
+                .collect();
+            errs.sort_by(|a, b| b.1.total_cmp(&a.1));
+            let hd = f.heading.iter().map(|h| h.abs()).fold(0.0, f64::max);
+            let sd = f
+                .speed
+                .iter()
+                .map(|v| (v / params.cruise_speed - 1.0).abs())
+                .fold(0.0, f64::max);
+            let lost = f.reference.iter().filter(|r| r.is_none()).count();
+            println!(
+                "step {step}: in slot {} matched {matched} lost {lost} leader {} mind {:.3} maxhd {:.3} maxsd {:.3} worst {:?}",
+                sim.birds_in_slot(0.1), f.leader, sim.min_distance(), hd, sd, &errs[..errs.len().min(4)]
+            );
+        }
     }
 }

@@ -68,6 +68,11 @@ pub struct InitiateOptions {
     pub leader_hysteresis: f64,
     /// Keep the current reference bird while it is visible and acceptable.
     pub sticky_reference: bool,
+    /// Upper bound of the distance divisor max(r, 1) of eq. (6), wingspans.
+    pub turn_distance_cap: f64,
+    /// Eq. (5)'s √|r − v_j| is replaced by its chord within this distance of the fixed point,
+    /// wingspans.
+    pub linear_zone: f64,
     /// Convergence: distance of every bird from its slot, wingspans.
     pub tolerance: f64,
     /// Convergence: heading difference from the cruise heading, radians.
@@ -94,7 +99,7 @@ impl Default for InitiateOptions {
             max_turn_rate: PI / 2.0,
             max_accel: 4.0,
             min_speed: 0.5,
-            max_speed: 2.0,
+            max_speed: 1.6,
             separation_distance: 10.0,
             lookahead: 4.0,
             avoid_distance: 0.6,
@@ -103,6 +108,8 @@ impl Default for InitiateOptions {
             lost_speed_factor: 0.9,
             leader_hysteresis: 1.0,
             sticky_reference: true,
+            turn_distance_cap: 5.0,
+            linear_zone: 0.25,
             tolerance: 0.1,
             heading_tolerance: 2f64.to_radians(),
             speed_tolerance: 0.02,
@@ -197,7 +204,10 @@ impl StartState {
                 ));
             }
             if let Some(i) = a.iter().position(|v| !v.is_finite()) {
-                return Err(Error::format(path, format!("{name}[{i}]: not a finite number")));
+                return Err(Error::format(
+                    path,
+                    format!("{name}[{i}]: not a finite number"),
+                ));
             }
         }
         if let Some(v) = &s.speed {
@@ -260,7 +270,10 @@ impl InitiateOptions {
             if v.is_finite() && v > 0.0 {
                 Ok(())
             } else {
-                Err(Error::parameter(name, format!("must be a positive number, got {v}")))
+                Err(Error::parameter(
+                    name,
+                    format!("must be a positive number, got {v}"),
+                ))
             }
         };
         let fov = self.perception.fov_per_eye;
@@ -315,6 +328,8 @@ impl InitiateOptions {
         pos("--avoid-range", self.avoid_range)?;
         pos("--avoid-horizon", self.avoid_horizon)?;
         pos("lost speed factor", self.lost_speed_factor)?;
+        pos("--turn-distance-cap", self.turn_distance_cap)?;
+        pos("--linear-zone", self.linear_zone)?;
         if !(self.leader_hysteresis.is_finite() && self.leader_hysteresis >= 0.0) {
             return Err(Error::parameter(
                 "leader hysteresis",
@@ -327,7 +342,10 @@ impl InitiateOptions {
         if !(self.hold.is_finite() && self.hold >= 0.0) {
             return Err(Error::parameter(
                 "--hold",
-                format!("must be a non-negative number of seconds, got {}", self.hold),
+                format!(
+                    "must be a non-negative number of seconds, got {}",
+                    self.hold
+                ),
             ));
         }
         if self.max_steps == 0 {
@@ -380,6 +398,8 @@ impl InitiateOptions {
             lost_speed_factor: self.lost_speed_factor,
             leader_hysteresis: self.leader_hysteresis,
             sticky_reference: self.sticky_reference,
+            turn_distance_cap: self.turn_distance_cap,
+            linear_zone: self.linear_zone,
         }
     }
 }
@@ -414,11 +434,14 @@ pub fn check_steady(steady: &Animation, origin: &Path) -> Result<()> {
     };
     let n = steady.birds;
     if f0.x.len() != n || f0.speed.len() != n || f0.heading.len() != n {
-        return Err(Error::format(origin, "frames[0]: one value per bird expected"));
+        return Err(Error::format(
+            origin,
+            "frames[0]: one value per bird expected",
+        ));
     }
     let pts: Vec<DVec2> = ks.birds.iter().map(|b| DVec2::new(b.x, b.y)).collect();
-    let t = TargetShape::new(&pts)
-        .map_err(|e| Error::format(origin, format!("key_shapes[0]: {e}")))?;
+    let t =
+        TargetShape::new(&pts).map_err(|e| Error::format(origin, format!("key_shapes[0]: {e}")))?;
     let vc = f0.speed[t.leader];
     if !(vc.is_finite() && vc > 0.0) {
         return Err(Error::format(
@@ -527,7 +550,11 @@ pub fn simulate(
                     format!("{} start positions for {n} birds", s.x.len()),
                 ));
             }
-            let pos = s.x.iter().zip(&s.y).map(|(&x, &y)| DVec2::new(x, y)).collect();
+            let pos =
+                s.x.iter()
+                    .zip(&s.y)
+                    .map(|(&x, &y)| DVec2::new(x, y))
+                    .collect();
             let heading = s.heading.clone().unwrap_or_else(|| vec![cruise_heading; n]);
             let speed = match &s.speed {
                 Some(v) => v
@@ -781,7 +808,11 @@ pub fn hand_over(
     stats.min_distance = out.frames[..offset]
         .iter()
         .map(|f| {
-            let pts: Vec<DVec2> = f.x.iter().zip(&f.y).map(|(&x, &y)| DVec2::new(x, y)).collect();
+            let pts: Vec<DVec2> =
+                f.x.iter()
+                    .zip(&f.y)
+                    .map(|(&x, &y)| DVec2::new(x, y))
+                    .collect();
             sim::min_pair_distance(&pts)
         })
         .fold(f64::INFINITY, f64::min);

@@ -77,7 +77,8 @@ pub fn right_of(heading: f64) -> DVec2 {
 /// Bearing of `rel` seen from a bird at heading θ: radians in (−π, π], 0 straight ahead, positive
 /// to the right.
 pub fn bearing(heading: f64, rel: DVec2) -> f64 {
-    rel.dot(right_of(heading)).atan2(rel.dot(direction(heading)))
+    rel.dot(right_of(heading))
+        .atan2(rel.dot(direction(heading)))
 }
 
 /// True when `rel` (a flockmate relative to the viewer) lies inside the visual field of a bird at
@@ -323,11 +324,7 @@ pub fn choose_reference(
             (outside_cone, rel.length(), j)
         })
         .collect();
-    ranked.sort_unstable_by(|a, b| {
-        a.0.cmp(&b.0)
-            .then(a.1.total_cmp(&b.1))
-            .then(a.2.cmp(&b.2))
-    });
+    ranked.sort_unstable_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)).then(a.2.cmp(&b.2)));
     ranked.into_iter().map(|r| r.2).find(|&j| accept(j))
 }
 
@@ -385,7 +382,13 @@ mod tests {
     #[test]
     fn field_of_view_is_respected() {
         // Heading east (θ = π/2): birds to the west are behind.
-        let pos = [v(0.0, 0.0), v(5.0, 0.0), v(-5.0, 0.0), v(0.0, 5.0), v(-3.0, 3.0)];
+        let pos = [
+            v(0.0, 0.0),
+            v(5.0, 0.0),
+            v(-5.0, 0.0),
+            v(0.0, 5.0),
+            v(-3.0, 3.0),
+        ];
         for mode in MODES {
             assert_eq!(see(0, &pos, PI / 2.0, mode), vec![1, 3], "{mode:?}");
         }
@@ -408,10 +411,22 @@ mod tests {
         let pos = [v(0.0, 0.0), v(-2.0, 4.0), v(0.0, 4.0), v(2.0, 4.0)];
         assert_eq!(see(0, &pos, 0.0, hpr), vec![1, 2, 3]);
         // A bird far behind a near one, slightly off the line of sight: hidden.
-        let pos = [v(0.0, 0.0), v(0.0, 2.0), v(0.05, 10.0), v(-3.0, 3.0), v(3.0, 3.0)];
+        let pos = [
+            v(0.0, 0.0),
+            v(0.0, 2.0),
+            v(0.05, 10.0),
+            v(-3.0, 3.0),
+            v(3.0, 3.0),
+        ];
         assert_eq!(see(0, &pos, 0.0, hpr), vec![1, 3, 4]);
         // The same bird well off the line of sight: visible.
-        let pos = [v(0.0, 0.0), v(0.0, 2.0), v(4.0, 10.0), v(-3.0, 3.0), v(3.0, 3.0)];
+        let pos = [
+            v(0.0, 0.0),
+            v(0.0, 2.0),
+            v(4.0, 10.0),
+            v(-3.0, 3.0),
+            v(3.0, 3.0),
+        ];
         assert_eq!(see(0, &pos, 0.0, hpr), vec![1, 2, 3, 4]);
         // The outermost bird on either side is always on the hull, however far.
         let pos = [v(0.0, 0.0), v(0.0, 2.0), v(0.05, 10.0), v(-3.0, 3.0)];
@@ -439,6 +454,9 @@ mod tests {
         assert_eq!(r, Some(1));
         let r = choose_reference(0, &[1, 2], &pos, 0.0, 0.35 * PI, |j| j != 2);
         assert_eq!(r, Some(1));
-        assert_eq!(choose_reference(0, &[], &pos, 0.0, 0.35 * PI, |_| true), None);
+        assert_eq!(
+            choose_reference(0, &[], &pos, 0.0, 0.35 * PI, |_| true),
+            None
+        );
     }
 }

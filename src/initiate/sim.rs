@@ -10,7 +10,9 @@
 
 use glam::DVec2;
 
-use super::perception::{bearing, choose_reference, direction, right_of, PerceptionParams, Perceiver};
+use super::perception::{
+    bearing, choose_reference, direction, right_of, Perceiver, PerceptionParams,
+};
 use super::target::{Side, TargetShape};
 
 /// Per-step parameters of the drives and actions (derived from [`super::InitiateOptions`]).
@@ -52,6 +54,10 @@ pub struct StepParams {
     pub leader_hysteresis: f64,
     /// Keep the current reference bird while it stays visible and acceptable.
     pub sticky_reference: bool,
+    /// Upper bound of the distance divisor of eq. (6), wingspans.
+    pub turn_distance_cap: f64,
+    /// Half-width of the linear zone of eq. (5)'s √|r − v_j| around its fixed point, wingspans.
+    pub linear_zone: f64,
 }
 
 /// The state of every bird (world frame).
@@ -211,11 +217,9 @@ impl Simulation {
                 let fs = self.target.follower_slot(sj, side)?;
                 Some((self.target.offset(sj, fs), Some(fs)))
             }
-            None => {
-                let m = self.target.mean_offset;
-                let dx = if side == Side::Right { m.x } else { -m.x };
-                Some((DVec2::new(dx, m.y), None))
-            }
+            // An unmatched bird is not a reference: following it would give no consistent
+            // target, and birds following each other in a cycle never reach the flock.
+            None => None,
         }
     }
 
@@ -307,10 +311,7 @@ impl Simulation {
                     }
                 }
             };
-            let (mut dh, mut v) = (
-                wrap_angle(want_heading - self.flock.heading[i]),
-                want_speed,
-            );
+            let (mut dh, mut v) = (wrap_angle(want_heading - self.flock.heading[i]), want_speed);
             if let Some((turn, slow)) = self.avoidance(i) {
                 dh = turn * p.max_turn;
                 if slow {
@@ -398,11 +399,27 @@ impl Simulation {
         let to_aim = aim - f.pos[i];
         let dd = bearing(f.heading[i], to_aim);
         let vj = f.speed[j];
-        // Eq. (5): K > 0 only when behind the target by more than one step of the reference.
-        let k = if behind > vj { p.k } else { -p.k };
-        let v = vj * (1.0 - dd.abs() / std::f64::consts::PI + k * (r - vj).abs().sqrt());
-        // Eq. (6).
-        let h = f.heading[i] + p.alpha * dd / r.max(1.0);
+        // Eq. (5): K > 0 only when behind the target by more than one step of the reference, and
+        // not while facing away from it (a far bird flying the wrong way must not speed up).
+        let k = if behind <= vj {
+            -p.k
+        } else if dd.abs() < std::f64::consts::FRAC_PI_2 {
+            p.k
+        } else {
+            0.0
+        };
+        // √|u| has an infinite slope at the fixed point u = 0, which with a bounded acceleration
+        // makes a speed limit cycle; within `linear_zone` use its chord |u|/√u₀ instead.
+        let u = (r - vj).abs();
+        let z = p.linear_zone;
+        let root = if u < z { u / z.sqrt() } else { u.sqrt() };
+        let mut v = vj * (1.0 - dd.abs() / std::f64::consts::PI + k * root);
+        // Braking distance: close on the target no faster than the speed that can still be shed
+        // before reaching it, v ≤ v_j + √(2 a g) with g the longitudinal gap (no overshoot).
+        let gap = (behind - vj).max(0.0);
+        v = v.min(vj + (2.0 * p.max_dv * gap).sqrt());
+        // Eq. (6), with the divisor capped so that a far bird can still turn toward its target.
+        let h = f.heading[i] + p.alpha * dd / r.clamp(1.0, p.turn_distance_cap);
         (h, v)
     }
 

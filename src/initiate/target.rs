@@ -60,7 +60,10 @@ impl TargetShape {
     /// Builds the slot tree of a key shape given as formation-frame points (wingspans).
     pub fn new(points: &[DVec2]) -> Result<TargetShape> {
         if points.is_empty() {
-            return Err(Error::parameter("key_shapes[0]", "the key shape has no birds"));
+            return Err(Error::parameter(
+                "key_shapes[0]",
+                "the key shape has no birds",
+            ));
         }
         if let Some(i) = points.iter().position(|p| !p.is_finite()) {
             return Err(Error::parameter(
