@@ -43,6 +43,42 @@ fn rate(label: &str, shape: &[(f64, f64)], seeds: u64, opts: &InitiateOptions) {
     );
 }
 
+fn env_f(name: &str) -> Option<f64> {
+    std::env::var(name).ok().and_then(|s| s.parse().ok())
+}
+
+/// Defaults, overridden by environment variables for parameter sweeps.
+fn env_opts() -> InitiateOptions {
+    let mut o = InitiateOptions::default();
+    if let Some(v) = env_f("AVOID") {
+        o.avoid_distance = v;
+    }
+    if let Some(v) = env_f("RANGE") {
+        o.avoid_range = v;
+    }
+    if let Some(v) = env_f("HORIZON") {
+        o.avoid_horizon = v;
+    }
+    if let Some(v) = env_f("TURN") {
+        o.max_turn_rate = v.to_radians();
+    }
+    if let Some(v) = env_f("ACCEL") {
+        o.max_accel = v;
+    }
+    if let Some(v) = env_f("GAMMA") {
+        o.perception.mode = initiate::PerceptionMode::Hpr { gamma: v };
+    }
+    if std::env::var("EXACT").is_ok() {
+        o.perception.mode = initiate::PerceptionMode::Exact;
+    }
+    if let Some(v) = env_f("SPREAD") {
+        if let initiate::Start::Random(r) = &mut o.start {
+            r.heading_spread = v.to_radians();
+        }
+    }
+    o
+}
+
 #[test]
 #[ignore]
 fn convergence_rates() {
@@ -50,7 +86,7 @@ fn convergence_rates() {
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(20);
-    let opts = InitiateOptions::default();
+    let opts = env_opts();
     for n in [9usize, 14, 41] {
         let s = if n == 41 { seeds / 2 } else { seeds };
         rate(
@@ -73,7 +109,7 @@ fn diagnose() {
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(1);
-    let opts = InitiateOptions::default();
+    let opts = env_opts();
     let t = target(&initiate_support::v_shape(n, 1.0, 0.6));
     let params = opts.step_params(30.0, 0.0, 10.0);
     let mut r = rng::seeded(seed);
@@ -83,8 +119,23 @@ fn diagnose() {
     };
     let (p, h, v) = initiate::random_start(n, &region, &params, &mut r).unwrap();
     let mut sim = initiate::Simulation::new(t, params, p, h, v);
-    for step in 0..9000 {
+    let steps: usize = std::env::var("STEPS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(9000);
+    for step in 0..steps {
         sim.step();
+        if step + 1 == steps {
+            let f = &sim.flock;
+            let slots = sim.slot_positions();
+            for i in 0..n {
+                let err = f.slot[i].map(|s| f.pos[i] - slots[s]);
+                println!(
+                    "  bird {i}: pos ({:.2},{:.2}) hd {:.1}° v {:.3} ref {:?} side {:?} slot {:?} err {:?}",
+                    f.pos[i].x, f.pos[i].y, f.heading[i].to_degrees(), f.speed[i], f.reference[i], f.side[i], f.slot[i], err
+                );
+            }
+        }
         if step % 500 == 0 || sim.min_distance() < 0.3 {
             let slots = sim.slot_positions();
             let f = &sim.flock;
@@ -104,6 +155,62 @@ fn diagnose() {
                 "step {step}: in slot {} matched {matched} lost {lost} leader {} mind {:.3} maxhd {:.3} maxsd {:.3} worst {:?}",
                 sim.birds_in_slot(0.1), f.leader, sim.min_distance(), hd, sd, &errs[..errs.len().min(4)]
             );
+        }
+    }
+}
+
+#[test]
+#[ignore]
+fn near_misses() {
+    let n: usize = std::env::var("N")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(41);
+    let seeds: u64 = std::env::var("SEEDS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(50);
+    let opts = env_opts();
+    let t = target(&initiate_support::v_shape(n, 1.0, 0.6));
+    let params = opts.step_params(30.0, 0.0, 10.0);
+    let region = match &opts.start {
+        initiate::Start::Random(r) => *r,
+        _ => unreachable!(),
+    };
+    for seed in 0..seeds {
+        let mut r = rng::seeded(seed);
+        let (p, h, v) = initiate::random_start(n, &region, &params, &mut r).unwrap();
+        let mut sim = initiate::Simulation::new(t.clone(), params, p, h, v);
+        let mut prev: Option<initiate::sim::Flock> = None;
+        for step in 0..2500 {
+            sim.step();
+            let f = &sim.flock;
+            let mut best = (f64::INFINITY, 0, 0);
+            for a in 0..n {
+                for b in a + 1..n {
+                    let d = (f.pos[a] - f.pos[b]).length();
+                    if d < best.0 {
+                        best = (d, a, b);
+                    }
+                }
+            }
+            if best.0 < 0.25 {
+                let (_, a, b) = best;
+                let pf = prev.as_ref().unwrap();
+                println!(
+                    "seed {seed} step {step}: birds {a},{b} d={:.3} leader {}",
+                    best.0, f.leader
+                );
+                for i in [a, b] {
+                    println!(
+                        "  bird {i}: pos ({:.2},{:.2}) hd {:.1}° v {:.3} ref {:?} side {:?} slot {:?}; prev hd {:.1}° ref {:?}",
+                        f.pos[i].x, f.pos[i].y, f.heading[i].to_degrees(), f.speed[i], f.reference[i], f.side[i], f.slot[i],
+                        pf.heading[i].to_degrees(), pf.reference[i]
+                    );
+                }
+                break;
+            }
+            prev = Some(sim.flock.clone());
         }
     }
 }

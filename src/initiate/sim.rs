@@ -15,6 +15,10 @@ use super::perception::{
 };
 use super::target::{Side, TargetShape};
 
+/// Collision avoidance ignores flockmates whose speed relative to the bird is below this
+/// fraction of the cruise speed (unless they are already closer than the avoidance distance).
+pub const AVOID_MIN_RELATIVE_SPEED: f64 = 0.15;
+
 /// Per-step parameters of the drives and actions (derived from [`super::InitiateOptions`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StepParams {
@@ -312,8 +316,8 @@ impl Simulation {
                 }
             };
             let (mut dh, mut v) = (wrap_angle(want_heading - self.flock.heading[i]), want_speed);
-            if let Some((turn, slow)) = self.avoidance(i) {
-                dh = turn * p.max_turn;
+            if let Some((turn, slow)) = self.avoidance(i, dh.clamp(-p.max_turn, p.max_turn)) {
+                dh = turn;
                 if slow {
                     v = v.min(self.flock.speed[i] - p.max_dv);
                 }
@@ -423,47 +427,77 @@ impl Simulation {
         (h, v)
     }
 
-    /// Short-range collision avoidance, all around (not limited to the visual field): the most
-    /// urgent flockmate whose predicted closest approach within the horizon is below
-    /// `avoid_distance`. Returns the turn direction (−1 left, +1 right) and whether to slow
-    /// (the other is ahead). Birds flying in parallel (V neighbours) predict no approach and are
-    /// left alone.
-    fn avoidance(&self, i: usize) -> Option<(f64, bool)> {
+    /// Short-range collision avoidance, all around (not limited to the visual field). A threat is
+    /// a flockmate within `avoid_range` whose predicted closest approach (both flying straight)
+    /// within the horizon is below `avoid_distance`, or one already that close. When there is a
+    /// threat, the bird picks among its desired turn `want` and five turns across the turn-rate
+    /// range the one that maximises the smallest predicted miss distance to every flockmate in
+    /// range (the desired turn wins whenever it is safe, then the one nearest to it), and slows if
+    /// the nearest threat is ahead. Birds flying in parallel (V neighbours) are no threat, so they
+    /// are left alone. Returns the heading change (radians) and whether to slow.
+    fn avoidance(&self, i: usize, want: f64) -> Option<(f64, bool)> {
         let p = &self.params;
         let f = &self.flock;
         let pi = f.pos[i];
         let vi = direction(f.heading[i]) * f.speed[i];
-        let mut best: Option<(f64, DVec2, DVec2)> = None;
-        for (k, &pk) in f.pos.iter().enumerate() {
-            if k == i {
-                continue;
-            }
-            let dp = pk - pi;
-            if dp.length_squared() > p.avoid_range * p.avoid_range {
-                continue;
-            }
-            let dv = direction(f.heading[k]) * f.speed[k] - vi;
+        let range2 = p.avoid_range * p.avoid_range;
+        let miss = |dp: DVec2, dv: DVec2| -> f64 {
             let vv = dv.length_squared();
             let tau = if vv > 1e-12 {
                 (-dp.dot(dv) / vv).clamp(0.0, p.avoid_horizon)
             } else {
                 0.0
             };
-            let closest = dp + dv * tau;
-            if closest.length() < p.avoid_distance {
-                // Urgency: earlier conflicts first, then nearer ones.
-                let urgency = tau + closest.length();
-                if best.is_none_or(|b| urgency < b.0) {
-                    best = Some((urgency, dp, closest));
+            (dp + dv * tau).length()
+        };
+        let mut threat: Option<(f64, DVec2)> = None;
+        for (k, &pk) in f.pos.iter().enumerate() {
+            if k == i {
+                continue;
+            }
+            let dp = pk - pi;
+            if dp.length_squared() > range2 {
+                continue;
+            }
+            let dv = direction(f.heading[k]) * f.speed[k] - vi;
+            let closing = dv.length() >= AVOID_MIN_RELATIVE_SPEED * p.cruise_speed;
+            let m = miss(dp, dv);
+            if (closing && m < p.avoid_distance) || dp.length() < p.avoid_distance {
+                let d = dp.length();
+                if threat.is_none_or(|t| d < t.0) {
+                    threat = Some((d, dp));
                 }
             }
         }
-        let (_, dp, closest) = best?;
-        let away_from = if closest.length() > 1e-6 { closest } else { dp };
-        let b = bearing(f.heading[i], away_from);
-        let turn = if b > 0.0 { -1.0 } else { 1.0 };
-        let ahead = dp.dot(direction(f.heading[i])) > 0.0;
-        Some((turn, ahead))
+        let (_, nearest) = threat?;
+        // Score of a heading change: the smallest predicted miss distance over the neighbours.
+        let score = |dh: f64| -> f64 {
+            let vnew = direction(f.heading[i] + dh) * f.speed[i];
+            let mut worst = f64::INFINITY;
+            for (k, &pk) in f.pos.iter().enumerate() {
+                let dp = pk - pi;
+                if k == i || dp.length_squared() > range2 {
+                    continue;
+                }
+                let dv = direction(f.heading[k]) * f.speed[k] - vnew;
+                worst = worst.min(miss(dp, dv));
+            }
+            worst
+        };
+        let m = p.max_turn;
+        let mut best = (score(want), want);
+        if best.0 < p.avoid_distance {
+            for dh in [-m, -0.5 * m, 0.0, 0.5 * m, m] {
+                let sc = score(dh);
+                let better = sc > best.0 + 1e-9
+                    || ((sc - best.0).abs() <= 1e-9 && (dh - want).abs() < (best.1 - want).abs());
+                if better {
+                    best = (sc, dh);
+                }
+            }
+        }
+        let ahead = nearest.dot(direction(f.heading[i])) > 0.0;
+        Some((best.1, ahead))
     }
 
     /// Positions of the slots in the world if the leader were exactly in its slot and the flock
