@@ -5,6 +5,8 @@
 use std::path::Path;
 use std::sync::Once;
 
+pub mod paths;
+
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
