@@ -22,7 +22,8 @@ fn rate(label: &str, shape: &[(f64, f64)], seeds: u64, opts: &InitiateOptions) {
     let mut minds = Vec::new();
     for seed in 0..seeds {
         let mut r = rng::seeded(seed);
-        let run = initiate::simulate(&t, 30.0, 0.0, 10.0, opts, &mut r, &Silent).unwrap();
+        let heading = env_f("HEADING").unwrap_or(0.0).to_radians();
+        let run = initiate::simulate(&t, 30.0, heading, 10.0, opts, &mut r, &Silent).unwrap();
         if run.stats.converged {
             ok += 1;
             steps.push(run.stats.steps);
@@ -87,14 +88,16 @@ fn convergence_rates() {
         .and_then(|s| s.parse().ok())
         .unwrap_or(20);
     let opts = env_opts();
+    let shape = std::env::var("SHAPE").unwrap_or_else(|_| "v".into());
     for n in [9usize, 14, 41] {
         let s = if n == 41 { seeds / 2 } else { seeds };
-        rate(
-            &format!("V{n}"),
-            &initiate_support::v_shape(n, 1.0, 0.6),
-            s,
-            &opts,
-        );
+        let pts = match shape.as_str() {
+            "u" => initiate_support::u_shape(n),
+            "e" => initiate_support::echelon(n),
+            "vwide" => initiate_support::v_shape(n, 1.2, 1.0),
+            _ => initiate_support::v_shape(n, 1.0, 0.6),
+        };
+        rate(&format!("{shape}{n}"), &pts, s, &opts);
     }
 }
 
@@ -110,7 +113,11 @@ fn diagnose() {
         .and_then(|s| s.parse().ok())
         .unwrap_or(1);
     let opts = env_opts();
-    let t = target(&initiate_support::v_shape(n, 1.0, 0.6));
+    let t = target(&if std::env::var("SHAPE").is_ok() {
+        initiate_support::u_shape(n)
+    } else {
+        initiate_support::v_shape(n, 1.0, 0.6)
+    });
     let params = opts.step_params(30.0, 0.0, 10.0);
     let mut r = rng::seeded(seed);
     let region = match &opts.start {

@@ -17,7 +17,7 @@ use super::target::{Side, TargetShape};
 
 /// Collision avoidance ignores flockmates whose speed relative to the bird is below this
 /// fraction of the cruise speed (unless they are already closer than the avoidance distance).
-pub const AVOID_MIN_RELATIVE_SPEED: f64 = 0.15;
+pub const AVOID_MIN_RELATIVE_SPEED: f64 = 0.08;
 
 /// Per-step parameters of the drives and actions (derived from [`super::InitiateOptions`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -414,7 +414,10 @@ impl Simulation {
         };
         // √|u| has an infinite slope at the fixed point u = 0, which with a bounded acceleration
         // makes a speed limit cycle; within `linear_zone` use its chord |u|/√u₀ instead.
-        let u = (r - vj).abs();
+        // The distance is signed (negative ahead of the target): with |r − v_j| alone a bird one
+        // step *ahead* of its target would sit at a second fixed point of eq. (5).
+        let signed_r = if behind >= 0.0 { r } else { -r };
+        let u = (signed_r - vj).abs();
         let z = p.linear_zone;
         let root = if u < z { u / z.sqrt() } else { u.sqrt() };
         let mut v = vj * (1.0 - dd.abs() / std::f64::consts::PI + k * root);
