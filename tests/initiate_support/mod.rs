@@ -74,3 +74,27 @@ pub fn steady(shape: &[(f64, f64)], frames: usize, fps: f64, speed: f64) -> Anim
     }
     a
 }
+
+/// A steady flight carrying `shape` along `heading` (radians clockwise from north).
+pub fn steady_heading(
+    shape: &[(f64, f64)],
+    frames: usize,
+    fps: f64,
+    speed: f64,
+    heading: f64,
+) -> Animation {
+    let mut a = steady(shape, frames, fps, speed);
+    let (s, c) = heading.sin_cos();
+    let d = (s, c);
+    let r = (c, -s);
+    for (k, f) in a.frames.iter_mut().enumerate() {
+        let t = k as f64 / fps;
+        let lead = (-3.0 + speed * t * d.0, 4.0 + speed * t * d.1);
+        for (i, p) in shape.iter().enumerate() {
+            f.x[i] = lead.0 + p.0 * r.0 - p.1 * d.0;
+            f.y[i] = lead.1 + p.0 * r.1 - p.1 * d.1;
+            f.heading[i] = heading;
+        }
+    }
+    a
+}
