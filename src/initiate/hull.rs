@@ -81,61 +81,66 @@ fn grow_expansion(e: &mut Vec<f64>, b: f64) {
 }
 
 /// Indices of the strictly convex vertices of the convex hull of `points`, counter-clockwise,
-/// starting at the lexicographically smallest point. Duplicated points appear once (the first
-/// index of the group). Fewer than three distinct points: all distinct points are returned.
+/// starting at the lexicographically smallest point. Duplicated points appear once (one index of
+/// the group). Fewer than three distinct points: all distinct points are returned.
 ///
-/// `order` is scratch space (reused between calls to avoid allocation).
-pub fn convex_hull(points: &[DVec2], order: &mut Vec<usize>, hull: &mut Vec<usize>) {
+/// `sorted` is scratch space (reused between calls to avoid allocation). Returns the number of
+/// distinct points.
+pub fn convex_hull(
+    points: &[DVec2],
+    sorted: &mut Vec<(f64, f64, usize)>,
+    hull: &mut Vec<usize>,
+) -> usize {
     hull.clear();
-    order.clear();
-    order.extend(0..points.len());
-    order.sort_unstable_by(|&i, &j| {
-        points[i]
-            .x
-            .total_cmp(&points[j].x)
-            .then(points[i].y.total_cmp(&points[j].y))
-            .then(i.cmp(&j))
-    });
-    order.dedup_by(|j, i| points[*i] == points[*j]);
-    let n = order.len();
+    sorted.clear();
+    sorted.extend(points.iter().enumerate().map(|(i, p)| (p.x, p.y, i)));
+    // Sorting the coordinates themselves (not indices into `points`) keeps the sort cache-friendly.
+    sorted.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    sorted.dedup_by(|b, a| a.0 == b.0 && a.1 == b.1);
+    let n = sorted.len();
+    let pt = |k: usize| DVec2::new(sorted[k].0, sorted[k].1);
     if n < 3 {
-        hull.extend_from_slice(order);
-        return;
+        hull.extend(sorted.iter().map(|s| s.2));
+        return n;
     }
-    // Lower hull, then upper hull; pop on clockwise or collinear turns (strict convexity).
-    for &k in order.iter() {
-        while hull.len() >= 2
+    // Positions (in `sorted`) of the chain; lower hull, then upper hull; pop on clockwise or
+    // collinear turns (strict convexity).
+    let mut chain: Vec<usize> = Vec::with_capacity(n + 1);
+    for k in 0..n {
+        while chain.len() >= 2
             && orient2d(
-                points[hull[hull.len() - 2]],
-                points[hull[hull.len() - 1]],
-                points[k],
+                pt(chain[chain.len() - 2]),
+                pt(chain[chain.len() - 1]),
+                pt(k),
             ) <= 0.0
         {
-            hull.pop();
+            chain.pop();
         }
-        hull.push(k);
+        chain.push(k);
     }
-    let lower_len = hull.len() + 1;
-    for &k in order.iter().rev().skip(1) {
-        while hull.len() >= lower_len
+    let lower_len = chain.len() + 1;
+    for k in (0..n - 1).rev() {
+        while chain.len() >= lower_len
             && orient2d(
-                points[hull[hull.len() - 2]],
-                points[hull[hull.len() - 1]],
-                points[k],
+                pt(chain[chain.len() - 2]),
+                pt(chain[chain.len() - 1]),
+                pt(k),
             ) <= 0.0
         {
-            hull.pop();
+            chain.pop();
         }
-        hull.push(k);
+        chain.push(k);
     }
     // The last point pushed is the first one again.
-    hull.pop();
-    if hull.len() < 3 && n >= 3 {
+    chain.pop();
+    if chain.len() < 3 {
         // All points collinear: the two extremes are the hull.
-        hull.clear();
-        hull.push(order[0]);
-        hull.push(order[n - 1]);
+        chain.clear();
+        chain.push(0);
+        chain.push(n - 1);
     }
+    hull.extend(chain.iter().map(|&k| sorted[k].2));
+    n
 }
 
 #[cfg(test)]

@@ -698,8 +698,7 @@ pub fn hand_over(
     let s0 = |s: usize| DVec2::new(f0.x[s], f0.y[s]);
     // Translation of the steady flight: least squares over birds of the one-step continuation.
     let mut shift = DVec2::ZERO;
-    for b in 0..n {
-        let s = perm[b];
+    for (b, &s) in perm.iter().enumerate() {
         shift += run.pos[last][b] + step_of(s) - s0(s);
     }
     shift /= n as f64;
@@ -734,8 +733,7 @@ pub fn hand_over(
             let u = (t + window - last) as f64 / window as f64;
             u * u * (3.0 - 2.0 * u)
         };
-        for b in 0..n {
-            let s = perm[b];
+        for (b, &s) in perm.iter().enumerate() {
             let back = (last + 1 - t) as f64;
             let ideal = s0(s) + shift - step_of(s) * back;
             let p = run.pos[t][b].lerp(ideal, w);

@@ -100,7 +100,7 @@ pub fn in_field_of_view(heading: f64, rel: DVec2, fov_per_eye: f64) -> bool {
 pub struct Perceiver {
     cand: Vec<usize>,
     pts: Vec<DVec2>,
-    order: Vec<usize>,
+    sorted: Vec<(f64, f64, usize)>,
     hull: Vec<usize>,
     covered: Vec<(f64, f64)>,
     by_dist: Vec<(f64, usize)>,
@@ -127,8 +127,18 @@ impl Perceiver {
             return;
         };
         self.cand.clear();
+        let d = direction(heading);
+        let cos_fov = params.fov_per_eye.cos() - 1e-12;
+        let all_round = params.fov_per_eye >= std::f64::consts::PI;
         for (j, &q) in positions.iter().enumerate() {
-            if j != viewer && in_field_of_view(heading, q - p, params.fov_per_eye) {
+            let rel = q - p;
+            let len2 = rel.length_squared();
+            if j == viewer || len2 <= 0.0 || !len2.is_finite() {
+                continue;
+            }
+            // Same test as `in_field_of_view`, with the direction computed once per viewer.
+            let dot = rel.dot(d);
+            if all_round || dot * dot.abs() >= len2 * cos_fov * cos_fov.abs() {
                 self.cand.push(j);
             }
         }
@@ -182,7 +192,7 @@ impl Perceiver {
             }
             return;
         }
-        convex_hull(&self.pts, &mut self.order, &mut self.hull);
+        let distinct = convex_hull(&self.pts, &mut self.sorted, &mut self.hull);
         for &h in &self.hull {
             if h > 0 {
                 out.push(self.cand[h - 1]);
@@ -190,7 +200,7 @@ impl Perceiver {
         }
         // Birds at exactly the same position as a visible one are visible too (the hull keeps one
         // index of each group of duplicates).
-        if out.len() < n {
+        if distinct < self.pts.len() {
             let vis: Vec<DVec2> = out.iter().map(|&j| positions[j]).collect();
             for &j in &self.cand {
                 if !out.contains(&j) && vis.contains(&positions[j]) {
@@ -315,12 +325,13 @@ pub fn choose_reference(
     mut accept: impl FnMut(usize) -> bool,
 ) -> Option<usize> {
     let p = *positions.get(viewer)?;
+    let (d, r) = (direction(heading), right_of(heading));
     let mut ranked: Vec<(bool, f64, usize)> = visible
         .iter()
         .filter(|&&j| j != viewer && j < positions.len())
         .map(|&j| {
             let rel = positions[j] - p;
-            let outside_cone = bearing(heading, rel).abs() > reference_cone;
+            let outside_cone = rel.dot(r).atan2(rel.dot(d)).abs() > reference_cone;
             (outside_cone, rel.length(), j)
         })
         .collect();

@@ -64,6 +64,20 @@ pub struct StepParams {
     pub linear_zone: f64,
 }
 
+/// Flocks at least this large decide in parallel (one thread per core).
+pub const PARALLEL_MIN_BIRDS: usize = 256;
+
+/// What one bird does in the next step.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+struct Decision {
+    /// Heading change, radians.
+    turn: f64,
+    /// New speed, wingspans per step.
+    speed: f64,
+    reference: Option<usize>,
+    side: Option<Side>,
+}
+
 /// The state of every bird (world frame).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Flock {
@@ -100,8 +114,9 @@ pub struct Simulation {
     pub leader_changes: usize,
     perceiver: Perceiver,
     visible: Vec<usize>,
-    next_heading: Vec<f64>,
-    next_speed: Vec<f64>,
+    vel: Vec<DVec2>,
+    dir: Vec<DVec2>,
+    decisions: Vec<Decision>,
     next_reference: Vec<Option<usize>>,
     next_side: Vec<Option<Side>>,
 }
@@ -136,8 +151,9 @@ impl Simulation {
             leader_changes: 0,
             perceiver: Perceiver::new(),
             visible: Vec::new(),
-            next_heading: vec![0.0; n],
-            next_speed: vec![0.0; n],
+            vel: Vec::new(),
+            dir: Vec::new(),
+            decisions: Vec::new(),
             next_reference: vec![None; n],
             next_side: vec![None; n],
         };
@@ -209,9 +225,18 @@ impl Simulation {
     /// Δy behind), one step ahead: T = P_j + v_j d_j + Δx r_j − Δy d_j.
     fn target_point(&self, j: usize, offset: DVec2) -> DVec2 {
         let f = &self.flock;
-        let d = direction(f.heading[j]);
-        let r = right_of(f.heading[j]);
+        let d = self.dir_of(j);
+        // Right of d = (sin θ, cos θ) is (cos θ, −sin θ).
+        let r = DVec2::new(d.y, -d.x);
         f.pos[j] + d * f.speed[j] + r * offset.x - d * offset.y
+    }
+
+    /// Flight direction of bird `j` (cached for the current step).
+    fn dir_of(&self, j: usize) -> DVec2 {
+        match self.dir.get(j) {
+            Some(d) if self.dir.len() == self.flock.pos.len() => *d,
+            _ => direction(self.flock.heading[j]),
+        }
     }
 
     /// Offset of the follower of `j` on `side`, and the slot it takes if `j` is matched.
@@ -250,7 +275,8 @@ impl Simulation {
     /// matched to an arm, or has chosen a side itself), else by relative position.
     fn sides_for(&self, i: usize, j: usize) -> [Option<Side>; 2] {
         let f = &self.flock;
-        let geometric = if (f.pos[i] - f.pos[j]).dot(right_of(f.heading[j])) > 0.0 {
+        let dj = self.dir_of(j);
+        let geometric = if (f.pos[i] - f.pos[j]).dot(DVec2::new(dj.y, -dj.x)) > 0.0 {
             Side::Right
         } else {
             Side::Left
@@ -283,67 +309,105 @@ impl Simulation {
             self.leader_changes += 1;
             self.match_slots();
         }
-        let leader = self.flock.leader;
-
-        let mut visible = std::mem::take(&mut self.visible);
-        for i in 0..n {
-            let (want_heading, want_speed, reference, side) = if i == leader {
-                (p.cruise_heading, p.cruise_speed, None, None)
-            } else {
-                self.perceiver.visible(
-                    i,
-                    &self.flock.pos,
-                    self.flock.heading[i],
-                    &p.perception,
-                    &mut visible,
-                );
-                let (reference, side) = self.choose(i, &visible);
-                match (reference, side) {
-                    (Some(j), Some(side)) => {
-                        let (h, v) = self.pursue(i, j, side);
-                        (h, v, Some(j), Some(side))
-                    }
-                    _ => {
-                        // Lost: turn toward the cruise heading and slow a little.
-                        let dd = wrap_angle(p.cruise_heading - self.flock.heading[i]);
-                        (
-                            self.flock.heading[i] + p.alpha * dd,
-                            p.lost_speed_factor * p.cruise_speed,
-                            None,
-                            None,
-                        )
-                    }
-                }
-            };
-            let (mut dh, mut v) = (wrap_angle(want_heading - self.flock.heading[i]), want_speed);
-            if let Some((turn, slow)) = self.avoidance(i, dh.clamp(-p.max_turn, p.max_turn)) {
-                dh = turn;
-                if slow {
-                    v = v.min(self.flock.speed[i] - p.max_dv);
-                }
+        // Velocities of the previous step, shared by every bird's decisions.
+        let mut vel = std::mem::take(&mut self.vel);
+        vel.clear();
+        vel.extend((0..n).map(|i| direction(self.flock.heading[i]) * self.flock.speed[i]));
+        self.vel = vel;
+        let mut dir = std::mem::take(&mut self.dir);
+        dir.clear();
+        dir.extend(self.flock.heading.iter().map(|&h| direction(h)));
+        self.dir = dir;
+        let mut decisions = std::mem::take(&mut self.decisions);
+        decisions.resize(n, Decision::default());
+        let threads = if n >= PARALLEL_MIN_BIRDS {
+            std::thread::available_parallelism().map_or(1, |t| t.get().min(8))
+        } else {
+            1
+        };
+        if threads <= 1 {
+            let mut perceiver = std::mem::take(&mut self.perceiver);
+            let mut visible = std::mem::take(&mut self.visible);
+            for (i, d) in decisions.iter_mut().enumerate() {
+                *d = self.decide(i, &mut perceiver, &mut visible);
             }
-            let dh = dh.clamp(-p.max_turn, p.max_turn);
-            let v0 = self.flock.speed[i];
-            let v = v
-                .clamp(v0 - p.max_dv, v0 + p.max_dv)
-                .clamp(p.min_speed, p.max_speed);
-            self.max_heading_change = self.max_heading_change.max(dh.abs());
-            self.next_heading[i] = wrap_angle(self.flock.heading[i] + dh);
-            self.next_speed[i] = v;
-            self.next_reference[i] = reference;
-            self.next_side[i] = side;
+            self.perceiver = perceiver;
+            self.visible = visible;
+        } else {
+            // Every decision reads only the previous state, so birds can be split across
+            // threads; the result does not depend on the split.
+            let chunk = n.div_ceil(threads);
+            let this = &*self;
+            std::thread::scope(|scope| {
+                for (c, out) in decisions.chunks_mut(chunk).enumerate() {
+                    scope.spawn(move || {
+                        let mut perceiver = Perceiver::new();
+                        let mut visible = Vec::new();
+                        for (k, d) in out.iter_mut().enumerate() {
+                            *d = this.decide(c * chunk + k, &mut perceiver, &mut visible);
+                        }
+                    });
+                }
+            });
         }
-        self.visible = visible;
         let f = &mut self.flock;
-        for i in 0..n {
-            f.heading[i] = self.next_heading[i];
-            f.speed[i] = self.next_speed[i];
+        for (i, d) in decisions.iter().enumerate() {
+            self.max_heading_change = self.max_heading_change.max(d.turn.abs());
+            f.heading[i] = wrap_angle(f.heading[i] + d.turn);
+            f.speed[i] = d.speed;
             f.pos[i] += direction(f.heading[i]) * f.speed[i];
+            self.next_reference[i] = d.reference;
+            self.next_side[i] = d.side;
         }
+        self.decisions = decisions;
         std::mem::swap(&mut f.reference, &mut self.next_reference);
         std::mem::swap(&mut f.side, &mut self.next_side);
         self.steps += 1;
         self.match_slots();
+    }
+
+    /// The decision of bird `i` for the next step, from the current state only.
+    fn decide(&self, i: usize, perceiver: &mut Perceiver, visible: &mut Vec<usize>) -> Decision {
+        let p = &self.params;
+        let f = &self.flock;
+        let (want_heading, want_speed, reference, side) = if i == f.leader {
+            (p.cruise_heading, p.cruise_speed, None, None)
+        } else {
+            perceiver.visible(i, &f.pos, f.heading[i], &p.perception, visible);
+            let (reference, side) = self.choose(i, visible);
+            match (reference, side) {
+                (Some(j), Some(side)) => {
+                    let (h, v) = self.pursue(i, j, side);
+                    (h, v, Some(j), Some(side))
+                }
+                _ => {
+                    // Lost: turn toward the cruise heading and slow a little.
+                    let dd = wrap_angle(p.cruise_heading - f.heading[i]);
+                    (
+                        f.heading[i] + p.alpha * dd,
+                        p.lost_speed_factor * p.cruise_speed,
+                        None,
+                        None,
+                    )
+                }
+            }
+        };
+        let (mut dh, mut v) = (wrap_angle(want_heading - f.heading[i]), want_speed);
+        if let Some((turn, slow)) = self.avoidance(i, dh.clamp(-p.max_turn, p.max_turn)) {
+            dh = turn;
+            if slow {
+                v = v.min(f.speed[i] - p.max_dv);
+            }
+        }
+        let v0 = f.speed[i];
+        Decision {
+            turn: dh.clamp(-p.max_turn, p.max_turn),
+            speed: v
+                .clamp(v0 - p.max_dv, v0 + p.max_dv)
+                .clamp(p.min_speed, p.max_speed),
+            reference,
+            side,
+        }
     }
 
     /// Reference bird and side of bird `i` among its `visible` flockmates.
@@ -388,7 +452,7 @@ impl Simulation {
             .follower_offset(j, side)
             .unwrap_or((self.target.mean_offset, None));
         let t = self.target_point(j, offset);
-        let dj = direction(f.heading[j]);
+        let dj = self.dir_of(j);
         let to_t = t - f.pos[i];
         let r = to_t.length();
         // How far the bird is behind its target along the reference's flight direction.
@@ -442,7 +506,8 @@ impl Simulation {
         let p = &self.params;
         let f = &self.flock;
         let pi = f.pos[i];
-        let vi = direction(f.heading[i]) * f.speed[i];
+        let vel = &self.vel;
+        let vi = vel[i];
         let range2 = p.avoid_range * p.avoid_range;
         let miss = |dp: DVec2, dv: DVec2| -> f64 {
             let vv = dv.length_squared();
@@ -462,12 +527,12 @@ impl Simulation {
             if dp.length_squared() > range2 {
                 continue;
             }
-            let dv = direction(f.heading[k]) * f.speed[k] - vi;
+            let dv = vel[k] - vi;
             let closing = dv.length() >= AVOID_MIN_RELATIVE_SPEED * p.cruise_speed;
             let m = miss(dp, dv);
             if (closing && m < p.avoid_distance) || dp.length() < p.avoid_distance {
                 let d = dp.length();
-                if threat.is_none_or(|t| d < t.0) {
+                if threat.map_or(true, |t| d < t.0) {
                     threat = Some((d, dp));
                 }
             }
@@ -482,7 +547,7 @@ impl Simulation {
                 if k == i || dp.length_squared() > range2 {
                     continue;
                 }
-                let dv = direction(f.heading[k]) * f.speed[k] - vnew;
+                let dv = vel[k] - vnew;
                 worst = worst.min(miss(dp, dv));
             }
             worst
