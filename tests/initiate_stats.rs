@@ -221,3 +221,99 @@ fn near_misses() {
         }
     }
 }
+
+/// HPR with an absolute flipping radius (the paper's literal "R = half a wingspan").
+fn hpr_absolute(viewer: usize, pos: &[DVec2], heading: f64, r_flip: f64) -> Vec<usize> {
+    use formation::initiate::perception::in_field_of_view;
+    let p = pos[viewer];
+    let cand: Vec<usize> = (0..pos.len())
+        .filter(|&j| j != viewer && in_field_of_view(heading, pos[j] - p, std::f64::consts::FRAC_PI_2))
+        .collect();
+    let mut pts = vec![DVec2::ZERO];
+    for &j in &cand {
+        let q = pos[j] - p;
+        pts.push(q * (2.0 * r_flip / q.length() - 1.0));
+    }
+    let (mut sorted, mut hull) = (Vec::new(), Vec::new());
+    initiate::hull::convex_hull(&pts, &mut sorted, &mut hull);
+    let mut out: Vec<usize> = hull.iter().filter(|&&h| h > 0).map(|&h| cand[h - 1]).collect();
+    out.sort_unstable();
+    out
+}
+
+#[test]
+#[ignore]
+fn hpr_agreement() {
+    use formation::initiate::perception::{choose_reference, Perceiver};
+    use formation::initiate::{PerceptionMode, PerceptionParams};
+    let flocks: u64 = std::env::var("FLOCKS").ok().and_then(|s| s.parse().ok()).unwrap_or(40);
+    let opts = InitiateOptions::default();
+    let params = opts.step_params(30.0, 0.0, 10.0);
+    let cone = 0.35 * std::f64::consts::PI;
+    for n in [9usize, 14, 41] {
+        // Configurations: random take-off clusters, and the flock 5 s and 20 s into an initiation.
+        let mut configs: Vec<(Vec<DVec2>, Vec<f64>)> = Vec::new();
+        for seed in 0..flocks {
+            let mut r = rng::seeded(1000 + seed);
+            let (p, h, v) = initiate::random_start(n, &initiate::StartRegion::default(), &params, &mut r).unwrap();
+            configs.push((p.clone(), h.clone()));
+            let t = target(&initiate_support::v_shape(n, 1.0, 0.6));
+            let mut sim = initiate::Simulation::new(t, params, p, h, v);
+            for step in 1..=600 {
+                sim.step();
+                if step == 150 || step == 600 {
+                    configs.push((sim.flock.pos.clone(), sim.flock.heading.clone()));
+                }
+            }
+        }
+        let exact = PerceptionParams { mode: PerceptionMode::Exact, ..Default::default() };
+        let mut perceiver = Perceiver::new();
+        let variants: Vec<(String, Option<f64>)> = vec![
+            ("R = 0.5 wingspan".into(), None),
+            ("γ = 0.5".into(), Some(0.5)),
+            ("γ = 1".into(), Some(1.0)),
+            ("γ = 1.5".into(), Some(1.5)),
+            ("γ = 2".into(), Some(2.0)),
+            ("γ = 3".into(), Some(3.0)),
+        ];
+        for (label, gamma) in variants {
+            let (mut views, mut same_set, mut same_ref, mut jac, mut refs) = (0usize, 0usize, 0usize, 0.0, 0usize);
+            for (pos, heading) in &configs {
+                for i in 0..n {
+                    let mut ve = Vec::new();
+                    perceiver.visible(i, pos, heading[i], &exact, &mut ve);
+                    let vh = match gamma {
+                        None => hpr_absolute(i, pos, heading[i], 0.5),
+                        Some(g) => {
+                            let hp = PerceptionParams { mode: PerceptionMode::Hpr { gamma: g }, ..Default::default() };
+                            let mut v = Vec::new();
+                            perceiver.visible(i, pos, heading[i], &hp, &mut v);
+                            v
+                        }
+                    };
+                    views += 1;
+                    if ve == vh {
+                        same_set += 1;
+                    }
+                    let inter = ve.iter().filter(|j| vh.contains(j)).count() as f64;
+                    let uni = (ve.len() + vh.len()) as f64 - inter;
+                    jac += if uni > 0.0 { inter / uni } else { 1.0 };
+                    let re = choose_reference(i, &ve, pos, heading[i], cone, |_| true);
+                    let rh = choose_reference(i, &vh, pos, heading[i], cone, |_| true);
+                    if re.is_some() || rh.is_some() {
+                        refs += 1;
+                        if re == rh {
+                            same_ref += 1;
+                        }
+                    }
+                }
+            }
+            println!(
+                "N={n} {label}: views {views}, identical visible sets {:.1}%, mean Jaccard {:.3}, same reference bird {:.1}%",
+                100.0 * same_set as f64 / views as f64,
+                jac / views as f64,
+                100.0 * same_ref as f64 / refs.max(1) as f64
+            );
+        }
+    }
+}

@@ -20,7 +20,7 @@ use glam::DVec2;
 use super::hull::convex_hull;
 
 /// Default HPR radius exponent γ in R = max|q|·10^γ (measured: docs/initiation.md).
-pub const HPR_GAMMA_DEFAULT: f64 = 1.5;
+pub const HPR_GAMMA_DEFAULT: f64 = 2.0;
 
 /// How occlusion between flockmates is decided.
 #[derive(Debug, Clone, Copy, PartialEq)]
