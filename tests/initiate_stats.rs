@@ -1,5 +1,6 @@
 //! Measurements behind docs/initiation.md (ignored by default; run with
 //! `cargo test --release --test initiate_stats -- --ignored --nocapture`).
+#![allow(clippy::needless_range_loop)]
 
 mod initiate_support;
 
@@ -227,7 +228,9 @@ fn hpr_absolute(viewer: usize, pos: &[DVec2], heading: f64, r_flip: f64) -> Vec<
     use formation::initiate::perception::in_field_of_view;
     let p = pos[viewer];
     let cand: Vec<usize> = (0..pos.len())
-        .filter(|&j| j != viewer && in_field_of_view(heading, pos[j] - p, std::f64::consts::FRAC_PI_2))
+        .filter(|&j| {
+            j != viewer && in_field_of_view(heading, pos[j] - p, std::f64::consts::FRAC_PI_2)
+        })
         .collect();
     let mut pts = vec![DVec2::ZERO];
     for &j in &cand {
@@ -236,7 +239,11 @@ fn hpr_absolute(viewer: usize, pos: &[DVec2], heading: f64, r_flip: f64) -> Vec<
     }
     let (mut sorted, mut hull) = (Vec::new(), Vec::new());
     initiate::hull::convex_hull(&pts, &mut sorted, &mut hull);
-    let mut out: Vec<usize> = hull.iter().filter(|&&h| h > 0).map(|&h| cand[h - 1]).collect();
+    let mut out: Vec<usize> = hull
+        .iter()
+        .filter(|&&h| h > 0)
+        .map(|&h| cand[h - 1])
+        .collect();
     out.sort_unstable();
     out
 }
@@ -246,7 +253,10 @@ fn hpr_absolute(viewer: usize, pos: &[DVec2], heading: f64, r_flip: f64) -> Vec<
 fn hpr_agreement() {
     use formation::initiate::perception::{choose_reference, Perceiver};
     use formation::initiate::{PerceptionMode, PerceptionParams};
-    let flocks: u64 = std::env::var("FLOCKS").ok().and_then(|s| s.parse().ok()).unwrap_or(40);
+    let flocks: u64 = std::env::var("FLOCKS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(40);
     let opts = InitiateOptions::default();
     let params = opts.step_params(30.0, 0.0, 10.0);
     let cone = 0.35 * std::f64::consts::PI;
@@ -255,7 +265,9 @@ fn hpr_agreement() {
         let mut configs: Vec<(Vec<DVec2>, Vec<f64>)> = Vec::new();
         for seed in 0..flocks {
             let mut r = rng::seeded(1000 + seed);
-            let (p, h, v) = initiate::random_start(n, &initiate::StartRegion::default(), &params, &mut r).unwrap();
+            let (p, h, v) =
+                initiate::random_start(n, &initiate::StartRegion::default(), &params, &mut r)
+                    .unwrap();
             configs.push((p.clone(), h.clone()));
             let t = target(&initiate_support::v_shape(n, 1.0, 0.6));
             let mut sim = initiate::Simulation::new(t, params, p, h, v);
@@ -266,7 +278,10 @@ fn hpr_agreement() {
                 }
             }
         }
-        let exact = PerceptionParams { mode: PerceptionMode::Exact, ..Default::default() };
+        let exact = PerceptionParams {
+            mode: PerceptionMode::Exact,
+            ..Default::default()
+        };
         let mut perceiver = Perceiver::new();
         let variants: Vec<(String, Option<f64>)> = vec![
             ("R = 0.5 wingspan".into(), None),
@@ -277,7 +292,8 @@ fn hpr_agreement() {
             ("γ = 3".into(), Some(3.0)),
         ];
         for (label, gamma) in variants {
-            let (mut views, mut same_set, mut same_ref, mut jac, mut refs) = (0usize, 0usize, 0usize, 0.0, 0usize);
+            let (mut views, mut same_set, mut same_ref, mut jac, mut refs) =
+                (0usize, 0usize, 0usize, 0.0, 0usize);
             for (pos, heading) in &configs {
                 for i in 0..n {
                     let mut ve = Vec::new();
@@ -285,7 +301,10 @@ fn hpr_agreement() {
                     let vh = match gamma {
                         None => hpr_absolute(i, pos, heading[i], 0.5),
                         Some(g) => {
-                            let hp = PerceptionParams { mode: PerceptionMode::Hpr { gamma: g }, ..Default::default() };
+                            let hp = PerceptionParams {
+                                mode: PerceptionMode::Hpr { gamma: g },
+                                ..Default::default()
+                            };
                             let mut v = Vec::new();
                             perceiver.visible(i, pos, heading[i], &hp, &mut v);
                             v

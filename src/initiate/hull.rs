@@ -105,7 +105,7 @@ pub fn convex_hull(
     }
     // Positions (in `sorted`) of the chain; lower hull, then upper hull; pop on clockwise or
     // collinear turns (strict convexity).
-    let mut chain: Vec<usize> = Vec::with_capacity(n + 1);
+    let mut chain = std::mem::take(hull);
     for k in 0..n {
         while chain.len() >= 2
             && orient2d(
@@ -139,7 +139,11 @@ pub fn convex_hull(
         chain.push(0);
         chain.push(n - 1);
     }
-    hull.extend(chain.iter().map(|&k| sorted[k].2));
+    // `chain` holds positions in `sorted`; turn them into indices of `points` in place.
+    for k in chain.iter_mut() {
+        *k = sorted[*k].2;
+    }
+    *hull = chain;
     n
 }
 
