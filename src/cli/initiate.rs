@@ -57,25 +57,26 @@ pub struct InitiateArgs {
     /// Maximum turn rate, degrees per second.
     #[arg(long, default_value_t = 90.0)]
     pub max_turn_rate: f64,
-    /// Maximum acceleration, wingspans per second squared.
+    /// Maximum acceleration, wingspans per second squared [default: 4].
     #[arg(long)]
     pub max_accel: Option<f64>,
-    /// Minimum flight speed, fraction of the cruise speed.
+    /// Minimum flight speed, fraction of the cruise speed [default: 0.5].
     #[arg(long)]
     pub min_speed: Option<f64>,
-    /// Maximum flight speed, fraction of the cruise speed.
+    /// Maximum flight speed, fraction of the cruise speed [default: 1.6].
     #[arg(long)]
     pub max_speed: Option<f64>,
-    /// Separation drive distance, wingspans (paper: 10).
+    /// Separation drive distance, wingspans [default: 10, as in the paper].
     #[arg(long)]
     pub separation: Option<f64>,
-    /// Collision avoidance: predicted closest approach that triggers evasion, wingspans.
+    /// Collision avoidance: predicted closest approach that triggers evasion, wingspans
+    /// [default: 0.8].
     #[arg(long)]
     pub avoid_distance: Option<f64>,
-    /// Convergence: every bird within this distance of its slot, wingspans.
+    /// Convergence: every bird within this distance of its slot, wingspans [default: 0.1].
     #[arg(long)]
     pub tolerance: Option<f64>,
-    /// Convergence: for this long, seconds (also the hand-over blend window).
+    /// Convergence: for this long, seconds (also the hand-over blend window) [default: 1].
     #[arg(long)]
     pub hold: Option<f64>,
     /// Start file: JSON {"x": [...], "y": [...], "heading": [...], "speed": [...]} (world frame,

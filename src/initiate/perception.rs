@@ -470,4 +470,49 @@ mod tests {
             None
         );
     }
+
+    mod props {
+        use super::*;
+        use proptest::prelude::*;
+
+        fn flock() -> impl Strategy<Value = (Vec<(f64, f64)>, f64, usize)> {
+            (
+                proptest::collection::vec((-20.0f64..20.0, -20.0f64..20.0), 2..40),
+                -PI..PI,
+                0usize..40,
+            )
+        }
+
+        proptest! {
+            /// Never itself; only birds in the field; the nearest bird in the field is always
+            /// seen (nothing can hide it); the reference bird is one of the visible.
+            #[test]
+            fn visibility_invariants((pts, heading, viewer) in flock(), fov in 0.2f64..PI) {
+                let pos: Vec<DVec2> = pts.iter().map(|&(x, y)| DVec2::new(x, y)).collect();
+                let viewer = viewer % pos.len();
+                for mode in MODES {
+                    let params = PerceptionParams { mode, fov_per_eye: fov, ..Default::default() };
+                    let mut out = Vec::new();
+                    Perceiver::new().visible(viewer, &pos, heading, &params, &mut out);
+                    prop_assert!(!out.contains(&viewer));
+                    for &j in &out {
+                        prop_assert!(in_field_of_view(heading, pos[j] - pos[viewer], fov));
+                    }
+                    let mut in_field: Vec<(f64, usize)> = (0..pos.len())
+                        .filter(|&j| j != viewer && in_field_of_view(heading, pos[j] - pos[viewer], fov))
+                        .map(|j| ((pos[j] - pos[viewer]).length(), j))
+                        .collect();
+                    in_field.sort_by(|a, b| a.0.total_cmp(&b.0));
+                    if in_field.len() >= 2 && in_field[0].0 < in_field[1].0 - 1e-9 {
+                        prop_assert!(out.contains(&in_field[0].1), "{mode:?}: nearest {} hidden", in_field[0].1);
+                    }
+                    let r = choose_reference(viewer, &out, &pos, heading, 0.35 * PI, |_| true);
+                    prop_assert_eq!(r.is_some(), !out.is_empty());
+                    if let Some(r) = r {
+                        prop_assert!(out.contains(&r));
+                    }
+                }
+            }
+        }
+    }
 }
