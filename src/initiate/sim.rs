@@ -64,6 +64,10 @@ pub struct StepParams {
     pub linear_zone: f64,
 }
 
+/// A bird claims a slot already held by a visible bird only when it is nearer the slot's target
+/// by this much, wingspans.
+pub const SLOT_CLAIM_MARGIN: f64 = 1.0;
+
 /// Flocks at least this large decide in parallel (one thread per core).
 pub const PARALLEL_MIN_BIRDS: usize = 256;
 
@@ -262,12 +266,16 @@ impl Simulation {
         let f = &self.flock;
         let t = self.target_point(j, offset);
         let my = (f.pos[i] - t).length();
+        // A bird that does not follow `j` yet must be nearer than a holder by a margin to claim
+        // the slot, so that birds at the tail of an arm do not trade places forever.
+        let holds = f.reference[i] == Some(j) && f.side[i] == Some(side);
+        let margin = if holds { 0.0 } else { SLOT_CLAIM_MARGIN };
         !visible.iter().any(|&k| {
             k != i
                 && f.reference[k] == Some(j)
                 && f.side[k] == Some(side)
                 && (f.pos[k] - f.pos[i]).length() < self.params.separation_distance
-                && (f.pos[k] - t).length() < my
+                && (f.pos[k] - t).length() < my + margin
         })
     }
 
