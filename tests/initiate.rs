@@ -273,3 +273,30 @@ fn bad_parameters_are_named() {
     assert_eq!(e.exit_code(), 2);
     assert!(e.to_string().contains("key_shapes"), "{e}");
 }
+
+#[test]
+fn wing_phases_continue_backward_into_the_initiation() {
+    use std::f64::consts::TAU;
+    let fps = 30.0;
+    let mut st = steady(&v_shape(5, 1.0, 0.6), 20, fps, 10.0);
+    // 3 wingbeats per second, a different phase per bird.
+    for (k, f) in st.frames.iter_mut().enumerate() {
+        f.wing_phase = Some(
+            (0..5)
+                .map(|i| (0.3 * i as f64 + k as f64 * TAU * 3.0 / fps).rem_euclid(TAU))
+                .collect(),
+        );
+    }
+    let (a, _) = run_initiate(&st, 2);
+    let k = a.stage("initiation").unwrap().end;
+    for t in 1..=k {
+        let (p0, p1) = (
+            a.frames[t - 1].wing_phase.as_ref().unwrap(),
+            a.frames[t].wing_phase.as_ref().unwrap(),
+        );
+        for i in 0..5 {
+            let step = (p1[i] - p0[i]).rem_euclid(TAU);
+            assert!((step - TAU * 3.0 / fps).abs() < 1e-9, "frame {t} bird {i}");
+        }
+    }
+}
