@@ -109,6 +109,22 @@ fn bad_input_is_exit_2_with_one_line() {
         ),
         (vec!["initiate", s, "-o", o, "--start-width", "2"], "region"),
         (
+            vec!["initiate", s, "-o", o, "--start-width", "1e300"],
+            "--start-width",
+        ),
+        (
+            vec!["initiate", s, "-o", o, "--tolerance", "1e-300"],
+            "--tolerance",
+        ),
+        (
+            vec!["initiate", s, "-o", o, "--max-steps", "99999999"],
+            "--max-steps",
+        ),
+        (
+            vec!["initiate", s, "-o", o, "--hpr-gamma", "1e9"],
+            "--hpr-gamma",
+        ),
+        (
             vec!["initiate", s, "-o", o, "--perception", "psychic"],
             "psychic",
         ),

@@ -35,6 +35,12 @@ pub use perception::{PerceptionMode, PerceptionParams, HPR_GAMMA_DEFAULT};
 pub use sim::{Simulation, StepParams};
 pub use target::{Side, TargetShape};
 
+/// Largest accepted step limit (9¼ hours of flight at 30 fps).
+pub const MAX_STEPS_LIMIT: usize = 1_000_000;
+
+/// Largest accepted width or depth of the random start region, wingspans.
+pub const MAX_START_EXTENT: f64 = 1e6;
+
 /// Parameters of the initiation (units per second; converted to per-step values at the file's fps).
 #[derive(Debug, Clone, PartialEq)]
 pub struct InitiateOptions {
@@ -337,6 +343,15 @@ impl InitiateOptions {
             ));
         }
         pos("--tolerance", self.tolerance)?;
+        if self.tolerance < 1e-6 {
+            return Err(Error::parameter(
+                "--tolerance",
+                format!(
+                    "{:e} wingspans cannot be met in floating point; use at least 1e-6",
+                    self.tolerance
+                ),
+            ));
+        }
         pos("--heading-tolerance", self.heading_tolerance)?;
         pos("--speed-tolerance", self.speed_tolerance)?;
         if !(self.hold.is_finite() && self.hold >= 0.0) {
@@ -354,12 +369,26 @@ impl InitiateOptions {
                 "must be at least 1 (the initiation needs at least one step)",
             ));
         }
+        if self.max_steps > MAX_STEPS_LIMIT {
+            return Err(Error::parameter(
+                "--max-steps",
+                format!(
+                    "at most {MAX_STEPS_LIMIT} (every step is kept in memory for the output), got {}",
+                    self.max_steps
+                ),
+            ));
+        }
         if let Start::Random(r) = &self.start {
-            if let Some(w) = r.width {
-                pos("--start-width", w)?;
-            }
-            if let Some(d) = r.depth {
-                pos("--start-depth", d)?;
+            for (name, v) in [("--start-width", r.width), ("--start-depth", r.depth)] {
+                if let Some(v) = v {
+                    pos(name, v)?;
+                    if v > MAX_START_EXTENT {
+                        return Err(Error::parameter(
+                            name,
+                            format!("at most {MAX_START_EXTENT} wingspans, got {v:e}"),
+                        ));
+                    }
+                }
             }
             if !(r.heading_spread.is_finite() && (0.0..=PI).contains(&r.heading_spread)) {
                 return Err(Error::parameter(
@@ -490,10 +519,11 @@ pub fn random_start(
         let (kx, ky) = key(p);
         let clash = (-1..=1).any(|dx| {
             (-1..=1).any(|dy| {
-                grid.get(&(kx + dx, ky + dy)).is_some_and(|v| {
-                    v.iter()
-                        .any(|&j| (pos[j] - p).length() < region.min_spacing)
-                })
+                grid.get(&(kx.saturating_add(dx), ky.saturating_add(dy)))
+                    .is_some_and(|v| {
+                        v.iter()
+                            .any(|&j| (pos[j] - p).length() < region.min_spacing)
+                    })
             })
         });
         if clash {
