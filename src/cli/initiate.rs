@@ -1,11 +1,28 @@
-//! `formation initiate` and `formation plot paths` (issue 5).
+//! `formation initiate` and `formation plot paths` (issue 5): flags → [`InitiateOptions`], run the
+//! §6 simulation into the first key shape of a steady-flight file, write the combined animation.
 
+use std::io::Write;
 use std::path::PathBuf;
 
-use clap::Args;
-use formation::Result;
+use clap::{Args, ValueEnum};
+use formation::animation::Animation;
+use formation::initiate::{
+    self, InitiateOptions, PerceptionMode, Start, StartRegion, StartState, HPR_GAMMA_DEFAULT,
+};
+use formation::io::{write_json_atomic, AtomicFile, OutputKind};
+use formation::{Error, Result};
 
+use super::progress::TermProgress;
 use super::Global;
+
+/// Occlusion model of the perception.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum PerceptionArg {
+    /// Hidden Point Removal (the paper's; radius R = max distance · 10^γ).
+    Hpr,
+    /// Birds as discs of half a wingspan occluding one another.
+    Exact,
+}
 
 /// Arguments of `formation initiate`.
 #[derive(Debug, Args)]
@@ -15,11 +32,180 @@ pub struct InitiateArgs {
     /// Output animation (.json or .csv); may be repeated.
     #[arg(short = 'o', long = "output", required = true)]
     pub output: Vec<PathBuf>,
+    /// Step limit (one step = one frame); no convergence within it fails with exit 1.
+    #[arg(long, default_value_t = 9000)]
+    pub max_steps: usize,
+    /// Occlusion model.
+    #[arg(long, value_enum, default_value_t = PerceptionArg::Hpr)]
+    pub perception: PerceptionArg,
+    /// HPR radius exponent γ: R = (distance of the farthest bird) · 10^γ.
+    #[arg(long, default_value_t = HPR_GAMMA_DEFAULT)]
+    pub hpr_gamma: f64,
+    /// Visual field per eye, degrees from straight ahead (paper: 90).
+    #[arg(long, default_value_t = 90.0)]
+    pub fov: f64,
+    /// Cone per eye in which the closest visible bird is the preferred reference, degrees
+    /// (paper: 0.35π = 63).
+    #[arg(long, default_value_t = 63.0)]
+    pub reference_cone: f64,
+    /// α of eq. (6) (heading gain).
+    #[arg(long, default_value_t = 0.2)]
+    pub alpha: f64,
+    /// |K| of eq. (5) (speed gain).
+    #[arg(long, default_value_t = 0.06)]
+    pub k: f64,
+    /// Maximum turn rate, degrees per second.
+    #[arg(long, default_value_t = 90.0)]
+    pub max_turn_rate: f64,
+    /// Maximum acceleration, wingspans per second squared [default: 4].
+    #[arg(long)]
+    pub max_accel: Option<f64>,
+    /// Minimum flight speed, fraction of the cruise speed [default: 0.5].
+    #[arg(long)]
+    pub min_speed: Option<f64>,
+    /// Maximum flight speed, fraction of the cruise speed [default: 1.6].
+    #[arg(long)]
+    pub max_speed: Option<f64>,
+    /// Separation drive distance, wingspans [default: 10, as in the paper].
+    #[arg(long)]
+    pub separation: Option<f64>,
+    /// Collision avoidance: predicted closest approach that triggers evasion, wingspans
+    /// [default: 0.8].
+    #[arg(long)]
+    pub avoid_distance: Option<f64>,
+    /// Convergence: every bird within this distance of its slot, wingspans [default: 0.1].
+    #[arg(long)]
+    pub tolerance: Option<f64>,
+    /// Convergence: for this long, seconds (also the hand-over blend window) [default: 1].
+    #[arg(long)]
+    pub hold: Option<f64>,
+    /// Start file: JSON {"x": [...], "y": [...], "heading": [...], "speed": [...]} (world frame,
+    /// wingspans, radians clockwise from north, wingspans per second; heading and speed optional).
+    #[arg(long, conflicts_with_all = ["start_width", "start_depth", "heading_spread"])]
+    pub start: Option<PathBuf>,
+    /// Width of the random start region across the cruise heading, wingspans
+    /// (default 30, or 6√N for large flocks).
+    #[arg(long)]
+    pub start_width: Option<f64>,
+    /// Depth of the random start region along the cruise heading, wingspans (default: the width).
+    #[arg(long)]
+    pub start_depth: Option<f64>,
+    /// Start headings are uniform within this many degrees of the cruise heading (180: any).
+    #[arg(long, default_value_t = 180.0)]
+    pub heading_spread: f64,
+    /// Print the run's statistics as JSON on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+impl InitiateArgs {
+    /// The library options these flags describe (validated by the library).
+    fn options(&self, g: &Global, birds: usize) -> Result<InitiateOptions> {
+        let mut o = InitiateOptions {
+            seed: g.seed,
+            max_steps: self.max_steps,
+            alpha: self.alpha,
+            k: self.k,
+            max_turn_rate: self.max_turn_rate.to_radians(),
+            ..Default::default()
+        };
+        o.perception.fov_per_eye = self.fov.to_radians();
+        o.perception.reference_cone = self.reference_cone.to_radians();
+        o.perception.mode = match self.perception {
+            PerceptionArg::Hpr => PerceptionMode::Hpr {
+                gamma: self.hpr_gamma,
+            },
+            PerceptionArg::Exact => PerceptionMode::Exact,
+        };
+        let set = |field: &mut f64, v: Option<f64>| {
+            if let Some(v) = v {
+                *field = v;
+            }
+        };
+        set(&mut o.max_accel, self.max_accel);
+        set(&mut o.min_speed, self.min_speed);
+        set(&mut o.max_speed, self.max_speed);
+        set(&mut o.separation_distance, self.separation);
+        set(&mut o.avoid_distance, self.avoid_distance);
+        set(&mut o.tolerance, self.tolerance);
+        set(&mut o.hold, self.hold);
+        o.start = match &self.start {
+            Some(path) => Start::Given(StartState::read(path, birds)?),
+            None => Start::Random(StartRegion {
+                width: self.start_width,
+                depth: self.start_depth,
+                heading_spread: self.heading_spread.to_radians(),
+                ..Default::default()
+            }),
+        };
+        if !(self.heading_spread.is_finite() && (0.0..=180.0).contains(&self.heading_spread)) {
+            return Err(Error::parameter(
+                "--heading-spread",
+                format!("must be in [0, 180] degrees, got {}", self.heading_spread),
+            ));
+        }
+        o.validate()?;
+        Ok(o)
+    }
 }
 
 /// Runs `formation initiate`.
-pub fn run(_args: InitiateArgs, _g: Global) -> Result<()> {
-    Err(super::not_yet("initiate"))
+pub fn run(args: InitiateArgs, g: Global) -> Result<()> {
+    let kinds = args
+        .output
+        .iter()
+        .map(|p| OutputKind::from_path(p, &[OutputKind::Json, OutputKind::Csv]))
+        .collect::<Result<Vec<_>>>()?;
+    let steady = Animation::read(&args.steady)?;
+    initiate::check_steady(&steady, &args.steady)?;
+    let opts = args.options(&g, steady.birds)?;
+    let mut rng = formation::rng::stream(g.seed, "initiate");
+    let progress = TermProgress::new(g.quiet);
+    let (anim, stats) = initiate::initiate(&steady, &opts, &mut rng, &progress)?;
+    for (path, kind) in args.output.iter().zip(kinds) {
+        match kind {
+            OutputKind::Csv => write_csv(&anim, path)?,
+            _ => write_json_atomic(path, &anim)?,
+        }
+    }
+    if args.json {
+        let text = serde_json::to_string_pretty(&stats)
+            .map_err(|e| Error::Internal(format!("serialising statistics: {e}")))?;
+        println!("{text}");
+    }
+    Ok(())
+}
+
+/// SPEC §4.4 long CSV: `frame,t,bird,x,y,z,heading,speed,e,xi` (e and ξ empty where undefined).
+fn write_csv(a: &Animation, path: &std::path::Path) -> Result<()> {
+    let mut f = AtomicFile::create(path)?;
+    let io = |e: std::io::Error| Error::io(path, e);
+    let w = f.writer();
+    writeln!(w, "frame,t,bird,x,y,z,heading,speed,e,xi").map_err(io)?;
+    for (k, fr) in a.frames.iter().enumerate() {
+        for i in 0..a.birds {
+            let opt = |v: &Option<Vec<f64>>| {
+                v.as_ref()
+                    .and_then(|v| v.get(i))
+                    .map(|x| x.to_string())
+                    .unwrap_or_default()
+            };
+            writeln!(
+                w,
+                "{k},{},{i},{},{},{},{},{},{},{}",
+                fr.t,
+                fr.x[i],
+                fr.y[i],
+                fr.z[i],
+                fr.heading[i],
+                fr.speed[i],
+                opt(&fr.e),
+                opt(&fr.xi)
+            )
+            .map_err(io)?;
+        }
+    }
+    f.commit()
 }
 
 /// Arguments of `formation plot paths`.
@@ -33,6 +219,10 @@ pub struct PlotPathsArgs {
 }
 
 /// Runs `formation plot paths`.
-pub fn run_plot_paths(_args: PlotPathsArgs, _g: Global) -> Result<()> {
-    Err(super::not_yet("plot paths"))
+pub fn run_plot_paths(args: PlotPathsArgs, _g: Global) -> Result<()> {
+    OutputKind::from_path(&args.output, &[OutputKind::Png, OutputKind::Svg])?;
+    let a = Animation::read(&args.input)?;
+    let chart = formation::plot::paths::PathsChart::from_animation(&a)
+        .map_err(|e| Error::format(&args.input, e.to_string()))?;
+    formation::plot::save(&chart, &args.output)
 }

@@ -49,7 +49,7 @@ enum Command {
     /// §5 Algorithm 1: a steady-flight animation from formation parameters.
     Steady(steady::SteadyArgs),
     /// §6 initiation: random take-off converging into the first key shape.
-    Initiate(initiate::InitiateArgs),
+    Initiate(Box<initiate::InitiateArgs>),
     /// The whole chain: annotations or params → extract → steady → initiate → outputs.
     Animate(animate::AnimateArgs),
     /// Render or export an animation file (GIF, PNG frames, glTF, CSV, JSON).
@@ -69,7 +69,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Power(a) => power::run(a, g),
         Command::Solve(a) => solve::run(a, g),
         Command::Steady(a) => steady::run(a, g),
-        Command::Initiate(a) => initiate::run(a, g),
+        Command::Initiate(a) => initiate::run(*a, g),
         Command::Animate(a) => animate::run(a, g),
         Command::Render(a) => render::run(a, g),
         Command::Plot(a) => plot::run(a, g),

@@ -5,8 +5,10 @@
 use std::path::Path;
 use std::sync::Once;
 
+pub mod paths;
 pub mod power;
 pub mod shape;
+pub mod wingbeat;
 pub mod xi;
 
 use plotters::coord::Shift;
@@ -92,4 +94,3 @@ pub fn encode_png_rgb(buf: &[u8], w: u32, h: u32) -> Result<Vec<u8>> {
 
 use image::ImageEncoder as _;
 
-pub mod wingbeat;

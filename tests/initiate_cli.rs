@@ -1,0 +1,178 @@
+//! `formation initiate` and `formation plot paths` through the binary: outputs, exit codes,
+//! one-line messages, nothing written on failure, byte-identical reruns.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_formation"))
+}
+
+fn data(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data")
+        .join(name)
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("formation-initiate-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+/// Runs the binary; returns exit code and stderr.
+fn run(args: &[&str]) -> (i32, String) {
+    let out = bin().args(args).output().unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn initiate_writes_an_animation_and_the_paths_chart() {
+    let steady = data("initiate_steady_v9.json");
+    let out = tmp("init9.json");
+    let csv = tmp("init9.csv");
+    let (code, err) = run(&[
+        "initiate",
+        steady.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "-o",
+        csv.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let a = formation::Animation::read(&out).unwrap();
+    assert_eq!(a.stages[0].name, "initiation");
+    assert_eq!(a.stages[1].name, "steady");
+    assert_eq!(a.stages[1].end, a.frames.len());
+    let text = std::fs::read_to_string(&csv).unwrap();
+    assert!(text.starts_with("frame,t,bird,x,y,z,heading,speed,e,xi\n"));
+    assert_eq!(text.lines().count(), 1 + a.frames.len() * a.birds);
+    let png = tmp("paths.png");
+    let (code, err) = run(&[
+        "plot",
+        "paths",
+        out.to_str().unwrap(),
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let bytes = std::fs::read(&png).unwrap();
+    assert!(bytes.starts_with(b"\x89PNG"));
+}
+
+#[test]
+fn same_seed_gives_byte_identical_files() {
+    let steady = data("initiate_steady_v9.json");
+    let (a, b, c) = (tmp("s1.json"), tmp("s2.json"), tmp("s3.json"));
+    for (p, seed) in [(&a, "4"), (&b, "4"), (&c, "5")] {
+        let (code, err) = run(&[
+            "initiate",
+            steady.to_str().unwrap(),
+            "-o",
+            p.to_str().unwrap(),
+            "--seed",
+            seed,
+        ]);
+        assert_eq!(code, 0, "{err}");
+    }
+    assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
+    assert_ne!(std::fs::read(&a).unwrap(), std::fs::read(&c).unwrap());
+}
+
+#[test]
+fn bad_input_is_exit_2_with_one_line() {
+    let steady = data("initiate_steady_v9.json");
+    let s = steady.to_str().unwrap();
+    let no_ks = data("initiate_steady_no_keyshape.json");
+    let out = tmp("bad.json");
+    let o = out.to_str().unwrap();
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (
+            vec!["initiate", no_ks.to_str().unwrap(), "-o", o],
+            "key_shapes",
+        ),
+        (
+            vec!["initiate", s, "-o", o, "--max-steps", "0"],
+            "--max-steps",
+        ),
+        (vec!["initiate", s, "-o", o, "--alpha=-1"], "--alpha"),
+        (vec!["initiate", s, "-o", o, "--alpha", "-1"], "-1"),
+        (vec!["initiate", s, "-o", o, "--fov", "0"], "--fov"),
+        (vec!["initiate", s, "-o", o, "--fov", "200"], "--fov"),
+        (
+            vec!["initiate", s, "-o", o, "--start-width=-3"],
+            "--start-width",
+        ),
+        (vec!["initiate", s, "-o", o, "--start-width", "2"], "region"),
+        (
+            vec!["initiate", s, "-o", o, "--start-width", "1e300"],
+            "--start-width",
+        ),
+        (
+            vec!["initiate", s, "-o", o, "--tolerance", "1e-300"],
+            "--tolerance",
+        ),
+        (
+            vec!["initiate", s, "-o", o, "--max-steps", "99999999"],
+            "--max-steps",
+        ),
+        (
+            vec!["initiate", s, "-o", o, "--hpr-gamma", "1e9"],
+            "--hpr-gamma",
+        ),
+        (
+            vec!["initiate", s, "-o", o, "--perception", "psychic"],
+            "psychic",
+        ),
+        (vec!["initiate", s, "-o", "out.xyz"], "out.xyz"),
+        (
+            vec!["initiate", "/nonexistent/steady.json", "-o", o],
+            "/nonexistent/steady.json",
+        ),
+        (
+            vec!["initiate", s, "-o", o, "--start", s],
+            "unexpected JSON structure",
+        ),
+    ];
+    for (args, needle) in cases {
+        let (code, err) = run(&args);
+        assert_eq!(code, 2, "{args:?}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: {err}");
+        assert!(!out.exists(), "{args:?} wrote a file");
+    }
+}
+
+#[test]
+fn no_convergence_is_exit_1_and_writes_nothing() {
+    let steady = data("initiate_steady_v9.json");
+    let out = tmp("nc.json");
+    std::fs::write(&out, b"previous").unwrap();
+    let (code, err) = run(&[
+        "initiate",
+        steady.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--max-steps",
+        "40",
+    ]);
+    assert_eq!(code, 1, "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(err.contains("did not converge"), "{err}");
+    assert_eq!(std::fs::read(&out).unwrap(), b"previous");
+    let fresh = tmp("nc-fresh.json");
+    let (code, _) = run(&[
+        "initiate",
+        steady.to_str().unwrap(),
+        "-o",
+        fresh.to_str().unwrap(),
+        "--max-steps",
+        "40",
+    ]);
+    assert_eq!(code, 1);
+    assert!(!fresh.exists());
+}
