@@ -87,6 +87,17 @@ pub fn install_signal_cleanup() {
     });
 }
 
+/// Writes `anim` to every output (by extension: .json, .csv, .gif, DIR/, .glb), atomically, with
+/// a progress bar unless `--quiet`.
+pub fn write_animation(
+    anim: &formation::Animation,
+    outputs: &[std::path::PathBuf],
+    opts: &formation::export::RenderOptions,
+    g: Global,
+) -> Result<()> {
+    formation::export::write_outputs(anim, outputs, opts, &progress::TermProgress::new(g.quiet))
+}
+
 /// The error for a command that is not built yet.
 #[allow(dead_code)]
 pub fn not_yet(what: &str) -> formation::Error {

@@ -53,7 +53,7 @@ impl PictureArgs {
 }
 
 /// Parses `960x540`.
-fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
+pub fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
     let (w, h) = s
         .split_once(['x', 'X'])
         .ok_or_else(|| format!("expected WIDTHxHEIGHT like 960x540, got {s:?}"))?;
