@@ -63,7 +63,7 @@ pub fn run(args: AnimateArgs, g: Global) -> Result<()> {
         ));
     }
     let frames_f = (args.seconds * args.steady.fps).round();
-    if !(frames_f >= 1.0 && frames_f <= 10_000_000.0) {
+    if !(1.0..=10_000_000.0).contains(&frames_f) {
         return Err(Error::parameter(
             "--seconds",
             format!(
