@@ -47,7 +47,7 @@ pub struct FitArgs {
 }
 
 impl ReadArgs {
-    fn options(&self) -> ReadOptions {
+    pub fn options(&self) -> ReadOptions {
         ReadOptions {
             heading: self.heading,
             wingspan_px: self.wingspan_px,

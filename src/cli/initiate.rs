@@ -1,7 +1,6 @@
 //! `formation initiate` and `formation plot paths` (issue 5): flags → [`InitiateOptions`], run the
 //! §6 simulation into the first key shape of a steady-flight file, write the combined animation.
 
-use std::io::Write;
 use std::path::PathBuf;
 
 use clap::{Args, ValueEnum};
@@ -9,7 +8,7 @@ use formation::animation::Animation;
 use formation::initiate::{
     self, InitiateOptions, PerceptionMode, Start, StartRegion, StartState, HPR_GAMMA_DEFAULT,
 };
-use formation::io::{write_json_atomic, AtomicFile, OutputKind};
+use formation::io::OutputKind;
 use formation::{Error, Result};
 
 use super::progress::TermProgress;
@@ -29,9 +28,22 @@ pub enum PerceptionArg {
 pub struct InitiateArgs {
     /// A steady-flight animation file (its first key shape is the target).
     pub steady: PathBuf,
-    /// Output animation (.json or .csv); may be repeated.
+    /// Outputs by extension: .json (the animation file), .csv, and also .gif, DIR/, .glb; may be
+    /// repeated.
     #[arg(short = 'o', long = "output", required = true)]
     pub output: Vec<PathBuf>,
+    #[command(flatten)]
+    pub initiate: InitiateFlags,
+    #[command(flatten)]
+    pub wingbeat: super::wingbeat::WingbeatFlags,
+    /// Print the run's statistics as JSON on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Initiation flags shared by `initiate` and `animate`.
+#[derive(Debug, Clone, Args)]
+pub struct InitiateFlags {
     /// Step limit (one step = one frame); no convergence within it fails with exit 1.
     #[arg(long, default_value_t = 9000)]
     pub max_steps: usize,
@@ -93,16 +105,13 @@ pub struct InitiateArgs {
     /// Start headings are uniform within this many degrees of the cruise heading (180: any).
     #[arg(long, default_value_t = 180.0)]
     pub heading_spread: f64,
-    /// Print the run's statistics as JSON on stdout.
-    #[arg(long)]
-    pub json: bool,
 }
 
-impl InitiateArgs {
+impl InitiateFlags {
     /// The library options these flags describe (validated by the library).
-    fn options(&self, g: &Global, birds: usize) -> Result<InitiateOptions> {
+    pub fn options(&self, seed: u64, birds: usize) -> Result<InitiateOptions> {
         let mut o = InitiateOptions {
-            seed: g.seed,
+            seed,
             max_steps: self.max_steps,
             alpha: self.alpha,
             k: self.k,
@@ -151,61 +160,22 @@ impl InitiateArgs {
 
 /// Runs `formation initiate`.
 pub fn run(args: InitiateArgs, g: Global) -> Result<()> {
-    let kinds = args
-        .output
-        .iter()
-        .map(|p| OutputKind::from_path(p, &[OutputKind::Json, OutputKind::Csv]))
-        .collect::<Result<Vec<_>>>()?;
+    let wing = args.wingbeat.options()?;
+    formation::export::plan_outputs(&args.output)?;
     let steady = Animation::read(&args.steady)?;
     initiate::check_steady(&steady, &args.steady)?;
-    let opts = args.options(&g, steady.birds)?;
+    let opts = args.initiate.options(g.seed, steady.birds)?;
     let mut rng = formation::rng::stream(g.seed, "initiate");
     let progress = TermProgress::new(g.quiet);
-    let (anim, stats) = initiate::initiate(&steady, &opts, &mut rng, &progress)?;
-    for (path, kind) in args.output.iter().zip(kinds) {
-        match kind {
-            OutputKind::Csv => write_csv(&anim, path)?,
-            _ => write_json_atomic(path, &anim)?,
-        }
-    }
+    let (mut anim, stats) = initiate::initiate(&steady, &opts, &mut rng, &progress)?;
+    formation::wingbeat::assign_phases(&mut anim, &wing)?;
+    super::write_animation(&anim, &args.output, &Default::default(), g)?;
     if args.json {
         let text = serde_json::to_string_pretty(&stats)
             .map_err(|e| Error::Internal(format!("serialising statistics: {e}")))?;
         println!("{text}");
     }
     Ok(())
-}
-
-/// SPEC §4.4 long CSV: `frame,t,bird,x,y,z,heading,speed,e,xi` (e and ξ empty where undefined).
-fn write_csv(a: &Animation, path: &std::path::Path) -> Result<()> {
-    let mut f = AtomicFile::create(path)?;
-    let io = |e: std::io::Error| Error::io(path, e);
-    let w = f.writer();
-    writeln!(w, "frame,t,bird,x,y,z,heading,speed,e,xi").map_err(io)?;
-    for (k, fr) in a.frames.iter().enumerate() {
-        for i in 0..a.birds {
-            let opt = |v: &Option<Vec<f64>>| {
-                v.as_ref()
-                    .and_then(|v| v.get(i))
-                    .map(|x| x.to_string())
-                    .unwrap_or_default()
-            };
-            writeln!(
-                w,
-                "{k},{},{i},{},{},{},{},{},{},{}",
-                fr.t,
-                fr.x[i],
-                fr.y[i],
-                fr.z[i],
-                fr.heading[i],
-                fr.speed[i],
-                opt(&fr.e),
-                opt(&fr.xi)
-            )
-            .map_err(io)?;
-        }
-    }
-    f.commit()
 }
 
 /// Arguments of `formation plot paths`.

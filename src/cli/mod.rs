@@ -51,7 +51,7 @@ enum Command {
     /// §6 initiation: random take-off converging into the first key shape.
     Initiate(Box<initiate::InitiateArgs>),
     /// The whole chain: annotations or params → extract → steady → initiate → outputs.
-    Animate(animate::AnimateArgs),
+    Animate(Box<animate::AnimateArgs>),
     /// Render or export an animation file (GIF, PNG frames, glTF, CSV, JSON).
     Render(render::RenderArgs),
     /// Charts: power, xi, shape, paths, wingbeat.
@@ -70,7 +70,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Solve(a) => solve::run(a, g),
         Command::Steady(a) => steady::run(a, g),
         Command::Initiate(a) => initiate::run(*a, g),
-        Command::Animate(a) => animate::run(a, g),
+        Command::Animate(a) => animate::run(*a, g),
         Command::Render(a) => render::run(a, g),
         Command::Plot(a) => plot::run(a, g),
     }
@@ -85,6 +85,17 @@ pub fn install_signal_cleanup() {
         eprintln!("error: interrupted; no output written");
         std::process::exit(130);
     });
+}
+
+/// Writes `anim` to every output (by extension: .json, .csv, .gif, DIR/, .glb), atomically, with
+/// a progress bar unless `--quiet`.
+pub fn write_animation(
+    anim: &formation::Animation,
+    outputs: &[std::path::PathBuf],
+    opts: &formation::export::RenderOptions,
+    g: Global,
+) -> Result<()> {
+    formation::export::write_outputs(anim, outputs, opts, &progress::TermProgress::new(g.quiet))
 }
 
 /// The error for a command that is not built yet.

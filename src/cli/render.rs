@@ -31,11 +31,11 @@ pub struct PictureArgs {
     /// Frame rate of the pictures, frames per second [default: 25 for GIF (rounded to whole
     /// 1/100 s per frame, at most 50), the animation's own rate for PNG frames]. JSON, CSV and glTF
     /// keep the animation's frames.
-    #[arg(long, value_name = "FPS")]
+    #[arg(long, value_name = "FPS", allow_negative_numbers = true)]
     pub fps: Option<f64>,
     /// Bird wingspan in metres for the .glb (and recorded in the .json) [default: the
     /// animation's, 1.5 for a goose].
-    #[arg(long, value_name = "M")]
+    #[arg(long, value_name = "M", allow_negative_numbers = true)]
     pub wingspan_m: Option<f64>,
 }
 
@@ -53,7 +53,7 @@ impl PictureArgs {
 }
 
 /// Parses `960x540`.
-fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
+pub fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
     let (w, h) = s
         .split_once(['x', 'X'])
         .ok_or_else(|| format!("expected WIDTHxHEIGHT like 960x540, got {s:?}"))?;

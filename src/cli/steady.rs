@@ -1,14 +1,13 @@
 //! `formation steady`, `formation plot power` and `formation plot xi` (issue 4): flags into
 //! [`SteadyOptions`], the library's Algorithm 1, and the animation written as JSON or long CSV.
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use clap::{Args, ValueEnum};
 use formation::aero::power_reduction;
 use formation::animation::Animation;
 use formation::extract::params::FormationParams;
-use formation::io::{write_json_atomic, AtomicFile, OutputKind};
+use formation::io::{write_json_atomic, OutputKind};
 use formation::keyshape::{steady_flight_report, SteadyOptions};
 use formation::plot::power::{PowerChart, PowerMetric};
 use formation::plot::xi::XiChart;
@@ -29,10 +28,23 @@ pub struct SteadyArgs {
     /// Number of frames (F ≥ 1).
     #[arg(long)]
     pub frames: usize,
-    /// Output animation (.json or .csv); may be repeated.
+    /// Outputs by extension: .json (the animation file), .csv, and also .gif, DIR/, .glb; may be
+    /// repeated.
     #[arg(short = 'o', long = "output", required = true)]
     pub output: Vec<PathBuf>,
-    /// Frames per second.
+    #[command(flatten)]
+    pub steady: SteadyFlags,
+    #[command(flatten)]
+    pub wingbeat: super::wingbeat::WingbeatFlags,
+    /// Also write the run's report (correspondence, ranges, solve statistics) as JSON here.
+    #[arg(long)]
+    pub report: Option<PathBuf>,
+}
+
+/// Steady-flight flags shared by `steady` and `animate`.
+#[derive(Debug, Clone, Args)]
+pub struct SteadyFlags {
+    /// Frames per second of the animation.
     #[arg(long, default_value_t = 30.0, allow_negative_numbers = true)]
     pub fps: f64,
     /// Time between key shapes, seconds.
@@ -54,7 +66,7 @@ pub struct SteadyArgs {
     /// C2 of eq. (2): largest step ratio of ξ between key shapes, in [1, 2].
     #[arg(long, default_value_t = 1.15, allow_negative_numbers = true)]
     pub c2: f64,
-    /// Wingspan of one bird, metres (recorded for exports).
+    /// Wingspan of one bird, metres (recorded in the animation; used by the .glb export).
     #[arg(
         long = "wingspan-m",
         default_value_t = 1.5,
@@ -68,46 +80,44 @@ pub struct SteadyArgs {
         allow_negative_numbers = true
     )]
     pub max_jump: f64,
-    /// Also write the run's report (correspondence, ranges, solve statistics) as JSON here.
-    #[arg(long)]
-    pub report: Option<PathBuf>,
+}
+
+impl SteadyFlags {
+    /// The validated library options for `birds` birds and `frames` frames.
+    pub fn options(&self, birds: usize, frames: usize, seed: u64) -> Result<SteadyOptions> {
+        let opts = SteadyOptions {
+            birds,
+            frames,
+            fps: self.fps,
+            key_every_s: self.key_every,
+            speed: self.speed,
+            epsilon: self.epsilon,
+            c1: self.c1,
+            c2: self.c2,
+            wingspan_m: self.wingspan_m,
+            seed,
+            max_jump: self.max_jump,
+            ..SteadyOptions::default()
+        };
+        opts.validate()?;
+        Ok(opts)
+    }
 }
 
 /// Runs `formation steady`.
 pub fn run(args: SteadyArgs, g: Global) -> Result<()> {
-    let opts = SteadyOptions {
-        birds: args.birds,
-        frames: args.frames,
-        fps: args.fps,
-        key_every_s: args.key_every,
-        speed: args.speed,
-        epsilon: args.epsilon,
-        c1: args.c1,
-        c2: args.c2,
-        wingspan_m: args.wingspan_m,
-        seed: g.seed,
-        max_jump: args.max_jump,
-        ..SteadyOptions::default()
-    };
-    opts.validate()?;
-    let kinds: Vec<OutputKind> = args
-        .output
-        .iter()
-        .map(|p| OutputKind::from_path(p, &[OutputKind::Json, OutputKind::Csv]))
-        .collect::<Result<_>>()?;
+    let opts = args.steady.options(args.birds, args.frames, g.seed)?;
+    let wing = args.wingbeat.options()?;
+    formation::export::plan_outputs(&args.output)?;
     if let Some(r) = &args.report {
         OutputKind::from_path(r, &[OutputKind::Json])?;
     }
     let params = read_params(&args.params)?;
     let mut rng = formation::rng::stream(g.seed, "steady");
     let progress = TermProgress::new(g.quiet);
-    let (anim, report) = steady_flight_report(&params, &opts, &mut rng, &progress)?;
-    for (path, kind) in args.output.iter().zip(kinds) {
-        match kind {
-            OutputKind::Csv => write_csv(path, &anim)?,
-            _ => write_json_atomic(path, &anim)?,
-        }
-    }
+    let (mut anim, report) = steady_flight_report(&params, &opts, &mut rng, &progress)?;
+    formation::wingbeat::assign_phases(&mut anim, &wing)?;
+    super::write_animation(&anim, &args.output, &Default::default(), g)?;
     if let Some(r) = &args.report {
         write_json_atomic(r, &report)?;
     }
@@ -122,7 +132,7 @@ pub fn run(args: SteadyArgs, g: Global) -> Result<()> {
 }
 
 /// Reads a params file, telling other `formation` files apart before serde's field errors.
-fn read_params(path: &Path) -> Result<FormationParams> {
+pub fn read_params(path: &Path) -> Result<FormationParams> {
     let value: serde_json::Value = formation::io::read_json(path)?;
     let tag = value.get("format").and_then(|f| f.as_str());
     if tag != Some(formation::extract::params::PARAMS_FORMAT) {
@@ -140,41 +150,6 @@ fn read_params(path: &Path) -> Result<FormationParams> {
         ));
     }
     FormationParams::read(path)
-}
-
-/// Long CSV of SPEC §4.4: `frame,t,bird,x,y,z,heading,speed,e,xi` (e, xi empty when undefined).
-fn write_csv(path: &Path, anim: &Animation) -> Result<()> {
-    let mut f = AtomicFile::create(path)?;
-    {
-        let w = f.writer();
-        let io = |e| Error::io(path, e);
-        writeln!(w, "frame,t,bird,x,y,z,heading,speed,e,xi").map_err(io)?;
-        for (k, fr) in anim.frames.iter().enumerate() {
-            for b in 0..anim.birds {
-                let opt = |v: &Option<Vec<f64>>| {
-                    v.as_ref()
-                        .and_then(|v| v.get(b))
-                        .map(|x| x.to_string())
-                        .unwrap_or_default()
-                };
-                let get = |v: &Vec<f64>| v.get(b).copied().unwrap_or(f64::NAN);
-                writeln!(
-                    w,
-                    "{k},{},{b},{},{},{},{},{},{},{}",
-                    fr.t,
-                    get(&fr.x),
-                    get(&fr.y),
-                    get(&fr.z),
-                    get(&fr.heading),
-                    get(&fr.speed),
-                    opt(&fr.e),
-                    opt(&fr.xi)
-                )
-                .map_err(io)?;
-            }
-        }
-    }
-    f.commit()
 }
 
 /// What `plot power` shows.

@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use clap::Args;
 use formation::plot::wingbeat::WingbeatChart;
-use formation::wingbeat::Species;
+use formation::wingbeat::{Glide, PhaseMode, Species, WingbeatOptions};
 use formation::Result;
 
 use super::Global;
@@ -24,4 +24,43 @@ pub struct PlotWingbeatArgs {
 pub fn run_plot_wingbeat(args: PlotWingbeatArgs, _g: Global) -> Result<()> {
     let species: Species = args.species.parse()?;
     formation::plot::save(&WingbeatChart::new(species), &args.output)
+}
+
+/// Wingbeat flags shared by `steady`, `initiate` and `animate` (the wing phases written into the
+/// animation file and drawn by the renderers).
+#[derive(Debug, Clone, Args)]
+pub struct WingbeatFlags {
+    /// Species preset of the wingbeat (frequency, amplitudes, downstroke fraction): goose, crane
+    /// or pelican.
+    #[arg(long, default_value = "goose")]
+    pub species: String,
+    /// Phase relation between birds: `locked` (followers flap with a lag that tracks their
+    /// streamwise distance to the bird ahead, Portugal et al. 2014) or `independent`.
+    #[arg(long, default_value = "locked", value_name = "locked|independent")]
+    pub phase: String,
+    /// Gliding: `off` (continuous flapping), `bouts` (flap-gliding) or `always`.
+    #[arg(long, default_value = "off", value_name = "off|bouts|always")]
+    pub glide: String,
+    /// Scale of the per-bird and per-wingbeat variation: 0 = identical birds, 1 = default.
+    #[arg(
+        long = "wing-variation",
+        default_value_t = 1.0,
+        allow_negative_numbers = true
+    )]
+    pub variation: f64,
+}
+
+impl WingbeatFlags {
+    /// The validated library options.
+    pub fn options(&self) -> Result<WingbeatOptions> {
+        let opts = WingbeatOptions {
+            species: self.species.parse::<Species>()?,
+            phase_mode: self.phase.parse::<PhaseMode>()?,
+            glide: self.glide.parse::<Glide>()?,
+            variation: self.variation,
+            ..WingbeatOptions::default()
+        };
+        opts.validate()?;
+        Ok(opts)
+    }
 }

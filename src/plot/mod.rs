@@ -93,4 +93,3 @@ pub fn encode_png_rgb(buf: &[u8], w: u32, h: u32) -> Result<Vec<u8>> {
 }
 
 use image::ImageEncoder as _;
-
