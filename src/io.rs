@@ -253,12 +253,24 @@ pub fn write_bytes_atomic(target: &Path, bytes: &[u8]) -> Result<()> {
     f.commit()
 }
 
-/// Serialises `value` as pretty JSON (with a trailing newline) to `target` atomically.
+/// Serialises `value` as pretty JSON (with a trailing newline) to `target` atomically. A
+/// non-finite number anywhere in `value` (which JSON cannot hold; serde_json would write `null`)
+/// is refused with [`Error::Internal`] naming its path, before the file is created. The JSON is
+/// streamed into the temporary file, not built in memory.
 pub fn write_json_atomic<T: Serialize>(target: &Path, value: &T) -> Result<()> {
-    let mut bytes = serde_json::to_vec_pretty(value)
-        .map_err(|e| Error::Internal(format!("serialising {}: {e}", target.display())))?;
-    bytes.push(b'\n');
-    write_bytes_atomic(target, &bytes)
+    crate::finite::check_serialize(&target.display().to_string(), value)?;
+    let mut f = AtomicFile::create(target)?;
+    serde_json::to_writer_pretty(f.writer(), value).map_err(|e| {
+        if e.is_io() {
+            Error::io(target, e.into())
+        } else {
+            Error::Internal(format!("serialising {}: {e}", target.display()))
+        }
+    })?;
+    f.writer()
+        .write_all(b"\n")
+        .map_err(|e| Error::io(target, e))?;
+    f.commit()
 }
 
 /// A directory being filled atomically: files go into a temporary sibling directory that

@@ -154,6 +154,7 @@ impl InitiateFlags {
             ));
         }
         o.validate()?;
+        formation::initiate::check_size(birds, 0, self.max_steps)?;
         Ok(o)
     }
 }
