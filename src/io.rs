@@ -197,8 +197,13 @@ impl AtomicFile {
             ));
         }
         let tmp = temp_path_for(target);
-        let file = fs::File::create(&tmp).map_err(|e| Error::io(target, e))?;
-        register_temp(&tmp);
+        // Created and registered under the lock, so a signal cannot leave it unregistered.
+        let file = with_temps(|v| {
+            let f = fs::File::create(&tmp)?;
+            v.push(tmp.clone());
+            Ok(f)
+        })
+        .map_err(|e| Error::io(target, e))?;
         Ok(AtomicFile {
             target: target.to_path_buf(),
             tmp,
@@ -211,17 +216,29 @@ impl AtomicFile {
         self.writer.as_mut().expect("writer present until commit")
     }
 
-    /// Flushes, syncs and renames the temporary file onto the target.
+    /// Flushes, syncs and renames the temporary file onto the target. On any failure the
+    /// temporary is removed and the target left as it was.
     pub fn commit(mut self) -> Result<()> {
         let writer = self.writer.take().expect("writer present until commit");
-        let file = writer
-            .into_inner()
-            .map_err(|e| Error::io(&self.target, e.into_error()))?;
-        file.sync_all().map_err(|e| Error::io(&self.target, e))?;
-        drop(file);
-        fs::rename(&self.tmp, &self.target).map_err(|e| Error::io(&self.target, e))?;
-        unregister_temp(&self.tmp);
-        Ok(())
+        let tmp = self.tmp.clone();
+        let result = (|| {
+            let file = writer.into_inner().map_err(|e| e.into_error())?;
+            file.sync_all()?;
+            drop(file);
+            with_temps(|v| {
+                fs::rename(&tmp, &self.target)?;
+                v.retain(|q| q != &tmp);
+                Ok(())
+            })
+        })();
+        result.map_err(|e| {
+            let _ = with_temps(|v| {
+                let _ = fs::remove_file(&tmp);
+                v.retain(|q| q != &tmp);
+                Ok(())
+            });
+            Error::io(&self.target, e)
+        })
     }
 }
 
@@ -238,8 +255,11 @@ impl Drop for AtomicFile {
     fn drop(&mut self) {
         if self.writer.is_some() {
             self.writer = None;
-            let _ = fs::remove_file(&self.tmp);
-            unregister_temp(&self.tmp);
+            let _ = with_temps(|v| {
+                let _ = fs::remove_file(&self.tmp);
+                v.retain(|q| q != &self.tmp);
+                Ok(())
+            });
         }
     }
 }
@@ -290,9 +310,13 @@ impl AtomicDir {
             return Err(Error::format(&trimmed, "exists and is not a directory"));
         }
         let tmp = temp_path_for(&trimmed);
-        let _ = fs::remove_dir_all(&tmp);
-        fs::create_dir(&tmp).map_err(|e| Error::io(&trimmed, e))?;
-        register_temp(&tmp);
+        with_temps(|v| {
+            let _ = fs::remove_dir_all(&tmp);
+            fs::create_dir(&tmp)?;
+            v.push(tmp.clone());
+            Ok(())
+        })
+        .map_err(|e| Error::io(&trimmed, e))?;
         Ok(AtomicDir {
             target: trimmed,
             tmp,
@@ -307,16 +331,24 @@ impl AtomicDir {
 
     /// Moves the finished directory into place. An existing target directory is replaced.
     pub fn commit(mut self) -> Result<()> {
-        if self.target.is_dir() {
-            let old = temp_path_for(&self.target).with_extension("old");
-            let _ = fs::remove_dir_all(&old);
-            fs::rename(&self.target, &old).map_err(|e| Error::io(&self.target, e))?;
-            fs::rename(&self.tmp, &self.target).map_err(|e| Error::io(&self.target, e))?;
-            let _ = fs::remove_dir_all(&old);
-        } else {
-            fs::rename(&self.tmp, &self.target).map_err(|e| Error::io(&self.target, e))?;
-        }
-        unregister_temp(&self.tmp);
+        // Under the lock: a signal waits until the old directory is replaced (or restored).
+        with_temps(|v| {
+            if self.target.is_dir() {
+                let old = temp_path_for(&self.target).with_extension("old");
+                let _ = fs::remove_dir_all(&old);
+                fs::rename(&self.target, &old)?;
+                if let Err(e) = fs::rename(&self.tmp, &self.target) {
+                    let _ = fs::rename(&old, &self.target);
+                    return Err(e);
+                }
+                let _ = fs::remove_dir_all(&old);
+            } else {
+                fs::rename(&self.tmp, &self.target)?;
+            }
+            v.retain(|q| q != &self.tmp);
+            Ok(())
+        })
+        .map_err(|e| Error::io(&self.target, e))?;
         self.committed = true;
         Ok(())
     }
@@ -325,38 +357,45 @@ impl AtomicDir {
 impl Drop for AtomicDir {
     fn drop(&mut self) {
         if !self.committed {
-            let _ = fs::remove_dir_all(&self.tmp);
-            unregister_temp(&self.tmp);
+            let _ = with_temps(|v| {
+                let _ = fs::remove_dir_all(&self.tmp);
+                v.retain(|q| q != &self.tmp);
+                Ok(())
+            });
         }
     }
 }
 
 // Temporaries still open, so that a signal handler in the binary can remove them before exiting.
+// Creating, committing and removing a temporary all happen under this lock, so the handler sees
+// every temporary that exists and never runs in the middle of a commit's renames.
 static OPEN_TEMPS: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
 
-fn register_temp(p: &Path) {
-    if let Ok(mut v) = OPEN_TEMPS.lock() {
-        v.push(p.to_path_buf());
-    }
+fn with_temps<R>(f: impl FnOnce(&mut Vec<PathBuf>) -> std::io::Result<R>) -> std::io::Result<R> {
+    let mut guard = OPEN_TEMPS.lock().unwrap_or_else(|p| p.into_inner());
+    f(&mut guard)
 }
 
-fn unregister_temp(p: &Path) {
-    if let Ok(mut v) = OPEN_TEMPS.lock() {
-        v.retain(|q| q != p);
-    }
-}
-
-/// Removes every temporary file or directory still open (called on Ctrl-C / SIGTERM).
+/// Removes every temporary file or directory still open (called on Ctrl-C / SIGTERM, right
+/// before the process exits). The list stays locked afterwards: no temporary can be created or
+/// committed any more, so nothing new appears between the cleanup and the exit.
 pub fn remove_open_temporaries() {
-    if let Ok(v) = OPEN_TEMPS.lock() {
-        for p in v.iter() {
-            if p.is_dir() {
-                let _ = fs::remove_dir_all(p);
+    let guard = OPEN_TEMPS.lock().unwrap_or_else(|p| p.into_inner());
+    for p in guard.iter() {
+        // Worker threads may still be adding frames to a temporary directory: retry.
+        for _ in 0..50 {
+            let gone = if p.is_dir() {
+                fs::remove_dir_all(p).is_ok() || !p.exists()
             } else {
-                let _ = fs::remove_file(p);
+                fs::remove_file(p).is_ok() || !p.exists()
+            };
+            if gone {
+                break;
             }
+            std::thread::sleep(std::time::Duration::from_millis(10));
         }
     }
+    std::mem::forget(guard);
 }
 
 #[cfg(test)]
