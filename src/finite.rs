@@ -22,6 +22,14 @@ pub fn check_serialize<T: Serialize + ?Sized>(what: &str, value: &T) -> Result<(
     }
 }
 
+/// Pretty JSON text of `value` for stdout (`--json`), refusing non-finite numbers like
+/// [`crate::io::write_json_atomic`] does for files.
+pub fn to_json_pretty<T: Serialize + ?Sized>(what: &str, value: &T) -> Result<String> {
+    check_serialize(what, value)?;
+    serde_json::to_string_pretty(value)
+        .map_err(|e| Error::Internal(format!("serialising {what}: {e}")))
+}
+
 /// Checks a slice of numbers, naming `field` and the index of the first non-finite one.
 pub fn check_slice(what: &str, field: &str, values: &[f64]) -> Result<()> {
     match values.iter().position(|v| !v.is_finite()) {
