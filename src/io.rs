@@ -11,8 +11,10 @@ use serde::Serialize;
 
 use crate::error::{Error, Result};
 
-/// Upper bound on the size of any input file we read fully into memory, bytes.
-pub const MAX_INPUT_BYTES: u64 = 512 * 1024 * 1024;
+/// Upper bound on the size of any input file we read fully into memory, bytes: 2 GiB, enough for
+/// the largest animation file `formation` writes (10⁷ bird-frames of pretty JSON, about 2 GB; see
+/// [`crate::limits::MAX_BIRD_FRAMES`]).
+pub const MAX_INPUT_BYTES: u64 = 2 * 1024 * 1024 * 1024;
 
 /// Reads a whole file as bytes, with the path in the error and a size limit.
 pub fn read_bytes(path: &Path) -> Result<Vec<u8>> {

@@ -299,9 +299,10 @@ pub fn write_outputs(
                 write_json_atomic(&o.path, &a)?;
             }
             OutputKind::Csv => {
-                let mut buf = Vec::new();
-                table::write_csv(anim, &mut buf).map_err(|e| Error::io(&o.path, e))?;
-                write_bytes_atomic(&o.path, &buf)?;
+                // Streamed into the temporary file (not built in memory: up to 1.4 GB).
+                let mut f = AtomicFile::create(&o.path)?;
+                table::write_csv(anim, f.writer()).map_err(|e| Error::io(&o.path, e))?;
+                f.commit()?;
             }
             OutputKind::Glb => {
                 progress.start("glb", 1);
