@@ -56,8 +56,13 @@ fn bench(c: &mut Criterion) {
     g.bench_function("geese_14_birds_20s_with_gif_960x540", |b| {
         b.iter(|| {
             let anim = simulate();
-            write_outputs(&anim, std::slice::from_ref(&gif), &RenderOptions::default(), &Silent)
-                .unwrap()
+            write_outputs(
+                &anim,
+                std::slice::from_ref(&gif),
+                &RenderOptions::default(),
+                &Silent,
+            )
+            .unwrap()
         })
     });
     g.finish();

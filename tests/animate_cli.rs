@@ -97,7 +97,10 @@ fn every_output_opens_and_matches_the_animation() {
     let glb = std::fs::read(p("a.glb")).unwrap();
     assert_eq!(&glb[0..4], b"glTF");
     assert_eq!(u32::from_le_bytes(glb[4..8].try_into().unwrap()), 2);
-    assert_eq!(u32::from_le_bytes(glb[8..12].try_into().unwrap()) as usize, glb.len());
+    assert_eq!(
+        u32::from_le_bytes(glb[8..12].try_into().unwrap()) as usize,
+        glb.len()
+    );
 }
 
 #[test]
@@ -107,9 +110,22 @@ fn equal_seeds_give_equal_bytes_and_params_input_gives_the_same_flock() {
     let geese = example("barnacle_geese_v.json");
     let go = |seed: &str, input: &str, out: &str| {
         let (code, err) = run(&[
-            "animate", input, "--birds", "9", "-o", &p(&format!("{out}.json")), "-o",
-            &p(&format!("{out}.gif")), "--seed", seed, "--seconds", "1", "--size", "96x54",
-            "--picture-fps", "5",
+            "animate",
+            input,
+            "--birds",
+            "9",
+            "-o",
+            &p(&format!("{out}.json")),
+            "-o",
+            &p(&format!("{out}.gif")),
+            "--seed",
+            seed,
+            "--seconds",
+            "1",
+            "--size",
+            "96x54",
+            "--picture-fps",
+            "5",
         ]);
         assert_eq!(code, 0, "{err}");
     };
@@ -132,8 +148,15 @@ fn steady_only() {
     let dir = scratch("steady-only");
     let out = dir.join("s.json");
     let (code, err) = run(&[
-        "animate", &example("pelicans_u_labelme"), "--birds", "20", "--no-initiation",
-        "--seconds", "3", "-o", out.to_str().unwrap(),
+        "animate",
+        &example("pelicans_u_labelme"),
+        "--birds",
+        "20",
+        "--no-initiation",
+        "--seconds",
+        "3",
+        "-o",
+        out.to_str().unwrap(),
     ]);
     assert_eq!(code, 0, "{err}");
     let anim = formation::Animation::read(&out).unwrap();
@@ -167,8 +190,15 @@ fn bad_flags_fail_up_front_with_one_line_and_no_file() {
         let (code, err) = run(&args);
         assert_eq!(code, 2, "{extra:?}: exit {code}: {err}");
         assert_eq!(err.trim_end().lines().count(), 1, "{extra:?}: {err}");
-        assert!(err.contains(needle), "{extra:?}: expected {needle:?} in {err}");
-        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 0, "{extra:?} left a file");
+        assert!(
+            err.contains(needle),
+            "{extra:?}: expected {needle:?} in {err}"
+        );
+        assert_eq!(
+            std::fs::read_dir(&dir).unwrap().count(),
+            0,
+            "{extra:?} left a file"
+        );
     }
     let (code, err) = run(&["animate", &geese, "--birds", "0", "-o", "x.gif"]);
     assert_eq!(code, 2, "{err}");

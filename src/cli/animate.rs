@@ -41,7 +41,11 @@ pub struct AnimateArgs {
     #[arg(long, value_name = "WxH", default_value = "960x540", value_parser = super::render::parse_size)]
     pub size: (u32, u32),
     /// Frame rate of the pictures [default: 25 for GIF, the animation's --fps for PNG frames].
-    #[arg(long = "picture-fps", value_name = "FPS", allow_negative_numbers = true)]
+    #[arg(
+        long = "picture-fps",
+        value_name = "FPS",
+        allow_negative_numbers = true
+    )]
     pub picture_fps: Option<f64>,
     #[command(flatten)]
     pub read: ReadArgs,
