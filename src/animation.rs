@@ -120,7 +120,24 @@ impl Animation {
 
     /// Reads and validates an animation file.
     pub fn read(path: &Path) -> Result<Animation> {
-        let a: Animation = crate::io::read_json(path)?;
+        let text = crate::io::read_text(path)?;
+        let a: Animation = crate::io::parse_json(path, &text).map_err(|e| {
+            // A structure error on another kind of file: say what the file is instead.
+            let tag = serde_json::from_str::<serde_json::Value>(&text).ok().map(|v| {
+                match v.get("format").and_then(|f| f.as_str()) {
+                    Some(t) => format!("a \"{t}\" file"),
+                    None if v.get("birds").is_some_and(|b| b.is_array()) => "a shape file".into(),
+                    None => "no \"format\" field".into(),
+                }
+            });
+            match tag {
+                Some(found) if !found.contains(ANIMATION_FORMAT) => Error::format(
+                    path,
+                    format!("not an animation file ({found}, expected \"format\": \"{ANIMATION_FORMAT}\"); write one with `formation steady` or `formation animate`"),
+                ),
+                _ => e,
+            }
+        })?;
         a.validate(path)?;
         Ok(a)
     }

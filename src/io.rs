@@ -11,8 +11,10 @@ use serde::Serialize;
 
 use crate::error::{Error, Result};
 
-/// Upper bound on the size of any input file we read fully into memory, bytes.
-pub const MAX_INPUT_BYTES: u64 = 512 * 1024 * 1024;
+/// Upper bound on the size of any input file we read fully into memory, bytes: 2 GiB, enough for
+/// the largest animation file `formation` writes (10⁷ bird-frames of pretty JSON, about 2 GB; see
+/// [`crate::limits::MAX_BIRD_FRAMES`]).
+pub const MAX_INPUT_BYTES: u64 = 2 * 1024 * 1024 * 1024;
 
 /// Reads a whole file as bytes, with the path in the error and a size limit.
 pub fn read_bytes(path: &Path) -> Result<Vec<u8>> {
@@ -197,8 +199,13 @@ impl AtomicFile {
             ));
         }
         let tmp = temp_path_for(target);
-        let file = fs::File::create(&tmp).map_err(|e| Error::io(target, e))?;
-        register_temp(&tmp);
+        // Created and registered under the lock, so a signal cannot leave it unregistered.
+        let file = with_temps(|v| {
+            let f = fs::File::create(&tmp)?;
+            v.push(tmp.clone());
+            Ok(f)
+        })
+        .map_err(|e| Error::io(target, e))?;
         Ok(AtomicFile {
             target: target.to_path_buf(),
             tmp,
@@ -211,17 +218,29 @@ impl AtomicFile {
         self.writer.as_mut().expect("writer present until commit")
     }
 
-    /// Flushes, syncs and renames the temporary file onto the target.
+    /// Flushes, syncs and renames the temporary file onto the target. On any failure the
+    /// temporary is removed and the target left as it was.
     pub fn commit(mut self) -> Result<()> {
         let writer = self.writer.take().expect("writer present until commit");
-        let file = writer
-            .into_inner()
-            .map_err(|e| Error::io(&self.target, e.into_error()))?;
-        file.sync_all().map_err(|e| Error::io(&self.target, e))?;
-        drop(file);
-        fs::rename(&self.tmp, &self.target).map_err(|e| Error::io(&self.target, e))?;
-        unregister_temp(&self.tmp);
-        Ok(())
+        let tmp = self.tmp.clone();
+        let result = (|| {
+            let file = writer.into_inner().map_err(|e| e.into_error())?;
+            file.sync_all()?;
+            drop(file);
+            with_temps(|v| {
+                fs::rename(&tmp, &self.target)?;
+                v.retain(|q| q != &tmp);
+                Ok(())
+            })
+        })();
+        result.map_err(|e| {
+            let _ = with_temps(|v| {
+                let _ = fs::remove_file(&tmp);
+                v.retain(|q| q != &tmp);
+                Ok(())
+            });
+            Error::io(&self.target, e)
+        })
     }
 }
 
@@ -238,8 +257,11 @@ impl Drop for AtomicFile {
     fn drop(&mut self) {
         if self.writer.is_some() {
             self.writer = None;
-            let _ = fs::remove_file(&self.tmp);
-            unregister_temp(&self.tmp);
+            let _ = with_temps(|v| {
+                let _ = fs::remove_file(&self.tmp);
+                v.retain(|q| q != &self.tmp);
+                Ok(())
+            });
         }
     }
 }
@@ -253,12 +275,24 @@ pub fn write_bytes_atomic(target: &Path, bytes: &[u8]) -> Result<()> {
     f.commit()
 }
 
-/// Serialises `value` as pretty JSON (with a trailing newline) to `target` atomically.
+/// Serialises `value` as pretty JSON (with a trailing newline) to `target` atomically. A
+/// non-finite number anywhere in `value` (which JSON cannot hold; serde_json would write `null`)
+/// is refused with [`Error::Internal`] naming its path, before the file is created. The JSON is
+/// streamed into the temporary file, not built in memory.
 pub fn write_json_atomic<T: Serialize>(target: &Path, value: &T) -> Result<()> {
-    let mut bytes = serde_json::to_vec_pretty(value)
-        .map_err(|e| Error::Internal(format!("serialising {}: {e}", target.display())))?;
-    bytes.push(b'\n');
-    write_bytes_atomic(target, &bytes)
+    crate::finite::check_serialize(&target.display().to_string(), value)?;
+    let mut f = AtomicFile::create(target)?;
+    serde_json::to_writer_pretty(f.writer(), value).map_err(|e| {
+        if e.is_io() {
+            Error::io(target, e.into())
+        } else {
+            Error::Internal(format!("serialising {}: {e}", target.display()))
+        }
+    })?;
+    f.writer()
+        .write_all(b"\n")
+        .map_err(|e| Error::io(target, e))?;
+    f.commit()
 }
 
 /// A directory being filled atomically: files go into a temporary sibling directory that
@@ -278,9 +312,13 @@ impl AtomicDir {
             return Err(Error::format(&trimmed, "exists and is not a directory"));
         }
         let tmp = temp_path_for(&trimmed);
-        let _ = fs::remove_dir_all(&tmp);
-        fs::create_dir(&tmp).map_err(|e| Error::io(&trimmed, e))?;
-        register_temp(&tmp);
+        with_temps(|v| {
+            let _ = fs::remove_dir_all(&tmp);
+            fs::create_dir(&tmp)?;
+            v.push(tmp.clone());
+            Ok(())
+        })
+        .map_err(|e| Error::io(&trimmed, e))?;
         Ok(AtomicDir {
             target: trimmed,
             tmp,
@@ -295,16 +333,24 @@ impl AtomicDir {
 
     /// Moves the finished directory into place. An existing target directory is replaced.
     pub fn commit(mut self) -> Result<()> {
-        if self.target.is_dir() {
-            let old = temp_path_for(&self.target).with_extension("old");
-            let _ = fs::remove_dir_all(&old);
-            fs::rename(&self.target, &old).map_err(|e| Error::io(&self.target, e))?;
-            fs::rename(&self.tmp, &self.target).map_err(|e| Error::io(&self.target, e))?;
-            let _ = fs::remove_dir_all(&old);
-        } else {
-            fs::rename(&self.tmp, &self.target).map_err(|e| Error::io(&self.target, e))?;
-        }
-        unregister_temp(&self.tmp);
+        // Under the lock: a signal waits until the old directory is replaced (or restored).
+        with_temps(|v| {
+            if self.target.is_dir() {
+                let old = temp_path_for(&self.target).with_extension("old");
+                let _ = fs::remove_dir_all(&old);
+                fs::rename(&self.target, &old)?;
+                if let Err(e) = fs::rename(&self.tmp, &self.target) {
+                    let _ = fs::rename(&old, &self.target);
+                    return Err(e);
+                }
+                let _ = fs::remove_dir_all(&old);
+            } else {
+                fs::rename(&self.tmp, &self.target)?;
+            }
+            v.retain(|q| q != &self.tmp);
+            Ok(())
+        })
+        .map_err(|e| Error::io(&self.target, e))?;
         self.committed = true;
         Ok(())
     }
@@ -313,38 +359,45 @@ impl AtomicDir {
 impl Drop for AtomicDir {
     fn drop(&mut self) {
         if !self.committed {
-            let _ = fs::remove_dir_all(&self.tmp);
-            unregister_temp(&self.tmp);
+            let _ = with_temps(|v| {
+                let _ = fs::remove_dir_all(&self.tmp);
+                v.retain(|q| q != &self.tmp);
+                Ok(())
+            });
         }
     }
 }
 
 // Temporaries still open, so that a signal handler in the binary can remove them before exiting.
+// Creating, committing and removing a temporary all happen under this lock, so the handler sees
+// every temporary that exists and never runs in the middle of a commit's renames.
 static OPEN_TEMPS: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
 
-fn register_temp(p: &Path) {
-    if let Ok(mut v) = OPEN_TEMPS.lock() {
-        v.push(p.to_path_buf());
-    }
+fn with_temps<R>(f: impl FnOnce(&mut Vec<PathBuf>) -> std::io::Result<R>) -> std::io::Result<R> {
+    let mut guard = OPEN_TEMPS.lock().unwrap_or_else(|p| p.into_inner());
+    f(&mut guard)
 }
 
-fn unregister_temp(p: &Path) {
-    if let Ok(mut v) = OPEN_TEMPS.lock() {
-        v.retain(|q| q != p);
-    }
-}
-
-/// Removes every temporary file or directory still open (called on Ctrl-C / SIGTERM).
+/// Removes every temporary file or directory still open (called on Ctrl-C / SIGTERM, right
+/// before the process exits). The list stays locked afterwards: no temporary can be created or
+/// committed any more, so nothing new appears between the cleanup and the exit.
 pub fn remove_open_temporaries() {
-    if let Ok(v) = OPEN_TEMPS.lock() {
-        for p in v.iter() {
-            if p.is_dir() {
-                let _ = fs::remove_dir_all(p);
+    let guard = OPEN_TEMPS.lock().unwrap_or_else(|p| p.into_inner());
+    for p in guard.iter() {
+        // Worker threads may still be adding frames to a temporary directory: retry.
+        for _ in 0..50 {
+            let gone = if p.is_dir() {
+                fs::remove_dir_all(p).is_ok() || !p.exists()
             } else {
-                let _ = fs::remove_file(p);
+                fs::remove_file(p).is_ok() || !p.exists()
+            };
+            if gone {
+                break;
             }
+            std::thread::sleep(std::time::Duration::from_millis(10));
         }
     }
+    std::mem::forget(guard);
 }
 
 #[cfg(test)]

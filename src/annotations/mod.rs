@@ -316,6 +316,30 @@ fn finish(path: &Path, raw: RawAnnotations, opts: &ReadOptions) -> Result<Annota
     if raw.frames.is_empty() {
         return Err(Error::format(path, "no frames with marked birds"));
     }
+    use crate::limits::{MAX_ANNOTATED_BIRDS, MAX_ANNOTATED_FRAMES};
+    if raw.frames.len() > MAX_ANNOTATED_FRAMES {
+        return Err(Error::format(
+            path,
+            format!(
+                "{} annotated frames, at most {MAX_ANNOTATED_FRAMES}; annotate a subset (a few dozen frames are plenty)",
+                raw.frames.len()
+            ),
+        ));
+    }
+    if let Some(f) = raw
+        .frames
+        .iter()
+        .find(|f| f.birds.len() > MAX_ANNOTATED_BIRDS)
+    {
+        return Err(Error::format(
+            path,
+            format!(
+                "frame {}: {} birds marked, at most {MAX_ANNOTATED_BIRDS} per frame",
+                f.index,
+                f.birds.len()
+            ),
+        ));
+    }
     if let Some(w) = opts.wingspan_px {
         if !w.is_finite() || w <= 0.0 {
             return Err(Error::parameter(

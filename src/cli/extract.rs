@@ -117,8 +117,7 @@ pub fn run(args: ExtractArgs, g: Global) -> Result<()> {
         write_json_atomic(o, &params)?;
     }
     if args.json {
-        let s = serde_json::to_string_pretty(&params)
-            .map_err(|e| Error::Internal(format!("serialising params: {e}")))?;
+        let s = formation::finite::to_json_pretty("params", &params)?;
         println!("{s}");
     } else {
         print!(

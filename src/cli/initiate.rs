@@ -154,6 +154,7 @@ impl InitiateFlags {
             ));
         }
         o.validate()?;
+        formation::initiate::check_size(birds, 0, self.max_steps)?;
         Ok(o)
     }
 }
@@ -171,8 +172,7 @@ pub fn run(args: InitiateArgs, g: Global) -> Result<()> {
     formation::wingbeat::assign_phases(&mut anim, &wing)?;
     super::write_animation(&anim, &args.output, &Default::default(), g)?;
     if args.json {
-        let text = serde_json::to_string_pretty(&stats)
-            .map_err(|e| Error::Internal(format!("serialising statistics: {e}")))?;
+        let text = formation::finite::to_json_pretty("statistics", &stats)?;
         println!("{text}");
     }
     Ok(())

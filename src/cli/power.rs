@@ -55,8 +55,7 @@ pub fn run(args: PowerArgs, _g: Global) -> Result<()> {
                 })
                 .collect(),
         };
-        out = serde_json::to_string_pretty(&doc)
-            .map_err(|e| Error::Internal(format!("serialising power: {e}")))?;
+        out = formation::finite::to_json_pretty("power", &doc)?;
         out.push('\n');
     } else {
         let leader = shape.leader().unwrap_or(0);

@@ -206,6 +206,11 @@ pub fn glb_bytes(anim: &Animation, wingspan_m: f64) -> Result<Vec<u8>> {
         name: Some("flight".into()),
         samplers,
     });
+    if let Some(at) = b.non_finite.take() {
+        return Err(Error::Internal(format!(
+            "glTF: refusing to write a non-finite number in {at}"
+        )));
+    }
     let bin = b.finish(&mut root);
     let json_bytes = root
         .to_vec()
@@ -358,6 +363,8 @@ fn fix_winding(m: &mut MeshData) {
 #[derive(Default)]
 struct Builder {
     bin: Vec<u8>,
+    /// The first accessor holding a non-finite number (issue 8: never written), by index.
+    non_finite: Option<String>,
 }
 
 impl Builder {
@@ -394,6 +401,16 @@ impl Builder {
         min_max: bool,
         target: Option<json::buffer::Target>,
     ) -> json::Index<json::Accessor> {
+        if self.non_finite.is_none() {
+            if let Some(i) = data.iter().position(|v| !v.is_finite()) {
+                self.non_finite = Some(format!(
+                    "accessor {} element {} ({}; beyond f32 range?)",
+                    root.accessors.len(),
+                    i / width.max(1),
+                    data[i]
+                ));
+            }
+        }
         let bytes: Vec<u8> = data.iter().flat_map(|v| v.to_le_bytes()).collect();
         let view = self.view(root, &bytes, target);
         let (min, max) = if min_max {

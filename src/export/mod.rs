@@ -92,6 +92,18 @@ impl RenderOptions {
                 ));
             }
         }
+        let pixels = self.width as u64 * self.height as u64;
+        if pixels > crate::limits::MAX_FRAME_PIXELS {
+            return Err(Error::parameter(
+                "--size",
+                format!(
+                    "{}x{} is {pixels} pixels, more than 8K UHD (7680x4320 = {}); give a smaller size",
+                    self.width,
+                    self.height,
+                    crate::limits::MAX_FRAME_PIXELS
+                ),
+            ));
+        }
         if let Some(f) = self.fps {
             if !(f.is_finite() && (1.0..=MAX_FPS).contains(&f)) {
                 return Err(Error::parameter(
@@ -231,6 +243,8 @@ pub fn write_outputs(
 ) -> Result<()> {
     opts.validate()?;
     let origin = Path::new("animation");
+    // Issue 8: no NaN or infinity reaches any output (CSV, glTF, pictures, JSON).
+    crate::finite::check_serialize("animation", anim)?;
     anim.validate(origin)?;
     sample::check_times(anim, origin)?;
     let plan = plan_outputs(outputs)?;
@@ -248,6 +262,21 @@ pub fn write_outputs(
         if matches!(o.kind, OutputKind::Gif | OutputKind::Directory) {
             let fps = picture_fps(anim, o.kind, opts);
             let n = sample::output_times(anim, fps).len();
+            let pixels = n as u64 * opts.width as u64 * opts.height as u64;
+            if n <= MAX_FRAMES && pixels > crate::limits::MAX_PICTURE_PIXELS {
+                return Err(Error::parameter(
+                    "--size",
+                    format!(
+                        "{}: {n} frames of {}x{} is {:.1e} pixels, more than the {:.0e} limit (about {} GB uncompressed); lower --size or --fps",
+                        o.path.display(),
+                        opts.width,
+                        opts.height,
+                        pixels as f64,
+                        crate::limits::MAX_PICTURE_PIXELS as f64,
+                        crate::limits::MAX_PICTURE_PIXELS / 1_000_000_000
+                    ),
+                ));
+            }
             if n > MAX_FRAMES {
                 return Err(Error::parameter(
                     "--fps",
@@ -270,9 +299,10 @@ pub fn write_outputs(
                 write_json_atomic(&o.path, &a)?;
             }
             OutputKind::Csv => {
-                let mut buf = Vec::new();
-                table::write_csv(anim, &mut buf).map_err(|e| Error::io(&o.path, e))?;
-                write_bytes_atomic(&o.path, &buf)?;
+                // Streamed into the temporary file (not built in memory: up to 1.4 GB).
+                let mut f = AtomicFile::create(&o.path)?;
+                table::write_csv(anim, f.writer()).map_err(|e| Error::io(&o.path, e))?;
+                f.commit()?;
             }
             OutputKind::Glb => {
                 progress.start("glb", 1);

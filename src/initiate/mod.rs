@@ -674,6 +674,7 @@ pub fn initiate(
     progress: &dyn Progress,
 ) -> Result<(Animation, InitiateStats)> {
     check_steady(steady, Path::new("steady flight"))?;
+    check_size(steady.birds, steady.frames.len(), opts.max_steps)?;
     let (target, cruise_heading, cruise_speed) = steady_target(steady)?;
     let run = simulate(
         &target,
@@ -691,6 +692,31 @@ pub fn initiate(
         )));
     }
     hand_over(steady, &run, opts)
+}
+
+/// Refuses an initiation that could hold more than [`crate::limits::MAX_BIRD_FRAMES`]
+/// bird-frames in memory: `birds` × (`steady_frames` + `max_steps`), every step being kept for the
+/// output (issue 8: refused up front instead of exhausting memory).
+pub fn check_size(birds: usize, steady_frames: usize, max_steps: usize) -> Result<()> {
+    let frames = steady_frames.saturating_add(max_steps);
+    match birds.checked_mul(frames) {
+        Some(p) if p <= crate::limits::MAX_BIRD_FRAMES => Ok(()),
+        _ => {
+            let plus = if steady_frames > 0 {
+                format!(" + {steady_frames} steady frames")
+            } else {
+                String::new()
+            };
+            Err(Error::parameter(
+                "--max-steps",
+                format!(
+                    "{birds} birds × ({max_steps} steps{plus}) could be more than {} bird-frames in memory; lower --max-steps to at most {}",
+                    crate::limits::MAX_BIRD_FRAMES,
+                    (crate::limits::MAX_BIRD_FRAMES / birds.max(1)).saturating_sub(steady_frames)
+                ),
+            ))
+        }
+    }
 }
 
 /// Joins a converged run to the steady flight: birds are renumbered by their final slot, the last

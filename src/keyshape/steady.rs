@@ -103,15 +103,16 @@ impl SteadyOptions {
                 format!("{}: a formation needs at least 2 birds", self.birds),
             ));
         }
-        if self.birds > 100_000 {
+        if self.birds > crate::limits::MAX_BIRDS {
             return Err(p(
                 "--birds",
-                format!("{}: at most 100000 birds", self.birds),
+                format!("{}: at most {} birds", self.birds, crate::limits::MAX_BIRDS),
             ));
         }
         if self.frames == 0 {
             return Err(p("--frames", "0: at least 1 frame is needed".into()));
         }
+        crate::limits::check_animation_size("--frames", self.birds, self.frames)?;
         if !(self.fps.is_finite() && self.fps > 0.0 && self.fps <= 1000.0) {
             return Err(p(
                 "--fps",

@@ -1,0 +1,77 @@
+//! Size limits shared by every stage (issue 8): requests beyond them are refused up front, before
+//! any work, with a one-line message naming the flag or file (exit 2), instead of running out of
+//! memory, disk or patience hours later. They are far above what a line formation needs (the
+//! paper's flocks have 5–30 birds) and are documented with their memory cost in
+//! `docs/reliability.md`.
+//!
+//! Memory per *bird-frame* (one bird in one frame of an animation): 8 numbers × 8 bytes in
+//! memory (about 130 bytes resident with copies), about 200 bytes of pretty-printed JSON on disk.
+//! Hence the bound on the product birds × frames rather than on each factor alone.
+
+/// Most birds in an animation (`--birds` of `steady`/`animate`, `birds` of an animation file).
+pub const MAX_BIRDS: usize = 100_000;
+
+/// Most frames in an animation (`steady --frames`, `animate --seconds × --fps`): 9¼ hours at
+/// 30 fps.
+pub const MAX_FRAMES: usize = 1_000_000;
+
+/// Most bird-frames (birds × frames) in an animation. Measured at the limit (100 birds ×
+/// 100 000 frames, release build): `steady` takes 51 s and 1.3 GB resident and writes 1.97 GB of
+/// JSON, which `render` reads back (under [`crate::io::MAX_INPUT_BYTES`] = 2 GiB) in 70 s and
+/// 2.8 GB resident. E.g. 100 birds for 55 minutes at 30 fps, or 1000 birds for 5½ minutes.
+pub const MAX_BIRD_FRAMES: usize = 10_000_000;
+
+/// Most pixels in one picture (width × height): 8K UHD, 7680 × 4320.
+pub const MAX_FRAME_PIXELS: u64 = 7680 * 4320;
+
+/// Most pixels over all frames of one picture output (GIF or PNG frames), frames × width ×
+/// height: 2·10¹⁰, i.e. 20 GB of raw 8-bit frames (a GIF compresses it to a few percent). E.g.
+/// 1920 × 1080 at 25 fps allows about 6½ minutes; a request for a 10-GB GIF is far beyond it.
+pub const MAX_PICTURE_PIXELS: u64 = 20_000_000_000;
+
+/// Most birds marked in one annotated frame (matching ids across frames is cubic in this).
+pub const MAX_ANNOTATED_BIRDS: usize = 1_000;
+
+/// Most annotated frames in one annotation file or directory.
+pub const MAX_ANNOTATED_FRAMES: usize = 100_000;
+
+/// Checks an animation's size: `birds`, `frames` and their product, naming `what` (a flag such
+/// as `--frames`, or a file) in the message.
+pub fn check_animation_size(what: &str, birds: usize, frames: usize) -> crate::Result<()> {
+    let err = |msg: String| Err(crate::Error::parameter(what, msg));
+    if birds > MAX_BIRDS {
+        return err(format!("{birds} birds: at most {MAX_BIRDS}"));
+    }
+    if frames > MAX_FRAMES {
+        return err(format!(
+            "{frames} frames: at most {MAX_FRAMES} (9 hours at 30 fps); shorten the animation"
+        ));
+    }
+    match birds.checked_mul(frames) {
+        Some(p) if p <= MAX_BIRD_FRAMES => Ok(()),
+        _ => err(format!(
+            "{birds} birds × {frames} frames is more than {MAX_BIRD_FRAMES} bird-frames (memory and file size); use fewer birds or frames"
+        )),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes_are_checked_without_overflow() {
+        assert!(check_animation_size("--frames", 9, 300).is_ok());
+        assert!(check_animation_size("--frames", 100, 100_000).is_ok());
+        for (b, f) in [
+            (1_000_000, 10),
+            (9, 10_000_000),
+            (10_000, 10_000),
+            (usize::MAX, usize::MAX),
+        ] {
+            let e = check_animation_size("--frames", b, f).unwrap_err();
+            assert_eq!(e.exit_code(), 2);
+            assert!(e.to_string().starts_with("--frames: "), "{e}");
+        }
+    }
+}

@@ -1,0 +1,180 @@
+//! No lost files (issue 8, SPEC §4): a render interrupted mid-way by SIGTERM or SIGINT (Ctrl-C)
+//! exits non-zero (130), leaves no temporary (`.NAME.tmp-formation-PID`), never touches an
+//! existing output (byte-identical afterwards) and creates no later output.
+//!
+//! The render is made slow on purpose (a 70-second animation as a 1280×720 GIF at 50 fps, or as
+//! PNG frames); the signal is sent once the output's temporary exists, i.e. while it is being
+//! written. Signals are sent with the `kill` command (no `libc` dependency).
+#![cfg(unix)]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+use formation::Animation;
+
+const PREVIOUS: &[u8] = b"previous output: an interrupted run must leave this byte-identical\n";
+
+fn workdir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("formation-interrupt-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// A long animation: `tests/data/flock_small.json` (50 frames, 1.6 s) slowed down 40 times.
+fn long_animation(dir: &Path) -> PathBuf {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/flock_small.json");
+    let mut a = Animation::read(&src).unwrap();
+    for f in &mut a.frames {
+        f.t *= 40.0;
+    }
+    a.fps /= 40.0;
+    let path = dir.join("long.json");
+    std::fs::write(&path, serde_json::to_vec(&a).unwrap()).unwrap();
+    path
+}
+
+/// Every file under `dir` (relative path → bytes), sorted.
+fn snapshot(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut out = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                out.push((
+                    p.strip_prefix(dir).unwrap().display().to_string() + "/",
+                    Vec::new(),
+                ));
+                stack.push(p);
+            } else {
+                let bytes = std::fs::read(&p).unwrap_or_default();
+                out.push((p.strip_prefix(dir).unwrap().display().to_string(), bytes));
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+fn has_temporary(dir: &Path) -> bool {
+    snapshot(dir)
+        .iter()
+        .any(|(name, _)| name.contains(".tmp-formation-"))
+}
+
+/// Starts `formation render` writing `output` (then `later`), waits until it is writing, sends
+/// `signal`, and checks the aftermath.
+fn interrupt(signal: &str, name: &str, output: &str) {
+    let dir = workdir(name);
+    let anim = long_animation(&dir);
+    // Existing outputs that must survive: the file itself, or a frames directory of ours.
+    if output.ends_with('/') {
+        let frames = dir.join(output.trim_end_matches('/'));
+        std::fs::create_dir(&frames).unwrap();
+        std::fs::write(frames.join("frame_00000.png"), PREVIOUS).unwrap();
+    } else {
+        std::fs::write(dir.join(output), PREVIOUS).unwrap();
+    }
+    let before = snapshot(&dir);
+    let mut child = Command::new(env!("CARGO_BIN_EXE_formation"))
+        .args([
+            "render", "--quiet", "--size", "1280x720", "--fps", "50", "-o",
+        ])
+        .arg(dir.join(output))
+        .arg("-o")
+        .arg(dir.join("later.csv"))
+        .arg(&anim)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    while !has_temporary(&dir) {
+        if let Some(status) = child.try_wait().unwrap() {
+            panic!("{name}: render ended ({status}) before writing anything");
+        }
+        assert!(
+            start.elapsed() < Duration::from_secs(120),
+            "{name}: no temporary after 2 minutes"
+        );
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    // Let it write for a while: the temporary holds part of the output.
+    std::thread::sleep(Duration::from_millis(300));
+    assert!(
+        child.try_wait().unwrap().is_none(),
+        "{name}: render finished before the signal; make it slower"
+    );
+    let killed = Command::new("kill")
+        .args([format!("-{signal}"), child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(killed.success());
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(
+        out.status.code(),
+        Some(130),
+        "{name}: exit {:?}, stderr {stderr}",
+        out.status
+    );
+    assert!(
+        stderr.contains("interrupted; no output written"),
+        "{name}: {stderr}"
+    );
+    let after = snapshot(&dir);
+    assert_eq!(
+        after.iter().map(|e| &e.0).collect::<Vec<_>>(),
+        before.iter().map(|e| &e.0).collect::<Vec<_>>(),
+        "{name}: files differ after the interruption (temporaries or new outputs left)"
+    );
+    assert!(after == before, "{name}: an existing output changed");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn sigterm_during_gif_keeps_the_old_gif() {
+    interrupt("TERM", "term-gif", "flock.gif");
+}
+
+#[test]
+fn sigint_during_gif_keeps_the_old_gif() {
+    interrupt("INT", "int-gif", "flock.gif");
+}
+
+#[test]
+fn sigterm_during_png_frames_keeps_the_old_frames() {
+    interrupt("TERM", "term-png", "frames/");
+}
+
+#[test]
+fn sigint_during_png_frames_keeps_the_old_frames() {
+    interrupt("INT", "int-png", "frames/");
+}
+
+/// A write that fails (a number JSON cannot hold) refuses before creating anything: the existing
+/// file stays byte-identical and no temporary is left.
+#[test]
+fn failed_write_leaves_no_temporary_and_keeps_the_target() {
+    let dir = workdir("failed");
+    let target = dir.join("out.json");
+    std::fs::write(&target, PREVIOUS).unwrap();
+    #[derive(serde::Serialize)]
+    struct Bad {
+        x: Vec<f64>,
+    }
+    let e = formation::io::write_json_atomic(
+        &target,
+        &Bad {
+            x: vec![1.0, f64::NAN],
+        },
+    )
+    .unwrap_err();
+    assert_eq!(e.exit_code(), 1);
+    assert!(e.to_string().contains("x[1]"), "{e}");
+    assert_eq!(std::fs::read(&target).unwrap(), PREVIOUS);
+    assert_eq!(snapshot(&dir).len(), 1);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
