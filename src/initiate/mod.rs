@@ -35,6 +35,10 @@ pub use perception::{PerceptionMode, PerceptionParams, HPR_GAMMA_DEFAULT};
 pub use sim::{Simulation, StepParams};
 pub use target::{Side, TargetShape};
 
+/// Margin between the largest bearing of a reference slot and the edge of the visual field when
+/// the field is widened for the target shape, radians (15°).
+pub const FIELD_MARGIN: f64 = 15.0 * PI / 180.0;
+
 /// Largest accepted step limit (9¼ hours of flight at 30 fps).
 pub const MAX_STEPS_LIMIT: usize = 1_000_000;
 
@@ -46,6 +50,10 @@ pub const MAX_START_EXTENT: f64 = 1e6;
 pub struct InitiateOptions {
     /// Perception model: visual field, reference cone, occlusion mode.
     pub perception: PerceptionParams,
+    /// Widen the visual field per eye, where the target shape needs it, to the largest bearing
+    /// at which a bird in its slot sees its reference bird plus [`FIELD_MARGIN`] (the paper:
+    /// "90° per eye, though it may be wider for real birds"); never narrows it.
+    pub widen_field: bool,
     /// α of eq. (6), dimensionless (paper: 0.2).
     pub alpha: f64,
     /// |K| of eq. (5), per √wingspan (paper: 0.06).
@@ -100,6 +108,7 @@ impl Default for InitiateOptions {
     fn default() -> Self {
         InitiateOptions {
             perception: PerceptionParams::default(),
+            widen_field: true,
             alpha: 0.2,
             k: 0.06,
             max_turn_rate: PI / 2.0,
@@ -252,6 +261,8 @@ pub struct InitiateStats {
     pub leader_changes: usize,
     /// Birds within the tolerance of a slot of their own at the end.
     pub birds_in_slot: usize,
+    /// Visual field per eye used, radians (the option's, or wider if the target shape needs it).
+    pub field_per_eye: f64,
 }
 
 /// The simulated initiation before the hand-over: per-step states in simulation bird order.
@@ -547,18 +558,17 @@ pub fn random_start(
     Ok((pos, heading, speed))
 }
 
-/// Runs the simulation until convergence or the step limit, without the hand-over. The flock's
-/// target is `target`; cruise heading (radians) and speed (wingspans per second) are those of the
-/// steady flight's leader; `fps` sets the step length.
-pub fn simulate(
+/// The simulation at its first step: parameters at `fps` for the cruise heading (radians) and
+/// speed (wingspans per second), the visual field widened for `target` if asked, and the start
+/// positions, headings and speeds (random ones drawn from `rng`).
+pub fn start_simulation(
     target: &TargetShape,
     fps: f64,
     cruise_heading: f64,
     cruise_speed: f64,
     opts: &InitiateOptions,
     rng: &mut impl Rng,
-    progress: &dyn Progress,
-) -> Result<InitiationRun> {
+) -> Result<Simulation> {
     opts.validate()?;
     if !(fps.is_finite() && fps > 0.0) {
         return Err(Error::parameter("fps", "must be a positive number"));
@@ -570,7 +580,11 @@ pub fn simulate(
         ));
     }
     let n = target.len();
-    let params = opts.step_params(fps, cruise_heading, cruise_speed);
+    let mut params = opts.step_params(fps, cruise_heading, cruise_speed);
+    if opts.widen_field {
+        let field = &mut params.perception.fov_per_eye;
+        *field = field.max(target.required_field(FIELD_MARGIN));
+    }
     let (pos, heading, speed) = match &opts.start {
         Start::Random(region) => random_start(n, region, &params, rng)?,
         Start::Given(s) => {
@@ -596,7 +610,24 @@ pub fn simulate(
             (pos, heading, speed)
         }
     };
-    let mut sim = Simulation::new(target.clone(), params, pos, heading, speed);
+    Ok(Simulation::new(target.clone(), params, pos, heading, speed))
+}
+
+/// Runs the simulation until convergence or the step limit, without the hand-over. The flock's
+/// target is `target`; cruise heading (radians) and speed (wingspans per second) are those of the
+/// steady flight's leader; `fps` sets the step length.
+pub fn simulate(
+    target: &TargetShape,
+    fps: f64,
+    cruise_heading: f64,
+    cruise_speed: f64,
+    opts: &InitiateOptions,
+    rng: &mut impl Rng,
+    progress: &dyn Progress,
+) -> Result<InitiationRun> {
+    let mut sim = start_simulation(target, fps, cruise_heading, cruise_speed, opts, rng)?;
+    let n = target.len();
+    let params = sim.params;
     let hold_steps = (opts.hold * fps).round() as usize;
     let mut run = InitiationRun {
         pos: vec![sim.flock.pos.clone()],
@@ -611,6 +642,7 @@ pub fn simulate(
             max_turn_rate: 0.0,
             leader_changes: 0,
             birds_in_slot: 0,
+            field_per_eye: params.perception.fov_per_eye,
         },
     };
     progress.start("initiate", opts.max_steps as u64);

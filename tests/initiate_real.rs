@@ -1,0 +1,266 @@
+//! Initiation on real steady-flight output: the example flocks of `examples_data/` go through
+//! extraction (§4), the steady flight (§5) and the initiation (§6) through the library, as
+//! `formation animate` does, and the flock must converge into the first key shape with no two
+//! birds closer than a quarter wingspan. The ignored tests measure the rates in
+//! docs/initiation.md.
+#![allow(clippy::needless_range_loop)]
+
+use std::path::PathBuf;
+
+use formation::annotations::{Heading, ReadOptions};
+use formation::extract::params::FormationParams;
+use formation::extract::{self, ExtractOptions};
+use formation::initiate::{self, InitiateOptions, TargetShape};
+use formation::keyshape::steady::{steady_flight, SteadyOptions};
+use formation::progress::Silent;
+use formation::{rng, Animation};
+use glam::DVec2;
+
+/// An example flock: its file and the reading options `formation animate` needs for it.
+#[derive(Clone, Copy)]
+struct Example {
+    name: &'static str,
+    file: &'static str,
+    heading: Option<f64>,
+    wingspan_px: Option<f64>,
+}
+
+const GEESE: Example = Example {
+    name: "geese",
+    file: "barnacle_geese_v.json",
+    heading: None,
+    wingspan_px: None,
+};
+const SNOW: Example = Example {
+    name: "snow",
+    file: "snow_geese_j.csv",
+    heading: None,
+    wingspan_px: None,
+};
+const CRANES: Example = Example {
+    name: "cranes",
+    file: "cranes_v_dltdv.csv",
+    heading: Some(300.0),
+    wingspan_px: Some(22.0),
+};
+const PELICANS: Example = Example {
+    name: "pelicans",
+    file: "pelicans_u_labelme",
+    heading: None,
+    wingspan_px: None,
+};
+
+fn params(ex: Example) -> FormationParams {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("examples_data")
+        .join(ex.file);
+    let read = ReadOptions {
+        heading: ex.heading.map(Heading::Degrees),
+        wingspan_px: ex.wingspan_px,
+        y_origin: None,
+    };
+    extract::params_from_path(
+        &path,
+        &read,
+        &ExtractOptions::default(),
+        &mut rng::stream(0, "extract"),
+    )
+    .unwrap()
+}
+
+/// The steady flight `formation animate --seed seed` would make (a few frames are enough: the
+/// initiation targets the first key shape and the first frame's cruise state).
+fn steady(p: &FormationParams, birds: usize, seed: u64) -> Animation {
+    let opts = SteadyOptions {
+        birds,
+        frames: 3,
+        seed,
+        ..SteadyOptions::default()
+    };
+    steady_flight(p, &opts, &mut rng::stream(seed, "steady"), &Silent).unwrap()
+}
+
+fn key_points(a: &Animation) -> Vec<DVec2> {
+    a.key_shapes[0]
+        .birds
+        .iter()
+        .map(|b| DVec2::new(b.x, b.y))
+        .collect()
+}
+
+struct Outcome {
+    converged: bool,
+    steps: usize,
+    min_distance: f64,
+    in_slot: usize,
+}
+
+fn run(a: &Animation, seed: u64, opts: &InitiateOptions) -> Outcome {
+    let (t, h, v) = initiate::steady_target(a).unwrap();
+    let r = initiate::simulate(
+        &t,
+        a.fps,
+        h,
+        v,
+        opts,
+        &mut rng::stream(seed, "initiate"),
+        &Silent,
+    )
+    .unwrap();
+    Outcome {
+        converged: r.stats.converged,
+        steps: r.stats.steps,
+        min_distance: r.stats.min_distance,
+        in_slot: r.stats.birds_in_slot,
+    }
+}
+
+fn env_u(name: &str) -> Option<u64> {
+    std::env::var(name).ok().and_then(|s| s.parse().ok())
+}
+
+/// Convergence rates over seeds for every example and flock size (the table of
+/// docs/initiation.md): `SEEDS=30 cargo test --release --test initiate_real rates -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn rates() {
+    let seeds = env_u("SEEDS").unwrap_or(30);
+    let only = std::env::var("ONLY").ok();
+    let cases: [(Example, &[usize]); 4] = [
+        (GEESE, &[9, 14, 28]),
+        (SNOW, &[16, 28]),
+        (CRANES, &[41]),
+        (PELICANS, &[12, 24]),
+    ];
+    let opts = InitiateOptions::default();
+    for (ex, ns) in cases {
+        let p = params(ex);
+        for &n in ns {
+            let label = format!("{}{n}", ex.name);
+            if only
+                .as_ref()
+                .is_some_and(|o| !o.split(',').any(|o| o == label))
+            {
+                continue;
+            }
+            let mut ok = 0;
+            let mut steps = Vec::new();
+            let mut mind = f64::INFINITY;
+            let mut fails = Vec::new();
+            for seed in 0..seeds {
+                let a = steady(&p, n, seed);
+                let o = run(&a, seed, &opts);
+                if o.converged {
+                    ok += 1;
+                    steps.push(o.steps);
+                } else {
+                    fails.push((seed, o.in_slot));
+                }
+                mind = mind.min(o.min_distance);
+            }
+            steps.sort_unstable();
+            let med = steps.get(steps.len() / 2).copied().unwrap_or(0);
+            println!(
+                "{label}: {ok}/{seeds} converged, median steps {med}, slowest {:?}, closest {mind:.3}, fails {:?}",
+                steps.last(),
+                &fails[..fails.len().min(10)]
+            );
+        }
+    }
+}
+
+/// Prints the key shape and slot tree of one example (`EX=snow N=28 SEED=0`).
+#[test]
+#[ignore]
+fn show_shape() {
+    let ex = match std::env::var("EX").as_deref() {
+        Ok("snow") => SNOW,
+        Ok("cranes") => CRANES,
+        Ok("pelicans") => PELICANS,
+        _ => GEESE,
+    };
+    let n = env_u("N").unwrap_or(14) as usize;
+    let seed = env_u("SEED").unwrap_or(0);
+    let a = steady(&params(ex), n, seed);
+    let pts = key_points(&a);
+    let t = TargetShape::new(&pts).unwrap();
+    println!("leader {} at {:?}", t.leader, pts[t.leader]);
+    for (k, arm) in t.arms.iter().enumerate() {
+        println!("arm {k}:");
+        let mut prev = t.leader;
+        for &s in arm {
+            let d = pts[s] - pts[prev];
+            println!(
+                "  slot {s:3} at ({:7.3}, {:7.3})  offset from previous ({:6.3}, {:6.3})",
+                pts[s].x, pts[s].y, d.x, d.y
+            );
+            prev = s;
+        }
+    }
+}
+
+/// Runs one initiation step by step and prints the state of every bird at the end
+/// (`EX=snow N=28 SEED=0`): slot, reference, side, distance from the slot, whether the
+/// reference is visible.
+#[test]
+#[ignore]
+fn diagnose() {
+    use formation::initiate::perception::Perceiver;
+    let ex = match std::env::var("EX").as_deref() {
+        Ok("snow") => SNOW,
+        Ok("cranes") => CRANES,
+        Ok("pelicans") => PELICANS,
+        _ => GEESE,
+    };
+    let n = env_u("N").unwrap_or(14) as usize;
+    let seed = env_u("SEED").unwrap_or(0);
+    let steps = env_u("STEPS").unwrap_or(9000) as usize;
+    let a = steady(&params(ex), n, seed);
+    let (t, h, v) = initiate::steady_target(&a).unwrap();
+    let opts = InitiateOptions::default();
+    let mut sim =
+        initiate::start_simulation(&t, a.fps, h, v, &opts, &mut rng::stream(seed, "initiate"))
+            .unwrap();
+    let sp = sim.params;
+    let mut held = 0;
+    let mut trace: Vec<Vec<Option<usize>>> = Vec::new();
+    while sim.steps < steps {
+        sim.step();
+        if sim.in_formation(opts.tolerance, opts.heading_tolerance, opts.speed_tolerance) {
+            held += 1;
+            if held > 30 {
+                break;
+            }
+        } else {
+            held = 0;
+        }
+        if sim.steps + 300 >= steps {
+            trace.push(sim.flock.reference.clone());
+        }
+    }
+    println!("steps {} converged {}", sim.steps, held > 30);
+    let slots = sim.slot_positions();
+    let mut per = Perceiver::new();
+    let mut vis = Vec::new();
+    let f = &sim.flock;
+    let mut count = vec![0; n];
+    for s in f.slot.iter().flatten() {
+        count[*s] += 1;
+    }
+    for i in 0..n {
+        per.visible(i, &f.pos, f.heading[i], &sp.perception, &mut vis);
+        let err = f.slot[i].map(|s| (f.pos[i] - slots[s]).length());
+        let changes = trace.windows(2).filter(|w| w[0][i] != w[1][i]).count();
+        println!(
+            "bird {i:2} slot {:?} (x{}) ref {:?} side {:?} err {:?} ref visible {} speed {:.3} heading {:.1}° ref changes (last 300) {changes}",
+            f.slot[i],
+            f.slot[i].map_or(0, |s| count[s]),
+            f.reference[i],
+            f.side[i],
+            err.map(|e| (e * 1000.0).round() / 1000.0),
+            f.reference[i].is_some_and(|j| vis.contains(&j)),
+            f.speed[i] / sp.cruise_speed,
+            f.heading[i].to_degrees()
+        );
+    }
+}
