@@ -184,15 +184,22 @@ fn show_shape() {
     let a = steady(&params(ex), n, seed);
     let pts = key_points(&a);
     let t = TargetShape::new(&pts).unwrap();
-    println!("leader {} at {:?}", t.leader, pts[t.leader]);
+    println!(
+        "leader {} at {:?}; field needed {:.1}°",
+        t.leader,
+        pts[t.leader],
+        t.required_field(initiate::FIELD_MARGIN).to_degrees()
+    );
     for (k, arm) in t.arms.iter().enumerate() {
         println!("arm {k}:");
         let mut prev = t.leader;
         for &s in arm {
             let d = pts[s] - pts[prev];
+            let par = t.parent[s].unwrap();
             println!(
-                "  slot {s:3} at ({:7.3}, {:7.3})  offset from previous ({:6.3}, {:6.3})",
-                pts[s].x, pts[s].y, d.x, d.y
+                "  slot {s:3} at ({:7.3}, {:7.3})  offset from previous ({:6.3}, {:6.3})  reference slot {par} at {:.1}°",
+                pts[s].x, pts[s].y, d.x, d.y,
+                formation::initiate::target::link_bearing(pts[s], pts[par]).to_degrees()
             );
             prev = s;
         }
@@ -224,6 +231,8 @@ fn diagnose() {
     let sp = sim.params;
     let mut held = 0;
     let mut trace: Vec<Vec<Option<usize>>> = Vec::new();
+    let plot_from = env_u("PLOT_FROM").unwrap_or(0) as usize;
+    let mut frames = Vec::new();
     while sim.steps < steps {
         sim.step();
         if sim.in_formation(opts.tolerance, opts.heading_tolerance, opts.speed_tolerance) {
@@ -237,6 +246,40 @@ fn diagnose() {
         if sim.steps + 300 >= steps {
             trace.push(sim.flock.reference.clone());
         }
+        if let Some(b) = env_u("BIRD") {
+            let b = b as usize;
+            if sim.steps + 12 >= steps {
+                let f = &sim.flock;
+                println!(
+                    "step {} bird {b}: ref {:?} side {:?} branch {:?} slot {:?} speed {:.3} heading {:.1}°",
+                    sim.steps,
+                    f.reference[b],
+                    f.side[b],
+                    f.branch[b],
+                    f.slot[b],
+                    f.speed[b] / sim.params.cruise_speed,
+                    f.heading[b].to_degrees()
+                );
+            }
+        }
+        if sim.steps >= plot_from {
+            let f = &sim.flock;
+            frames.push(formation::animation::Frame {
+                t: sim.steps as f64 / a.fps,
+                x: f.pos.iter().map(|p| p.x).collect(),
+                y: f.pos.iter().map(|p| p.y).collect(),
+                z: vec![0.0; n],
+                heading: f.heading.clone(),
+                speed: f.speed.iter().map(|v| v * a.fps).collect(),
+                ..Default::default()
+            });
+        }
+    }
+    if let Ok(path) = std::env::var("PLOT") {
+        let mut anim = Animation::new(seed, a.fps, 1.5, n);
+        anim.frames = frames;
+        let chart = formation::plot::paths::PathsChart::from_animation(&anim).unwrap();
+        formation::plot::save(&chart, std::path::Path::new(&path)).unwrap();
     }
     println!("steps {} converged {}", sim.steps, held > 30);
     let slots = sim.slot_positions();
@@ -247,8 +290,31 @@ fn diagnose() {
     for s in f.slot.iter().flatten() {
         count[*s] += 1;
     }
+    // Formation-frame positions (x right, y behind the leader) of every bird, by slot.
+    let dc = formation::initiate::perception::direction(sp.cruise_heading);
+    let rc = formation::initiate::perception::right_of(sp.cruise_heading);
+    let lp = f.pos[f.leader];
+    let sl = t.slots[t.leader];
+    for i in 0..n {
+        let q = f.pos[i] - lp;
+        let fx = q.dot(rc) + sl.x;
+        let fy = -q.dot(dc) + sl.y;
+        if let Some(s) = f.slot[i] {
+            println!(
+                "  bird {i:2} at ({fx:7.2}, {fy:6.2}) slot {s:2} at ({:7.2}, {:6.2})",
+                t.slots[s].x, t.slots[s].y
+            );
+        } else {
+            println!("  bird {i:2} at ({fx:7.2}, {fy:6.2}) unmatched");
+        }
+    }
     for i in 0..n {
         per.visible(i, &f.pos, f.heading[i], &sp.perception, &mut vis);
+        if env_u("BIRD") == Some(i as u64) {
+            let mut v = vis.clone();
+            v.sort_unstable();
+            println!("bird {i} sees {v:?}");
+        }
         let err = f.slot[i].map(|s| (f.pos[i] - slots[s]).length());
         let changes = trace.windows(2).filter(|w| w[0][i] != w[1][i]).count();
         println!(

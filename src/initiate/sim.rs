@@ -58,6 +58,8 @@ pub struct StepParams {
     pub leader_hysteresis: f64,
     /// Keep the current reference bird while it stays visible and acceptable.
     pub sticky_reference: bool,
+    /// A kept reference hidden for at most this many steps is kept all the same.
+    pub reference_memory: u32,
     /// Upper bound of the distance divisor of eq. (6), wingspans.
     pub turn_distance_cap: f64,
     /// Half-width of the linear zone of eq. (5)'s √|r − v_j| around its fixed point, wingspans.
@@ -86,6 +88,7 @@ struct Decision {
     reference: Option<usize>,
     side: Option<Side>,
     branch: Option<usize>,
+    unseen: u32,
 }
 
 /// The state of every bird (world frame).
@@ -104,6 +107,8 @@ pub struct Flock {
     /// The follower slot of its reference's slot each bird aims for (where the target tree
     /// branches, a reference slot has several).
     pub branch: Vec<Option<usize>>,
+    /// Steps since each bird last saw its reference bird (0: visible now).
+    pub unseen: Vec<u32>,
     /// Slot of the target shape each bird corresponds to (§6.2.1), if matched.
     pub slot: Vec<Option<usize>>,
     /// The leader: the front-most bird along the cruise heading.
@@ -133,6 +138,7 @@ pub struct Simulation {
     next_reference: Vec<Option<usize>>,
     next_side: Vec<Option<Side>>,
     next_branch: Vec<Option<usize>>,
+    next_unseen: Vec<u32>,
 }
 
 impl Simulation {
@@ -158,6 +164,7 @@ impl Simulation {
                 reference: vec![None; n],
                 side: vec![None; n],
                 branch: vec![None; n],
+                unseen: vec![0; n],
                 slot: vec![None; n],
                 leader,
             },
@@ -172,6 +179,7 @@ impl Simulation {
             next_reference: vec![None; n],
             next_side: vec![None; n],
             next_branch: vec![None; n],
+            next_unseen: vec![0; n],
         };
         sim.match_slots();
         sim
@@ -387,11 +395,13 @@ impl Simulation {
             self.next_reference[i] = d.reference;
             self.next_side[i] = d.side;
             self.next_branch[i] = d.branch;
+            self.next_unseen[i] = d.unseen;
         }
         self.decisions = decisions;
         std::mem::swap(&mut f.reference, &mut self.next_reference);
         std::mem::swap(&mut f.side, &mut self.next_side);
         std::mem::swap(&mut f.branch, &mut self.next_branch);
+        std::mem::swap(&mut f.unseen, &mut self.next_unseen);
         self.steps += 1;
         self.match_slots();
     }
@@ -400,12 +410,14 @@ impl Simulation {
     fn decide(&self, i: usize, perceiver: &mut Perceiver, visible: &mut Vec<usize>) -> Decision {
         let p = &self.params;
         let f = &self.flock;
+        let mut unseen = 0;
         let (want_heading, want_speed, reference, side, branch) = if i == f.leader {
             (p.cruise_heading, p.cruise_speed, None, None, None)
         } else {
             perceiver.visible(i, &f.pos, f.heading[i], &p.perception, visible);
             match self.choose(i, visible) {
-                Some((j, side, c)) => {
+                Some((j, side, c, u)) => {
+                    unseen = u;
                     let (h, v) = self.pursue(i, j, c);
                     (h, v, Some(j), Some(side), Some(c))
                 }
@@ -438,17 +450,24 @@ impl Simulation {
             reference,
             side,
             branch,
+            unseen,
         }
     }
 
-    /// Reference bird, side and follower slot of bird `i` among its `visible` flockmates.
-    fn choose(&self, i: usize, visible: &[usize]) -> Option<(usize, Side, usize)> {
+    /// Reference bird, side and follower slot of bird `i` among its `visible` flockmates, and
+    /// the steps since the reference was last seen. The current reference is kept while it stays
+    /// acceptable and is visible, or hidden for no more than the reference memory (a bird does not
+    /// forget the bird it follows when another passes in front of it for a moment).
+    fn choose(&self, i: usize, visible: &[usize]) -> Option<(usize, Side, usize, u32)> {
         let f = &self.flock;
         if self.params.sticky_reference {
             if let (Some(j), Some(side)) = (f.reference[i], f.side[i]) {
-                if self.sides_for(i, j).contains(&Some(side)) && visible.contains(&j) {
+                let seen = visible.contains(&j);
+                let remembered = seen || f.unseen[i] < self.params.reference_memory;
+                if remembered && self.sides_for(i, j).contains(&Some(side)) {
                     if let Some(c) = self.acceptable(i, j, side, visible) {
-                        return Some((j, side, c));
+                        let unseen = if seen { 0 } else { f.unseen[i] + 1 };
+                        return Some((j, side, c, unseen));
                     }
                 }
             }
@@ -470,7 +489,7 @@ impl Simulation {
                 false
             },
         );
-        reference.zip(chosen).map(|(j, (side, c))| (j, side, c))
+        reference.zip(chosen).map(|(j, (side, c))| (j, side, c, 0))
     }
 
     /// Eqs. (5) and (6) with the fixes of docs/initiation.md: desired heading and speed of bird `i`

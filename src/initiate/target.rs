@@ -6,12 +6,14 @@
 //! Input is the first key shape in the formation frame (`x` right of the flight direction, `y`
 //! behind the leader, wingspans). Arms: slots right of the leader (x > x_L) form the right arm,
 //! slots left of it the left arm, each ordered by lateral distance from the leader; slots exactly
-//! in line with the leader join the shorter arm. The reference slot of an arm slot is the nearest
-//! of the leader and the inner slots of its arm that a bird in the slot can see: not more than
-//! [`MAX_LINK_BEARING`] from straight ahead (the leader, front-most, always qualifies). On a clean
-//! V, U or echelon this is the next slot inward, so every slot has one follower and the arms are
-//! chains as in the paper; on a real key shape it skips an outlier lying behind the line (which
-//! then hangs off the line as a branch) and never makes a bird follow one behind its back.
+//! in line with the leader join the shorter arm. The reference slot of an arm slot is the next
+//! slot inward on its arm (the paper's chain: every bird followed by at most one) when a bird in
+//! the slot can see it, i.e. it lies at most [`MAX_LINK_BEARING`] from straight ahead; otherwise
+//! the nearest slot it can see among the leader and the inner slots of its arm (the leader,
+//! front-most, always qualifies). On a clean V, U or echelon every arm is a chain; on a real key
+//! shape an outlier behind the line hangs off it as a branch (the next slot skips it), the slot
+//! after an outlier ahead of the line follows the outlier, and no bird has to follow one behind
+//! its back.
 //! The offset of a follower from its reference is the difference of their slot coordinates, so
 //! a perfect tree of followers rebuilds the shape.
 
@@ -131,16 +133,23 @@ impl TargetShape {
             let side = if a == 0 { Side::Left } else { Side::Right };
             for (k, &s) in arm.iter().enumerate() {
                 place[s] = Some((side, k));
-                // The nearest visible candidate among the leader and the inner slots of the arm;
-                // ties to the one nearer the leader. The leader (smallest y) is always visible.
-                let mut best = (leader, (points[leader] - points[s]).length());
-                for &c in &arm[..k] {
-                    let d = (points[c] - points[s]).length();
-                    if link_bearing(points[s], points[c]) <= MAX_LINK_BEARING && d < best.1 {
-                        best = (c, d);
+                // The previous slot of the arm (the paper's chain) if a bird in this slot can see
+                // it, else the nearest visible one among the leader and the inner slots of the
+                // arm (ties to the one nearer the leader). The leader, front-most, is always
+                // visible.
+                let prev = if k == 0 { leader } else { arm[k - 1] };
+                let p = if link_bearing(points[s], points[prev]) <= MAX_LINK_BEARING {
+                    prev
+                } else {
+                    let mut best = (leader, (points[leader] - points[s]).length());
+                    for &c in &arm[..k] {
+                        let d = (points[c] - points[s]).length();
+                        if link_bearing(points[s], points[c]) <= MAX_LINK_BEARING && d < best.1 {
+                            best = (c, d);
+                        }
                     }
-                }
-                let p = best.0;
+                    best.0
+                };
                 parent[s] = Some(p);
                 children[p][a].push(s);
                 let d = points[s] - points[p];
