@@ -147,6 +147,7 @@ fn rates() {
             let mut steps = Vec::new();
             let mut mind = f64::INFINITY;
             let mut fails = Vec::new();
+            let mut close = Vec::new();
             for seed in 0..seeds {
                 let a = steady(&p, n, seed);
                 let o = run(&a, seed, &opts);
@@ -157,13 +158,17 @@ fn rates() {
                     fails.push((seed, o.in_slot));
                 }
                 mind = mind.min(o.min_distance);
+                if o.min_distance < 0.25 {
+                    close.push((seed, (o.min_distance * 1000.0).round() / 1000.0));
+                }
             }
             steps.sort_unstable();
             let med = steps.get(steps.len() / 2).copied().unwrap_or(0);
             println!(
-                "{label}: {ok}/{seeds} converged, median steps {med}, slowest {:?}, closest {mind:.3}, fails {:?}",
+                "{label}: {ok}/{seeds} converged, median steps {med}, slowest {:?}, closest {mind:.3}, fails {:?}, closer than 0.25: {:?}",
                 steps.last(),
-                &fails[..fails.len().min(10)]
+                &fails[..fails.len().min(10)],
+                &close[..close.len().min(10)]
             );
         }
     }
@@ -233,8 +238,33 @@ fn diagnose() {
     let mut trace: Vec<Vec<Option<usize>>> = Vec::new();
     let plot_from = env_u("PLOT_FROM").unwrap_or(0) as usize;
     let mut frames = Vec::new();
+    let mut closest = (sim.min_distance(), 0usize);
     while sim.steps < steps {
         sim.step();
+        let d = sim.min_distance();
+        if d < closest.0 {
+            closest = (d, sim.steps);
+        }
+        if d < 0.3 && std::env::var("NEAR").is_ok() {
+            let f = &sim.flock;
+            for a in 0..n {
+                for b in a + 1..n {
+                    if (f.pos[a] - f.pos[b]).length() < 0.3 {
+                        println!(
+                            "step {}: birds {a} {b} {:.3} apart; headings {:.1}° {:.1}°, speeds {:.2} {:.2}, refs {:?} {:?}",
+                            sim.steps,
+                            (f.pos[a] - f.pos[b]).length(),
+                            f.heading[a].to_degrees(),
+                            f.heading[b].to_degrees(),
+                            f.speed[a] / sim.params.cruise_speed,
+                            f.speed[b] / sim.params.cruise_speed,
+                            f.reference[a],
+                            f.reference[b]
+                        );
+                    }
+                }
+            }
+        }
         if sim.in_formation(opts.tolerance, opts.heading_tolerance, opts.speed_tolerance) {
             held += 1;
             if held > 30 {
@@ -281,7 +311,13 @@ fn diagnose() {
         let chart = formation::plot::paths::PathsChart::from_animation(&anim).unwrap();
         formation::plot::save(&chart, std::path::Path::new(&path)).unwrap();
     }
-    println!("steps {} converged {}", sim.steps, held > 30);
+    println!(
+        "steps {} converged {}; closest approach {:.3} at step {}",
+        sim.steps,
+        held > 30,
+        closest.0,
+        closest.1
+    );
     let slots = sim.slot_positions();
     let mut per = Perceiver::new();
     let mut vis = Vec::new();

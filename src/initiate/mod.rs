@@ -39,6 +39,10 @@ pub use target::{Side, TargetShape};
 /// the field is widened for the target shape, radians (15°).
 pub const FIELD_MARGIN: f64 = 15.0 * PI / 180.0;
 
+/// Draws of a start heading and speed per bird before the one with the largest predicted miss
+/// distance is kept ([`random_start`]).
+pub const START_DRAWS: usize = 100;
+
 /// Largest accepted step limit (9¼ hours of flight at 30 fps).
 pub const MAX_STEPS_LIMIT: usize = 1_000_000;
 
@@ -506,7 +510,11 @@ pub fn check_steady(steady: &Animation, origin: &Path) -> Result<()> {
     Ok(())
 }
 
-/// Random start positions, headings and speeds (wingspans, radians, wingspans per step).
+/// Random start positions, headings and speeds (wingspans, radians, wingspans per step):
+/// positions uniform in the region at least `min_spacing` apart; headings uniform within the
+/// spread and speeds between the minimum and the cruise speed, redrawn while two birds would,
+/// flying straight, come closer than the avoidance distance within the time a quarter turn takes
+/// (no take-off on a collision course that no turn could avoid).
 pub fn random_start(
     n: usize,
     region: &StartRegion,
@@ -554,17 +562,45 @@ pub fn random_start(
         grid.entry((kx, ky)).or_default().push(pos.len());
         pos.push(p);
     }
-    let mut heading = Vec::with_capacity(n);
-    let mut speed = Vec::with_capacity(n);
-    for _ in 0..n {
-        let h = if region.heading_spread > 0.0 {
-            rng.random_range(-region.heading_spread..=region.heading_spread)
-        } else {
-            0.0
-        };
-        heading.push(sim::wrap_angle(params.cruise_heading + h));
-        let v = rng.random_range(params.min_speed..=params.cruise_speed);
-        speed.push(v);
+    // Headings and speeds: no two birds start on a course that brings them closer than the
+    // avoidance distance before they could turn a quarter circle away (straight-line
+    // prediction); a draw that does is redrawn, up to START_DRAWS times (then the safest is kept).
+    let horizon = std::f64::consts::FRAC_PI_2 / params.max_turn;
+    let mut heading: Vec<f64> = Vec::with_capacity(n);
+    let mut speed: Vec<f64> = Vec::with_capacity(n);
+    for i in 0..n {
+        let mut best = (f64::NEG_INFINITY, 0.0, 0.0);
+        for _ in 0..START_DRAWS {
+            let h = if region.heading_spread > 0.0 {
+                rng.random_range(-region.heading_spread..=region.heading_spread)
+            } else {
+                0.0
+            };
+            let h = sim::wrap_angle(params.cruise_heading + h);
+            let v = rng.random_range(params.min_speed..=params.cruise_speed);
+            let vel = perception::direction(h) * v;
+            let miss = (0..i)
+                .map(|j| {
+                    let dp = pos[j] - pos[i];
+                    let dv = perception::direction(heading[j]) * speed[j] - vel;
+                    let vv = dv.length_squared();
+                    let tau = if vv > 0.0 {
+                        (-dp.dot(dv) / vv).clamp(0.0, horizon)
+                    } else {
+                        0.0
+                    };
+                    (dp + dv * tau).length()
+                })
+                .fold(f64::INFINITY, f64::min);
+            if miss > best.0 {
+                best = (miss, h, v);
+            }
+            if miss >= params.avoid_distance {
+                break;
+            }
+        }
+        heading.push(best.1);
+        speed.push(best.2);
     }
     Ok((pos, heading, speed))
 }
