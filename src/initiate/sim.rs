@@ -300,7 +300,7 @@ impl Simulation {
                 continue;
             }
             let score = if holds { f64::NEG_INFINITY } else { my };
-            if best.is_none_or(|b| score < b.0) {
+            if best.map_or(true, |b| score < b.0) {
                 best = Some((score, c));
             }
         }

@@ -262,4 +262,72 @@ mod tests {
             }
         }
     }
+
+    #[test]
+    fn outlier_behind_the_line_hangs_off_as_a_branch() {
+        // Right arm: 1, 2, then 3 lies 2.7 behind the line and 4 is back on it.
+        let pts = [
+            DVec2::new(0.0, 0.0),
+            DVec2::new(1.0, 0.5),
+            DVec2::new(2.0, 1.0),
+            DVec2::new(3.0, 4.2),
+            DVec2::new(4.0, 2.0),
+            DVec2::new(5.0, 2.5),
+        ];
+        let t = TargetShape::new(&pts).unwrap();
+        assert_eq!(t.arms[1], vec![1, 2, 3, 4, 5]);
+        assert_eq!(t.parent[3], Some(2));
+        // From slot 4, slot 3 is behind its back: it follows 2, which has two followers.
+        assert_eq!(t.parent[4], Some(2));
+        assert_eq!(t.followers(2, Side::Right), &[3, 4]);
+        assert_eq!(t.follower_slot(3, Side::Right), None);
+        assert_eq!(t.parent[5], Some(4));
+        assert!(t.max_link_bearing() <= MAX_LINK_BEARING);
+    }
+
+    #[test]
+    fn slot_after_an_outlier_ahead_follows_the_outlier() {
+        // Right arm: 1..3 on a line, 4 is 1.5 ahead of it, 5 back on the line.
+        let pts = [
+            DVec2::new(0.0, 0.0),
+            DVec2::new(1.0, 0.5),
+            DVec2::new(2.0, 1.0),
+            DVec2::new(3.0, 1.5),
+            DVec2::new(4.0, 0.5),
+            DVec2::new(5.0, 2.5),
+        ];
+        let t = TargetShape::new(&pts).unwrap();
+        // Slots 3 and 2 are behind slot 4's back (135° and 104°): 4 follows the nearest slot it
+        // can see, 1 (abreast), and the chain goes on through the outlier.
+        assert_eq!(t.parent[4], Some(1));
+        assert_eq!(t.parent[5], Some(4));
+        assert_eq!(t.followers(1, Side::Right), &[2, 4]);
+        for s in 1..pts.len() {
+            let p = t.parent[s].unwrap();
+            assert!(link_bearing(pts[s], pts[p]) <= MAX_LINK_BEARING, "slot {s}");
+        }
+    }
+
+    #[test]
+    fn abreast_neighbours_need_a_wider_field() {
+        // A flat J front: the second bird is 0.001 ahead of the first on the right arm.
+        let pts = [
+            DVec2::new(0.0, 0.0),
+            DVec2::new(1.0, 0.1),
+            DVec2::new(2.0, 0.099),
+            DVec2::new(3.0, 0.6),
+        ];
+        let t = TargetShape::new(&pts).unwrap();
+        assert_eq!(t.parent[2], Some(1));
+        let need = t.required_field(0.0);
+        assert!(need > std::f64::consts::FRAC_PI_2 && need < 1.6, "{need}");
+        // A clean V needs less than the paper's 90° even with a 15° margin.
+        let v = TargetShape::new(&[
+            DVec2::new(0.0, 0.0),
+            DVec2::new(-1.0, 0.6),
+            DVec2::new(1.0, 0.6),
+        ])
+        .unwrap();
+        assert!(v.required_field(15f64.to_radians()) < std::f64::consts::FRAC_PI_2);
+    }
 }
