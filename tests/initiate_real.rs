@@ -89,6 +89,7 @@ fn key_points(a: &Animation) -> Vec<DVec2> {
 }
 
 struct Outcome {
+    field: f64,
     converged: bool,
     steps: usize,
     min_distance: f64,
@@ -108,6 +109,7 @@ fn run(a: &Animation, seed: u64, opts: &InitiateOptions) -> Outcome {
     )
     .unwrap();
     Outcome {
+        field: r.stats.field_per_eye,
         converged: r.stats.converged,
         steps: r.stats.steps,
         min_distance: r.stats.min_distance,
@@ -261,7 +263,16 @@ fn rates() {
         (CRANES, &[41]),
         (PELICANS, &[12, 24]),
     ];
-    let opts = InitiateOptions::default();
+    let mut opts = InitiateOptions::default();
+    if std::env::var("EXACT").is_ok() {
+        opts.perception.mode = initiate::PerceptionMode::Exact;
+    }
+    if std::env::var("NO_WIDEN").is_ok() {
+        opts.widen_field = false;
+    }
+    if let Some(m) = std::env::var("MEMORY").ok().and_then(|s| s.parse().ok()) {
+        opts.reference_memory = m;
+    }
     for (ex, ns) in cases {
         let p = params(ex);
         for &n in ns {
@@ -277,9 +288,11 @@ fn rates() {
             let mut mind = f64::INFINITY;
             let mut fails = Vec::new();
             let mut close = Vec::new();
+            let mut field = (f64::INFINITY, 0.0f64);
             for seed in 0..seeds {
                 let a = steady(&p, n, seed);
                 let o = run(&a, seed, &opts);
+                field = (field.0.min(o.field), field.1.max(o.field));
                 if o.converged {
                     ok += 1;
                     steps.push(o.steps);
@@ -294,8 +307,10 @@ fn rates() {
             steps.sort_unstable();
             let med = steps.get(steps.len() / 2).copied().unwrap_or(0);
             println!(
-                "{label}: {ok}/{seeds} converged, median steps {med}, slowest {:?}, closest {mind:.3}, fails {:?}, closer than 0.25: {:?}",
+                "{label}: {ok}/{seeds} converged, median steps {med}, slowest {:?}, closest {mind:.3}, field {:.0}–{:.0}°, fails {:?}, closer than 0.25: {:?}",
                 steps.last(),
+                field.0.to_degrees(),
+                field.1.to_degrees(),
                 &fails[..fails.len().min(10)],
                 &close[..close.len().min(10)]
             );
