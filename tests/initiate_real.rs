@@ -271,7 +271,7 @@ fn rates() {
         opts.widen_field = false;
     }
     if let Some(m) = std::env::var("MEMORY").ok().and_then(|s| s.parse().ok()) {
-        opts.reference_memory = m;
+        opts.reference_memory = Some(m);
     }
     for (ex, ns) in cases {
         let p = params(ex);

@@ -87,8 +87,9 @@ pub struct InitiateOptions {
     /// Keep the current reference bird while it is visible and acceptable.
     pub sticky_reference: bool,
     /// A kept reference bird hidden (occluded or out of the field) for at most this long is kept
-    /// all the same, seconds (0: only while visible).
-    pub reference_memory: f64,
+    /// all the same, seconds (0: only while visible; `None`: 0.5 s with HPR, 2 s with exact
+    /// occlusion, whose discs hide birds for longer).
+    pub reference_memory: Option<f64>,
     /// Upper bound of the distance divisor max(r, 1) of eq. (6), wingspans.
     pub turn_distance_cap: f64,
     /// Eq. (5)'s √|r − v_j| is replaced by its chord within this distance of the fixed point,
@@ -130,7 +131,7 @@ impl Default for InitiateOptions {
             lost_speed_factor: 0.9,
             leader_hysteresis: 1.0,
             sticky_reference: true,
-            reference_memory: 0.5,
+            reference_memory: None,
             turn_distance_cap: 5.0,
             linear_zone: 0.25,
             tolerance: 0.1,
@@ -355,10 +356,11 @@ impl InitiateOptions {
         pos("lost speed factor", self.lost_speed_factor)?;
         pos("--turn-distance-cap", self.turn_distance_cap)?;
         pos("--linear-zone", self.linear_zone)?;
-        if !(self.reference_memory.is_finite() && (0.0..=60.0).contains(&self.reference_memory)) {
+        let memory = self.reference_memory();
+        if !(memory.is_finite() && (0.0..=60.0).contains(&memory)) {
             return Err(Error::parameter(
                 "reference memory",
-                format!("must be in [0, 60] seconds, got {}", self.reference_memory),
+                format!("must be in [0, 60] seconds, got {memory}"),
             ));
         }
         if !(self.leader_hysteresis.is_finite() && self.leader_hysteresis >= 0.0) {
@@ -431,6 +433,14 @@ impl InitiateOptions {
         Ok(())
     }
 
+    /// The reference memory in seconds (the option, or the default of the perception mode).
+    pub fn reference_memory(&self) -> f64 {
+        self.reference_memory.unwrap_or(match self.perception.mode {
+            PerceptionMode::Hpr { .. } => 0.5,
+            PerceptionMode::Exact => 2.0,
+        })
+    }
+
     /// Per-step parameters at `fps` for a cruise heading (radians) and speed (wingspans per second).
     pub fn step_params(&self, fps: f64, cruise_heading: f64, cruise_speed: f64) -> StepParams {
         let vc = cruise_speed / fps;
@@ -452,7 +462,7 @@ impl InitiateOptions {
             lost_speed_factor: self.lost_speed_factor,
             leader_hysteresis: self.leader_hysteresis,
             sticky_reference: self.sticky_reference,
-            reference_memory: (self.reference_memory * fps).round() as u32,
+            reference_memory: (self.reference_memory() * fps).round() as u32,
             turn_distance_cap: self.turn_distance_cap,
             linear_zone: self.linear_zone,
         }
