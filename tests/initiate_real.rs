@@ -267,6 +267,12 @@ fn rates() {
     if std::env::var("EXACT").is_ok() {
         opts.perception.mode = initiate::PerceptionMode::Exact;
     }
+    if let Some(k) = std::env::var("K").ok().and_then(|s| s.parse().ok()) {
+        opts.k = k;
+    }
+    if let Some(a) = std::env::var("ACCEL").ok().and_then(|s| s.parse().ok()) {
+        opts.max_accel = a;
+    }
     if std::env::var("NO_WIDEN").is_ok() {
         opts.widen_field = false;
     }

@@ -73,6 +73,9 @@ fn env_opts() -> InitiateOptions {
     if std::env::var("EXACT").is_ok() {
         o.perception.mode = initiate::PerceptionMode::Exact;
     }
+    if let Some(v) = env_f("K") {
+        o.k = v;
+    }
     if let Some(v) = env_f("MEMORY") {
         o.reference_memory = Some(v);
     }
