@@ -73,6 +73,12 @@ fn env_opts() -> InitiateOptions {
     if std::env::var("EXACT").is_ok() {
         o.perception.mode = initiate::PerceptionMode::Exact;
     }
+    if let Some(v) = env_f("K") {
+        o.k = v;
+    }
+    if let Some(v) = env_f("MEMORY") {
+        o.reference_memory = Some(v);
+    }
     if let Some(v) = env_f("SPREAD") {
         if let initiate::Start::Random(r) = &mut o.start {
             r.heading_spread = v.to_radians();

@@ -53,7 +53,8 @@ pub struct InitiateFlags {
     /// HPR radius exponent γ: R = (distance of the farthest bird) · 10^γ.
     #[arg(long, default_value_t = HPR_GAMMA_DEFAULT)]
     pub hpr_gamma: f64,
-    /// Visual field per eye, degrees from straight ahead (paper: 90).
+    /// Visual field per eye, degrees from straight ahead (paper: 90); widened when the key shape
+    /// needs it for a bird to see its reference from its slot (docs/initiation.md).
     #[arg(long, default_value_t = 90.0)]
     pub fov: f64,
     /// Cone per eye in which the closest visible bird is the preferred reference, degrees

@@ -1,14 +1,15 @@
-//! CSV export in SPEC §4.4's long format, one row per frame and bird:
-//! `frame,t,bird,x,y,z,heading,speed,e,xi,wing_phase` (world frame, wingspans, radians, wingspans
-//! per second, seconds). `e`, `xi` and `wing_phase` are empty where the animation has none (e.g.
-//! `e`/`xi` during initiation). Numbers use the shortest text that reads back to the same `f64`.
+//! CSV export in SPEC §4.4's long format, one row per frame and bird, exactly the SPEC's columns
+//! `frame,t,bird,x,y,z,heading,speed,e,xi` (world frame, wingspans, radians, wingspans per
+//! second, seconds). `e` and `xi` are empty where the animation has none (during initiation).
+//! Numbers use the shortest text that reads back to the same `f64`. The wing phases are in the
+//! JSON animation file and drive the glTF wing nodes.
 
 use std::io::Write;
 
 use crate::animation::Animation;
 
 /// The header line, without newline.
-pub const CSV_HEADER: &str = "frame,t,bird,x,y,z,heading,speed,e,xi,wing_phase";
+pub const CSV_HEADER: &str = "frame,t,bird,x,y,z,heading,speed,e,xi";
 
 /// Writes the CSV text of `anim` to `w`.
 pub fn write_csv<W: Write>(anim: &Animation, w: &mut W) -> std::io::Result<()> {
@@ -22,7 +23,7 @@ pub fn write_csv<W: Write>(anim: &Animation, w: &mut W) -> std::io::Result<()> {
             };
             writeln!(
                 w,
-                "{k},{},{b},{},{},{},{},{},{},{},{}",
+                "{k},{},{b},{},{},{},{},{},{},{}",
                 f.t,
                 v(&f.x),
                 v(&f.y),
@@ -30,8 +31,7 @@ pub fn write_csv<W: Write>(anim: &Animation, w: &mut W) -> std::io::Result<()> {
                 v(&f.heading),
                 v(&f.speed),
                 o(&f.e),
-                o(&f.xi),
-                o(&f.wing_phase)
+                o(&f.xi)
             )?;
         }
     }

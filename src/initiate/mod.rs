@@ -35,6 +35,14 @@ pub use perception::{PerceptionMode, PerceptionParams, HPR_GAMMA_DEFAULT};
 pub use sim::{Simulation, StepParams};
 pub use target::{Side, TargetShape};
 
+/// Margin between the largest bearing of a reference slot and the edge of the visual field when
+/// the field is widened for the target shape, radians (15°).
+pub const FIELD_MARGIN: f64 = 15.0 * PI / 180.0;
+
+/// Draws of a start heading and speed per bird before the one with the largest predicted miss
+/// distance is kept ([`random_start`]).
+pub const START_DRAWS: usize = 100;
+
 /// Largest accepted step limit (9¼ hours of flight at 30 fps).
 pub const MAX_STEPS_LIMIT: usize = 1_000_000;
 
@@ -46,6 +54,10 @@ pub const MAX_START_EXTENT: f64 = 1e6;
 pub struct InitiateOptions {
     /// Perception model: visual field, reference cone, occlusion mode.
     pub perception: PerceptionParams,
+    /// Widen the visual field per eye, where the target shape needs it, to the largest bearing
+    /// at which a bird in its slot sees its reference bird plus [`FIELD_MARGIN`] (the paper:
+    /// "90° per eye, though it may be wider for real birds"); never narrows it.
+    pub widen_field: bool,
     /// α of eq. (6), dimensionless (paper: 0.2).
     pub alpha: f64,
     /// |K| of eq. (5), per √wingspan (paper: 0.06).
@@ -74,6 +86,10 @@ pub struct InitiateOptions {
     pub leader_hysteresis: f64,
     /// Keep the current reference bird while it is visible and acceptable.
     pub sticky_reference: bool,
+    /// A kept reference bird hidden (occluded or out of the field) for at most this long is kept
+    /// all the same, seconds (0: only while visible; `None`: 0.5 s with HPR, 2 s with exact
+    /// occlusion, whose discs hide birds for longer).
+    pub reference_memory: Option<f64>,
     /// Upper bound of the distance divisor max(r, 1) of eq. (6), wingspans.
     pub turn_distance_cap: f64,
     /// Eq. (5)'s √|r − v_j| is replaced by its chord within this distance of the fixed point,
@@ -100,6 +116,7 @@ impl Default for InitiateOptions {
     fn default() -> Self {
         InitiateOptions {
             perception: PerceptionParams::default(),
+            widen_field: true,
             alpha: 0.2,
             k: 0.06,
             max_turn_rate: PI / 2.0,
@@ -114,6 +131,7 @@ impl Default for InitiateOptions {
             lost_speed_factor: 0.9,
             leader_hysteresis: 1.0,
             sticky_reference: true,
+            reference_memory: None,
             turn_distance_cap: 5.0,
             linear_zone: 0.25,
             tolerance: 0.1,
@@ -252,6 +270,8 @@ pub struct InitiateStats {
     pub leader_changes: usize,
     /// Birds within the tolerance of a slot of their own at the end.
     pub birds_in_slot: usize,
+    /// Visual field per eye used, radians (the option's, or wider if the target shape needs it).
+    pub field_per_eye: f64,
 }
 
 /// The simulated initiation before the hand-over: per-step states in simulation bird order.
@@ -336,6 +356,13 @@ impl InitiateOptions {
         pos("lost speed factor", self.lost_speed_factor)?;
         pos("--turn-distance-cap", self.turn_distance_cap)?;
         pos("--linear-zone", self.linear_zone)?;
+        let memory = self.reference_memory();
+        if !(memory.is_finite() && (0.0..=60.0).contains(&memory)) {
+            return Err(Error::parameter(
+                "reference memory",
+                format!("must be in [0, 60] seconds, got {memory}"),
+            ));
+        }
         if !(self.leader_hysteresis.is_finite() && self.leader_hysteresis >= 0.0) {
             return Err(Error::parameter(
                 "leader hysteresis",
@@ -406,6 +433,14 @@ impl InitiateOptions {
         Ok(())
     }
 
+    /// The reference memory in seconds (the option, or the default of the perception mode).
+    pub fn reference_memory(&self) -> f64 {
+        self.reference_memory.unwrap_or(match self.perception.mode {
+            PerceptionMode::Hpr { .. } => 0.5,
+            PerceptionMode::Exact => 2.0,
+        })
+    }
+
     /// Per-step parameters at `fps` for a cruise heading (radians) and speed (wingspans per second).
     pub fn step_params(&self, fps: f64, cruise_heading: f64, cruise_speed: f64) -> StepParams {
         let vc = cruise_speed / fps;
@@ -427,6 +462,7 @@ impl InitiateOptions {
             lost_speed_factor: self.lost_speed_factor,
             leader_hysteresis: self.leader_hysteresis,
             sticky_reference: self.sticky_reference,
+            reference_memory: (self.reference_memory() * fps).round() as u32,
             turn_distance_cap: self.turn_distance_cap,
             linear_zone: self.linear_zone,
         }
@@ -484,7 +520,11 @@ pub fn check_steady(steady: &Animation, origin: &Path) -> Result<()> {
     Ok(())
 }
 
-/// Random start positions, headings and speeds (wingspans, radians, wingspans per step).
+/// Random start positions, headings and speeds (wingspans, radians, wingspans per step):
+/// positions uniform in the region at least `min_spacing` apart; headings uniform within the
+/// spread and speeds between the minimum and the cruise speed, redrawn while two birds would,
+/// flying straight, come closer than the avoidance distance within the time a quarter turn takes
+/// (no take-off on a collision course that no turn could avoid).
 pub fn random_start(
     n: usize,
     region: &StartRegion,
@@ -532,33 +572,60 @@ pub fn random_start(
         grid.entry((kx, ky)).or_default().push(pos.len());
         pos.push(p);
     }
-    let mut heading = Vec::with_capacity(n);
-    let mut speed = Vec::with_capacity(n);
-    for _ in 0..n {
-        let h = if region.heading_spread > 0.0 {
-            rng.random_range(-region.heading_spread..=region.heading_spread)
-        } else {
-            0.0
-        };
-        heading.push(sim::wrap_angle(params.cruise_heading + h));
-        let v = rng.random_range(params.min_speed..=params.cruise_speed);
-        speed.push(v);
+    // Headings and speeds: no two birds start on a course that brings them closer than the
+    // avoidance distance before they could turn a quarter circle away (straight-line
+    // prediction); a draw that does is redrawn, up to START_DRAWS times (then the safest is kept).
+    let horizon = std::f64::consts::FRAC_PI_2 / params.max_turn;
+    let mut heading: Vec<f64> = Vec::with_capacity(n);
+    let mut speed: Vec<f64> = Vec::with_capacity(n);
+    for i in 0..n {
+        let mut best = (f64::NEG_INFINITY, 0.0, 0.0);
+        for _ in 0..START_DRAWS {
+            let h = if region.heading_spread > 0.0 {
+                rng.random_range(-region.heading_spread..=region.heading_spread)
+            } else {
+                0.0
+            };
+            let h = sim::wrap_angle(params.cruise_heading + h);
+            let v = rng.random_range(params.min_speed..=params.cruise_speed);
+            let vel = perception::direction(h) * v;
+            let miss = (0..i)
+                .map(|j| {
+                    let dp = pos[j] - pos[i];
+                    let dv = perception::direction(heading[j]) * speed[j] - vel;
+                    let vv = dv.length_squared();
+                    let tau = if vv > 0.0 {
+                        (-dp.dot(dv) / vv).clamp(0.0, horizon)
+                    } else {
+                        0.0
+                    };
+                    (dp + dv * tau).length()
+                })
+                .fold(f64::INFINITY, f64::min);
+            if miss > best.0 {
+                best = (miss, h, v);
+            }
+            if miss >= params.avoid_distance {
+                break;
+            }
+        }
+        heading.push(best.1);
+        speed.push(best.2);
     }
     Ok((pos, heading, speed))
 }
 
-/// Runs the simulation until convergence or the step limit, without the hand-over. The flock's
-/// target is `target`; cruise heading (radians) and speed (wingspans per second) are those of the
-/// steady flight's leader; `fps` sets the step length.
-pub fn simulate(
+/// The simulation at its first step: parameters at `fps` for the cruise heading (radians) and
+/// speed (wingspans per second), the visual field widened for `target` if asked, and the start
+/// positions, headings and speeds (random ones drawn from `rng`).
+pub fn start_simulation(
     target: &TargetShape,
     fps: f64,
     cruise_heading: f64,
     cruise_speed: f64,
     opts: &InitiateOptions,
     rng: &mut impl Rng,
-    progress: &dyn Progress,
-) -> Result<InitiationRun> {
+) -> Result<Simulation> {
     opts.validate()?;
     if !(fps.is_finite() && fps > 0.0) {
         return Err(Error::parameter("fps", "must be a positive number"));
@@ -570,7 +637,11 @@ pub fn simulate(
         ));
     }
     let n = target.len();
-    let params = opts.step_params(fps, cruise_heading, cruise_speed);
+    let mut params = opts.step_params(fps, cruise_heading, cruise_speed);
+    if opts.widen_field {
+        let field = &mut params.perception.fov_per_eye;
+        *field = field.max(target.required_field(FIELD_MARGIN));
+    }
     let (pos, heading, speed) = match &opts.start {
         Start::Random(region) => random_start(n, region, &params, rng)?,
         Start::Given(s) => {
@@ -596,7 +667,24 @@ pub fn simulate(
             (pos, heading, speed)
         }
     };
-    let mut sim = Simulation::new(target.clone(), params, pos, heading, speed);
+    Ok(Simulation::new(target.clone(), params, pos, heading, speed))
+}
+
+/// Runs the simulation until convergence or the step limit, without the hand-over. The flock's
+/// target is `target`; cruise heading (radians) and speed (wingspans per second) are those of the
+/// steady flight's leader; `fps` sets the step length.
+pub fn simulate(
+    target: &TargetShape,
+    fps: f64,
+    cruise_heading: f64,
+    cruise_speed: f64,
+    opts: &InitiateOptions,
+    rng: &mut impl Rng,
+    progress: &dyn Progress,
+) -> Result<InitiationRun> {
+    let mut sim = start_simulation(target, fps, cruise_heading, cruise_speed, opts, rng)?;
+    let n = target.len();
+    let params = sim.params;
     let hold_steps = (opts.hold * fps).round() as usize;
     let mut run = InitiationRun {
         pos: vec![sim.flock.pos.clone()],
@@ -611,6 +699,7 @@ pub fn simulate(
             max_turn_rate: 0.0,
             leader_changes: 0,
             birds_in_slot: 0,
+            field_per_eye: params.perception.fov_per_eye,
         },
     };
     progress.start("initiate", opts.max_steps as u64);

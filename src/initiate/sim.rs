@@ -58,6 +58,8 @@ pub struct StepParams {
     pub leader_hysteresis: f64,
     /// Keep the current reference bird while it stays visible and acceptable.
     pub sticky_reference: bool,
+    /// A kept reference hidden for at most this many steps is kept all the same.
+    pub reference_memory: u32,
     /// Upper bound of the distance divisor of eq. (6), wingspans.
     pub turn_distance_cap: f64,
     /// Half-width of the linear zone of eq. (5)'s √|r − v_j| around its fixed point, wingspans.
@@ -67,6 +69,11 @@ pub struct StepParams {
 /// A bird claims a slot already held by a visible bird only when it is nearer the slot's target
 /// by this much, wingspans.
 pub const SLOT_CLAIM_MARGIN: f64 = 1.0;
+
+/// A bird this close to its target holds its slot against a claimant at any distance, wingspans
+/// (the separation drive's distance threshold only lets birds far apart share a reference while
+/// neither is in the slot yet).
+pub const SETTLED_DISTANCE: f64 = 1.0;
 
 /// Flocks at least this large decide in parallel (one thread per core).
 pub const PARALLEL_MIN_BIRDS: usize = 256;
@@ -80,6 +87,8 @@ struct Decision {
     speed: f64,
     reference: Option<usize>,
     side: Option<Side>,
+    branch: Option<usize>,
+    unseen: u32,
 }
 
 /// The state of every bird (world frame).
@@ -95,6 +104,11 @@ pub struct Flock {
     pub reference: Vec<Option<usize>>,
     /// Side of each bird relative to its reference bird.
     pub side: Vec<Option<Side>>,
+    /// The follower slot of its reference's slot each bird aims for (where the target tree
+    /// branches, a reference slot has several).
+    pub branch: Vec<Option<usize>>,
+    /// Steps since each bird last saw its reference bird (0: visible now).
+    pub unseen: Vec<u32>,
     /// Slot of the target shape each bird corresponds to (§6.2.1), if matched.
     pub slot: Vec<Option<usize>>,
     /// The leader: the front-most bird along the cruise heading.
@@ -123,6 +137,8 @@ pub struct Simulation {
     decisions: Vec<Decision>,
     next_reference: Vec<Option<usize>>,
     next_side: Vec<Option<Side>>,
+    next_branch: Vec<Option<usize>>,
+    next_unseen: Vec<u32>,
 }
 
 impl Simulation {
@@ -147,6 +163,8 @@ impl Simulation {
                 speed,
                 reference: vec![None; n],
                 side: vec![None; n],
+                branch: vec![None; n],
+                unseen: vec![0; n],
                 slot: vec![None; n],
                 leader,
             },
@@ -160,6 +178,8 @@ impl Simulation {
             decisions: Vec::new(),
             next_reference: vec![None; n],
             next_side: vec![None; n],
+            next_branch: vec![None; n],
+            next_unseen: vec![0; n],
         };
         sim.match_slots();
         sim
@@ -176,8 +196,9 @@ impl Simulation {
     }
 
     /// §6.2.1 correspondence: the leader takes the leader slot; a bird whose reference bird is
-    /// matched takes the slot that follows its reference's slot on its side. Birds in cycles, with
-    /// unmatched references, or on a full arm stay unmatched. Several birds may share a slot.
+    /// matched takes the slot that follows its reference's slot on its side (the one it aims for
+    /// where the tree branches, else the first). Birds in cycles, with unmatched references, or
+    /// on a full arm stay unmatched. Several birds may share a slot.
     pub fn match_slots(&mut self) {
         let f = &mut self.flock;
         let n = f.pos.len();
@@ -215,7 +236,11 @@ impl Simulation {
             for &b in path.iter().rev() {
                 s = match (s, f.side[b]) {
                     (Some(sj), Some(side)) if f.reference[b].is_some() => {
-                        self.target.follower_slot(sj, side)
+                        let fl = self.target.followers(sj, side);
+                        match f.branch[b] {
+                            Some(c) if fl.contains(&c) => Some(c),
+                            _ => fl.first().copied(),
+                        }
                     }
                     _ => None,
                 };
@@ -243,40 +268,43 @@ impl Simulation {
         }
     }
 
-    /// Offset of the follower of `j` on `side`, and the slot it takes if `j` is matched.
-    fn follower_offset(&self, j: usize, side: Side) -> Option<(DVec2, Option<usize>)> {
-        match self.flock.slot[j] {
-            Some(sj) => {
-                let fs = self.target.follower_slot(sj, side)?;
-                Some((self.target.offset(sj, fs), Some(fs)))
-            }
-            // An unmatched bird is not a reference: following it would give no consistent
-            // target, and birds following each other in a cycle never reach the flock.
-            None => None,
-        }
-    }
-
-    /// Whether bird `i` may take `j` as reference on `side`: `j`'s arm is not full (capacity) and
-    /// no visible bird that already follows `j` on that side is nearer the shared target and
-    /// within the separation distance (separation drive, §6.2.2).
-    fn acceptable(&self, i: usize, j: usize, side: Side, visible: &[usize]) -> bool {
-        let Some((offset, _)) = self.follower_offset(j, side) else {
-            return false;
-        };
+    /// Which follower slot of `j` on `side` bird `i` may take, if any. `j` must be matched (an
+    /// unmatched bird gives no consistent target, and birds following each other in a cycle
+    /// never reach the flock) and its slot must have a follower slot on that side (capacity: the
+    /// tail of an arm has none); a follower slot is refused when a visible bird that already takes
+    /// it is within the separation distance and nearer its target (separation drive, §6.2.2).
+    /// Among the free ones, the bird keeps the one it holds, else takes the one whose target is
+    /// nearest.
+    fn acceptable(&self, i: usize, j: usize, side: Side, visible: &[usize]) -> Option<usize> {
         let f = &self.flock;
-        let t = self.target_point(j, offset);
-        let my = (f.pos[i] - t).length();
-        // A bird that does not follow `j` yet must be nearer than a holder by a margin to claim
-        // the slot, so that birds at the tail of an arm do not trade places forever.
-        let holds = f.reference[i] == Some(j) && f.side[i] == Some(side);
-        let margin = if holds { 0.0 } else { SLOT_CLAIM_MARGIN };
-        !visible.iter().any(|&k| {
-            k != i
-                && f.reference[k] == Some(j)
-                && f.side[k] == Some(side)
-                && (f.pos[k] - f.pos[i]).length() < self.params.separation_distance
-                && (f.pos[k] - t).length() < my + margin
-        })
+        let sj = f.slot[j]?;
+        let mut best: Option<(f64, usize)> = None;
+        for &c in self.target.followers(sj, side) {
+            let t = self.target_point(j, self.target.offset(sj, c));
+            let my = (f.pos[i] - t).length();
+            // A bird that does not take the slot yet must be nearer than a holder by a margin to
+            // claim it, so that birds at the tail of an arm do not trade places forever.
+            let holds =
+                f.reference[i] == Some(j) && f.side[i] == Some(side) && f.slot[i] == Some(c);
+            let margin = if holds { 0.0 } else { SLOT_CLAIM_MARGIN };
+            let taken = visible.iter().any(|&k| {
+                k != i
+                    && f.reference[k] == Some(j)
+                    && f.side[k] == Some(side)
+                    && f.slot[k] == Some(c)
+                    && ((f.pos[k] - f.pos[i]).length() < self.params.separation_distance
+                        || (f.pos[k] - t).length() < SETTLED_DISTANCE)
+                    && (f.pos[k] - t).length() < my + margin
+            });
+            if taken {
+                continue;
+            }
+            let score = if holds { f64::NEG_INFINITY } else { my };
+            if best.map_or(true, |b| score < b.0) {
+                best = Some((score, c));
+            }
+        }
+        best.map(|b| b.1)
     }
 
     /// Side rule of §6.2.1 for bird `i` following `j`: the reference's side if it has one (it is
@@ -366,10 +394,14 @@ impl Simulation {
             f.pos[i] += direction(f.heading[i]) * f.speed[i];
             self.next_reference[i] = d.reference;
             self.next_side[i] = d.side;
+            self.next_branch[i] = d.branch;
+            self.next_unseen[i] = d.unseen;
         }
         self.decisions = decisions;
         std::mem::swap(&mut f.reference, &mut self.next_reference);
         std::mem::swap(&mut f.side, &mut self.next_side);
+        std::mem::swap(&mut f.branch, &mut self.next_branch);
+        std::mem::swap(&mut f.unseen, &mut self.next_unseen);
         self.steps += 1;
         self.match_slots();
     }
@@ -378,22 +410,24 @@ impl Simulation {
     fn decide(&self, i: usize, perceiver: &mut Perceiver, visible: &mut Vec<usize>) -> Decision {
         let p = &self.params;
         let f = &self.flock;
-        let (want_heading, want_speed, reference, side) = if i == f.leader {
-            (p.cruise_heading, p.cruise_speed, None, None)
+        let mut unseen = 0;
+        let (want_heading, want_speed, reference, side, branch) = if i == f.leader {
+            (p.cruise_heading, p.cruise_speed, None, None, None)
         } else {
             perceiver.visible(i, &f.pos, f.heading[i], &p.perception, visible);
-            let (reference, side) = self.choose(i, visible);
-            match (reference, side) {
-                (Some(j), Some(side)) => {
-                    let (h, v) = self.pursue(i, j, side);
-                    (h, v, Some(j), Some(side))
+            match self.choose(i, visible) {
+                Some((j, side, c, u)) => {
+                    unseen = u;
+                    let (h, v) = self.pursue(i, j, c);
+                    (h, v, Some(j), Some(side), Some(c))
                 }
-                _ => {
+                None => {
                     // Lost: turn toward the cruise heading and slow a little.
                     let dd = wrap_angle(p.cruise_heading - f.heading[i]);
                     (
                         f.heading[i] + p.alpha * dd,
                         p.lost_speed_factor * p.cruise_speed,
+                        None,
                         None,
                         None,
                     )
@@ -415,23 +449,30 @@ impl Simulation {
                 .clamp(p.min_speed, p.max_speed),
             reference,
             side,
+            branch,
+            unseen,
         }
     }
 
-    /// Reference bird and side of bird `i` among its `visible` flockmates.
-    fn choose(&self, i: usize, visible: &[usize]) -> (Option<usize>, Option<Side>) {
+    /// Reference bird, side and follower slot of bird `i` among its `visible` flockmates, and
+    /// the steps since the reference was last seen. The current reference is kept while it stays
+    /// acceptable and is visible, or hidden for no more than the reference memory (a bird does not
+    /// forget the bird it follows when another passes in front of it for a moment).
+    fn choose(&self, i: usize, visible: &[usize]) -> Option<(usize, Side, usize, u32)> {
         let f = &self.flock;
         if self.params.sticky_reference {
-            if let Some(j) = f.reference[i] {
-                if let Some(side) = f.side[i] {
-                    let allowed = self.sides_for(i, j).contains(&Some(side));
-                    if allowed && visible.contains(&j) && self.acceptable(i, j, side, visible) {
-                        return (Some(j), Some(side));
+            if let (Some(j), Some(side)) = (f.reference[i], f.side[i]) {
+                let seen = visible.contains(&j);
+                let remembered = seen || f.unseen[i] < self.params.reference_memory;
+                if remembered && self.sides_for(i, j).contains(&Some(side)) {
+                    if let Some(c) = self.acceptable(i, j, side, visible) {
+                        let unseen = if seen { 0 } else { f.unseen[i] + 1 };
+                        return Some((j, side, c, unseen));
                     }
                 }
             }
         }
-        let mut chosen_side = None;
+        let mut chosen = None;
         let reference = choose_reference(
             i,
             visible,
@@ -440,25 +481,26 @@ impl Simulation {
             self.params.perception.reference_cone,
             |j| {
                 for side in self.sides_for(i, j).into_iter().flatten() {
-                    if self.acceptable(i, j, side, visible) {
-                        chosen_side = Some(side);
+                    if let Some(c) = self.acceptable(i, j, side, visible) {
+                        chosen = Some((side, c));
                         return true;
                     }
                 }
                 false
             },
         );
-        (reference, chosen_side)
+        reference.zip(chosen).map(|(j, (side, c))| (j, side, c, 0))
     }
 
     /// Eqs. (5) and (6) with the fixes of docs/initiation.md: desired heading and speed of bird `i`
-    /// following `j` on `side`.
-    fn pursue(&self, i: usize, j: usize, side: Side) -> (f64, f64) {
+    /// following `j` into slot `c` (a follower slot of `j`'s slot).
+    fn pursue(&self, i: usize, j: usize, c: usize) -> (f64, f64) {
         let p = &self.params;
         let f = &self.flock;
-        let (offset, _) = self
-            .follower_offset(j, side)
-            .unwrap_or((self.target.mean_offset, None));
+        let offset = match f.slot[j] {
+            Some(sj) => self.target.offset(sj, c),
+            None => self.target.mean_offset,
+        };
         let t = self.target_point(j, offset);
         let dj = self.dir_of(j);
         let to_t = t - f.pos[i];
