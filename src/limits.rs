@@ -35,6 +35,15 @@ pub const MAX_ANNOTATED_BIRDS: usize = 1_000;
 /// Most annotated frames in one annotation file or directory.
 pub const MAX_ANNOTATED_FRAMES: usize = 100_000;
 
+/// Largest spacing statistic of a params file (`mu_x`, `sigma_x`, `mu_y`, `sigma_y`), wingspans
+/// in magnitude: neighbours in a formation are a wingspan or so apart. Found by fuzzing: a finite
+/// but huge `sigma_x` (10⁹⁴) made the steady flight's ranges NaN.
+pub const MAX_PARAM_SPACING: f64 = 100.0;
+
+/// Largest coordinate or shape coefficient in a params file, in magnitude (the annotation readers
+/// refuse birds more than a million wingspans from the image origin).
+pub const MAX_PARAM_COORDINATE: f64 = 1e6;
+
 /// Checks an animation's size: `birds`, `frames` and their product, naming `what` (a flag such
 /// as `--frames`, or a file) in the message.
 pub fn check_animation_size(what: &str, birds: usize, frames: usize) -> crate::Result<()> {

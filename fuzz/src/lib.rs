@@ -95,6 +95,10 @@ pub fn animation(data: &[u8]) {
     let mut csv = Vec::new();
     let _ = table::write_csv(&a, &mut csv);
     let _ = gltf::glb_bytes(&a, a.wingspan_m);
+    // As `export::write_outputs` does before drawing: refuse absurd frame counts first.
+    if sample::output_count(&a, 25.0) > formation::export::MAX_FRAMES {
+        return;
+    }
     let film = Film::new(&a, 25.0, 32, 24);
     if !film.is_empty() {
         let mut canvas = raster::Canvas::new(32, 24);

@@ -261,7 +261,7 @@ pub fn write_outputs(
         }
         if matches!(o.kind, OutputKind::Gif | OutputKind::Directory) {
             let fps = picture_fps(anim, o.kind, opts);
-            let n = sample::output_times(anim, fps).len();
+            let n = sample::output_count(anim, fps);
             let pixels = n as u64 * opts.width as u64 * opts.height as u64;
             if n <= MAX_FRAMES && pixels > crate::limits::MAX_PICTURE_PIXELS {
                 return Err(Error::parameter(

@@ -42,12 +42,22 @@ pub fn check_times(anim: &Animation, origin: &Path) -> Result<()> {
     Ok(())
 }
 
+/// Number of output frames at `fps` (of [`output_times`]), computed without allocating them, so
+/// that an absurd count can be refused first (issue 8). Saturates at `usize::MAX`.
+pub fn output_count(anim: &Animation, fps: f64) -> usize {
+    let (Some(first), Some(last)) = (anim.frames.first(), anim.frames.last()) else {
+        return 0;
+    };
+    // `as usize` saturates (and maps NaN to 0).
+    (((last.t - first.t) * fps + 1e-6).floor().max(0.0) as usize).saturating_add(1)
+}
+
 /// Times of the output frames at `fps`, from the first frame's time up to the last one's.
 pub fn output_times(anim: &Animation, fps: f64) -> Vec<f64> {
-    let (Some(first), Some(last)) = (anim.frames.first(), anim.frames.last()) else {
+    let Some(first) = anim.frames.first() else {
         return Vec::new();
     };
-    let n = ((last.t - first.t) * fps + 1e-6).floor().max(0.0) as usize + 1;
+    let n = output_count(anim, fps);
     (0..n).map(|k| first.t + k as f64 / fps).collect()
 }
 

@@ -183,6 +183,20 @@ impl FormationParams {
                     ));
                 }
             }
+            // Issue 8 (found by fuzzing): huge finite values overflow the steady flight's ranges
+            // to NaN. No formation has neighbours 100 wingspans apart.
+            if let Some((name, v)) = nums
+                .iter()
+                .find(|(_, v)| v.abs() > crate::limits::MAX_PARAM_SPACING)
+            {
+                return Err(Error::format(
+                    origin,
+                    format!(
+                        "frames[{k}].{name}: {v} wingspans is not a formation spacing (at most {} in magnitude)",
+                        crate::limits::MAX_PARAM_SPACING
+                    ),
+                ));
+            }
             if f.sigma_x < 0.0 || f.sigma_y < 0.0 {
                 return Err(Error::format(
                     origin,
@@ -211,17 +225,27 @@ impl FormationParams {
                 ShapeModel::Line { intercept, slope } => vec![intercept, slope],
                 ShapeModel::U { a, b, c } | ShapeModel::J { a, b, c } => vec![a, b, c],
             };
-            if coefs.iter().any(|v| !v.is_finite()) {
+            if coefs
+                .iter()
+                .any(|v| !v.is_finite() || v.abs() > crate::limits::MAX_PARAM_COORDINATE)
+            {
                 return Err(Error::format(
                     origin,
-                    format!("frames[{k}].shape: coefficients must be finite numbers"),
+                    format!(
+                        "frames[{k}].shape: coefficients must be finite numbers of at most {:e} in magnitude",
+                        crate::limits::MAX_PARAM_COORDINATE
+                    ),
                 ));
             }
             for (i, p) in f.positions.iter().enumerate() {
-                if !(p.x.is_finite() && p.y.is_finite() && p.dy.is_finite()) {
+                let ok = |v: f64| v.is_finite() && v.abs() <= crate::limits::MAX_PARAM_COORDINATE;
+                if !(ok(p.x) && ok(p.y) && ok(p.dy)) {
                     return Err(Error::format(
                         origin,
-                        format!("frames[{k}].positions[{i}]: not a finite number"),
+                        format!(
+                            "frames[{k}].positions[{i}]: not a finite number of at most {:e} wingspans",
+                            crate::limits::MAX_PARAM_COORDINATE
+                        ),
                     ));
                 }
             }
