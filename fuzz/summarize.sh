@@ -15,6 +15,7 @@ for t in native_json long_csv dltdv_csv labelme_json params animation shape targ
     cov=$(grep -o 'cov: [0-9]*' "$log" | tail -1 | cut -d' ' -f2)
     corp=$(grep -o 'corp: [0-9]*/[0-9]*[a-zA-Z]*' "$log" | tail -1 | cut -d' ' -f2)
     n=$(find "artifacts/$t" -type f 2>/dev/null | wc -l)
-    printf '| `%s` | %.1f | %s | %s | %s | %s | %s MB | %s s | %s |\n' \
-        "$t" "$(echo "$secs / 60" | bc -l)" "$runs" "$eps" "$cov" "$corp" "$rss" "$slow" "$n"
+    if [ -z "$secs" ]; then mins="stopped"; else mins=$(printf '%.1f' "$(echo "$secs / 60" | bc -l)"); fi
+    printf '| `%s` | %s | %s | %s | %s | %s | %s MB | %s s | %s |\n' \
+        "$t" "$mins" "$runs" "$eps" "$cov" "$corp" "$rss" "$slow" "$n"
 done
