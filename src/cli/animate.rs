@@ -67,12 +67,14 @@ pub fn run(args: AnimateArgs, g: Global) -> Result<()> {
         ));
     }
     let frames_f = (args.seconds * args.steady.fps).round();
-    if !(1.0..=10_000_000.0).contains(&frames_f) {
+    if !(1.0..=formation::limits::MAX_FRAMES as f64).contains(&frames_f) {
         return Err(Error::parameter(
             "--seconds",
             format!(
-                "{} s at {} fps is {frames_f} frames; give between 1 and 10,000,000",
-                args.seconds, args.steady.fps
+                "{} s at {} fps is {frames_f} frames; give between 1 and {} frames",
+                args.seconds,
+                args.steady.fps,
+                formation::limits::MAX_FRAMES
             ),
         ));
     }
