@@ -257,11 +257,7 @@ fn accumulate(x: &[f64], y: &[f64], e: &mut [f64], mut jac: Option<&mut [f64]>) 
                 e[j] += back;
             }
             if let Some(jac) = jac.as_deref_mut() {
-                let s = TWO_OVER_PI2 * p.slope;
-                jac[i * n + j] = -s;
-                jac[j * n + i] = -s;
-                jac[i * n + i] += s;
-                jac[j * n + j] += s;
+                scatter_slope(jac, n, i, j, TWO_OVER_PI2 * p.slope);
             }
         }
     }
@@ -298,14 +294,20 @@ pub fn power_jacobian_unchecked(x: &[f64], y: &[f64]) -> Vec<f64> {
     let mut jac = vec![0.0; n * n];
     for i in 0..n {
         for k in (i + 1)..n {
-            let s = dg_dy((x[i] - x[k]).abs(), y[i] - y[k]);
-            jac[i * n + k] = -s;
-            jac[k * n + i] = -s;
-            jac[i * n + i] += s;
-            jac[k * n + k] += s;
+            scatter_slope(&mut jac, n, i, k, dg_dy((x[i] - x[k]).abs(), y[i] - y[k]));
         }
     }
     jac
+}
+
+/// Adds pair (i, j)'s ∂g/∂y = `s` to the row-major N×N Jacobian of e: +s on both diagonal
+/// entries, −s on the two off-diagonal ones (a weighted graph Laplacian).
+#[inline]
+fn scatter_slope(jac: &mut [f64], n: usize, i: usize, j: usize, s: f64) {
+    jac[i * n + j] = -s;
+    jac[j * n + i] = -s;
+    jac[i * n + i] += s;
+    jac[j * n + j] += s;
 }
 
 #[cfg(test)]
