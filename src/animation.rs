@@ -15,7 +15,7 @@ pub const ANIMATION_FORMAT: &str = "formation-animation/1";
 pub struct Animation {
     /// Always [`ANIMATION_FORMAT`].
     pub format: String,
-    /// The `--seed` that produced it.
+    /// The seed that produced it.
     pub seed: u64,
     /// Frames per second.
     pub fps: f64,

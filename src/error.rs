@@ -32,7 +32,8 @@ pub enum Error {
     /// A parameter (command-line flag or field of an input) is outside its valid range.
     #[error("{name}: {message}")]
     Parameter {
-        /// The flag or field, e.g. `--birds` or `target.xi[3]`.
+        /// The option path (`steady.birds`, see [`crate::pipeline::Config`]) or input field
+        /// (`target.xi[3]`); the command line shows its own flag instead of an option path.
         name: String,
         /// What is wrong and what would be valid.
         message: String,

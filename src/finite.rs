@@ -22,7 +22,7 @@ pub fn check_serialize<T: Serialize + ?Sized>(what: &str, value: &T) -> Result<(
     }
 }
 
-/// Pretty JSON text of `value` for stdout (`--json`), refusing non-finite numbers like
+/// Pretty JSON text of `value` for stdout (the commands' JSON output), refusing non-finite numbers like
 /// [`crate::io::write_json_atomic`] does for files.
 pub fn to_json_pretty<T: Serialize + ?Sized>(what: &str, value: &T) -> Result<String> {
     check_serialize(what, value)?;

@@ -38,6 +38,7 @@ pub mod initiate;
 pub mod io;
 pub mod keyshape;
 pub mod limits;
+pub mod pipeline;
 pub mod plot;
 pub mod progress;
 pub mod rng;

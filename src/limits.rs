@@ -8,10 +8,10 @@
 //! memory (about 130 bytes resident with copies), about 200 bytes of pretty-printed JSON on disk.
 //! Hence the bound on the product birds × frames rather than on each factor alone.
 
-/// Most birds in an animation (`--birds` of `steady`/`animate`, `birds` of an animation file).
+/// Most birds in an animation (`steady.birds`, `birds` of an animation file).
 pub const MAX_BIRDS: usize = 100_000;
 
-/// Most frames in an animation (`steady --frames`, `animate --seconds × --fps`): 9¼ hours at
+/// Most frames in an animation (`steady.frames`, or `seconds` × `steady.fps`): 9¼ hours at
 /// 30 fps.
 pub const MAX_FRAMES: usize = 1_000_000;
 
@@ -45,7 +45,7 @@ pub const MAX_PARAM_SPACING: f64 = 100.0;
 pub const MAX_PARAM_COORDINATE: f64 = 1e6;
 
 /// Checks an animation's size: `birds`, `frames` and their product, naming `what` (a flag such
-/// as `--frames`, or a file) in the message.
+/// as `steady.frames`, or a file) in the message.
 pub fn check_animation_size(what: &str, birds: usize, frames: usize) -> crate::Result<()> {
     let err = |msg: String| Err(crate::Error::parameter(what, msg));
     if birds > MAX_BIRDS {
@@ -70,17 +70,17 @@ mod tests {
 
     #[test]
     fn sizes_are_checked_without_overflow() {
-        assert!(check_animation_size("--frames", 9, 300).is_ok());
-        assert!(check_animation_size("--frames", 100, 100_000).is_ok());
+        assert!(check_animation_size("steady.frames", 9, 300).is_ok());
+        assert!(check_animation_size("steady.frames", 100, 100_000).is_ok());
         for (b, f) in [
             (1_000_000, 10),
             (9, 10_000_000),
             (10_000, 10_000),
             (usize::MAX, usize::MAX),
         ] {
-            let e = check_animation_size("--frames", b, f).unwrap_err();
+            let e = check_animation_size("steady.frames", b, f).unwrap_err();
             assert_eq!(e.exit_code(), 2);
-            assert!(e.to_string().starts_with("--frames: "), "{e}");
+            assert!(e.to_string().starts_with("steady.frames: "), "{e}");
         }
     }
 }

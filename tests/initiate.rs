@@ -243,21 +243,21 @@ fn bad_parameters_are_named() {
                 max_steps: 0,
                 ..Default::default()
             },
-            "--max-steps",
+            "initiate.max_steps",
         ),
         (
             InitiateOptions {
                 alpha: -0.2,
                 ..Default::default()
             },
-            "--alpha",
+            "initiate.alpha",
         ),
         (
             InitiateOptions {
                 k: f64::NAN,
                 ..Default::default()
             },
-            "--k",
+            "initiate.k",
         ),
     ];
     for (opts, name) in cases {

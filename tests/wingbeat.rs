@@ -415,7 +415,7 @@ fn options_parse_and_reject_unknown_names() {
     assert_eq!("Crane".parse::<Species>().unwrap(), Species::Crane);
     let e = "heron".parse::<Species>().unwrap_err();
     assert_eq!(e.exit_code(), 2);
-    assert!(e.to_string().contains("--species"));
+    assert!(e.to_string().contains("wingbeat.species"));
     assert_eq!(
         "independent".parse::<PhaseMode>().unwrap(),
         PhaseMode::Independent

@@ -2,10 +2,10 @@
 //!
 //! - Long CSV: header with `frame`, `x`, `y` and optionally `bird` (ids) and `wingspan_px`
 //!   (per-row scale, constant within a frame); other columns are ignored. One row per bird per
-//!   frame; y grows downward unless `--y-origin bottom`.
+//!   frame; y grows downward unless `read.y_origin` is bottom.
 //! - DLTdv digitizer CSV: header `pt1_cam1_X,pt1_cam1_Y,pt2_cam1_X,...`, one row per frame, `NaN`
 //!   (or an empty field) where a bird is not marked. DLTdv measures y from the image's bottom
-//!   edge, so y grows upward unless `--y-origin top`. With several cameras the lowest-numbered
+//!   edge, so y grows upward unless `read.y_origin` is top. With several cameras the lowest-numbered
 //!   camera is read. Bird `ptN` gets id N − 1; rows with no mark at all are skipped (frames not
 //!   digitised).
 //!

@@ -98,7 +98,8 @@ impl FromStr for YOrigin {
 }
 
 /// Options of [`read`]; each `Some` overrides what the file says.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct ReadOptions {
     /// Flight direction in the image (default: the file's, else up).
     pub heading: Option<Heading>,
@@ -145,7 +146,7 @@ pub struct MarkedBird {
     /// Image x, pixels (right).
     pub px: f64,
     /// Image y, pixels, as in the file (downward from the top edge, or upward from the bottom edge
-    /// for DLTdv and `--y-origin bottom`).
+    /// for DLTdv and `read.y_origin` bottom).
     pub py: f64,
     /// Offset to the right of the flight direction from the image origin, wingspans.
     pub lateral: f64,
@@ -225,9 +226,9 @@ pub(crate) struct RawAnnotations {
     pub source: Option<String>,
     pub heading: Option<Heading>,
     pub wingspan_px: Option<f64>,
-    /// Whether pixel y grows upward in the file (before any `--y-origin`).
+    /// Whether pixel y grows upward in the file (before any `read.y_origin`).
     pub y_up: bool,
-    /// Whether `--y-origin` applies (CSV formats).
+    /// Whether `read.y_origin` applies (CSV formats).
     pub is_csv: bool,
     pub frames: Vec<RawFrame>,
 }
@@ -343,14 +344,14 @@ fn finish(path: &Path, raw: RawAnnotations, opts: &ReadOptions) -> Result<Annota
     if let Some(w) = opts.wingspan_px {
         if !w.is_finite() || w <= 0.0 {
             return Err(Error::parameter(
-                "--wingspan-px",
+                "read.wingspan_px",
                 format!("must be a positive number of pixels, got {w}"),
             ));
         }
     }
     if let Some(Heading::Degrees(d)) = opts.heading {
         if !d.is_finite() {
-            return Err(Error::parameter("--heading", "must be a finite angle"));
+            return Err(Error::parameter("read.heading", "must be a finite angle"));
         }
     }
     let heading = opts.heading.or(raw.heading).unwrap_or(Heading::Up);
@@ -378,7 +379,7 @@ fn finish(path: &Path, raw: RawAnnotations, opts: &ReadOptions) -> Result<Annota
                 return Err(Error::format(
                     path,
                     format!(
-                        "frame {}: no scale; give --wingspan-px PIXELS, or \"wingspan_px\" in the file (per file or per frame; see docs/annotating.md)",
+                        "frame {}: no scale; give read.wingspan_px PIXELS, or \"wingspan_px\" in the file (per file or per frame; see docs/annotating.md)",
                         f.index
                     ),
                 ))

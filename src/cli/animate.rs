@@ -8,8 +8,9 @@ use std::path::PathBuf;
 
 use clap::Args;
 use formation::export::RenderOptions;
-use formation::extract::{self, ExtractOptions};
-use formation::{initiate, keyshape, rng, wingbeat, Error, Result};
+use formation::extract::ExtractOptions;
+use formation::pipeline::{Config, Pipeline};
+use formation::Result;
 
 use super::extract::ReadArgs;
 use super::initiate::InitiateFlags;
@@ -59,63 +60,26 @@ pub struct AnimateArgs {
 
 /// Runs `formation animate`.
 pub fn run(args: AnimateArgs, g: Global) -> Result<()> {
+    let config = Config {
+        seed: g.seed,
+        seconds: Some(args.seconds),
+        initiation: !args.no_initiation,
+        read: args.read.options(),
+        extract: ExtractOptions::default(),
+        steady: args.steady.options(args.birds),
+        initiate: args.initiate.options(args.birds)?,
+        wingbeat: args.wingbeat.options()?,
+        render: RenderOptions {
+            width: args.size.0,
+            height: args.size.1,
+            fps: args.picture_fps,
+            ..RenderOptions::default()
+        },
+    };
     // Everything that can be checked is checked before any work.
-    if !(args.seconds.is_finite() && args.seconds > 0.0) {
-        return Err(Error::parameter(
-            "--seconds",
-            format!("must be a positive number of seconds, got {}", args.seconds),
-        ));
-    }
-    let frames_f = (args.seconds * args.steady.fps).round();
-    if !(1.0..=formation::limits::MAX_FRAMES as f64).contains(&frames_f) {
-        return Err(Error::parameter(
-            "--seconds",
-            format!(
-                "{} s at {} fps is {frames_f} frames; give between 1 and {} frames",
-                args.seconds,
-                args.steady.fps,
-                formation::limits::MAX_FRAMES
-            ),
-        ));
-    }
-    let frames = frames_f as usize;
-    let steady_opts = args.steady.options(args.birds, frames, g.seed)?;
-    let init_opts = args.initiate.options(g.seed, args.birds)?;
-    let wing = args.wingbeat.options()?;
-    let render = RenderOptions {
-        width: args.size.0,
-        height: args.size.1,
-        fps: args.picture_fps,
-        ..RenderOptions::default()
-    };
-    render.validate()?;
+    config.validate()?;
     formation::export::plan_outputs(&args.output)?;
-
     let progress = TermProgress::new(g.quiet);
-    let params = extract::params_from_path(
-        &args.input,
-        &args.read.options(),
-        &ExtractOptions::default(),
-        &mut rng::stream(g.seed, "extract"),
-    )?;
-    let steady = keyshape::steady::steady_flight(
-        &params,
-        &steady_opts,
-        &mut rng::stream(g.seed, "steady"),
-        &progress,
-    )?;
-    let mut anim = if args.no_initiation {
-        steady
-    } else {
-        initiate::check_steady(&steady, &args.input)?;
-        let (anim, _stats) = initiate::initiate(
-            &steady,
-            &init_opts,
-            &mut rng::stream(g.seed, "initiate"),
-            &progress,
-        )?;
-        anim
-    };
-    wingbeat::assign_phases(&mut anim, &wing)?;
-    super::write_animation(&anim, &args.output, &render, g)
+    let (anim, _report) = Pipeline::from_path(&args.input).run_with(&config, &progress)?;
+    super::write_animation(&anim, &args.output, &config.render, g)
 }

@@ -9,6 +9,7 @@ use clap::Args;
 use formation::annotations::{self, Heading, ReadOptions, YOrigin};
 use formation::extract::{self, ExtractOptions, FormationParams, FrameReport, ShapeKind};
 use formation::io::{write_json_atomic, OutputKind};
+use formation::pipeline::{extract_stage, Config};
 use formation::{Error, Result};
 
 use super::Global;
@@ -92,12 +93,16 @@ fn read_and_extract(
     fit: &FitArgs,
     g: Global,
 ) -> Result<(annotations::Annotations, FormationParams, Vec<FrameReport>)> {
-    let opts = fit.options();
-    opts.validate()?;
-    let ann = annotations::read(path, &read.options())?;
-    let mut rng = formation::rng::stream(g.seed, "extract");
+    let config = Config {
+        seed: g.seed,
+        read: read.options(),
+        extract: fit.options(),
+        ..Config::default()
+    };
+    config.extract.validate()?;
+    let ann = annotations::read(path, &config.read)?;
     let progress = super::progress::TermProgress::new(g.quiet);
-    let (params, reports) = extract::extract_with_report(&ann, &opts, &mut rng, &progress)?;
+    let (params, reports) = extract_stage(&ann, &config, &progress)?;
     Ok((ann, params, reports))
 }
 

@@ -9,6 +9,7 @@ use formation::initiate::{
     self, InitiateOptions, PerceptionMode, Start, StartRegion, StartState, HPR_GAMMA_DEFAULT,
 };
 use formation::io::OutputKind;
+use formation::pipeline::{initiate_stage, Config};
 use formation::{Error, Result};
 
 use super::progress::TermProgress;
@@ -109,10 +110,10 @@ pub struct InitiateFlags {
 }
 
 impl InitiateFlags {
-    /// The library options these flags describe (validated by the library).
-    pub fn options(&self, seed: u64, birds: usize) -> Result<InitiateOptions> {
+    /// The library options these flags describe, for `birds` birds (a start file is read and
+    /// checked against that count; the options are validated by the library).
+    pub fn options(&self, birds: usize) -> Result<InitiateOptions> {
         let mut o = InitiateOptions {
-            seed,
             max_steps: self.max_steps,
             alpha: self.alpha,
             k: self.k,
@@ -148,29 +149,25 @@ impl InitiateFlags {
                 ..Default::default()
             }),
         };
-        if !(self.heading_spread.is_finite() && (0.0..=180.0).contains(&self.heading_spread)) {
-            return Err(Error::parameter(
-                "--heading-spread",
-                format!("must be in [0, 180] degrees, got {}", self.heading_spread),
-            ));
-        }
-        o.validate()?;
-        formation::initiate::check_size(birds, 0, self.max_steps)?;
         Ok(o)
     }
 }
 
 /// Runs `formation initiate`.
 pub fn run(args: InitiateArgs, g: Global) -> Result<()> {
-    let wing = args.wingbeat.options()?;
+    let wingbeat = args.wingbeat.options()?;
     formation::export::plan_outputs(&args.output)?;
     let steady = Animation::read(&args.steady)?;
     initiate::check_steady(&steady, &args.steady)?;
-    let opts = args.initiate.options(g.seed, steady.birds)?;
-    let mut rng = formation::rng::stream(g.seed, "initiate");
+    let config = Config {
+        seed: g.seed,
+        initiate: args.initiate.options(steady.birds)?,
+        wingbeat,
+        ..Config::default()
+    };
     let progress = TermProgress::new(g.quiet);
-    let (mut anim, stats) = initiate::initiate(&steady, &opts, &mut rng, &progress)?;
-    formation::wingbeat::assign_phases(&mut anim, &wing)?;
+    let (mut anim, stats) = initiate_stage(&steady, &config, &progress)?;
+    formation::wingbeat::assign_phases(&mut anim, &config.wingbeat)?;
     super::write_animation(&anim, &args.output, &Default::default(), g)?;
     if args.json {
         let text = formation::finite::to_json_pretty("statistics", &stats)?;

@@ -6,6 +6,7 @@ use formation::Result;
 
 mod animate;
 mod extract;
+pub mod flags;
 mod initiate;
 mod plot;
 mod power;
@@ -64,16 +65,19 @@ pub fn run(cli: Cli) -> Result<()> {
         quiet: cli.quiet,
         seed: cli.seed,
     };
-    match cli.command {
-        Command::Extract(a) => extract::run(a, g),
-        Command::Power(a) => power::run(a, g),
-        Command::Solve(a) => solve::run(a, g),
-        Command::Steady(a) => steady::run(a, g),
-        Command::Initiate(a) => initiate::run(*a, g),
-        Command::Animate(a) => animate::run(*a, g),
-        Command::Render(a) => render::run(a, g),
-        Command::Plot(a) => plot::run(a, g),
-    }
+    use flags::Cmd;
+    let (cmd, result) = match cli.command {
+        Command::Extract(a) => (Cmd::Extract, extract::run(a, g)),
+        Command::Power(a) => (Cmd::Power, power::run(a, g)),
+        Command::Solve(a) => (Cmd::Solve, solve::run(a, g)),
+        Command::Steady(a) => (Cmd::Steady, steady::run(a, g)),
+        Command::Initiate(a) => (Cmd::Initiate, initiate::run(*a, g)),
+        Command::Animate(a) => (Cmd::Animate, animate::run(*a, g)),
+        Command::Render(a) => (Cmd::Render, render::run(a, g)),
+        Command::Plot(a) => (a.cmd(), plot::run(a, g)),
+    };
+    // Library errors name option paths; the user typed this command's flags.
+    result.map_err(|e| flags::name_flags(cmd, e))
 }
 
 /// On Ctrl-C or SIGTERM, remove temporary output files before exiting (no partial outputs).

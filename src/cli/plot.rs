@@ -26,6 +26,20 @@ enum PlotKind {
     Wingbeat(super::wingbeat::PlotWingbeatArgs),
 }
 
+impl PlotArgs {
+    /// The chart's entry in the flag table.
+    pub fn cmd(&self) -> super::flags::Cmd {
+        use super::flags::Cmd;
+        match self.kind {
+            PlotKind::Power(_) => Cmd::PlotPower,
+            PlotKind::Xi(_) => Cmd::PlotXi,
+            PlotKind::Shape(_) => Cmd::PlotShape,
+            PlotKind::Paths(_) => Cmd::PlotPaths,
+            PlotKind::Wingbeat(_) => Cmd::PlotWingbeat,
+        }
+    }
+}
+
 /// Runs `formation plot`.
 pub fn run(args: PlotArgs, g: Global) -> Result<()> {
     match args.kind {

@@ -68,8 +68,11 @@ pub fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
         height: h,
         ..RenderOptions::default()
     };
+    // `--size` is the same flag for `render` and `animate`.
     opts.validate().map_err(|e| match e {
-        formation::Error::Parameter { message, .. } => message,
+        formation::Error::Parameter { message, .. } => {
+            super::flags::rewrite(super::flags::Cmd::Render, &message)
+        }
         other => other.to_string(),
     })?;
     Ok((w, h))

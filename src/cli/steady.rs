@@ -8,7 +8,8 @@ use formation::aero::power_reduction;
 use formation::animation::Animation;
 use formation::extract::params::FormationParams;
 use formation::io::{write_json_atomic, OutputKind};
-use formation::keyshape::{steady_flight_report, SteadyOptions};
+use formation::keyshape::SteadyOptions;
+use formation::pipeline::{steady_stage, Config};
 use formation::plot::power::{PowerChart, PowerMetric};
 use formation::plot::xi::XiChart;
 use formation::shape::Shape;
@@ -83,11 +84,11 @@ pub struct SteadyFlags {
 }
 
 impl SteadyFlags {
-    /// The validated library options for `birds` birds and `frames` frames.
-    pub fn options(&self, birds: usize, frames: usize, seed: u64) -> Result<SteadyOptions> {
-        let opts = SteadyOptions {
+    /// The library options for `birds` birds (frames and seed are set by the caller's
+    /// [`Config`]; validated there).
+    pub fn options(&self, birds: usize) -> SteadyOptions {
+        SteadyOptions {
             birds,
-            frames,
             fps: self.fps,
             key_every_s: self.key_every,
             speed: self.speed,
@@ -95,28 +96,34 @@ impl SteadyFlags {
             c1: self.c1,
             c2: self.c2,
             wingspan_m: self.wingspan_m,
-            seed,
             max_jump: self.max_jump,
             ..SteadyOptions::default()
-        };
-        opts.validate()?;
-        Ok(opts)
+        }
     }
 }
 
 /// Runs `formation steady`.
 pub fn run(args: SteadyArgs, g: Global) -> Result<()> {
-    let opts = args.steady.options(args.birds, args.frames, g.seed)?;
-    let wing = args.wingbeat.options()?;
+    let config = Config {
+        seed: g.seed,
+        seconds: None,
+        steady: SteadyOptions {
+            frames: args.frames,
+            ..args.steady.options(args.birds)
+        },
+        wingbeat: args.wingbeat.options()?,
+        ..Config::default()
+    };
+    config.steady_options()?;
+    config.wingbeat.validate()?;
     formation::export::plan_outputs(&args.output)?;
     if let Some(r) = &args.report {
         OutputKind::from_path(r, &[OutputKind::Json])?;
     }
     let params = read_params(&args.params)?;
-    let mut rng = formation::rng::stream(g.seed, "steady");
     let progress = TermProgress::new(g.quiet);
-    let (mut anim, report) = steady_flight_report(&params, &opts, &mut rng, &progress)?;
-    formation::wingbeat::assign_phases(&mut anim, &wing)?;
+    let (mut anim, report) = steady_stage(&params, &config, &progress)?;
+    formation::wingbeat::assign_phases(&mut anim, &config.wingbeat)?;
     super::write_animation(&anim, &args.output, &Default::default(), g)?;
     if let Some(r) = &args.report {
         write_json_atomic(r, &report)?;

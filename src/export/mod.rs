@@ -54,7 +54,8 @@ pub const MAX_GIF_FPS: f64 = 50.0;
 pub const MAX_FRAMES: usize = 200_000;
 
 /// How to render; every field is checked by [`RenderOptions::validate`].
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct RenderOptions {
     /// Picture width, pixels.
     pub width: u32,
@@ -82,20 +83,20 @@ impl Default for RenderOptions {
 }
 
 impl RenderOptions {
-    /// Checks the size, frame rate and wingspan, naming the flag at fault.
+    /// Checks the size, frame rate and wingspan; errors name the option path (`render.fps`).
     pub fn validate(&self) -> Result<()> {
         for (v, what) in [(self.width, "width"), (self.height, "height")] {
             if !(MIN_SIDE..=MAX_SIDE).contains(&v) {
                 return Err(Error::parameter(
-                    "--size",
-                    format!("{what} {v} px is outside {MIN_SIDE}..={MAX_SIDE}; give e.g. --size 960x540"),
+                    "render.width/render.height",
+                    format!("{what} {v} px is outside {MIN_SIDE}..={MAX_SIDE}; give e.g. render.width/render.height 960x540"),
                 ));
             }
         }
         let pixels = self.width as u64 * self.height as u64;
         if pixels > crate::limits::MAX_FRAME_PIXELS {
             return Err(Error::parameter(
-                "--size",
+                "render.width/render.height",
                 format!(
                     "{}x{} is {pixels} pixels, more than 8K UHD (7680x4320 = {}); give a smaller size",
                     self.width,
@@ -107,7 +108,7 @@ impl RenderOptions {
         if let Some(f) = self.fps {
             if !(f.is_finite() && (1.0..=MAX_FPS).contains(&f)) {
                 return Err(Error::parameter(
-                    "--fps",
+                    "render.fps",
                     format!("{f} frames per second is not a usable frame rate; give a number from 1 to {MAX_FPS}"),
                 ));
             }
@@ -115,7 +116,7 @@ impl RenderOptions {
         if let Some(w) = self.wingspan_m {
             if !(w.is_finite() && w > 0.0 && w <= 100.0) {
                 return Err(Error::parameter(
-                    "--wingspan-m",
+                    "render.wingspan_m",
                     format!("{w} m is not a wingspan; give metres between 0 and 100 (a goose is about 1.5)"),
                 ));
             }
@@ -253,8 +254,8 @@ pub fn write_outputs(
             if let Some(f) = opts.fps {
                 if f > MAX_GIF_FPS {
                     return Err(Error::parameter(
-                        "--fps",
-                        format!("{f}: a GIF plays at most {MAX_GIF_FPS} frames per second (delays are whole 1/100 s, browsers slow shorter ones); give --fps 50 or less"),
+                        "render.fps",
+                        format!("{f}: a GIF plays at most {MAX_GIF_FPS} frames per second (delays are whole 1/100 s, browsers slow shorter ones); give render.fps 50 or less"),
                     ));
                 }
             }
@@ -265,9 +266,9 @@ pub fn write_outputs(
             let pixels = n as u64 * opts.width as u64 * opts.height as u64;
             if n <= MAX_FRAMES && pixels > crate::limits::MAX_PICTURE_PIXELS {
                 return Err(Error::parameter(
-                    "--size",
+                    "render.width/render.height",
                     format!(
-                        "{}: {n} frames of {}x{} is {:.1e} pixels, more than the {:.0e} limit (about {} GB uncompressed); lower --size or --fps",
+                        "{}: {n} frames of {}x{} is {:.1e} pixels, more than the {:.0e} limit (about {} GB uncompressed); lower render.width/render.height or render.fps",
                         o.path.display(),
                         opts.width,
                         opts.height,
@@ -279,9 +280,9 @@ pub fn write_outputs(
             }
             if n > MAX_FRAMES {
                 return Err(Error::parameter(
-                    "--fps",
+                    "render.fps",
                     format!(
-                        "{}: {n} frames at {fps} fps is more than {MAX_FRAMES}; lower --fps",
+                        "{}: {n} frames at {fps} fps is more than {MAX_FRAMES}; lower render.fps",
                         o.path.display()
                     ),
                 ));

@@ -95,7 +95,8 @@ impl FromStr for ShapeKind {
 }
 
 /// Settings of [`extract`].
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct ExtractOptions {
     /// Inlier threshold T: a bird farther than this from the curve (along y) is an outlier,
     /// wingspans.
@@ -125,11 +126,11 @@ impl Default for ExtractOptions {
 }
 
 impl ExtractOptions {
-    /// Checks ranges, naming the flag at fault.
+    /// Checks ranges; errors name the option path (`extract.j_offset`).
     pub fn validate(&self) -> Result<()> {
         if !(self.inlier_threshold.is_finite() && self.inlier_threshold > 0.0) {
             return Err(Error::parameter(
-                "--threshold",
+                "extract.inlier_threshold",
                 format!(
                     "must be a positive number of wingspans, got {}",
                     self.inlier_threshold
@@ -137,11 +138,14 @@ impl ExtractOptions {
             ));
         }
         if self.max_samples < 1 {
-            return Err(Error::parameter("--max-samples", "must be at least 1"));
+            return Err(Error::parameter(
+                "extract.max_samples",
+                "must be at least 1",
+            ));
         }
         if !(self.j_offset.is_finite() && (0.0..=1.0).contains(&self.j_offset)) {
             return Err(Error::parameter(
-                "--j-offset",
+                "extract.j_offset",
                 format!("must be between 0 and 1, got {}", self.j_offset),
             ));
         }

@@ -50,7 +50,8 @@ pub const MAX_STEPS_LIMIT: usize = 1_000_000;
 pub const MAX_START_EXTENT: f64 = 1e6;
 
 /// Parameters of the initiation (units per second; converted to per-step values at the file's fps).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct InitiateOptions {
     /// Perception model: visual field, reference cone, occlusion mode.
     pub perception: PerceptionParams,
@@ -108,7 +109,7 @@ pub struct InitiateOptions {
     pub max_steps: usize,
     /// Where and how the birds start.
     pub start: Start,
-    /// The `--seed` recorded in the output file.
+    /// The seed recorded in the output file (the pipeline sets it from `Config::seed`).
     pub seed: u64,
 }
 
@@ -146,7 +147,8 @@ impl Default for InitiateOptions {
 }
 
 /// Where the birds start.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
 pub enum Start {
     /// Random positions, headings and speeds in a region.
     Random(StartRegion),
@@ -157,7 +159,8 @@ pub enum Start {
 /// A random take-off: positions uniform in a rectangle centred on the origin, its width across
 /// and its depth along the cruise heading, at least `min_spacing` apart; headings uniform within
 /// `heading_spread` of the cruise heading; speeds uniform between the minimum and the cruise speed.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct StartRegion {
     /// Width across the cruise heading, wingspans (`None`: 30, or 6√N for large flocks).
     pub width: Option<f64>,
@@ -290,7 +293,7 @@ pub struct InitiationRun {
 }
 
 impl InitiateOptions {
-    /// Checks every parameter (names are the command-line flags).
+    /// Checks every parameter; errors name the option path (`initiate.alpha`).
     pub fn validate(&self) -> Result<()> {
         let pos = |name: &str, v: f64| -> Result<()> {
             if v.is_finite() && v > 0.0 {
@@ -305,7 +308,7 @@ impl InitiateOptions {
         let fov = self.perception.fov_per_eye;
         if !(fov.is_finite() && fov > 0.0 && fov <= PI) {
             return Err(Error::parameter(
-                "--fov",
+                "initiate.perception.fov_per_eye",
                 format!(
                     "visual field per eye must be in (0, 180] degrees, got {:.3}",
                     fov.to_degrees()
@@ -315,75 +318,78 @@ impl InitiateOptions {
         let cone = self.perception.reference_cone;
         if !(cone.is_finite() && cone > 0.0 && cone <= PI) {
             return Err(Error::parameter(
-                "--reference-cone",
+                "initiate.perception.reference_cone",
                 format!("must be in (0, 180] degrees, got {:.3}", cone.to_degrees()),
             ));
         }
         if let PerceptionMode::Hpr { gamma } = self.perception.mode {
             if !(gamma.is_finite() && (0.0..=8.0).contains(&gamma)) {
                 return Err(Error::parameter(
-                    "--hpr-gamma",
+                    "initiate.perception.mode.hpr.gamma",
                     format!("must be in [0, 8], got {gamma}"),
                 ));
             }
         }
-        pos("bird radius", self.perception.bird_radius)?;
+        pos(
+            "initiate.perception.bird_radius",
+            self.perception.bird_radius,
+        )?;
         if !(self.alpha.is_finite() && self.alpha > 0.0 && self.alpha <= 1.0) {
             return Err(Error::parameter(
-                "--alpha",
+                "initiate.alpha",
                 format!("must be in (0, 1], got {}", self.alpha),
             ));
         }
-        pos("--k", self.k)?;
-        pos("--max-turn-rate", self.max_turn_rate)?;
-        pos("--max-accel", self.max_accel)?;
-        pos("--min-speed", self.min_speed)?;
-        pos("--max-speed", self.max_speed)?;
+        pos("initiate.k", self.k)?;
+        pos("initiate.max_turn_rate", self.max_turn_rate)?;
+        pos("initiate.max_accel", self.max_accel)?;
+        pos("initiate.min_speed", self.min_speed)?;
+        pos("initiate.max_speed", self.max_speed)?;
         if self.min_speed >= 1.0 || self.max_speed <= 1.0 {
             return Err(Error::parameter(
-                "--min-speed/--max-speed",
+                "initiate.min_speed/initiate.max_speed",
                 format!(
                     "the cruise speed must lie between them (min < 1 < max), got {} and {}",
                     self.min_speed, self.max_speed
                 ),
             ));
         }
-        pos("--separation", self.separation_distance)?;
-        pos("--lookahead", self.lookahead)?;
-        pos("--avoid-distance", self.avoid_distance)?;
-        pos("--avoid-range", self.avoid_range)?;
-        pos("--avoid-horizon", self.avoid_horizon)?;
-        pos("lost speed factor", self.lost_speed_factor)?;
-        pos("--turn-distance-cap", self.turn_distance_cap)?;
-        pos("--linear-zone", self.linear_zone)?;
+        pos("initiate.separation_distance", self.separation_distance)?;
+        pos("initiate.lookahead", self.lookahead)?;
+        pos("initiate.avoid_distance", self.avoid_distance)?;
+        pos("initiate.avoid_range", self.avoid_range)?;
+        pos("initiate.avoid_horizon", self.avoid_horizon)?;
+        pos("initiate.lost_speed_factor", self.lost_speed_factor)?;
+        pos("initiate.turn_distance_cap", self.turn_distance_cap)?;
+        pos("initiate.linear_zone", self.linear_zone)?;
         let memory = self.reference_memory();
         if !(memory.is_finite() && (0.0..=60.0).contains(&memory)) {
             return Err(Error::parameter(
-                "reference memory",
+                "initiate.reference_memory",
                 format!("must be in [0, 60] seconds, got {memory}"),
             ));
         }
         if !(self.leader_hysteresis.is_finite() && self.leader_hysteresis >= 0.0) {
             return Err(Error::parameter(
-                "leader hysteresis",
+                "initiate.leader_hysteresis",
                 "must be a non-negative number",
             ));
         }
-        pos("--tolerance", self.tolerance)?;
+        pos("initiate.tolerance", self.tolerance)?;
         if self.tolerance < 1e-6 {
             return Err(Error::parameter(
-                "--tolerance",
+                "initiate.tolerance",
                 format!(
                     "{:e} wingspans cannot be met in floating point; use at least 1e-6",
                     self.tolerance
                 ),
             ));
         }
-        pos("--heading-tolerance", self.heading_tolerance)?;
-        pos("--speed-tolerance", self.speed_tolerance)?;
+        pos("initiate.heading_tolerance", self.heading_tolerance)?;
+        pos("initiate.speed_tolerance", self.speed_tolerance)?;
         if !(self.hold.is_finite() && self.hold >= 0.0) {
             return Err(Error::parameter(
-                "--hold",
+                "initiate.hold",
                 format!(
                     "must be a non-negative number of seconds, got {}",
                     self.hold
@@ -392,13 +398,13 @@ impl InitiateOptions {
         }
         if self.max_steps == 0 {
             return Err(Error::parameter(
-                "--max-steps",
+                "initiate.max_steps",
                 "must be at least 1 (the initiation needs at least one step)",
             ));
         }
         if self.max_steps > MAX_STEPS_LIMIT {
             return Err(Error::parameter(
-                "--max-steps",
+                "initiate.max_steps",
                 format!(
                     "at most {MAX_STEPS_LIMIT} (every step is kept in memory for the output), got {}",
                     self.max_steps
@@ -406,7 +412,10 @@ impl InitiateOptions {
             ));
         }
         if let Start::Random(r) = &self.start {
-            for (name, v) in [("--start-width", r.width), ("--start-depth", r.depth)] {
+            for (name, v) in [
+                ("initiate.start.random.width", r.width),
+                ("initiate.start.random.depth", r.depth),
+            ] {
                 if let Some(v) = v {
                     pos(name, v)?;
                     if v > MAX_START_EXTENT {
@@ -419,13 +428,16 @@ impl InitiateOptions {
             }
             if !(r.heading_spread.is_finite() && (0.0..=PI).contains(&r.heading_spread)) {
                 return Err(Error::parameter(
-                    "--heading-spread",
-                    "must be in [0, 180] degrees",
+                    "initiate.start.random.heading_spread",
+                    format!(
+                        "must be in [0, 180] degrees, got {}",
+                        r.heading_spread.to_degrees()
+                    ),
                 ));
             }
             if !(r.min_spacing.is_finite() && r.min_spacing >= 0.0) {
                 return Err(Error::parameter(
-                    "--min-spacing",
+                    "initiate.start.random.min_spacing",
                     "must be a non-negative number of wingspans",
                 ));
             }
@@ -546,7 +558,7 @@ pub fn random_start(
         tries += 1;
         if tries > attempts {
             return Err(Error::parameter(
-                "--start-width/--start-depth",
+                "initiate.start.random.width/initiate.start.random.depth",
                 format!(
                     "cannot place {n} birds {} wingspans apart in a {w:.1} × {d:.1} wingspan region; make it larger",
                     region.min_spacing
@@ -647,7 +659,7 @@ pub fn start_simulation(
         Start::Given(s) => {
             if s.x.len() != n || s.y.len() != n {
                 return Err(Error::parameter(
-                    "--start",
+                    "initiate.start",
                     format!("{} start positions for {n} birds", s.x.len()),
                 ));
             }
@@ -776,7 +788,7 @@ pub fn initiate(
     )?;
     if !run.stats.converged {
         return Err(Error::NotConverged(format!(
-            "the flock did not converge into the key shape within {} steps ({} of {} birds within {} wingspans of their slots); raise --max-steps, or start from a smaller region",
+            "the flock did not converge into the key shape within {} steps ({} of {} birds within {} wingspans of their slots); raise initiate.max_steps, or start from a smaller region",
             opts.max_steps, run.stats.birds_in_slot, run.stats.birds, opts.tolerance
         )));
     }
@@ -797,9 +809,9 @@ pub fn check_size(birds: usize, steady_frames: usize, max_steps: usize) -> Resul
                 String::new()
             };
             Err(Error::parameter(
-                "--max-steps",
+                "initiate.max_steps",
                 format!(
-                    "{birds} birds × ({max_steps} steps{plus}) could be more than {} bird-frames in memory; lower --max-steps to at most {}",
+                    "{birds} birds × ({max_steps} steps{plus}) could be more than {} bird-frames in memory; lower initiate.max_steps to at most {}",
                     crate::limits::MAX_BIRD_FRAMES,
                     (crate::limits::MAX_BIRD_FRAMES / birds.max(1)).saturating_sub(steady_frames)
                 ),

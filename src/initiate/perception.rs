@@ -23,7 +23,8 @@ use super::hull::convex_hull;
 pub const HPR_GAMMA_DEFAULT: f64 = 2.0;
 
 /// How occlusion between flockmates is decided.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
 pub enum PerceptionMode {
     /// Hidden Point Removal with radius R = max|q|·10^γ; the field is γ (dimensionless).
     Hpr {
@@ -35,7 +36,8 @@ pub enum PerceptionMode {
 }
 
 /// Parameters of the perception model (§6.1).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct PerceptionParams {
     /// Visual field per eye, measured from straight ahead to the side, radians (paper: 90° = π/2,
     /// so both eyes together see the front half-plane). Range (0, π].

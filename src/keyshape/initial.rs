@@ -61,7 +61,7 @@ impl Default for InitialOptions {
 pub fn correspondence(first: &FrameParams, n: usize) -> Result<Correspondence> {
     if n < 2 {
         return Err(Error::parameter(
-            "--birds",
+            "steady.birds",
             format!("{n} bird(s): a formation needs at least 2"),
         ));
     }

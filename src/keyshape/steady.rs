@@ -17,7 +17,7 @@
 //! (x_i, speed·t − y_i(t), 0) (SPEC §2).
 
 use rand::Rng;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::aero::{munk_total, power_reduction, VORTEX_SPAN};
 use crate::animation::{Animation, Frame, KeyBird, KeyShapeRecord, Stage};
@@ -33,8 +33,9 @@ use crate::keyshape::ranges::{power_at, xi_ranges, XiRanges};
 use crate::keyshape::solve::SolveOptions;
 use crate::progress::Progress;
 
-/// Options of the steady flight (`formation steady` flags).
-#[derive(Debug, Clone)]
+/// Options of the steady flight (the `steady` section of [`crate::pipeline::Config`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct SteadyOptions {
     /// N, birds to animate (≥ 2).
     pub birds: usize,
@@ -94,46 +95,46 @@ impl Default for SteadyOptions {
 }
 
 impl SteadyOptions {
-    /// Checks every option; the error names the command-line flag.
+    /// Checks every option; the error names the option path (`steady.fps`).
     pub fn validate(&self) -> Result<()> {
         let p = |name: &str, msg: String| Error::parameter(name, msg);
         if self.birds < 2 {
             return Err(p(
-                "--birds",
+                "steady.birds",
                 format!("{}: a formation needs at least 2 birds", self.birds),
             ));
         }
         if self.birds > crate::limits::MAX_BIRDS {
             return Err(p(
-                "--birds",
+                "steady.birds",
                 format!("{}: at most {} birds", self.birds, crate::limits::MAX_BIRDS),
             ));
         }
         if self.frames == 0 {
-            return Err(p("--frames", "0: at least 1 frame is needed".into()));
+            return Err(p("steady.frames", "0: at least 1 frame is needed".into()));
         }
-        crate::limits::check_animation_size("--frames", self.birds, self.frames)?;
+        crate::limits::check_animation_size("steady.frames", self.birds, self.frames)?;
         if !(self.fps.is_finite() && self.fps > 0.0 && self.fps <= 1000.0) {
             return Err(p(
-                "--fps",
+                "steady.fps",
                 format!("{}: must be in (0, 1000] frames per second", self.fps),
             ));
         }
         if !(self.key_every_s.is_finite() && self.key_every_s > 0.0) {
             return Err(p(
-                "--key-every",
+                "steady.key_every_s",
                 format!("{}: must be a positive number of seconds", self.key_every_s),
             ));
         }
         if !(self.speed.is_finite() && self.speed > 0.0 && self.speed <= 1000.0) {
             return Err(p(
-                "--speed",
+                "steady.speed",
                 format!("{}: must be in (0, 1000] wingspans per second", self.speed),
             ));
         }
         if !(self.epsilon.is_finite() && (0.0..=0.5).contains(&self.epsilon)) {
             return Err(p(
-                "--epsilon",
+                "steady.epsilon",
                 format!(
                     "{}: must be in [0, 0.5] (the paper uses 0 to 0.2)",
                     self.epsilon
@@ -142,7 +143,7 @@ impl SteadyOptions {
         }
         if !(self.c1.is_finite() && (0.5..=1.0).contains(&self.c1)) {
             return Err(p(
-                "--c1",
+                "steady.c1",
                 format!(
                     "{}: must be in [0.5, 1] (the paper uses 0.75 to 0.9)",
                     self.c1
@@ -151,7 +152,7 @@ impl SteadyOptions {
         }
         if !(self.c2.is_finite() && (1.0..=2.0).contains(&self.c2)) {
             return Err(p(
-                "--c2",
+                "steady.c2",
                 format!(
                     "{}: must be in [1, 2] (the paper uses 1.1 to 1.25)",
                     self.c2
@@ -160,24 +161,24 @@ impl SteadyOptions {
         }
         if !(self.wingspan_m.is_finite() && self.wingspan_m > 0.0 && self.wingspan_m <= 100.0) {
             return Err(p(
-                "--wingspan-m",
+                "steady.wingspan_m",
                 format!("{}: must be in (0, 100] metres", self.wingspan_m),
             ));
         }
         if !(self.max_jump.is_finite() && self.max_jump > 0.0) {
             return Err(p(
-                "max_jump",
+                "steady.max_jump",
                 "must be a positive number of wingspans".into(),
             ));
         }
         if !(self.accept_residual.is_finite() && self.accept_residual > 0.0) {
-            return Err(p("accept_residual", "must be positive".into()));
+            return Err(p("steady.accept_residual", "must be positive".into()));
         }
         if !(self.downwash_margin.is_finite() && self.downwash_margin >= 0.0) {
-            return Err(p("downwash_margin", "must not be negative".into()));
+            return Err(p("steady.downwash_margin", "must not be negative".into()));
         }
         if !(self.max_depth_factor.is_finite() && self.max_depth_factor >= 1.0) {
-            return Err(p("max_depth_factor", "must be at least 1".into()));
+            return Err(p("steady.max_depth_factor", "must be at least 1".into()));
         }
         Ok(())
     }
@@ -488,7 +489,13 @@ mod tests {
                 ..SteadyOptions::default()
             },
         ];
-        let flags = ["--birds", "--frames", "--epsilon", "--c1", "--c2"];
+        let flags = [
+            "steady.birds",
+            "steady.frames",
+            "steady.epsilon",
+            "steady.c1",
+            "steady.c2",
+        ];
         for (o, f) in bad.iter().zip(flags) {
             let e = o.validate().unwrap_err().to_string();
             assert!(e.starts_with(f), "{e}");

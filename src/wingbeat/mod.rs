@@ -13,7 +13,7 @@
 //!   deeper beats while a bird accelerates, gliding, and phase relations between birds
 //!   (independent, or locked to the bird ahead with the spatial phasing of Portugal et al. 2014).
 //!
-//! Determinism: everything is drawn from `rng::stream(anim.seed, "wingbeat")`, one generator per
+//! Determinism: everything is drawn from `rng::stream(anim.seed, Stream::Wingbeat)`, one generator per
 //! bird, consumed one wingbeat at a time. [`Flapper::from_animation`] replays the same decisions
 //! from the stored phases, so renderers see exactly the wingbeats [`assign_phases`] produced.
 
@@ -92,7 +92,7 @@ impl FromStr for PhaseMode {
             "locked" => Ok(PhaseMode::Locked),
             "independent" => Ok(PhaseMode::Independent),
             _ => Err(Error::parameter(
-                "--phase",
+                "wingbeat.phase_mode",
                 format!("unknown phase mode \"{s}\": expected locked or independent"),
             )),
         }
@@ -130,7 +130,7 @@ impl FromStr for Glide {
             "bouts" | "on" => Ok(Glide::Bouts),
             "always" => Ok(Glide::Always),
             _ => Err(Error::parameter(
-                "--glide",
+                "wingbeat.glide",
                 format!("unknown glide mode \"{s}\": expected off, bouts or always"),
             )),
         }
@@ -182,13 +182,13 @@ impl WingbeatOptions {
     pub fn validate(&self) -> Result<()> {
         if !(self.variation.is_finite() && (0.0..=5.0).contains(&self.variation)) {
             return Err(Error::parameter(
-                "variation",
+                "wingbeat.variation",
                 format!("{}: must be between 0 and 5", self.variation),
             ));
         }
         if !(self.lock_time_s.is_finite() && self.lock_time_s >= 0.05 && self.lock_time_s <= 60.0) {
             return Err(Error::parameter(
-                "lock_time_s",
+                "wingbeat.lock_time_s",
                 format!("{}: must be between 0.05 and 60 seconds", self.lock_time_s),
             ));
         }
@@ -424,7 +424,7 @@ impl BirdBeats {
 fn draw_birds(seed: u64, birds: usize, opts: &WingbeatOptions) -> (Vec<BirdBeats>, Vec<FlockRng>) {
     let preset = opts.species.preset();
     let v = opts.variation;
-    let mut master = stream(seed, "wingbeat");
+    let mut master = stream(seed, crate::rng::Stream::Wingbeat);
     let cycle = i64::from(preset.flap_beats + preset.glide_beats).max(1);
     let mut out = Vec::with_capacity(birds);
     let mut rngs = Vec::with_capacity(birds);

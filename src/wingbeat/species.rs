@@ -129,7 +129,7 @@ impl FromStr for Species {
             .find(|sp| sp.name() == t)
             .ok_or_else(|| {
                 Error::parameter(
-                    "--species",
+                    "wingbeat.species",
                     format!("unknown species \"{s}\": expected goose, crane or pelican"),
                 )
             })
@@ -149,7 +149,7 @@ pub struct SpeciesPreset {
     pub glide_dihedral: f64,
     /// Hand dihedral held while gliding, radians, up positive.
     pub glide_hand_dihedral: f64,
-    /// Flapping wingbeats per flap-glide bout (`--glide bouts`).
+    /// Flapping wingbeats per flap-glide bout (`wingbeat.glide` = bouts).
     pub flap_beats: u32,
     /// Gliding wingbeat periods per flap-glide bout.
     pub glide_beats: u32,

@@ -1,0 +1,202 @@
+//! The one table from library option paths (`initiate.max_turn_rate`, see
+//! `formation::pipeline::Config`) to the flags of each command. Library errors name option paths;
+//! [`name_flags`] rewrites every path that the command that was run has a flag for, in the error's
+//! name and in its message, so that every message names a flag that exists for that command.
+//! Paths without a flag (options only a config file can set) are left as they are.
+
+use formation::Error;
+
+/// The commands (and `plot` charts) whose flags the table knows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Cmd {
+    /// `formation extract`.
+    Extract,
+    /// `formation power`.
+    Power,
+    /// `formation solve`.
+    Solve,
+    /// `formation steady`.
+    Steady,
+    /// `formation initiate`.
+    Initiate,
+    /// `formation animate`.
+    Animate,
+    /// `formation render`.
+    Render,
+    /// `formation plot power`.
+    PlotPower,
+    /// `formation plot xi`.
+    PlotXi,
+    /// `formation plot shape`.
+    PlotShape,
+    /// `formation plot paths`.
+    PlotPaths,
+    /// `formation plot wingbeat`.
+    PlotWingbeat,
+}
+
+use Cmd::*;
+
+const READ: &[Cmd] = &[Extract, PlotShape, Animate];
+const FIT: &[Cmd] = &[Extract, PlotShape];
+const STEADY: &[Cmd] = &[Steady, Animate];
+const INITIATE: &[Cmd] = &[Initiate, Animate];
+const WINGBEAT: &[Cmd] = &[Steady, Initiate, Animate];
+const PICTURES: &[Cmd] = &[Render, Animate];
+
+/// (option path, flag, commands that have the flag). A path may appear several times with
+/// different flags for different commands (`steady.frames` is `--frames` of `steady` but
+/// `--seconds` of `animate`, which derives the frame count from the length).
+pub const FLAGS: &[(&str, &str, &[Cmd])] = &[
+    ("read.heading", "--heading", READ),
+    ("read.wingspan_px", "--wingspan-px", READ),
+    ("read.y_origin", "--y-origin", READ),
+    ("extract.inlier_threshold", "--threshold", FIT),
+    ("extract.kind", "--kind", FIT),
+    ("extract.max_samples", "--max-samples", FIT),
+    ("extract.j_offset", "--j-offset", FIT),
+    ("seconds", "--seconds", &[Animate]),
+    ("steady.birds", "--birds", STEADY),
+    ("steady.frames", "--frames", &[Steady]),
+    ("steady.frames", "--seconds", &[Animate]),
+    ("steady.fps", "--fps", STEADY),
+    ("steady.key_every_s", "--key-every", STEADY),
+    ("steady.speed", "--speed", STEADY),
+    ("steady.epsilon", "--epsilon", STEADY),
+    ("steady.c1", "--c1", STEADY),
+    ("steady.c2", "--c2", STEADY),
+    ("steady.wingspan_m", "--wingspan-m", STEADY),
+    ("steady.max_jump", "--max-jump", STEADY),
+    ("initiate.max_steps", "--max-steps", INITIATE),
+    ("initiate.perception.mode", "--perception", INITIATE),
+    (
+        "initiate.perception.mode.hpr.gamma",
+        "--hpr-gamma",
+        INITIATE,
+    ),
+    ("initiate.perception.fov_per_eye", "--fov", INITIATE),
+    (
+        "initiate.perception.reference_cone",
+        "--reference-cone",
+        INITIATE,
+    ),
+    ("initiate.alpha", "--alpha", INITIATE),
+    ("initiate.k", "--k", INITIATE),
+    ("initiate.max_turn_rate", "--max-turn-rate", INITIATE),
+    ("initiate.max_accel", "--max-accel", INITIATE),
+    ("initiate.min_speed", "--min-speed", INITIATE),
+    ("initiate.max_speed", "--max-speed", INITIATE),
+    ("initiate.separation_distance", "--separation", INITIATE),
+    ("initiate.avoid_distance", "--avoid-distance", INITIATE),
+    ("initiate.tolerance", "--tolerance", INITIATE),
+    ("initiate.hold", "--hold", INITIATE),
+    ("initiate.start", "--start", INITIATE),
+    ("initiate.start.random.width", "--start-width", INITIATE),
+    ("initiate.start.random.depth", "--start-depth", INITIATE),
+    (
+        "initiate.start.random.heading_spread",
+        "--heading-spread",
+        INITIATE,
+    ),
+    ("wingbeat.species", "--species", WINGBEAT),
+    ("wingbeat.species", "--species", &[PlotWingbeat]),
+    ("wingbeat.phase_mode", "--phase", WINGBEAT),
+    ("wingbeat.glide", "--glide", WINGBEAT),
+    ("wingbeat.variation", "--wing-variation", WINGBEAT),
+    // Width and height are one flag, `--size WxH`.
+    ("render.width/render.height", "--size", PICTURES),
+    ("render.width", "--size", PICTURES),
+    ("render.height", "--size", PICTURES),
+    ("render.fps", "--fps", &[Render]),
+    ("render.fps", "--picture-fps", &[Animate]),
+    ("render.wingspan_m", "--wingspan-m", &[Render]),
+];
+
+/// `text` with every option path that `cmd` has a flag for replaced by the flag. A path is
+/// replaced only as a whole word (`steady.c1` is not found in `steady.c10`); longer paths first,
+/// so that `render.width/render.height` becomes one `--size`.
+pub fn rewrite(cmd: Cmd, text: &str) -> String {
+    let mut paths: Vec<(&str, &str)> = FLAGS
+        .iter()
+        .filter(|(_, _, cmds)| cmds.contains(&cmd))
+        .map(|(p, f, _)| (*p, *f))
+        .collect();
+    paths.sort_by_key(|(p, _)| std::cmp::Reverse(p.len()));
+    let is_word = |c: char| c.is_ascii_alphanumeric() || c == '_' || c == '.';
+    let mut out = String::with_capacity(text.len());
+    let mut i = 0;
+    'scan: while i < text.len() {
+        let before_ok = !matches!(text[..i].chars().next_back(), Some(c) if is_word(c));
+        if before_ok {
+            for (p, f) in &paths {
+                if text[i..].starts_with(p) {
+                    let rest = &text[i + p.len()..];
+                    // A trailing full stop ends a sentence; any other word character continues
+                    // a longer path.
+                    let mut after = rest.chars();
+                    let after_ok = match after.next() {
+                        None => true,
+                        Some('.') => !matches!(after.next(), Some(c) if is_word(c)),
+                        Some(c) => !is_word(c),
+                    };
+                    if after_ok {
+                        out.push_str(f);
+                        i += p.len();
+                        continue 'scan;
+                    }
+                }
+            }
+        }
+        let c = text[i..].chars().next().unwrap_or(' ');
+        out.push(c);
+        i += c.len_utf8();
+    }
+    out
+}
+
+/// `e` with option paths replaced by the flags of `cmd` (see [`rewrite`]).
+pub fn name_flags(cmd: Cmd, e: Error) -> Error {
+    match e {
+        Error::Parameter { name, message } => Error::Parameter {
+            name: rewrite(cmd, &name),
+            message: rewrite(cmd, &message),
+        },
+        Error::Format { path, message } => Error::Format {
+            path,
+            message: rewrite(cmd, &message),
+        },
+        Error::Unreachable(m) => Error::Unreachable(rewrite(cmd, &m)),
+        Error::NotConverged(m) => Error::NotConverged(rewrite(cmd, &m)),
+        other => other,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn paths_become_the_flags_of_the_command() {
+        assert_eq!(
+            rewrite(Steady, "steady.frames: 0; lower steady.frames."),
+            "--frames: 0; lower --frames."
+        );
+        assert_eq!(rewrite(Animate, "steady.frames: x"), "--seconds: x");
+        assert_eq!(rewrite(Animate, "render.fps: 3"), "--picture-fps: 3");
+        assert_eq!(rewrite(Render, "render.fps: 3"), "--fps: 3");
+        assert_eq!(
+            rewrite(Render, "give e.g. render.width/render.height 960x540"),
+            "give e.g. --size 960x540"
+        );
+        // Only whole paths, and only those the command has.
+        assert_eq!(
+            rewrite(Steady, "steady.c10 xsteady.c1"),
+            "steady.c10 xsteady.c1"
+        );
+        assert_eq!(rewrite(Extract, "steady.fps"), "steady.fps");
+        assert_eq!(
+            rewrite(Initiate, "initiate.min_speed/initiate.max_speed: x"),
+            "--min-speed/--max-speed: x"
+        );
+    }
+}

@@ -1,0 +1,315 @@
+//! The whole chain in one call: annotations (a file in any SPEC §4.1 format, or points in memory)
+//! or formation parameters → §4 extraction → §5 steady flight → §6 initiation → wingbeats, giving
+//! an [`Animation`] and a [`Report`] of what each stage did. `formation animate`, the benches, the
+//! tests and the fuzz targets all run this; so can a game engine, a DCC plug-in or a notebook.
+//!
+//! ```no_run
+//! use formation::pipeline::{Config, Pipeline};
+//! let mut config = Config::default();
+//! config.steady.birds = 14;
+//! config.seconds = Some(10.0);
+//! let (animation, report) = Pipeline::from_path("examples_data/barnacle_geese_v.json")
+//!     .run(&config)?;
+//! # Ok::<(), formation::Error>(())
+//! ```
+//!
+//! Every option lives in one [`Config`] section, one per stage, each `Default` and serde-ready, so
+//! a whole run can be written to and read from JSON. Errors name the option by its path in the
+//! config (`steady.fps`, `initiate.max_turn_rate`); the command line maps those paths to its own
+//! flags. Each stage draws from its own random stream ([`Stream`]) derived from [`Config::seed`],
+//! so `animate` gives exactly what `extract`, `steady` and `initiate` give when run one after the
+//! other with the same seed.
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use crate::animation::Animation;
+use crate::annotations::{Annotations, ReadOptions};
+use crate::error::{Error, Result};
+use crate::export::RenderOptions;
+use crate::extract::{self, ExtractOptions, FormationParams, FrameReport};
+use crate::initiate::{self, InitiateOptions, InitiateStats};
+use crate::keyshape::{steady_flight_report, SteadyOptions, SteadyReport};
+use crate::progress::{Progress, Silent};
+use crate::rng::{stream, Stream};
+use crate::wingbeat::{self, WingbeatOptions};
+
+/// Every option of a run, one section per stage. The sections are the stages' own options
+/// structs; [`Pipeline::run`] sets the derived fields (`steady.frames` from [`Config::seconds`],
+/// `steady.seed` and `initiate.seed` from [`Config::seed`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Config {
+    /// Seed of every random stream; equal seeds and inputs give byte-identical animations.
+    pub seed: u64,
+    /// Length of the steady flight, seconds: `steady.frames` = round(seconds · `steady.fps`).
+    /// `None`: `steady.frames` as given.
+    pub seconds: Option<f64>,
+    /// Fly the §6 take-off before the steady flight; `false`: the steady flight alone.
+    pub initiation: bool,
+    /// How annotation files are read (ignored for params and for annotations in memory).
+    pub read: ReadOptions,
+    /// §4 parameter extraction (ignored when the input is formation parameters).
+    pub extract: ExtractOptions,
+    /// §5 steady flight: birds, frame rate, key shapes, speed.
+    pub steady: SteadyOptions,
+    /// §6 initiation.
+    pub initiate: InitiateOptions,
+    /// Wingbeats.
+    pub wingbeat: WingbeatOptions,
+    /// Pictures and exports (used by [`crate::export::write_outputs`], not by [`Pipeline::run`]).
+    pub render: RenderOptions,
+}
+
+impl Default for Config {
+    fn default() -> Self {
+        Config {
+            seed: 0,
+            seconds: Some(20.0),
+            initiation: true,
+            read: ReadOptions::default(),
+            extract: ExtractOptions::default(),
+            steady: SteadyOptions::default(),
+            initiate: InitiateOptions::default(),
+            wingbeat: WingbeatOptions::default(),
+            render: RenderOptions::default(),
+        }
+    }
+}
+
+impl Config {
+    /// The number of steady-flight frames: round(`seconds` · `steady.fps`), or `steady.frames`
+    /// without `seconds`. An unusable `steady.fps` is left to [`SteadyOptions::validate`] to
+    /// report (the count is then 1).
+    pub fn frames(&self) -> Result<usize> {
+        let Some(seconds) = self.seconds else {
+            return Ok(self.steady.frames);
+        };
+        if !(seconds.is_finite() && seconds > 0.0) {
+            return Err(Error::parameter(
+                "seconds",
+                format!("must be a positive number of seconds, got {seconds}"),
+            ));
+        }
+        let fps = self.steady.fps;
+        if !(fps.is_finite() && fps > 0.0) {
+            return Ok(1);
+        }
+        let frames = (seconds * fps).round();
+        if !(1.0..=crate::limits::MAX_FRAMES as f64).contains(&frames) {
+            return Err(Error::parameter(
+                "seconds",
+                format!(
+                    "{seconds} s at {fps} fps is {frames} frames; give between 1 and {} frames",
+                    crate::limits::MAX_FRAMES
+                ),
+            ));
+        }
+        Ok(frames as usize)
+    }
+
+    /// The steady-flight options with the derived fields set.
+    pub fn steady_options(&self) -> Result<SteadyOptions> {
+        let steady = SteadyOptions {
+            frames: self.frames()?,
+            seed: self.seed,
+            ..self.steady.clone()
+        };
+        steady.validate()?;
+        Ok(steady)
+    }
+
+    /// The initiation options with the seed set.
+    pub fn initiate_options(&self) -> Result<InitiateOptions> {
+        let o = InitiateOptions {
+            seed: self.seed,
+            ..self.initiate.clone()
+        };
+        o.validate()?;
+        initiate::check_size(self.steady.birds, 0, o.max_steps)?;
+        Ok(o)
+    }
+
+    /// Checks every section before any work, in the order the stages run; the error names the
+    /// option's path (`steady.fps`).
+    pub fn validate(&self) -> Result<()> {
+        self.steady_options()?;
+        // Checked with or without the take-off, so that a config is valid or not as a whole.
+        self.initiate_options()?;
+        self.wingbeat.validate()?;
+        self.render.validate()?;
+        self.extract.validate()
+    }
+}
+
+/// What each stage did.
+#[derive(Debug, Clone, Serialize)]
+pub struct Report {
+    /// Model-selection scores of every annotated frame (empty when the input was parameters).
+    pub extract: Vec<FrameReport>,
+    /// Algorithm 1's correspondence, ranges and key-shape statistics.
+    pub steady: SteadyReport,
+    /// The initiation's statistics (`None` without initiation).
+    pub initiate: Option<InitiateStats>,
+}
+
+/// What a pipeline starts from.
+#[derive(Debug, Clone)]
+enum Input {
+    /// A file or directory: params written by `extract`, or annotations in any format.
+    Path(PathBuf),
+    /// Annotations already read or built in memory.
+    Annotations(Annotations),
+    /// Formation parameters already extracted.
+    Params(FormationParams),
+}
+
+/// The input of a run; [`Pipeline::run`] takes it through every stage.
+#[derive(Debug, Clone)]
+pub struct Pipeline {
+    input: Input,
+}
+
+impl Pipeline {
+    /// Starts from a file: a params file (told apart by content) or annotations in any SPEC §4.1
+    /// format, read with [`Config::read`] when the pipeline runs.
+    pub fn from_path(path: impl Into<PathBuf>) -> Pipeline {
+        Pipeline {
+            input: Input::Path(path.into()),
+        }
+    }
+
+    /// Starts from annotations (e.g. [`Annotations::from_points`]).
+    pub fn from_annotations(annotations: Annotations) -> Pipeline {
+        Pipeline {
+            input: Input::Annotations(annotations),
+        }
+    }
+
+    /// Starts from formation parameters (skips extraction).
+    pub fn from_params(params: FormationParams) -> Pipeline {
+        Pipeline {
+            input: Input::Params(params),
+        }
+    }
+
+    /// The file or name that messages about the input mention.
+    pub fn origin(&self) -> &Path {
+        match &self.input {
+            Input::Path(p) => p,
+            Input::Annotations(a) => &a.path,
+            Input::Params(_) => Path::new("formation parameters"),
+        }
+    }
+
+    /// Runs every stage silently.
+    pub fn run(&self, config: &Config) -> Result<(Animation, Report)> {
+        self.run_with(config, &Silent)
+    }
+
+    /// Runs every stage, reporting progress to `progress`. Every option is checked before any
+    /// work.
+    pub fn run_with(
+        &self,
+        config: &Config,
+        progress: &dyn Progress,
+    ) -> Result<(Animation, Report)> {
+        config.validate()?;
+        let (params, extract_report) = self.params(config, progress)?;
+        let (steady, steady_report) = steady_stage(&params, config, progress)?;
+        let (mut anim, initiate_report) = if config.initiation {
+            initiate::check_steady(&steady, self.origin())?;
+            let (anim, stats) = initiate_stage(&steady, config, progress)?;
+            (anim, Some(stats))
+        } else {
+            (steady, None)
+        };
+        wingbeat::assign_phases(&mut anim, &config.wingbeat)?;
+        Ok((
+            anim,
+            Report {
+                extract: extract_report,
+                steady: steady_report,
+                initiate: initiate_report,
+            },
+        ))
+    }
+
+    /// The formation parameters of the input: read, or extracted with the `extract` stream.
+    pub fn params(
+        &self,
+        config: &Config,
+        progress: &dyn Progress,
+    ) -> Result<(FormationParams, Vec<FrameReport>)> {
+        match &self.input {
+            Input::Params(p) => {
+                p.validate(self.origin())?;
+                Ok((p.clone(), Vec::new()))
+            }
+            Input::Annotations(a) => extract_stage(a, config, progress),
+            Input::Path(path) => {
+                if !path.is_dir() {
+                    let text = crate::io::read_text(path)?;
+                    if extract::is_params_file(&text) {
+                        let p: FormationParams = crate::io::parse_json(path, &text)?;
+                        p.validate(path)?;
+                        return Ok((p, Vec::new()));
+                    }
+                }
+                let ann = crate::annotations::read(path, &config.read)?;
+                extract_stage(&ann, config, progress)
+            }
+        }
+    }
+}
+
+/// §4 extraction of `ann` with the config's `extract` section and the seed's `extract` stream.
+pub fn extract_stage(
+    ann: &Annotations,
+    config: &Config,
+    progress: &dyn Progress,
+) -> Result<(FormationParams, Vec<FrameReport>)> {
+    extract::extract_with_report(
+        ann,
+        &config.extract,
+        &mut stream(config.seed, Stream::Extract),
+        progress,
+    )
+}
+
+/// §5 steady flight from `params` with the config's `steady` section (frames from `seconds`) and
+/// the seed's `steady` stream.
+pub fn steady_stage(
+    params: &FormationParams,
+    config: &Config,
+    progress: &dyn Progress,
+) -> Result<(Animation, SteadyReport)> {
+    steady_flight_report(
+        params,
+        &config.steady_options()?,
+        &mut stream(config.seed, Stream::Steady),
+        progress,
+    )
+}
+
+/// §6 initiation into the first key shape of `steady` with the config's `initiate` section and
+/// the seed's `initiate` stream. The flock size is the steady flight's.
+pub fn initiate_stage(
+    steady: &Animation,
+    config: &Config,
+    progress: &dyn Progress,
+) -> Result<(Animation, InitiateStats)> {
+    let opts = InitiateOptions {
+        seed: config.seed,
+        ..config.initiate.clone()
+    };
+    opts.validate()?;
+    initiate::check_size(steady.birds, 0, opts.max_steps)?;
+    initiate::initiate(
+        steady,
+        &opts,
+        &mut stream(config.seed, Stream::Initiate),
+        progress,
+    )
+}
