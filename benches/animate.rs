@@ -6,37 +6,17 @@
 use std::path::{Path, PathBuf};
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use formation::annotations::ReadOptions;
 use formation::export::{write_outputs, RenderOptions};
-use formation::extract::{params_from_path, ExtractOptions};
-use formation::keyshape::steady::{steady_flight, SteadyOptions};
+use formation::pipeline::{Config, Pipeline};
 use formation::progress::Silent;
-use formation::{initiate, rng, wingbeat, Animation};
+use formation::Animation;
 
 fn simulate() -> Animation {
     let input = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples_data/barnacle_geese_v.json");
-    let params = params_from_path(
-        &input,
-        &ReadOptions::default(),
-        &ExtractOptions::default(),
-        &mut rng::stream(0, "extract"),
-    )
-    .unwrap();
-    let opts = SteadyOptions {
-        birds: 14,
-        frames: 600,
-        ..SteadyOptions::default()
-    };
-    let steady = steady_flight(&params, &opts, &mut rng::stream(0, "steady"), &Silent).unwrap();
-    let (mut anim, _) = initiate::initiate(
-        &steady,
-        &initiate::InitiateOptions::default(),
-        &mut rng::stream(0, "initiate"),
-        &Silent,
-    )
-    .unwrap();
-    wingbeat::assign_phases(&mut anim, &wingbeat::WingbeatOptions::default()).unwrap();
-    anim
+    let mut config = Config::default();
+    config.steady.birds = 14;
+    config.seconds = Some(20.0);
+    Pipeline::from_path(input).run(&config).unwrap().0
 }
 
 fn bench(c: &mut Criterion) {

@@ -7,13 +7,14 @@
 
 use std::path::PathBuf;
 
-use formation::annotations::{Heading, ReadOptions};
+use formation::annotations::Heading;
 use formation::extract::params::FormationParams;
-use formation::extract::{self, ExtractOptions};
 use formation::initiate::{self, InitiateOptions, TargetShape};
-use formation::keyshape::steady::{steady_flight, SteadyOptions};
+use formation::keyshape::steady::SteadyOptions;
+use formation::pipeline::{steady_stage, Config, Pipeline};
 use formation::progress::Silent;
-use formation::{rng, Animation};
+use formation::rng::{self, Stream};
+use formation::Animation;
 use glam::DVec2;
 
 /// An example flock: its file and the reading options `formation animate` needs for it.
@@ -50,34 +51,38 @@ const PELICANS: Example = Example {
     wingspan_px: None,
 };
 
+/// The reading options `formation animate` needs for `ex`.
+fn config(ex: Example) -> Config {
+    let mut c = Config::default();
+    c.read.heading = ex.heading.map(Heading::Degrees);
+    c.read.wingspan_px = ex.wingspan_px;
+    c
+}
+
 fn params(ex: Example) -> FormationParams {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("examples_data")
         .join(ex.file);
-    let read = ReadOptions {
-        heading: ex.heading.map(Heading::Degrees),
-        wingspan_px: ex.wingspan_px,
-        y_origin: None,
-    };
-    extract::params_from_path(
-        &path,
-        &read,
-        &ExtractOptions::default(),
-        &mut rng::stream(0, "extract"),
-    )
-    .unwrap()
+    Pipeline::from_path(path)
+        .params(&config(ex), &Silent)
+        .unwrap()
+        .0
 }
 
 /// The steady flight `formation animate --seed seed` would make (a few frames are enough: the
 /// initiation targets the first key shape and the first frame's cruise state).
 fn steady(p: &FormationParams, birds: usize, seed: u64) -> Animation {
-    let opts = SteadyOptions {
-        birds,
-        frames: 3,
+    let config = Config {
         seed,
-        ..SteadyOptions::default()
+        seconds: None,
+        steady: SteadyOptions {
+            birds,
+            frames: 3,
+            ..SteadyOptions::default()
+        },
+        ..Config::default()
     };
-    steady_flight(p, &opts, &mut rng::stream(seed, "steady"), &Silent).unwrap()
+    steady_stage(p, &config, &Silent).unwrap().0
 }
 
 fn key_points(a: &Animation) -> Vec<DVec2> {
@@ -104,7 +109,7 @@ fn run(a: &Animation, seed: u64, opts: &InitiateOptions) -> Outcome {
         h,
         v,
         opts,
-        &mut rng::stream(seed, "initiate"),
+        &mut rng::stream(seed, Stream::Initiate),
         &Silent,
     )
     .unwrap();
@@ -155,7 +160,7 @@ fn example_flocks_converge_from_random_starts() {
                     h,
                     v,
                     &opts,
-                    &mut rng::stream(seed, "initiate"),
+                    &mut rng::stream(seed, Stream::Initiate),
                     &Silent,
                 )
                 .unwrap();
@@ -223,20 +228,17 @@ fn real_key_shapes_give_followable_slot_trees() {
 /// visibility: it converges and hands over to the steady flight without a jump.
 #[test]
 fn snow_geese_j_initiates_through_the_library() {
-    let p = params(SNOW);
-    let opts = SteadyOptions {
-        birds: 28,
-        frames: 30,
-        ..SteadyOptions::default()
+    let config = Config {
+        seconds: None,
+        steady: SteadyOptions {
+            birds: 28,
+            frames: 30,
+            ..SteadyOptions::default()
+        },
+        ..config(SNOW)
     };
-    let steady = steady_flight(&p, &opts, &mut rng::stream(0, "steady"), &Silent).unwrap();
-    let (anim, stats) = initiate::initiate(
-        &steady,
-        &InitiateOptions::default(),
-        &mut rng::stream(0, "initiate"),
-        &Silent,
-    )
-    .unwrap();
+    let (anim, report) = Pipeline::from_params(params(SNOW)).run(&config).unwrap();
+    let stats = report.initiate.unwrap();
     assert!(stats.converged && stats.min_distance >= 0.25);
     let k = anim.stage("initiation").unwrap().end;
     let (a, b) = (&anim.frames[k - 1], &anim.frames[k]);
@@ -380,9 +382,15 @@ fn diagnose() {
     let a = steady(&params(ex), n, seed);
     let (t, h, v) = initiate::steady_target(&a).unwrap();
     let opts = InitiateOptions::default();
-    let mut sim =
-        initiate::start_simulation(&t, a.fps, h, v, &opts, &mut rng::stream(seed, "initiate"))
-            .unwrap();
+    let mut sim = initiate::start_simulation(
+        &t,
+        a.fps,
+        h,
+        v,
+        &opts,
+        &mut rng::stream(seed, Stream::Initiate),
+    )
+    .unwrap();
     let sp = sim.params;
     let mut held = 0;
     let mut trace: Vec<Vec<Option<usize>>> = Vec::new();

@@ -9,11 +9,10 @@ use std::path::{Path, PathBuf};
 use formation::annotations::synth::{generate, SynthSpec};
 use formation::annotations::{parse_str, ReadOptions};
 use formation::export::{write_outputs, RenderOptions};
-use formation::extract::{extract, ExtractOptions, ShapeKind};
-use formation::initiate::{self, InitiateOptions};
-use formation::keyshape::{steady_flight, SteadyOptions};
+use formation::extract::ShapeKind;
+use formation::pipeline::{extract_stage, initiate_stage, steady_stage, Config};
 use formation::progress::Silent;
-use formation::rng::{seeded, stream};
+use formation::rng::seeded;
 use formation::{Animation, Error};
 use proptest::prelude::*;
 
@@ -143,16 +142,22 @@ proptest! {
         let ann = parse_str(Path::new("movie.json"), &text, &ReadOptions::default()).unwrap();
         let dir = workdir(seed);
 
+        // The stages one by one, as `formation animate` runs them (each stage's result is
+        // checked on its own).
+        let mut config = Config { seed, seconds: None, ..Config::default() };
+        config.steady.birds = birds;
+        config.steady.frames = frames;
+        config.initiate.max_steps = 4000;
+
         // extract → params file.
-        let params = extract(&ann, &ExtractOptions::default(), &mut stream(seed, "extract")).unwrap();
+        let params = extract_stage(&ann, &config, &Silent).unwrap().0;
         let params_path = dir.join("params.json");
         formation::io::write_json_atomic(&params_path, &params).unwrap();
         assert_json_finite(&params_path);
 
         // steady → animation (may refuse a flock it cannot arrange, but only with a clean error).
-        let opts = SteadyOptions { birds, frames, seed, ..SteadyOptions::default() };
-        let steady = match steady_flight(&params, &opts, &mut stream(seed, "steady"), &Silent) {
-            Ok(a) => a,
+        let steady = match steady_stage(&params, &config, &Silent) {
+            Ok((a, _)) => a,
             Err(e @ (Error::Unreachable(_) | Error::NotConverged(_))) => {
                 eprintln!("steady refused: {e}");
                 let _ = std::fs::remove_dir_all(&dir);
@@ -163,8 +168,7 @@ proptest! {
         assert_animation_finite(&steady);
 
         // initiate → the combined animation, then wingbeats.
-        let init = InitiateOptions { seed, max_steps: 4000, ..InitiateOptions::default() };
-        let mut anim = match initiate::initiate(&steady, &init, &mut stream(seed, "initiate"), &Silent) {
+        let mut anim = match initiate_stage(&steady, &config, &Silent) {
             Ok((a, _)) => a,
             Err(Error::NotConverged(e)) => {
                 eprintln!("initiation did not converge: {e}");
@@ -172,7 +176,7 @@ proptest! {
             }
             Err(e) => panic!("initiate failed on a valid input: {e}"),
         };
-        formation::wingbeat::assign_phases(&mut anim, &Default::default()).unwrap();
+        formation::wingbeat::assign_phases(&mut anim, &config.wingbeat).unwrap();
         assert_animation_finite(&anim);
 
         // Every file writer.

@@ -1,13 +1,13 @@
 //! Shared bodies of the fuzz targets: each takes arbitrary bytes and runs exactly what the
-//! `formation` binary runs on a file of that content (see `src/cli/*.rs`), then a cheap downstream
+//! `formation` binary runs on a file of that content (the library's `pipeline` stages), then a cheap downstream
 //! consumer of whatever was accepted. Every call must return `Ok` or `Err`: a panic, a hang
 //! (libFuzzer `-timeout`) or an allocation beyond `-rss_limit_mb` is a finding.
 
 use std::path::Path;
 
 use formation::annotations::{parse_str, Format, Heading, ReadOptions};
-use formation::extract::{extract, ExtractOptions};
-use formation::rng::stream;
+use formation::pipeline::{extract_stage, steady_stage, Config};
+use formation::progress::Silent;
 
 /// The path named in messages (no file is read or written).
 pub const PATH: &str = "fuzz-input";
@@ -37,11 +37,9 @@ pub fn annotations(data: &[u8], expect: Format) {
             if ann.format != expect {
                 continue;
             }
-            let opts = ExtractOptions {
-                max_samples: 64,
-                ..ExtractOptions::default()
-            };
-            let _ = extract(&ann, &opts, &mut stream(0, "fuzz"));
+            let mut config = Config::default();
+            config.extract.max_samples = 64;
+            let _ = extract_stage(&ann, &config, &Silent);
         }
     }
 }
@@ -50,7 +48,6 @@ pub fn annotations(data: &[u8], expect: Format) {
 /// `io::parse_json` + `validate`; whatever validates drives a tiny steady flight (6 birds, 4 frames).
 pub fn params(data: &[u8]) {
     use formation::extract::params::FormationParams;
-    use formation::keyshape::{steady_flight, SteadyOptions};
     let Some(t) = text(data) else { return };
     let path = Path::new(PATH);
     let Ok(p) = formation::io::parse_json::<FormationParams>(path, t) else {
@@ -59,18 +56,14 @@ pub fn params(data: &[u8]) {
     if p.validate(path).is_err() {
         return;
     }
-    let opts = SteadyOptions {
-        birds: 6,
-        frames: 4,
-        key_every_s: 0.05,
-        ..SteadyOptions::default()
+    let mut config = Config {
+        seconds: None,
+        ..Config::default()
     };
-    let _ = steady_flight(
-        &p,
-        &opts,
-        &mut stream(0, "steady"),
-        &formation::progress::Silent,
-    );
+    config.steady.birds = 6;
+    config.steady.frames = 4;
+    config.steady.key_every_s = 0.05;
+    let _ = steady_stage(&p, &config, &Silent);
 }
 
 /// Animation file (`render`, `initiate`, `plot xi|power|paths`): `Animation::read` is
