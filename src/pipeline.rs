@@ -35,6 +35,9 @@ use crate::progress::{Progress, Silent};
 use crate::rng::{stream, Stream};
 use crate::wingbeat::{self, WingbeatOptions};
 
+/// Default length of the steady flight, seconds ([`Config::seconds`]).
+pub const DEFAULT_SECONDS: f64 = 20.0;
+
 /// Every option of a run, one section per stage. The sections are the stages' own options
 /// structs; [`Pipeline::run`] sets the derived fields (`steady.frames` from [`Config::seconds`],
 /// `steady.seed` and `initiate.seed` from [`Config::seed`]).
@@ -66,7 +69,7 @@ impl Default for Config {
     fn default() -> Self {
         Config {
             seed: 0,
-            seconds: Some(20.0),
+            seconds: Some(DEFAULT_SECONDS),
             initiation: true,
             read: ReadOptions::default(),
             extract: ExtractOptions::default(),

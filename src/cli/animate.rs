@@ -15,6 +15,7 @@ use formation::Result;
 use super::extract::ReadArgs;
 use super::initiate::InitiateFlags;
 use super::progress::TermProgress;
+use super::render::Size;
 use super::steady::SteadyFlags;
 use super::wingbeat::WingbeatFlags;
 use super::Global;
@@ -33,15 +34,16 @@ pub struct AnimateArgs {
     pub output: Vec<PathBuf>,
     /// Length of the steady flight, seconds (the initiation before it lasts as long as the flock
     /// needs to converge, typically 2–6 s).
-    #[arg(long, default_value_t = 20.0, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = formation::pipeline::DEFAULT_SECONDS, allow_negative_numbers = true)]
     pub seconds: f64,
     /// Skip the take-off: the animation is the steady flight alone.
     #[arg(long)]
     pub no_initiation: bool,
     /// Picture size WIDTHxHEIGHT in pixels (GIF and PNG frames).
-    #[arg(long, value_name = "WxH", default_value = "960x540", value_parser = super::render::parse_size)]
-    pub size: (u32, u32),
-    /// Frame rate of the pictures [default: 25 for GIF, the animation's --fps for PNG frames].
+    #[arg(long, value_name = "WxH", default_value_t = Size::of(&RenderOptions::default()), value_parser = super::render::parse_size)]
+    pub size: Size,
+    /// Frame rate of the pictures, frames per second (default: the GIF rate for GIF, the
+    /// animation's --fps for PNG frames).
     #[arg(
         long = "picture-fps",
         value_name = "FPS",
@@ -70,8 +72,8 @@ pub fn run(args: AnimateArgs, g: Global) -> Result<()> {
         initiate: args.initiate.options(args.birds)?,
         wingbeat: args.wingbeat.options()?,
         render: RenderOptions {
-            width: args.size.0,
-            height: args.size.1,
+            width: args.size.width,
+            height: args.size.height,
             fps: args.picture_fps,
             ..RenderOptions::default()
         },

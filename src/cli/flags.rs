@@ -55,6 +55,7 @@ pub const FLAGS: &[(&str, &str, &[Cmd])] = &[
     ("extract.kind", "--kind", FIT),
     ("extract.max_samples", "--max-samples", FIT),
     ("extract.j_offset", "--j-offset", FIT),
+    ("solve.tolerance", "--tolerance", &[Solve]),
     ("seconds", "--seconds", &[Animate]),
     ("steady.birds", "--birds", STEADY),
     ("steady.frames", "--frames", &[Steady]),

@@ -42,71 +42,81 @@ pub struct InitiateArgs {
     pub json: bool,
 }
 
-/// Initiation flags shared by `initiate` and `animate`.
+/// Initiation flags shared by `initiate` and `animate` (the `initiate` section of the library's
+/// `Config`; defaults from `InitiateOptions::default()`, angles shown in degrees).
 #[derive(Debug, Clone, Args)]
 pub struct InitiateFlags {
     /// Step limit (one step = one frame); no convergence within it fails with exit 1.
-    #[arg(long, default_value_t = 9000)]
+    #[arg(long, default_value_t = InitiateOptions::default().max_steps)]
     pub max_steps: usize,
     /// Occlusion model.
-    #[arg(long, value_enum, default_value_t = PerceptionArg::Hpr)]
+    #[arg(long, value_enum, default_value_t = PerceptionArg::of(InitiateOptions::default().perception.mode))]
     pub perception: PerceptionArg,
-    /// HPR radius exponent γ: R = (distance of the farthest bird) · 10^γ.
+    /// HPR radius exponent γ: R = (distance of the farthest bird) · 10^γ, dimensionless.
     #[arg(long, default_value_t = HPR_GAMMA_DEFAULT)]
     pub hpr_gamma: f64,
     /// Visual field per eye, degrees from straight ahead (paper: 90); widened when the key shape
-    /// needs it for a bird to see its reference from its slot (docs/initiation.md).
-    #[arg(long, default_value_t = 90.0)]
+    /// needs it (see docs/initiation.md).
+    #[arg(long, default_value_t = InitiateOptions::default().perception.fov_per_eye.to_degrees())]
     pub fov: f64,
     /// Cone per eye in which the closest visible bird is the preferred reference, degrees
-    /// (paper: 0.35π = 63).
-    #[arg(long, default_value_t = 63.0)]
+    /// (paper: 0.35π).
+    #[arg(long, default_value_t = InitiateOptions::default().perception.reference_cone.to_degrees())]
     pub reference_cone: f64,
-    /// α of eq. (6) (heading gain).
-    #[arg(long, default_value_t = 0.2)]
+    /// α of eq. (6) (heading gain), dimensionless.
+    #[arg(long, default_value_t = InitiateOptions::default().alpha)]
     pub alpha: f64,
-    /// |K| of eq. (5) (speed gain).
-    #[arg(long, default_value_t = 0.06)]
+    /// |K| of eq. (5) (speed gain), per √wingspan.
+    #[arg(long, default_value_t = InitiateOptions::default().k)]
     pub k: f64,
     /// Maximum turn rate, degrees per second.
-    #[arg(long, default_value_t = 90.0)]
+    #[arg(long, default_value_t = InitiateOptions::default().max_turn_rate.to_degrees())]
     pub max_turn_rate: f64,
-    /// Maximum acceleration, wingspans per second squared [default: 4].
-    #[arg(long)]
-    pub max_accel: Option<f64>,
-    /// Minimum flight speed, fraction of the cruise speed [default: 0.5].
-    #[arg(long)]
-    pub min_speed: Option<f64>,
-    /// Maximum flight speed, fraction of the cruise speed [default: 1.6].
-    #[arg(long)]
-    pub max_speed: Option<f64>,
-    /// Separation drive distance, wingspans [default: 10, as in the paper].
-    #[arg(long)]
-    pub separation: Option<f64>,
-    /// Collision avoidance: predicted closest approach that triggers evasion, wingspans
-    /// [default: 0.8].
-    #[arg(long)]
-    pub avoid_distance: Option<f64>,
-    /// Convergence: every bird within this distance of its slot, wingspans [default: 0.1].
-    #[arg(long)]
-    pub tolerance: Option<f64>,
-    /// Convergence: for this long, seconds (also the hand-over blend window) [default: 1].
-    #[arg(long)]
-    pub hold: Option<f64>,
+    /// Maximum acceleration, wingspans per second squared.
+    #[arg(long, default_value_t = InitiateOptions::default().max_accel)]
+    pub max_accel: f64,
+    /// Minimum flight speed, fraction of the cruise speed.
+    #[arg(long, default_value_t = InitiateOptions::default().min_speed)]
+    pub min_speed: f64,
+    /// Maximum flight speed, fraction of the cruise speed.
+    #[arg(long, default_value_t = InitiateOptions::default().max_speed)]
+    pub max_speed: f64,
+    /// Separation drive distance, wingspans (the paper's).
+    #[arg(long, default_value_t = InitiateOptions::default().separation_distance)]
+    pub separation: f64,
+    /// Collision avoidance: predicted closest approach that triggers evasion, wingspans.
+    #[arg(long, default_value_t = InitiateOptions::default().avoid_distance)]
+    pub avoid_distance: f64,
+    /// Convergence: every bird within this distance of its slot, wingspans.
+    #[arg(long, default_value_t = InitiateOptions::default().tolerance)]
+    pub tolerance: f64,
+    /// Convergence: for this long, seconds (also the hand-over blend window).
+    #[arg(long, default_value_t = InitiateOptions::default().hold)]
+    pub hold: f64,
     /// Start file: JSON {"x": [...], "y": [...], "heading": [...], "speed": [...]} (world frame,
     /// wingspans, radians clockwise from north, wingspans per second; heading and speed optional).
     #[arg(long, conflicts_with_all = ["start_width", "start_depth", "heading_spread"])]
     pub start: Option<PathBuf>,
-    /// Width of the random start region across the cruise heading, wingspans
-    /// (default 30, or 6√N for large flocks).
+    /// Width of the random start region across the cruise heading, wingspans (default: grows
+    /// with the flock, see docs/initiation.md).
     #[arg(long)]
     pub start_width: Option<f64>,
     /// Depth of the random start region along the cruise heading, wingspans (default: the width).
     #[arg(long)]
     pub start_depth: Option<f64>,
     /// Start headings are uniform within this many degrees of the cruise heading (180: any).
-    #[arg(long, default_value_t = 180.0)]
+    #[arg(long, default_value_t = StartRegion::default().heading_spread.to_degrees())]
     pub heading_spread: f64,
+}
+
+impl PerceptionArg {
+    /// The flag value of a library perception mode.
+    pub fn of(mode: PerceptionMode) -> PerceptionArg {
+        match mode {
+            PerceptionMode::Hpr { .. } => PerceptionArg::Hpr,
+            PerceptionMode::Exact => PerceptionArg::Exact,
+        }
+    }
 }
 
 impl InitiateFlags {
@@ -118,6 +128,13 @@ impl InitiateFlags {
             alpha: self.alpha,
             k: self.k,
             max_turn_rate: self.max_turn_rate.to_radians(),
+            max_accel: self.max_accel,
+            min_speed: self.min_speed,
+            max_speed: self.max_speed,
+            separation_distance: self.separation,
+            avoid_distance: self.avoid_distance,
+            tolerance: self.tolerance,
+            hold: self.hold,
             ..Default::default()
         };
         o.perception.fov_per_eye = self.fov.to_radians();
@@ -128,18 +145,6 @@ impl InitiateFlags {
             },
             PerceptionArg::Exact => PerceptionMode::Exact,
         };
-        let set = |field: &mut f64, v: Option<f64>| {
-            if let Some(v) = v {
-                *field = v;
-            }
-        };
-        set(&mut o.max_accel, self.max_accel);
-        set(&mut o.min_speed, self.min_speed);
-        set(&mut o.max_speed, self.max_speed);
-        set(&mut o.separation_distance, self.separation);
-        set(&mut o.avoid_distance, self.avoid_distance);
-        set(&mut o.tolerance, self.tolerance);
-        set(&mut o.hold, self.hold);
         o.start = match &self.start {
             Some(path) => Start::Given(StartState::read(path, birds)?),
             None => Start::Random(StartRegion {
@@ -156,6 +161,7 @@ impl InitiateFlags {
 /// Runs `formation initiate`.
 pub fn run(args: InitiateArgs, g: Global) -> Result<()> {
     let wingbeat = args.wingbeat.options()?;
+    wingbeat.validate()?;
     formation::export::plan_outputs(&args.output)?;
     let steady = Animation::read(&args.steady)?;
     initiate::check_steady(&steady, &args.steady)?;

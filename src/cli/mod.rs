@@ -26,7 +26,7 @@ pub struct Cli {
     #[arg(long, short = 'q', global = true)]
     quiet: bool,
     /// Seed of every random draw; equal seeds and inputs give byte-identical outputs.
-    #[arg(long, global = true, default_value_t = 0)]
+    #[arg(long, global = true, default_value_t = formation::pipeline::Config::default().seed)]
     seed: u64,
 }
 

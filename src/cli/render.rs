@@ -26,15 +26,15 @@ pub struct RenderArgs {
 #[derive(Debug, Clone, Args)]
 pub struct PictureArgs {
     /// Picture size WIDTHxHEIGHT in pixels (GIF and PNG frames), each side 16..=7680.
-    #[arg(long, value_name = "WxH", default_value = "960x540", value_parser = parse_size)]
-    pub size: (u32, u32),
-    /// Frame rate of the pictures, frames per second [default: 25 for GIF (rounded to whole
-    /// 1/100 s per frame, at most 50), the animation's own rate for PNG frames]. JSON, CSV and glTF
+    #[arg(long, value_name = "WxH", default_value_t = Size::of(&RenderOptions::default()), value_parser = parse_size)]
+    pub size: Size,
+    /// Frame rate of the pictures, frames per second (default: the GIF rate, rounded to whole
+    /// 1/100 s per frame, for GIF; the animation's own rate for PNG frames). JSON, CSV and glTF
     /// keep the animation's frames.
     #[arg(long, value_name = "FPS", allow_negative_numbers = true)]
     pub fps: Option<f64>,
-    /// Bird wingspan in metres for the .glb (and recorded in the .json) [default: the
-    /// animation's, 1.5 for a goose].
+    /// Bird wingspan in metres for the .glb (and recorded in the .json) (default: the
+    /// animation's).
     #[arg(long, value_name = "M", allow_negative_numbers = true)]
     pub wingspan_m: Option<f64>,
 }
@@ -43,8 +43,8 @@ impl PictureArgs {
     /// The library options for these flags.
     pub fn options(&self) -> RenderOptions {
         RenderOptions {
-            width: self.size.0,
-            height: self.size.1,
+            width: self.size.width,
+            height: self.size.height,
             fps: self.fps,
             wingspan_m: self.wingspan_m,
             threads: 0,
@@ -52,8 +52,33 @@ impl PictureArgs {
     }
 }
 
+/// A picture size, pixels; written and parsed as `WIDTHxHEIGHT`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Size {
+    /// Width, pixels.
+    pub width: u32,
+    /// Height, pixels.
+    pub height: u32,
+}
+
+impl Size {
+    /// The size of `opts`.
+    pub fn of(opts: &RenderOptions) -> Size {
+        Size {
+            width: opts.width,
+            height: opts.height,
+        }
+    }
+}
+
+impl std::fmt::Display for Size {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}x{}", self.width, self.height)
+    }
+}
+
 /// Parses `960x540`.
-pub fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
+pub fn parse_size(s: &str) -> std::result::Result<Size, String> {
     let (w, h) = s
         .split_once(['x', 'X'])
         .ok_or_else(|| format!("expected WIDTHxHEIGHT like 960x540, got {s:?}"))?;
@@ -75,7 +100,10 @@ pub fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
         }
         other => other.to_string(),
     })?;
-    Ok((w, h))
+    Ok(Size {
+        width: w,
+        height: h,
+    })
 }
 
 /// Runs `formation render`.

@@ -19,8 +19,8 @@ pub struct SolveArgs {
     /// Output shape (.json).
     #[arg(short = 'o', long = "output")]
     pub output: PathBuf,
-    /// Converged means ‖ξ − ξ̂‖₂ at most this.
-    #[arg(long, default_value_t = 1e-9)]
+    /// Converged means ‖ξ − ξ̂‖₂ at most this, dimensionless.
+    #[arg(long, default_value_t = SolveOptions::default().tolerance)]
     pub tolerance: f64,
     /// Write the shape even when the solver does not converge (the exit code is still 1).
     #[arg(long)]
@@ -50,14 +50,12 @@ struct Solved {
 /// Runs `formation solve`.
 pub fn run(args: SolveArgs, _g: Global) -> Result<()> {
     OutputKind::from_path(&args.output, &[OutputKind::Json])?;
-    if !(args.tolerance.is_finite() && args.tolerance > 0.0) {
-        return Err(Error::parameter("--tolerance", "must be a positive number"));
-    }
-    let target: Target = formation::io::read_json(&args.target)?;
     let opts = SolveOptions {
         tolerance: args.tolerance,
         ..SolveOptions::default()
     };
+    opts.validate()?;
+    let target: Target = formation::io::read_json(&args.target)?;
     let rep = solve(&target.x, &target.xi, target.y.as_deref(), &opts)
         .map_err(|e| in_file(&args.target, e))?;
     if !rep.converged && !args.keep_unconverged {

@@ -42,44 +42,33 @@ pub struct SteadyArgs {
     pub report: Option<PathBuf>,
 }
 
-/// Steady-flight flags shared by `steady` and `animate`.
+/// Steady-flight flags shared by `steady` and `animate` (the `steady` section of the library's
+/// `Config`; defaults from `SteadyOptions::default()`).
 #[derive(Debug, Clone, Args)]
 pub struct SteadyFlags {
     /// Frames per second of the animation.
-    #[arg(long, default_value_t = 30.0, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = SteadyOptions::default().fps, allow_negative_numbers = true)]
     pub fps: f64,
     /// Time between key shapes, seconds.
-    #[arg(
-        long = "key-every",
-        default_value_t = 3.0,
-        allow_negative_numbers = true
-    )]
+    #[arg(long = "key-every", default_value_t = SteadyOptions::default().key_every_s, allow_negative_numbers = true)]
     pub key_every: f64,
     /// Cruise speed of the flock, wingspans per second.
-    #[arg(long, default_value_t = 10.0, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = SteadyOptions::default().speed, allow_negative_numbers = true)]
     pub speed: f64,
     /// ε of eq. (2): widening of each bird's ξ range, in [0, 0.5].
-    #[arg(long, default_value_t = 0.1, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = SteadyOptions::default().epsilon, allow_negative_numbers = true)]
     pub epsilon: f64,
     /// C1 of eq. (2): smallest step ratio of ξ between key shapes, in [0.5, 1].
-    #[arg(long, default_value_t = 0.85, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = SteadyOptions::default().c1, allow_negative_numbers = true)]
     pub c1: f64,
     /// C2 of eq. (2): largest step ratio of ξ between key shapes, in [1, 2].
-    #[arg(long, default_value_t = 1.15, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = SteadyOptions::default().c2, allow_negative_numbers = true)]
     pub c2: f64,
     /// Wingspan of one bird, metres (recorded in the animation; used by the .glb export).
-    #[arg(
-        long = "wingspan-m",
-        default_value_t = 1.5,
-        allow_negative_numbers = true
-    )]
+    #[arg(long = "wingspan-m", default_value_t = SteadyOptions::default().wingspan_m, allow_negative_numbers = true)]
     pub wingspan_m: f64,
     /// Largest move of a bird between consecutive key shapes, wingspans.
-    #[arg(
-        long = "max-jump",
-        default_value_t = 0.5,
-        allow_negative_numbers = true
-    )]
+    #[arg(long = "max-jump", default_value_t = SteadyOptions::default().max_jump, allow_negative_numbers = true)]
     pub max_jump: f64,
 }
 

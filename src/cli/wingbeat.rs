@@ -13,7 +13,7 @@ use super::Global;
 #[derive(Debug, Args)]
 pub struct PlotWingbeatArgs {
     /// Species preset: goose, crane or pelican.
-    #[arg(long, default_value = "goose")]
+    #[arg(long, default_value_t = Species::default().to_string())]
     pub species: String,
     /// Output chart (.png or .svg).
     #[arg(short = 'o', long = "output")]
@@ -27,40 +27,36 @@ pub fn run_plot_wingbeat(args: PlotWingbeatArgs, _g: Global) -> Result<()> {
 }
 
 /// Wingbeat flags shared by `steady`, `initiate` and `animate` (the wing phases written into the
-/// animation file and drawn by the renderers).
+/// animation file and drawn by the renderers; the `wingbeat` section of the library's `Config`,
+/// defaults from `WingbeatOptions::default()`). Names are parsed by the library, whose messages
+/// list the valid ones.
 #[derive(Debug, Clone, Args)]
 pub struct WingbeatFlags {
     /// Species preset of the wingbeat (frequency, amplitudes, downstroke fraction): goose, crane
     /// or pelican.
-    #[arg(long, default_value = "goose")]
+    #[arg(long, default_value_t = WingbeatOptions::default().species.to_string())]
     pub species: String,
     /// Phase relation between birds: `locked` (followers flap with a lag that tracks their
     /// streamwise distance to the bird ahead, Portugal et al. 2014) or `independent`.
-    #[arg(long, default_value = "locked", value_name = "locked|independent")]
+    #[arg(long, default_value_t = WingbeatOptions::default().phase_mode.to_string(), value_name = "locked|independent")]
     pub phase: String,
     /// Gliding: `off` (continuous flapping), `bouts` (flap-gliding) or `always`.
-    #[arg(long, default_value = "off", value_name = "off|bouts|always")]
+    #[arg(long, default_value_t = WingbeatOptions::default().glide.to_string(), value_name = "off|bouts|always")]
     pub glide: String,
     /// Scale of the per-bird and per-wingbeat variation: 0 = identical birds, 1 = default.
-    #[arg(
-        long = "wing-variation",
-        default_value_t = 1.0,
-        allow_negative_numbers = true
-    )]
+    #[arg(long = "wing-variation", default_value_t = WingbeatOptions::default().variation, allow_negative_numbers = true)]
     pub variation: f64,
 }
 
 impl WingbeatFlags {
-    /// The validated library options.
+    /// The library options (names parsed here; numbers validated by the library).
     pub fn options(&self) -> Result<WingbeatOptions> {
-        let opts = WingbeatOptions {
+        Ok(WingbeatOptions {
             species: self.species.parse::<Species>()?,
             phase_mode: self.phase.parse::<PhaseMode>()?,
             glide: self.glide.parse::<Glide>()?,
             variation: self.variation,
             ..WingbeatOptions::default()
-        };
-        opts.validate()?;
-        Ok(opts)
+        })
     }
 }

@@ -60,6 +60,19 @@ impl Default for SolveOptions {
     }
 }
 
+impl SolveOptions {
+    /// Checks the options; errors name the option path (`solve.tolerance`).
+    pub fn validate(&self) -> Result<()> {
+        if !(self.tolerance.is_finite() && self.tolerance > 0.0) {
+            return Err(Error::parameter(
+                "solve.tolerance",
+                "must be a positive number",
+            ));
+        }
+        Ok(())
+    }
+}
+
 /// Outcome of a solve. Non-convergence is not an error: read `converged`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SolveReport {
