@@ -95,7 +95,7 @@ pub fn check_finite(name: &str, v: f64) -> Result<f64> {
     }
 }
 
-/// Kind of output, chosen by the `-o` path's extension (or a trailing `/` / existing directory).
+/// Kind of output, chosen by the output path's extension (or a trailing `/` / existing directory).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum OutputKind {
     /// `.json`
@@ -139,7 +139,7 @@ impl OutputKind {
         match kind {
             Some(k) if allowed.contains(&k) => Ok(k),
             _ => Err(Error::parameter(
-                "-o",
+                "output",
                 format!(
                     "{}: cannot tell the output format from this name; use one of: {}",
                     path.display(),

@@ -43,11 +43,27 @@ const STEADY: &[Cmd] = &[Steady, Animate];
 const INITIATE: &[Cmd] = &[Initiate, Animate];
 const WINGBEAT: &[Cmd] = &[Steady, Initiate, Animate];
 const PICTURES: &[Cmd] = &[Render, Animate];
+const ALL: &[Cmd] = &[
+    Extract,
+    Power,
+    Solve,
+    Steady,
+    Initiate,
+    Animate,
+    Render,
+    PlotPower,
+    PlotXi,
+    PlotShape,
+    PlotPaths,
+    PlotWingbeat,
+];
 
 /// (option path, flag, commands that have the flag). A path may appear several times with
 /// different flags for different commands (`steady.frames` is `--frames` of `steady` but
 /// `--seconds` of `animate`, which derives the frame count from the length).
 pub const FLAGS: &[(&str, &str, &[Cmd])] = &[
+    // The output files (`export::write_outputs`' `outputs`, `io::OutputKind`).
+    ("output", "-o", ALL),
     ("read.heading", "--heading", READ),
     ("read.wingspan_px", "--wingspan-px", READ),
     ("read.y_origin", "--y-origin", READ),
@@ -115,11 +131,28 @@ pub const FLAGS: &[(&str, &str, &[Cmd])] = &[
 
 /// `text` with every option path that `cmd` has a flag for replaced by the flag. A path is
 /// replaced only as a whole word (`steady.c1` is not found in `steady.c10`); longer paths first,
-/// so that `render.width/render.height` becomes one `--size`.
+/// so that `render.width/render.height` becomes one `--size`. Paths without a dot (`seconds`,
+/// `output`) are ordinary words in running text, so they are replaced only in an error's name
+/// ([`rewrite_name`]).
 pub fn rewrite(cmd: Cmd, text: &str) -> String {
+    replace_paths(cmd, text, true)
+}
+
+/// An error's name: the whole name may also be a top-level path without a dot.
+pub fn rewrite_name(cmd: Cmd, name: &str) -> String {
+    match FLAGS
+        .iter()
+        .find(|(p, _, cmds)| *p == name && cmds.contains(&cmd))
+    {
+        Some((_, f, _)) => f.to_string(),
+        None => replace_paths(cmd, name, true),
+    }
+}
+
+fn replace_paths(cmd: Cmd, text: &str, dotted_only: bool) -> String {
     let mut paths: Vec<(&str, &str)> = FLAGS
         .iter()
-        .filter(|(_, _, cmds)| cmds.contains(&cmd))
+        .filter(|(p, _, cmds)| cmds.contains(&cmd) && (!dotted_only || p.contains('.')))
         .map(|(p, f, _)| (*p, *f))
         .collect();
     paths.sort_by_key(|(p, _)| std::cmp::Reverse(p.len()));
@@ -159,7 +192,7 @@ pub fn rewrite(cmd: Cmd, text: &str) -> String {
 pub fn name_flags(cmd: Cmd, e: Error) -> Error {
     match e {
         Error::Parameter { name, message } => Error::Parameter {
-            name: rewrite(cmd, &name),
+            name: rewrite_name(cmd, &name),
             message: rewrite(cmd, &message),
         },
         Error::Format { path, message } => Error::Format {
@@ -183,6 +216,12 @@ mod tests {
             "--frames: 0; lower --frames."
         );
         assert_eq!(rewrite(Animate, "steady.frames: x"), "--seconds: x");
+        assert_eq!(rewrite_name(Animate, "seconds"), "--seconds");
+        assert_eq!(
+            rewrite(Animate, "a number of seconds, got 1"),
+            "a number of seconds, got 1"
+        );
+        assert_eq!(rewrite_name(Render, "output"), "-o");
         assert_eq!(rewrite(Animate, "render.fps: 3"), "--picture-fps: 3");
         assert_eq!(rewrite(Render, "render.fps: 3"), "--fps: 3");
         assert_eq!(

@@ -53,45 +53,45 @@ pub struct InitiateFlags {
     #[arg(long, value_enum, default_value_t = PerceptionArg::of(InitiateOptions::default().perception.mode))]
     pub perception: PerceptionArg,
     /// HPR radius exponent γ: R = (distance of the farthest bird) · 10^γ, dimensionless.
-    #[arg(long, default_value_t = HPR_GAMMA_DEFAULT)]
+    #[arg(long, default_value_t = HPR_GAMMA_DEFAULT, allow_negative_numbers = true)]
     pub hpr_gamma: f64,
     /// Visual field per eye, degrees from straight ahead (paper: 90); widened when the key shape
     /// needs it (see docs/initiation.md).
-    #[arg(long, default_value_t = InitiateOptions::default().perception.fov_per_eye.to_degrees())]
+    #[arg(long, default_value_t = InitiateOptions::default().perception.fov_per_eye.to_degrees(), allow_negative_numbers = true)]
     pub fov: f64,
     /// Cone per eye in which the closest visible bird is the preferred reference, degrees
     /// (paper: 0.35π).
-    #[arg(long, default_value_t = InitiateOptions::default().perception.reference_cone.to_degrees())]
+    #[arg(long, default_value_t = InitiateOptions::default().perception.reference_cone.to_degrees(), allow_negative_numbers = true)]
     pub reference_cone: f64,
     /// α of eq. (6) (heading gain), dimensionless.
-    #[arg(long, default_value_t = InitiateOptions::default().alpha)]
+    #[arg(long, default_value_t = InitiateOptions::default().alpha, allow_negative_numbers = true)]
     pub alpha: f64,
     /// |K| of eq. (5) (speed gain), per √wingspan.
-    #[arg(long, default_value_t = InitiateOptions::default().k)]
+    #[arg(long, default_value_t = InitiateOptions::default().k, allow_negative_numbers = true)]
     pub k: f64,
     /// Maximum turn rate, degrees per second.
-    #[arg(long, default_value_t = InitiateOptions::default().max_turn_rate.to_degrees())]
+    #[arg(long, default_value_t = InitiateOptions::default().max_turn_rate.to_degrees(), allow_negative_numbers = true)]
     pub max_turn_rate: f64,
     /// Maximum acceleration, wingspans per second squared.
-    #[arg(long, default_value_t = InitiateOptions::default().max_accel)]
+    #[arg(long, default_value_t = InitiateOptions::default().max_accel, allow_negative_numbers = true)]
     pub max_accel: f64,
     /// Minimum flight speed, fraction of the cruise speed.
-    #[arg(long, default_value_t = InitiateOptions::default().min_speed)]
+    #[arg(long, default_value_t = InitiateOptions::default().min_speed, allow_negative_numbers = true)]
     pub min_speed: f64,
     /// Maximum flight speed, fraction of the cruise speed.
-    #[arg(long, default_value_t = InitiateOptions::default().max_speed)]
+    #[arg(long, default_value_t = InitiateOptions::default().max_speed, allow_negative_numbers = true)]
     pub max_speed: f64,
     /// Separation drive distance, wingspans (the paper's).
-    #[arg(long, default_value_t = InitiateOptions::default().separation_distance)]
+    #[arg(long, default_value_t = InitiateOptions::default().separation_distance, allow_negative_numbers = true)]
     pub separation: f64,
     /// Collision avoidance: predicted closest approach that triggers evasion, wingspans.
-    #[arg(long, default_value_t = InitiateOptions::default().avoid_distance)]
+    #[arg(long, default_value_t = InitiateOptions::default().avoid_distance, allow_negative_numbers = true)]
     pub avoid_distance: f64,
     /// Convergence: every bird within this distance of its slot, wingspans.
-    #[arg(long, default_value_t = InitiateOptions::default().tolerance)]
+    #[arg(long, default_value_t = InitiateOptions::default().tolerance, allow_negative_numbers = true)]
     pub tolerance: f64,
     /// Convergence: for this long, seconds (also the hand-over blend window).
-    #[arg(long, default_value_t = InitiateOptions::default().hold)]
+    #[arg(long, default_value_t = InitiateOptions::default().hold, allow_negative_numbers = true)]
     pub hold: f64,
     /// Start file: JSON {"x": [...], "y": [...], "heading": [...], "speed": [...]} (world frame,
     /// wingspans, radians clockwise from north, wingspans per second; heading and speed optional).
@@ -99,13 +99,13 @@ pub struct InitiateFlags {
     pub start: Option<PathBuf>,
     /// Width of the random start region across the cruise heading, wingspans (default: grows
     /// with the flock, see docs/initiation.md).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub start_width: Option<f64>,
     /// Depth of the random start region along the cruise heading, wingspans (default: the width).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub start_depth: Option<f64>,
     /// Start headings are uniform within this many degrees of the cruise heading (180: any).
-    #[arg(long, default_value_t = StartRegion::default().heading_spread.to_degrees())]
+    #[arg(long, default_value_t = StartRegion::default().heading_spread.to_degrees(), allow_negative_numbers = true)]
     pub heading_spread: f64,
 }
 

@@ -20,7 +20,7 @@ pub struct SolveArgs {
     #[arg(short = 'o', long = "output")]
     pub output: PathBuf,
     /// Converged means ‖ξ − ξ̂‖₂ at most this, dimensionless.
-    #[arg(long, default_value_t = SolveOptions::default().tolerance)]
+    #[arg(long, default_value_t = SolveOptions::default().tolerance, allow_negative_numbers = true)]
     pub tolerance: f64,
     /// Write the shape even when the solver does not converge (the exit code is still 1).
     #[arg(long)]

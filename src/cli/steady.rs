@@ -107,7 +107,11 @@ pub fn run(args: SteadyArgs, g: Global) -> Result<()> {
     config.wingbeat.validate()?;
     formation::export::plan_outputs(&args.output)?;
     if let Some(r) = &args.report {
-        OutputKind::from_path(r, &[OutputKind::Json])?;
+        // The report is not an `-o` output: name its own flag.
+        OutputKind::from_path(r, &[OutputKind::Json]).map_err(|e| match e {
+            Error::Parameter { message, .. } => Error::parameter("--report", message),
+            other => other,
+        })?;
     }
     let params = read_params(&args.params)?;
     let progress = TermProgress::new(g.quiet);

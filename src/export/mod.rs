@@ -140,8 +140,8 @@ pub struct Output {
 pub fn plan_outputs(outputs: &[PathBuf]) -> Result<Vec<Output>> {
     if outputs.is_empty() {
         return Err(Error::parameter(
-            "-o",
-            "no output given; add e.g. -o flock.gif",
+            "output",
+            "no output given; add one, e.g. flock.gif",
         ));
     }
     let mut seen = BTreeSet::new();
@@ -153,9 +153,9 @@ pub fn plan_outputs(outputs: &[PathBuf]) -> Result<Vec<Output>> {
             let t = s.trim_end_matches(['/', std::path::MAIN_SEPARATOR]);
             if t.is_empty() || p.file_name().is_none() || t.ends_with("..") {
                 return Err(Error::parameter(
-                    "-o",
+                    "output",
                     format!(
-                        "{}: name a frames directory to create or replace, e.g. -o frames/",
+                        "{}: name a frames directory to create or replace, e.g. frames/",
                         p.display()
                     ),
                 ));
@@ -166,7 +166,7 @@ pub fn plan_outputs(outputs: &[PathBuf]) -> Result<Vec<Output>> {
         };
         if !seen.insert(path.clone()) {
             return Err(Error::parameter(
-                "-o",
+                "output",
                 format!("{}: given twice", path.display()),
             ));
         }
@@ -176,7 +176,7 @@ pub fn plan_outputs(outputs: &[PathBuf]) -> Result<Vec<Output>> {
         };
         if !parent.is_dir() {
             return Err(Error::parameter(
-                "-o",
+                "output",
                 format!(
                     "{}: directory {} does not exist; create it first",
                     path.display(),
