@@ -316,3 +316,111 @@ pub fn initiate_stage(
         progress,
     )
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn geese() -> PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("examples_data/barnacle_geese_v.json")
+    }
+
+    fn small() -> Config {
+        let mut c = Config {
+            seed: 3,
+            seconds: Some(1.0),
+            ..Config::default()
+        };
+        c.steady.birds = 7;
+        c
+    }
+
+    #[test]
+    fn every_input_gives_the_same_animation() {
+        let config = small();
+        let (a, rep) = Pipeline::from_path(geese()).run(&config).unwrap();
+        assert_eq!(rep.extract.len(), 20);
+        let ann = crate::annotations::read(&geese(), &config.read).unwrap();
+        let (b, _) = Pipeline::from_annotations(ann.clone())
+            .run(&config)
+            .unwrap();
+        assert_eq!(a, b);
+        let (params, _) = extract_stage(&ann, &config, &Silent).unwrap();
+        let (c, rep) = Pipeline::from_params(params).run(&config).unwrap();
+        assert_eq!(a, c);
+        assert!(rep.extract.is_empty());
+        assert_eq!(a.birds, 7);
+        assert_eq!(a.stage("steady").map(|s| s.end - s.start), Some(30));
+        assert!(rep.initiate.is_some_and(|s| s.converged));
+    }
+
+    #[test]
+    fn points_in_memory_are_annotations() {
+        let frames: Vec<Vec<[f64; 2]>> = (0..2)
+            .map(|f| {
+                (0..7)
+                    .map(|i| {
+                        let rank = ((i + 1) / 2) as f64;
+                        let side = if i % 2 == 1 { 1.0 } else { -1.0 };
+                        [100.0 + side * 30.0 * rank + f as f64, 50.0 + 20.0 * rank]
+                    })
+                    .collect()
+            })
+            .collect();
+        let ann =
+            Annotations::from_points("memory", crate::annotations::Heading::Up, 32.0, &frames)
+                .unwrap();
+        assert_eq!(ann.bird_count(), 7);
+        let (p, _) = extract_stage(&ann, &small(), &Silent).unwrap();
+        assert!(p
+            .frames
+            .iter()
+            .all(|f| f.shape.kind() == "v" && f.outliers.is_empty()));
+        let mut bad = frames.clone();
+        bad[1][3] = [f64::NAN, 0.0];
+        let e = Annotations::from_points("memory", crate::annotations::Heading::Up, 32.0, &bad)
+            .unwrap_err()
+            .to_string();
+        assert_eq!(e, "memory: frames[1][3]: not a finite number");
+    }
+
+    #[test]
+    fn config_round_trips_through_json_and_rejects_typos() {
+        let mut c = small();
+        c.initiate.perception.mode = crate::initiate::PerceptionMode::Exact;
+        c.wingbeat.species = crate::wingbeat::Species::Crane;
+        let text = serde_json::to_string(&c).unwrap();
+        let back: Config = serde_json::from_str(&text).unwrap();
+        assert_eq!(back, c);
+        let partial: Config = serde_json::from_str(r#"{"steady": {"birds": 12}}"#).unwrap();
+        assert_eq!(partial.steady.birds, 12);
+        assert_eq!(partial.steady.fps, SteadyOptions::default().fps);
+        assert!(serde_json::from_str::<Config>(r#"{"steady": {"bird": 12}}"#).is_err());
+    }
+
+    #[test]
+    fn errors_name_option_paths() {
+        let mut c = small();
+        c.seconds = Some(-1.0);
+        assert!(c
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .starts_with("seconds: "));
+        let mut c = small();
+        c.steady.fps = 0.0;
+        assert!(c
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .starts_with("steady.fps: "));
+        let mut c = small();
+        c.initiate.max_turn_rate = -1.0;
+        let e = c.validate().unwrap_err().to_string();
+        assert!(e.starts_with("initiate.max_turn_rate: "), "{e}");
+        let mut c = small();
+        c.wingbeat.variation = 9.0;
+        let e = c.validate().unwrap_err().to_string();
+        assert!(e.starts_with("wingbeat.variation: "), "{e}");
+    }
+}

@@ -185,6 +185,61 @@ pub struct Annotations {
 }
 
 impl Annotations {
+    /// Annotations built from points in memory, checked and resolved exactly as a file of the
+    /// native format would be (SPEC §4.1): `frames[k]` holds the image positions `[x, y]` of the
+    /// birds marked in frame `k`, pixels, x right and y down; `heading` is the flock's flight
+    /// direction in the image; `wingspan_px` the scale, pixels per wingspan. Bird ids are
+    /// assigned by lateral order and matched across frames, as for a file without ids. `source`
+    /// describes the footage and names the annotations in messages.
+    pub fn from_points(
+        source: &str,
+        heading: Heading,
+        wingspan_px: f64,
+        frames: &[Vec<[f64; 2]>],
+    ) -> Result<Annotations> {
+        let path = Path::new(source);
+        for (k, birds) in frames.iter().enumerate() {
+            if let Some(i) = birds
+                .iter()
+                .position(|p| !(p[0].is_finite() && p[1].is_finite()))
+            {
+                return Err(Error::format(
+                    path,
+                    format!("frames[{k}][{i}]: not a finite number"),
+                ));
+            }
+        }
+        let raw = RawAnnotations {
+            format: Format::Native,
+            source: Some(source.to_string()),
+            heading: Some(heading),
+            wingspan_px: Some(wingspan_px),
+            y_up: false,
+            is_csv: false,
+            frames: frames
+                .iter()
+                .enumerate()
+                .map(|(k, birds)| RawFrame {
+                    index: k as i64,
+                    image: None,
+                    wingspan_px: None,
+                    at: format!("frames[{k}]"),
+                    birds: birds
+                        .iter()
+                        .enumerate()
+                        .map(|(i, p)| RawBird {
+                            id: None,
+                            x: p[0],
+                            y: p[1],
+                            at: format!("frames[{k}][{i}]"),
+                        })
+                        .collect(),
+                })
+                .collect(),
+        };
+        finish(path, raw, &ReadOptions::default())
+    }
+
     /// Number of distinct bird ids over all frames (N̂).
     pub fn bird_count(&self) -> usize {
         let mut ids: Vec<usize> = self
