@@ -7,8 +7,9 @@ use std::path::Path;
 
 use crate::error::{Error, Result};
 
-/// Format tag of animation files.
-pub const ANIMATION_FORMAT: &str = "formation-animation/1";
+pub mod wing;
+
+pub use crate::sniff::ANIMATION_FORMAT;
 
 /// A whole animation: stages, key shapes and per-frame state of every bird.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -29,7 +30,7 @@ pub struct Animation {
     /// Options the wingbeats were assigned with (`wingbeat::assign_phases`), if any; renderers
     /// rebuild the same wingbeats from them.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub wingbeat: Option<crate::wingbeat::WingbeatOptions>,
+    pub wingbeat: Option<wing::WingbeatOptions>,
     /// Named frame ranges, `start` inclusive, `end` exclusive.
     pub stages: Vec<Stage>,
     /// Key shapes of the steady flight, formation frame.
@@ -123,17 +124,10 @@ impl Animation {
         let text = crate::io::read_text(path)?;
         let a: Animation = crate::io::parse_json(path, &text).map_err(|e| {
             // A structure error on another kind of file: say what the file is instead.
-            let tag = serde_json::from_str::<serde_json::Value>(&text).ok().map(|v| {
-                match v.get("format").and_then(|f| f.as_str()) {
-                    Some(t) => format!("a \"{t}\" file"),
-                    None if v.get("birds").is_some_and(|b| b.is_array()) => "a shape file".into(),
-                    None => "no \"format\" field".into(),
-                }
-            });
-            match tag {
-                Some(found) if !found.contains(ANIMATION_FORMAT) => Error::format(
+            match crate::sniff::text_kind(&text) {
+                Some(kind) if kind != crate::sniff::Kind::Animation => Error::format(
                     path,
-                    format!("not an animation file ({found}, expected \"format\": \"{ANIMATION_FORMAT}\"); write one with `formation steady` or `formation animate`"),
+                    format!("not an animation file ({}, expected \"format\": \"{ANIMATION_FORMAT}\"); write one with `formation steady` or `formation animate`", kind.describe()),
                 ),
                 _ => e,
             }

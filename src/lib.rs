@@ -43,6 +43,7 @@ pub mod plot;
 pub mod progress;
 pub mod rng;
 pub mod shape;
+pub mod sniff;
 pub mod wingbeat;
 
 pub use animation::Animation;

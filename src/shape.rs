@@ -3,6 +3,7 @@
 
 use serde::{Deserialize, Serialize};
 use std::path::Path;
+use std::str::FromStr;
 
 use crate::error::{Error, Result};
 
@@ -86,5 +87,44 @@ impl Shape {
             }
         }
         Ok(())
+    }
+}
+
+/// The shape families of §4 step 2.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ShapeKind {
+    /// Two lines meeting at the leader.
+    V,
+    /// Parabola with its vertex near the flock's centre.
+    U,
+    /// Parabola with its vertex well off the centre (one arm longer).
+    J,
+    /// One straight line (echelon, line abreast).
+    Line,
+}
+
+impl ShapeKind {
+    /// `"v"`, `"u"`, `"j"` or `"line"`, as in the params file.
+    pub fn name(self) -> &'static str {
+        match self {
+            ShapeKind::V => "v",
+            ShapeKind::U => "u",
+            ShapeKind::J => "j",
+            ShapeKind::Line => "line",
+        }
+    }
+}
+
+impl FromStr for ShapeKind {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Self, Self::Err> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "v" => Ok(ShapeKind::V),
+            "u" => Ok(ShapeKind::U),
+            "j" => Ok(ShapeKind::J),
+            "line" | "echelon" => Ok(ShapeKind::Line),
+            _ => Err(format!("`{s}` is not a shape kind; use v, u, j or line")),
+        }
     }
 }

@@ -313,7 +313,7 @@ fn detect_text(path: &Path, text: &str) -> Result<Format> {
                 "top level: expected a JSON object with \"frames\" (native) or \"shapes\" (Labelme)",
             )
         })?;
-        if obj.get("format").and_then(|f| f.as_str()) == Some(crate::extract::PARAMS_FORMAT) {
+        if crate::sniff::json_kind(&v) == crate::sniff::Kind::Params {
             return Err(Error::format(
                 path,
                 "this is a params file written by `formation extract`, not annotations",

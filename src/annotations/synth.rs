@@ -11,7 +11,7 @@ use rand::Rng;
 use rand_distr::{Distribution, Normal};
 use serde_json::json;
 
-use crate::extract::ShapeKind;
+use crate::shape::ShapeKind;
 
 /// What to generate. Lengths in wingspans unless the name ends in `_px`.
 #[derive(Debug, Clone, PartialEq)]

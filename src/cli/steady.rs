@@ -134,17 +134,13 @@ pub fn run(args: SteadyArgs, g: Global) -> Result<()> {
 /// Reads a params file, telling other `formation` files apart before serde's field errors.
 pub fn read_params(path: &Path) -> Result<FormationParams> {
     let value: serde_json::Value = formation::io::read_json(path)?;
-    let tag = value.get("format").and_then(|f| f.as_str());
-    if tag != Some(formation::extract::params::PARAMS_FORMAT) {
-        let found = match tag {
-            Some(t) => format!("a \"{t}\" file"),
-            None if value.get("birds").is_some_and(|b| b.is_array()) => "a shape file".into(),
-            None => "no \"format\" field".into(),
-        };
+    let kind = formation::sniff::json_kind(&value);
+    if kind != formation::sniff::Kind::Params {
         return Err(Error::format(
             path,
             format!(
-                "not a formation params file ({found}, expected \"format\": \"{}\"); write one with `formation extract ANNOTATIONS -o params.json`",
+                "not a formation params file ({}, expected \"format\": \"{}\"); write one with `formation extract ANNOTATIONS -o params.json`",
+                kind.describe(),
                 formation::extract::params::PARAMS_FORMAT
             ),
         ));
@@ -193,8 +189,7 @@ pub fn run_plot_power(args: PlotPowerArgs, _g: Global) -> Result<()> {
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
     let value: serde_json::Value = formation::io::read_json(&args.input)?;
-    let is_animation = value.get("format").and_then(|f| f.as_str())
-        == Some(formation::animation::ANIMATION_FORMAT);
+    let is_animation = formation::sniff::json_kind(&value) == formation::sniff::Kind::Animation;
     let chart = if is_animation {
         let anim = Animation::read(&args.input)?;
         let (x, e, xi, what) = match args.frame {

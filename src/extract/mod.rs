@@ -33,8 +33,6 @@
 pub mod params;
 pub mod ransac;
 
-use std::str::FromStr;
-
 use rand::Rng;
 use serde::{Deserialize, Serialize};
 
@@ -45,31 +43,9 @@ use crate::error::{Error, Result};
 use crate::progress::Progress;
 use ransac::{Line, Model, Parabola, RansacOptions};
 
-/// The shape families of §4 step 2.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum ShapeKind {
-    /// Two lines meeting at the leader.
-    V,
-    /// Parabola with its vertex near the flock's centre.
-    U,
-    /// Parabola with its vertex well off the centre (one arm longer).
-    J,
-    /// One straight line (echelon, line abreast).
-    Line,
-}
+pub use crate::shape::ShapeKind;
 
 impl ShapeKind {
-    /// `"v"`, `"u"`, `"j"` or `"line"`, as in the params file.
-    pub fn name(self) -> &'static str {
-        match self {
-            ShapeKind::V => "v",
-            ShapeKind::U => "u",
-            ShapeKind::J => "j",
-            ShapeKind::Line => "line",
-        }
-    }
-
     /// The kind of a fitted model.
     pub fn of(m: &ShapeModel) -> ShapeKind {
         match m {
@@ -77,19 +53,6 @@ impl ShapeKind {
             ShapeModel::U { .. } => ShapeKind::U,
             ShapeModel::J { .. } => ShapeKind::J,
             ShapeModel::Line { .. } => ShapeKind::Line,
-        }
-    }
-}
-
-impl FromStr for ShapeKind {
-    type Err = String;
-    fn from_str(s: &str) -> std::result::Result<Self, Self::Err> {
-        match s.trim().to_ascii_lowercase().as_str() {
-            "v" => Ok(ShapeKind::V),
-            "u" => Ok(ShapeKind::U),
-            "j" => Ok(ShapeKind::J),
-            "line" | "echelon" => Ok(ShapeKind::Line),
-            _ => Err(format!("`{s}` is not a shape kind; use v, u, j or line")),
         }
     }
 }
@@ -176,18 +139,9 @@ impl FrameReport {
 
 /// Tells a params file (`"format": "formation-params/1"`) from annotations, by content.
 pub fn is_params_file(text: &str) -> bool {
-    let t = text.trim_start_matches('\u{feff}').trim_start();
-    if !t.starts_with('{') || !t.contains(PARAMS_FORMAT) {
-        return false;
-    }
-    serde_json::from_str::<serde_json::Value>(t)
-        .ok()
-        .and_then(|v| {
-            v.get("format")
-                .and_then(|f| f.as_str())
-                .map(|f| f == PARAMS_FORMAT)
-        })
-        .unwrap_or(false)
+    // Cheap first: most inputs are annotations, which never carry the tag.
+    text.contains(PARAMS_FORMAT)
+        && crate::sniff::text_kind(text) == Some(crate::sniff::Kind::Params)
 }
 
 /// Formation parameters from `path`, whatever it holds: a params file written by `extract` is

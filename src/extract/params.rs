@@ -7,8 +7,7 @@ use std::path::Path;
 
 use crate::error::{Error, Result};
 
-/// Format tag of params files.
-pub const PARAMS_FORMAT: &str = "formation-params/1";
+pub use crate::sniff::PARAMS_FORMAT;
 
 /// Parameters of a whole annotated movie.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -2,40 +2,10 @@
 //! the glide pose and the flap-glide bout lengths of the birds the tool animates. Sources and the
 //! status of every number (measured, or an estimate) are tabulated in `docs/wingbeat.md`.
 
-use std::fmt;
-use std::str::FromStr;
-
-use serde::{Deserialize, Serialize};
-
 use super::kinematics::{Stroke, Strokes, Timing};
-use crate::error::{Error, Result};
-
-/// A species whose wingbeat the tool knows.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Species {
-    /// Canada goose (*Branta canadensis*), the default.
-    #[default]
-    Goose,
-    /// Common crane (*Grus grus*).
-    Crane,
-    /// Pelican (brown pelican, *Pelecanus occidentalis*).
-    Pelican,
-}
+use crate::animation::wing::Species;
 
 impl Species {
-    /// Every species, in documentation order.
-    pub const ALL: [Species; 3] = [Species::Goose, Species::Crane, Species::Pelican];
-
-    /// The lowercase name used on the command line and in animation files.
-    pub fn name(&self) -> &'static str {
-        match self {
-            Species::Goose => "goose",
-            Species::Crane => "crane",
-            Species::Pelican => "pelican",
-        }
-    }
-
     /// The preset of this species.
     pub fn preset(&self) -> SpeciesPreset {
         match self {
@@ -110,29 +80,6 @@ impl Species {
                 accel_ref_mps2: 0.8,
             },
         }
-    }
-}
-
-impl fmt::Display for Species {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl FromStr for Species {
-    type Err = Error;
-
-    fn from_str(s: &str) -> Result<Species> {
-        let t = s.trim().to_ascii_lowercase();
-        Species::ALL
-            .into_iter()
-            .find(|sp| sp.name() == t)
-            .ok_or_else(|| {
-                Error::parameter(
-                    "wingbeat.species",
-                    format!("unknown species \"{s}\": expected goose, crane or pelican"),
-                )
-            })
     }
 }
 
