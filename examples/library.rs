@@ -31,9 +31,11 @@ fn main() -> formation::Result<()> {
         .collect();
     let annotations = Annotations::from_points("hand-marked geese", Heading::Up, 40.0, &frames)?;
 
-    let mut config = Config::default();
-    config.seed = 7;
-    config.seconds = Some(6.0);
+    let mut config = Config {
+        seed: 7,
+        seconds: Some(6.0),
+        ..Config::default()
+    };
     config.steady.birds = 14;
     let (animation, report) = Pipeline::from_annotations(annotations).run(&config)?;
 
