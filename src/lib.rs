@@ -10,9 +10,29 @@
 //! initiation + steady flight ─render─▶ GIF · PNG frames · glTF (.glb) · CSV · JSON · plots
 //! ```
 //!
+//! One call runs it all: [`pipeline::Pipeline`] takes annotations (a file, or points in memory
+//! via [`annotations::Annotations::from_points`]) or formation parameters, and
+//! [`pipeline::Pipeline::run`] gives the [`Animation`] and a report of every stage, with every
+//! option in one serde-ready [`pipeline::Config`]. `examples/library.rs` goes from points to a
+//! `.glb` in a few lines; `docs/architecture.md` describes the design.
+//!
+//! Layers: each uses only those below it, and no two top-level modules depend on each other.
+//!
+//! ```text
+//! pipeline      pipeline (Config, Pipeline, one function per stage)
+//!                  │
+//! stages        extract (§4) · keyshape (§5, with aero) · initiate (§6) · wingbeat · export · plot
+//!                  │
+//! data types    annotations · extract::params · shape · animation (+ animation::wing) · sniff
+//!                  │
+//! foundation    error · io · limits · finite · rng · progress
+//! ```
+//!
 //! | stage | module |
 //! |---|---|
+//! | the whole chain, its options | [`pipeline`] |
 //! | reading annotations (every input format) | [`annotations`] |
+//! | telling formation's files apart | [`sniff`] |
 //! | §4 parameter extraction, RANSAC | [`extract`] |
 //! | §5 step 2, Hummel's power-reduction model | [`aero`] |
 //! | §5 steps 1–4, key shapes and steady flight | [`keyshape`] |
@@ -20,6 +40,10 @@
 //! | wingbeats (Wu & Popović) | [`wingbeat`] |
 //! | GIF, PNG, glTF, CSV, JSON | [`export`] |
 //! | charts | [`plot`] |
+//!
+//! Library code never prints or exits; errors are [`Error`] values naming the option path
+//! (`steady.fps`) or the file, frame and bird at fault. The `formation` binary (feature `cli`, on
+//! by default) maps option paths to its flags.
 //!
 //! Conventions (SPEC §2): lengths in wingspans; formation frame `x` right of the flight direction,
 //! `y` behind the leader; world frame `x` east, `y` north, `z` up, cruise heading +y.

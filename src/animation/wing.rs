@@ -136,7 +136,7 @@ impl fmt::Display for Glide {
 }
 
 /// Options of the wingbeat stage. Stored in the animation file (`"wingbeat"`) by
-/// [`assign_phases`] so that renderers rebuild the same wingbeats.
+/// `wingbeat::assign_phases` so that renderers rebuild the same wingbeats.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct WingbeatOptions {
