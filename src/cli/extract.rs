@@ -252,26 +252,11 @@ pub fn run_plot_shape(args: PlotShapeArgs, g: Global) -> Result<()> {
         let (_, p, _) = read_and_extract(&args.input, &args.read, &args.fit, g)?;
         (p, Some(args.fit.threshold))
     };
-    let frame = match args.frame {
-        None => params.frames.first(),
-        Some(k) => params.frames.iter().find(|f| f.index == k),
-    }
-    .ok_or_else(|| {
-        let lo = params.frames.first().map(|f| f.index).unwrap_or(0);
-        let hi = params.frames.last().map(|f| f.index).unwrap_or(0);
-        Error::parameter(
-            "--frame",
-            format!(
-                "no frame {} in {} (frames {lo}..={hi})",
-                args.frame.unwrap_or(0),
-                args.input.display()
-            ),
-        )
-    })?;
-    let chart = formation::plot::shape::ShapeChart {
-        frame: frame.clone(),
-        source: params.source.clone(),
+    let chart = formation::plot::shape::ShapeChart::from_params(
+        &params,
+        args.frame,
         threshold,
-    };
+        &args.input,
+    )?;
     formation::plot::save(&chart, &args.output)
 }

@@ -127,6 +127,9 @@ pub const FLAGS: &[(&str, &str, &[Cmd])] = &[
     ("render.fps", "--fps", &[Render]),
     ("render.fps", "--picture-fps", &[Animate]),
     ("render.wingspan_m", "--wingspan-m", &[Render]),
+    // Chart selections (`plot::power::PowerOf`, `plot::shape::ShapeChart::from_params`).
+    ("plot.key", "--key", &[PlotPower]),
+    ("plot.frame", "--frame", &[PlotPower, PlotShape]),
 ];
 
 /// `text` with every option path that `cmd` has a flag for replaced by the flag. A path is

@@ -4,13 +4,12 @@
 use std::path::{Path, PathBuf};
 
 use clap::{Args, ValueEnum};
-use formation::aero::power_reduction;
 use formation::animation::Animation;
 use formation::extract::params::FormationParams;
 use formation::io::{write_json_atomic, OutputKind};
 use formation::keyshape::SteadyOptions;
 use formation::pipeline::{steady_stage, Config};
-use formation::plot::power::{PowerChart, PowerMetric};
+use formation::plot::power::{PowerChart, PowerMetric, PowerOf};
 use formation::plot::xi::XiChart;
 use formation::shape::Shape;
 use formation::{Error, Result};
@@ -183,81 +182,15 @@ pub fn run_plot_power(args: PlotPowerArgs, _g: Global) -> Result<()> {
         MetricArg::Xi => PowerMetric::Xi,
         MetricArg::E => PowerMetric::E,
     };
-    let name = args
-        .input
-        .file_name()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default();
     let value: serde_json::Value = formation::io::read_json(&args.input)?;
     let is_animation = formation::sniff::json_kind(&value) == formation::sniff::Kind::Animation;
     let chart = if is_animation {
         let anim = Animation::read(&args.input)?;
-        let (x, e, xi, what) = match args.frame {
-            Some(k) => {
-                let fr = anim.frames.get(k).ok_or_else(|| {
-                    Error::parameter(
-                        "--frame",
-                        format!(
-                            "{k}: {} has {} frames (0..{})",
-                            args.input.display(),
-                            anim.frames.len(),
-                            anim.frames.len().saturating_sub(1)
-                        ),
-                    )
-                })?;
-                let (e, xi) = match (&fr.e, &fr.xi) {
-                    (Some(e), Some(xi)) => (e.clone(), xi.clone()),
-                    _ => {
-                        // World → formation frame for a flock heading +y: y behind = −north.
-                        let back: Vec<f64> = fr.y.iter().map(|v| -v).collect();
-                        let p = power_reduction(&fr.x, &back)?;
-                        (p.e, p.xi)
-                    }
-                };
-                (fr.x.clone(), e, xi, format!("frame {k}"))
-            }
-            None => {
-                let k = args.key.unwrap_or(0);
-                let ks = anim.key_shapes.get(k).ok_or_else(|| {
-                    Error::parameter(
-                        "--key",
-                        format!(
-                            "{k}: {} has {} key shape(s); use --frame for an animation without key shapes",
-                            args.input.display(),
-                            anim.key_shapes.len()
-                        ),
-                    )
-                })?;
-                let x: Vec<f64> = ks.birds.iter().map(|b| b.x).collect();
-                let y: Vec<f64> = ks.birds.iter().map(|b| b.y).collect();
-                let p = power_reduction(&x, &y)?;
-                (x, p.e, p.xi, format!("key shape {k} (frame {})", ks.frame))
-            }
+        let of = match (args.frame, args.key) {
+            (Some(k), _) => PowerOf::Frame(k),
+            (None, k) => PowerOf::Key(k.unwrap_or(0)),
         };
-        let leader = if args.frame.is_none() {
-            anim.key_shapes
-                .get(args.key.unwrap_or(0))
-                .and_then(|ks| {
-                    ks.birds
-                        .iter()
-                        .enumerate()
-                        .min_by(|a, b| a.1.y.total_cmp(&b.1.y))
-                })
-                .map(|(i, _)| i)
-        } else {
-            None
-        };
-        PowerChart {
-            title: format!("{name}: {what}"),
-            values: match metric {
-                PowerMetric::Xi => xi,
-                PowerMetric::E => e,
-            },
-            x,
-            metric,
-            ranges: anim.xi_ranges.clone(),
-            leader,
-        }
+        PowerChart::from_animation(&anim, &args.input, of, metric)?
     } else {
         if args.key.is_some() || args.frame.is_some() {
             return Err(Error::parameter(
@@ -273,18 +206,7 @@ pub fn run_plot_power(args: PlotPowerArgs, _g: Global) -> Result<()> {
             &serde_json::to_string(&value).map_err(|e| Error::Internal(e.to_string()))?,
         )?;
         shape.validate(&args.input, 2)?;
-        let p = power_reduction(&shape.xs(), &shape.ys())?;
-        PowerChart {
-            title: format!("{name}: E = {:.4}", p.total),
-            x: shape.xs(),
-            values: match metric {
-                PowerMetric::Xi => p.xi,
-                PowerMetric::E => p.e,
-            },
-            metric,
-            ranges: None,
-            leader: shape.leader(),
-        }
+        PowerChart::from_shape(&shape, &args.input, metric)?
     };
     formation::plot::save(&chart, &args.output)
 }
@@ -303,54 +225,6 @@ pub struct PlotXiArgs {
 pub fn run_plot_xi(args: PlotXiArgs, _g: Global) -> Result<()> {
     OutputKind::from_path(&args.output, &[OutputKind::Png, OutputKind::Svg])?;
     let anim = Animation::read(&args.input)?;
-    let n = anim.birds;
-    let mut xi = vec![Vec::with_capacity(anim.frames.len()); n];
-    let mut any = false;
-    for fr in &anim.frames {
-        let values = match &fr.xi {
-            Some(v) => Some(v.clone()),
-            None => {
-                let back: Vec<f64> = fr.y.iter().map(|v| -v).collect();
-                power_reduction(&fr.x, &back).ok().map(|p| p.xi)
-            }
-        };
-        any |= values.is_some();
-        for (i, series) in xi.iter_mut().enumerate() {
-            series.push(
-                values
-                    .as_ref()
-                    .and_then(|v| v.get(i).copied())
-                    .unwrap_or(f64::NAN),
-            );
-        }
-    }
-    if !any {
-        return Err(Error::format(
-            &args.input,
-            "no frame has a defined ξ (every frame has birds inside each other's downwash)",
-        ));
-    }
-    let lateral = anim
-        .key_shapes
-        .first()
-        .map(|k| k.birds.iter().map(|b| b.x).collect())
-        .or_else(|| anim.frames.first().map(|f| f.x.clone()))
-        .unwrap_or_default();
-    let name = args
-        .input
-        .file_name()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let chart = XiChart {
-        title: format!("{name}: ξ of {n} birds over time"),
-        t: anim.frames.iter().map(|f| f.t).collect(),
-        xi,
-        lateral,
-        key_times: anim
-            .key_shapes
-            .iter()
-            .filter_map(|k| anim.frames.get(k.frame).map(|f| f.t))
-            .collect(),
-    };
+    let chart = XiChart::from_animation(&anim, &args.input)?;
     formation::plot::save(&chart, &args.output)
 }

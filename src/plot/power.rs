@@ -5,7 +5,13 @@
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use std::path::Path;
+
 use super::{Chart, DrawResult, FONT_FAMILY};
+use crate::aero::power_reduction;
+use crate::animation::Animation;
+use crate::error::{Error, Result};
+use crate::shape::Shape;
 
 /// Which quantity the bars show.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -31,6 +37,119 @@ pub struct PowerChart {
     pub ranges: Option<Vec<[f64; 2]>>,
     /// Index of the leader, drawn in a distinct colour.
     pub leader: Option<usize>,
+}
+
+/// What part of an animation a [`PowerChart`] shows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PowerOf {
+    /// Key shape `k` (index into `key_shapes`), with the feasible ranges.
+    Key(usize),
+    /// Frame `k`, in the formation frame of a flock heading +y.
+    Frame(usize),
+}
+
+/// The file name of `origin`, for titles.
+fn file_name(origin: &Path) -> String {
+    origin
+        .file_name()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default()
+}
+
+impl PowerChart {
+    /// The chart of one key shape or frame of `anim`, read from `origin` (named in the title and
+    /// in messages). A frame without stored e and ξ gets them from Hummel's model. Errors name
+    /// `plot.key` or `plot.frame`.
+    pub fn from_animation(
+        anim: &Animation,
+        origin: &Path,
+        of: PowerOf,
+        metric: PowerMetric,
+    ) -> Result<PowerChart> {
+        let name = file_name(origin);
+        let (x, e, xi, what) = match of {
+            PowerOf::Frame(k) => {
+                let fr = anim.frames.get(k).ok_or_else(|| {
+                    Error::parameter(
+                        "plot.frame",
+                        format!(
+                            "{k}: {} has {} frames (0..{})",
+                            origin.display(),
+                            anim.frames.len(),
+                            anim.frames.len().saturating_sub(1)
+                        ),
+                    )
+                })?;
+                let (e, xi) = match (&fr.e, &fr.xi) {
+                    (Some(e), Some(xi)) => (e.clone(), xi.clone()),
+                    _ => {
+                        // World → formation frame for a flock heading +y: y behind = −north.
+                        let back: Vec<f64> = fr.y.iter().map(|v| -v).collect();
+                        let p = power_reduction(&fr.x, &back)?;
+                        (p.e, p.xi)
+                    }
+                };
+                (fr.x.clone(), e, xi, format!("frame {k}"))
+            }
+            PowerOf::Key(k) => {
+                let ks = anim.key_shapes.get(k).ok_or_else(|| {
+                Error::parameter(
+                    "plot.key",
+                    format!(
+                        "{k}: {} has {} key shape(s); use plot.frame for an animation without key shapes",
+                        origin.display(),
+                        anim.key_shapes.len()
+                    ),
+                )
+            })?;
+                let x: Vec<f64> = ks.birds.iter().map(|b| b.x).collect();
+                let y: Vec<f64> = ks.birds.iter().map(|b| b.y).collect();
+                let p = power_reduction(&x, &y)?;
+                (x, p.e, p.xi, format!("key shape {k} (frame {})", ks.frame))
+            }
+        };
+        let leader = if let PowerOf::Key(k) = of {
+            anim.key_shapes
+                .get(k)
+                .and_then(|ks| {
+                    ks.birds
+                        .iter()
+                        .enumerate()
+                        .min_by(|a, b| a.1.y.total_cmp(&b.1.y))
+                })
+                .map(|(i, _)| i)
+        } else {
+            None
+        };
+        Ok(PowerChart {
+            title: format!("{name}: {what}"),
+            values: match metric {
+                PowerMetric::Xi => xi,
+                PowerMetric::E => e,
+            },
+            x,
+            metric,
+            ranges: anim.xi_ranges.clone(),
+            leader,
+        })
+    }
+
+    /// The chart of a shape file's shape (already validated), read from `origin`.
+    pub fn from_shape(shape: &Shape, origin: &Path, metric: PowerMetric) -> Result<PowerChart> {
+        let name = file_name(origin);
+        let p = power_reduction(&shape.xs(), &shape.ys())?;
+        Ok(PowerChart {
+            title: format!("{name}: E = {:.4}", p.total),
+            x: shape.xs(),
+            values: match metric {
+                PowerMetric::Xi => p.xi,
+                PowerMetric::E => p.e,
+            },
+            metric,
+            ranges: None,
+            leader: shape.leader(),
+        })
+    }
 }
 
 impl Chart for PowerChart {

@@ -6,7 +6,8 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::{Chart, DrawResult, FONT_FAMILY};
-use crate::extract::{slope_at, FrameParams, ShapeModel};
+use crate::error::{Error, Result};
+use crate::extract::{slope_at, FormationParams, FrameParams, ShapeModel};
 
 /// The chart of one frame's fit.
 #[derive(Debug, Clone)]
@@ -17,6 +18,40 @@ pub struct ShapeChart {
     pub source: String,
     /// Inlier threshold, wingspans, when known: drawn as a band around the curve.
     pub threshold: Option<f64>,
+}
+
+impl ShapeChart {
+    /// The chart of the frame with index `frame` (the first frame when `None`) of `params`, read
+    /// from `origin` (named in messages); `threshold` is the inlier band, wingspans, when known.
+    /// A frame that is not there is an error naming `plot.frame`.
+    pub fn from_params(
+        params: &FormationParams,
+        frame: Option<i64>,
+        threshold: Option<f64>,
+        origin: &std::path::Path,
+    ) -> Result<ShapeChart> {
+        let found = match frame {
+            None => params.frames.first(),
+            Some(k) => params.frames.iter().find(|f| f.index == k),
+        }
+        .ok_or_else(|| {
+            let lo = params.frames.first().map(|f| f.index).unwrap_or(0);
+            let hi = params.frames.last().map(|f| f.index).unwrap_or(0);
+            Error::parameter(
+                "plot.frame",
+                format!(
+                    "no frame {} in {} (frames {lo}..={hi})",
+                    frame.unwrap_or(0),
+                    origin.display()
+                ),
+            )
+        })?;
+        Ok(ShapeChart {
+            frame: found.clone(),
+            source: params.source.clone(),
+            threshold,
+        })
+    }
 }
 
 const INLIER: RGBColor = RGBColor(31, 119, 180);

@@ -7,7 +7,12 @@ use plotters::coord::Shift;
 use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 
+use std::path::Path;
+
 use super::{Chart, DrawResult, FONT_FAMILY};
+use crate::aero::power_reduction;
+use crate::animation::Animation;
+use crate::error::{Error, Result};
 
 /// ξ of every bird over time.
 #[derive(Debug, Clone)]
@@ -22,6 +27,62 @@ pub struct XiChart {
     pub lateral: Vec<f64>,
     /// Times of the key shapes, seconds.
     pub key_times: Vec<f64>,
+}
+
+impl XiChart {
+    /// ξ of every bird of `anim` (read from `origin`, named in the title and in messages) over
+    /// time; frames without stored ξ get it from Hummel's model, and frames where it is undefined
+    /// (birds inside each other's downwash) are gaps.
+    pub fn from_animation(anim: &Animation, origin: &Path) -> Result<XiChart> {
+        let n = anim.birds;
+        let mut xi = vec![Vec::with_capacity(anim.frames.len()); n];
+        let mut any = false;
+        for fr in &anim.frames {
+            let values = match &fr.xi {
+                Some(v) => Some(v.clone()),
+                None => {
+                    let back: Vec<f64> = fr.y.iter().map(|v| -v).collect();
+                    power_reduction(&fr.x, &back).ok().map(|p| p.xi)
+                }
+            };
+            any |= values.is_some();
+            for (i, series) in xi.iter_mut().enumerate() {
+                series.push(
+                    values
+                        .as_ref()
+                        .and_then(|v| v.get(i).copied())
+                        .unwrap_or(f64::NAN),
+                );
+            }
+        }
+        if !any {
+            return Err(Error::format(
+                origin,
+                "no frame has a defined ξ (every frame has birds inside each other's downwash)",
+            ));
+        }
+        let lateral = anim
+            .key_shapes
+            .first()
+            .map(|k| k.birds.iter().map(|b| b.x).collect())
+            .or_else(|| anim.frames.first().map(|f| f.x.clone()))
+            .unwrap_or_default();
+        let name = origin
+            .file_name()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        Ok(XiChart {
+            title: format!("{name}: ξ of {n} birds over time"),
+            t: anim.frames.iter().map(|f| f.t).collect(),
+            xi,
+            lateral,
+            key_times: anim
+                .key_shapes
+                .iter()
+                .filter_map(|k| anim.frames.get(k.frame).map(|f| f.t))
+                .collect(),
+        })
+    }
 }
 
 /// Blue → cyan → green → orange → red by hue, `s` in [0, 1].
