@@ -2,35 +2,11 @@
 //! reader, equal seeds give equal bytes, and bad flags fail before any work with one line and
 //! no file.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+mod support;
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_formation"))
-}
+use support::{example_arg as example, run_quiet as run, scratch};
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("formation-animate-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn example(name: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("examples_data")
-        .join(name)
-        .to_string_lossy()
-        .into_owned()
-}
-
-fn run(args: &[&str]) -> (i32, String) {
-    let out = bin().args(args).arg("--quiet").output().unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+use std::path::Path;
 
 const SMALL: [&str; 6] = ["--seconds", "2", "--size", "160x90", "--picture-fps", "10"];
 

@@ -1,37 +1,9 @@
 //! `formation power` and `formation solve` through the binary: outputs and every bad input
 //! (exit 2, one line naming the file and field, no output file left behind).
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+mod support;
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_formation"))
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir =
-        std::env::temp_dir().join(format!("formation-cli-model-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn run(args: &[&str]) -> (i32, String, String) {
-    let out = bin().args(args).output().unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
-fn example(name: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("examples_data")
-        .join(name)
-        .to_string_lossy()
-        .into_owned()
-}
+use support::{example_arg as example, run_full as run, scratch};
 
 #[test]
 fn power_table_and_json() {

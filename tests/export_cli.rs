@@ -1,42 +1,13 @@
 //! `formation render` through the built binary: outputs, exit codes, one-line messages, and no
 //! partial or truncated file after a failure.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod support;
+
+use support::{assert_usage_error, run as formation, s, scratch as tmpdir};
+
+use std::path::Path;
 
 const FIXTURE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/flock_small.json");
-
-fn formation(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_formation"))
-        .args(args)
-        .output()
-        .expect("run formation")
-}
-
-fn tmpdir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("formation-cli-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
-
-/// Exit 2, exactly one line on stderr containing every `needle`.
-fn assert_usage_error(out: &Output, needles: &[&str]) {
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "stderr: {err}");
-    assert_eq!(
-        err.trim_end().lines().count(),
-        1,
-        "one line expected: {err}"
-    );
-    for n in needles {
-        assert!(err.contains(n), "{err:?} should mention {n:?}");
-    }
-}
 
 #[test]
 fn render_writes_every_output_kind() {

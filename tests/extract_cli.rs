@@ -3,31 +3,12 @@
 //! and an existing one untouched; the examples extract to the shapes they were made with; equal
 //! seeds give byte-identical params; charts are written.
 
+mod support;
+
+use support::{examples_dir as examples, run, scratch as tmpdir};
+
 use std::fs;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_formation"))
-}
-
-fn tmpdir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!(
-        "formation-extract-cli-{}-{name}",
-        std::process::id()
-    ));
-    let _ = fs::remove_dir_all(&d);
-    fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn examples() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("examples_data")
-}
-
-fn run(args: &[&str]) -> Output {
-    bin().args(args).output().expect("run formation")
-}
+use std::path::Path;
 
 /// Runs `extract` on `content` written to `name`; asserts exit 2, a one-line message containing
 /// the file name and every `needles`, and that no output was written.

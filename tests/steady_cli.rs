@@ -1,34 +1,16 @@
 //! `formation steady`, `plot power` and `plot xi` through the built binary: outputs, determinism,
 //! and one-line exit-2 errors for bad input.
 
+mod support;
+
+use support::{assert_usage_error, data, run};
+
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_formation"))
-}
-
-fn data(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/data")
-        .join(name)
-}
 
 fn tmp(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("formation-steady-cli-{}", std::process::id()));
     std::fs::create_dir_all(&d).unwrap();
     d.join(name)
-}
-
-fn run(args: &[&str]) -> Output {
-    bin().args(args).output().unwrap()
-}
-
-fn assert_usage_error(out: &Output, needle: &str) {
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "stderr: {err}");
-    assert_eq!(err.trim_end().lines().count(), 1, "one line: {err}");
-    assert!(err.contains(needle), "{needle:?} not in {err}");
 }
 
 #[test]
@@ -158,7 +140,7 @@ fn writes_json_and_csv_and_plots() {
         "-o",
         png.to_str().unwrap(),
     ]);
-    assert_usage_error(&out, "--key");
+    assert_usage_error(&out, &["--key"]);
 }
 
 #[test]
@@ -201,7 +183,7 @@ fn bad_input_is_one_line_exit_2_and_leaves_no_file() {
         a.extend_from_slice(args);
         a.extend_from_slice(&["-o", os]);
         let out = run(&a);
-        assert_usage_error(&out, needle);
+        assert_usage_error(&out, &[needle]);
         assert!(!o.exists());
     }
     // A params file of the wrong format: an animation, a shape, broken JSON, a missing file.
@@ -230,7 +212,7 @@ fn bad_input_is_one_line_exit_2_and_leaves_no_file() {
             "-o",
             os,
         ]);
-        assert_usage_error(&out, needle);
+        assert_usage_error(&out, &[needle]);
         assert!(!o.exists());
     }
     let out = run(&[
@@ -243,5 +225,5 @@ fn bad_input_is_one_line_exit_2_and_leaves_no_file() {
         "-o",
         tmp("x.txt").to_str().unwrap(),
     ]);
-    assert_usage_error(&out, "-o");
+    assert_usage_error(&out, &["-o"]);
 }

@@ -2,8 +2,11 @@
 //! C1 blending between wingbeats, seeded determinism, spatial phase locking, accelerating and
 //! gliding birds, the renderers' replay of the stored phases, and `formation plot wingbeat`.
 
+mod support;
+
+use support::bin;
+
 use std::f64::consts::{PI, TAU};
-use std::process::Command;
 
 use formation::animation::{Animation, Frame};
 use formation::wingbeat::{
@@ -430,10 +433,6 @@ fn options_parse_and_reject_unknown_names() {
     let mut a = v_flock(2, 1.0, 30.0, |_| 10.0);
     assert!(assign_phases(&mut a, &bad).is_err());
     assert!(a.frames[0].wing_phase.is_none());
-}
-
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_formation"))
 }
 
 #[test]

@@ -159,3 +159,14 @@ pub fn sha256_hex(bytes: &[u8]) -> String {
     }
     h.iter().map(|v| format!("{v:08x}")).collect()
 }
+
+/// Runs the binary with `args`: (exit code, stdout, stderr).
+pub fn run_full(args: &[&str]) -> (i32, String, String) {
+    let out = run(args);
+    (code(&out), stdout(&out), stderr(&out))
+}
+
+/// The `examples_data/` directory.
+pub fn examples_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("examples_data")
+}
