@@ -47,12 +47,76 @@ pub struct Animation {
 /// A named range of frames.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Stage {
-    /// `"initiation"` or `"steady"`.
-    pub name: String,
+    /// `"initiation"` or `"steady"` in the file.
+    pub name: StageName,
     /// First frame, inclusive.
     pub start: usize,
     /// Last frame, exclusive.
     pub end: usize,
+}
+
+/// The name of a [`Stage`], written as its lowercase word. Names this version does not know (a
+/// file written by a later one) are kept as they are.
+#[derive(Debug, Clone, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(from = "String", into = "String")]
+pub enum StageName {
+    /// §6: from the start to the hand-over into the first key shape.
+    Initiation,
+    /// §5: the steady flight through the key shapes.
+    Steady,
+    /// Any other name.
+    Other(String),
+}
+
+impl StageName {
+    /// The name as written in the file.
+    pub fn as_str(&self) -> &str {
+        match self {
+            StageName::Initiation => "initiation",
+            StageName::Steady => "steady",
+            StageName::Other(s) => s,
+        }
+    }
+}
+
+impl From<&str> for StageName {
+    fn from(s: &str) -> StageName {
+        match s {
+            "initiation" => StageName::Initiation,
+            "steady" => StageName::Steady,
+            other => StageName::Other(other.to_string()),
+        }
+    }
+}
+
+impl From<String> for StageName {
+    fn from(s: String) -> StageName {
+        StageName::from(s.as_str())
+    }
+}
+
+impl From<StageName> for String {
+    fn from(s: StageName) -> String {
+        s.as_str().to_string()
+    }
+}
+
+impl PartialEq<str> for StageName {
+    fn eq(&self, other: &str) -> bool {
+        self.as_str() == other
+    }
+}
+
+impl PartialEq<&str> for StageName {
+    fn eq(&self, other: &&str) -> bool {
+        self.as_str() == *other
+    }
+}
+
+impl std::fmt::Display for StageName {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
 }
 
 /// A key shape placed at a frame (formation frame, wingspans).
