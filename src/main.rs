@@ -4,6 +4,7 @@
 
 mod cli;
 
+use std::io::Write;
 use std::process::ExitCode;
 
 use clap::Parser;
@@ -36,7 +37,7 @@ fn main() -> ExitCode {
                             first = format!("{first} {next}");
                         }
                     }
-                    eprintln!("{first} (see `formation --help`)");
+                    let _ = writeln!(std::io::stderr(), "{first} (see `formation --help`)");
                     ExitCode::from(2)
                 }
             };
@@ -46,7 +47,7 @@ fn main() -> ExitCode {
     match cli::run(args) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e}");
+            let _ = writeln!(std::io::stderr(), "error: {e}");
             ExitCode::from(e.exit_code())
         }
     }
