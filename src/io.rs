@@ -275,7 +275,17 @@ fn with_temp_builder<T>(
     let prefix = format!("{TEMP_PREFIX}{}-", std::process::id());
     let mut b = tempfile::Builder::new();
     b.prefix(&prefix).suffix(suffix).rand_bytes(TEMP_RANDOM_LEN);
-    make(&b)
+    make(&b).map_err(without_temp_path)
+}
+
+/// tempfile's errors append "at path …" naming the temporary; the user named the output, and
+/// messages name that, so keep the operating system's own error only.
+fn without_temp_path(e: std::io::Error) -> std::io::Error {
+    let text = e.to_string();
+    match text.find(" at path \"") {
+        Some(cut) if e.get_ref().is_some() => std::io::Error::new(e.kind(), &text[..cut]),
+        _ => e,
+    }
 }
 
 /// Creates a new temporary file in `dir`, exclusively, with an unpredictable name.

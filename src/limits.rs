@@ -29,6 +29,36 @@ pub const MAX_FRAME_PIXELS: u64 = 7680 * 4320;
 /// 1920 × 1080 at 25 fps allows about 6½ minutes; a request for a 10-GB GIF is far beyond it.
 pub const MAX_PICTURE_PIXELS: u64 = 20_000_000_000;
 
+/// Most birds in a shape or target (`power`, `solve`). `power` is quadratic in birds (10 000
+/// birds: about a second); the solve's cost is measured in `docs/performance.md`.
+pub const MAX_SHAPE_BIRDS: usize = 10_000;
+
+/// Largest coordinate in an animation file or shape, wingspans in magnitude (10⁷ wingspans is
+/// 15 000 km of 1.5 m birds): every exported number then stays well inside f32 (glTF, USD) and
+/// keeps centimetre precision.
+pub const MAX_COORDINATE: f64 = 1e7;
+
+/// Largest `wingspan_m` of an animation file, metres (a flock of 747s is 68 m).
+pub const MAX_WINGSPAN_M: f64 = 1000.0;
+
+/// Largest frame rate of an animation file, frames per second.
+pub const MAX_FPS: f64 = 10_000.0;
+
+/// Largest magnitude of other per-frame numbers of an animation file (headings and wing phases
+/// in radians, speeds in wingspans per second, savings): far beyond any flight, inside f32.
+pub const MAX_FRAME_VALUE: f64 = 1e9;
+
+/// Checks the bird count of a shape or target, naming `what`.
+pub fn check_shape_size(what: &str, birds: usize) -> crate::Result<()> {
+    if birds > MAX_SHAPE_BIRDS {
+        return Err(crate::Error::parameter(
+            what,
+            format!("{birds} birds: at most {MAX_SHAPE_BIRDS}"),
+        ));
+    }
+    Ok(())
+}
+
 /// Most birds marked in one annotated frame (matching ids across frames is cubic in this).
 pub const MAX_ANNOTATED_BIRDS: usize = 1_000;
 

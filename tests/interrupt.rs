@@ -1,5 +1,5 @@
 //! No lost files (issue 8, SPEC §4): a render interrupted mid-way by SIGTERM or SIGINT (Ctrl-C)
-//! exits non-zero (130), leaves no temporary (`.NAME.tmp-formation-PID`), never touches an
+//! exits non-zero (130), leaves no temporary (`.formation-PID-RANDOM.tmp`, `.tmpdir`), never touches an
 //! existing output (byte-identical afterwards) and creates no later output.
 //!
 //! The render is made slow on purpose (a 70-second animation as a 1280×720 GIF at 50 fps, or as
@@ -61,7 +61,7 @@ fn snapshot(dir: &Path) -> Vec<(String, Vec<u8>)> {
 fn has_temporary(dir: &Path) -> bool {
     snapshot(dir)
         .iter()
-        .any(|(name, _)| name.contains(".tmp-formation-"))
+        .any(|(name, _)| name.contains(".formation-"))
 }
 
 /// Starts `formation render` writing `output` (then `later`), waits until it is writing, sends

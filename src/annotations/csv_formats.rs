@@ -153,6 +153,8 @@ fn parse_long(path: &Path, rdr: &mut csv::Reader<&[u8]>, hdr: &[String]) -> Resu
     };
     let (cb, cw) = (col("bird"), col("wingspan_px"));
     let mut frames: Vec<RawFrame> = Vec::new();
+    // Frame index → position in `frames` (a linear search made reading quadratic in frames).
+    let mut frame_pos: std::collections::HashMap<i64, usize> = std::collections::HashMap::new();
     let mut rec = csv::StringRecord::new();
     let mut row = 0usize;
     loop {
@@ -219,9 +221,10 @@ fn parse_long(path: &Path, rdr: &mut csv::Reader<&[u8]>, hdr: &[String]) -> Resu
             Some(c) if !field(c, "wingspan_px")?.is_empty() => Some(fnum(c, "wingspan_px")?),
             _ => None,
         };
-        let pos = match frames.iter().position(|f| f.index == index) {
-            Some(p) => p,
+        let pos = match frame_pos.get(&index) {
+            Some(&p) => p,
             None => {
+                frame_pos.insert(index, frames.len());
                 frames.push(RawFrame {
                     index,
                     image: None,
