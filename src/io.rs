@@ -19,40 +19,56 @@ pub const MAX_INPUT_BYTES: u64 = 2 * 1024 * 1024 * 1024;
 /// Opens an input for reading, refusing directories and regular files over the size limit up
 /// front. Devices, FIFOs and process substitutions (`<(…)`) are read too, through a bounded
 /// reader: their size is only known once read.
-fn open_input(path: &Path) -> Result<std::io::Take<fs::File>> {
+fn open_input(path: &Path) -> Result<(std::io::Take<fs::File>, u64)> {
     let meta = fs::metadata(path).map_err(|e| Error::io(path, e))?;
     if meta.is_dir() {
         return Err(Error::format(path, "is a directory, expected a file"));
     }
-    if meta.len() > MAX_INPUT_BYTES {
-        return Err(too_big(path, Some(meta.len())));
+    let limit = if meta.is_file() {
+        MAX_INPUT_BYTES
+    } else {
+        MAX_STREAM_BYTES
+    };
+    if meta.len() > limit {
+        return Err(too_big(path, Some(meta.len()), limit));
     }
     let file = fs::File::open(path).map_err(|e| Error::io(path, e))?;
-    Ok(std::io::Read::take(file, MAX_INPUT_BYTES + 1))
+    Ok((std::io::Read::take(file, limit + 1), limit))
 }
 
-fn too_big(path: &Path, len: Option<u64>) -> Error {
-    let size = match len {
-        Some(n) => format!("{n} bytes"),
-        None => "endless or over the limit".to_string(),
-    };
-    Error::format(
-        path,
-        format!("input is {size}, more than the {MAX_INPUT_BYTES} byte limit"),
-    )
+fn too_big(path: &Path, len: Option<u64>, limit: u64) -> Error {
+    match len {
+        Some(n) => Error::format(
+            path,
+            format!("input is {n} bytes, more than the {limit} byte limit"),
+        ),
+        None if limit < MAX_INPUT_BYTES => Error::format(
+            path,
+            format!(
+                "more than {limit} bytes from a pipe or device (the limit for inputs that are \
+                 not regular files); give the file itself"
+            ),
+        ),
+        None => Error::format(path, format!("input is more than the {limit} byte limit")),
+    }
 }
 
 /// Size of the chunks inputs are read in, bytes.
 const READ_CHUNK: usize = 1 << 20;
 
+/// Upper bound on what is read from an input that is not a regular file (a pipe, a FIFO, a
+/// device, a process substitution `<(…)`), bytes: 256 MiB. Its size is only known once read, so
+/// the bound is also the memory an endless stream can take before it is refused.
+pub const MAX_STREAM_BYTES: u64 = 256 * 1024 * 1024;
+
 /// Reads a whole file as bytes, with the path in the error and a size limit that also holds for
 /// devices and pipes (`/dev/zero` is refused after 2 GiB, not read until memory runs out).
 pub fn read_bytes(path: &Path) -> Result<Vec<u8>> {
-    let mut reader = open_input(path)?;
+    let (mut reader, limit) = open_input(path)?;
     let mut buf = Vec::new();
     std::io::Read::read_to_end(&mut reader, &mut buf).map_err(|e| Error::io(path, e))?;
-    if buf.len() as u64 > MAX_INPUT_BYTES {
-        return Err(too_big(path, None));
+    if buf.len() as u64 > limit {
+        return Err(too_big(path, None, limit));
     }
     Ok(buf)
 }
@@ -61,7 +77,7 @@ pub fn read_bytes(path: &Path) -> Result<Vec<u8>> {
 /// byte, bytes that are not UTF-8: `/dev/zero`, `/dev/urandom`, an image given by mistake) is
 /// refused after the first chunk rather than after reading it all.
 pub fn read_text(path: &Path) -> Result<String> {
-    let mut reader = open_input(path)?;
+    let (mut reader, limit) = open_input(path)?;
     let mut buf: Vec<u8> = Vec::new();
     let mut chunk = vec![0u8; READ_CHUNK];
     // Bytes of `buf` known to be complete, valid UTF-8.
@@ -73,8 +89,8 @@ pub fn read_text(path: &Path) -> Result<String> {
             Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
             Err(e) => return Err(Error::io(path, e)),
         };
-        if (buf.len() + n) as u64 > MAX_INPUT_BYTES {
-            return Err(too_big(path, None));
+        if (buf.len() + n) as u64 > limit {
+            return Err(too_big(path, None, limit));
         }
         if let Some(k) = chunk[..n].iter().position(|&b| b == 0) {
             return Err(Error::format(
