@@ -97,15 +97,15 @@ impl Error {
 pub const MAX_MESSAGE_CHARS: usize = 400;
 
 /// An error message made fit for one terminal line: control characters from file content
-/// (newlines, ESC, BEL) shown as escapes, numbers of more than 17 digits (1e308 printed in full)
-/// shortened to scientific notation, and the whole cut to [`MAX_MESSAGE_CHARS`].
+/// (newlines, ESC, BEL) shown as escapes, numbers of more than 24 digits (1e308 printed in full)
+/// shortened to scientific notation (every 64-bit integer keeps its digits), and the whole cut to [`MAX_MESSAGE_CHARS`].
 pub fn one_line(message: &str) -> String {
     let mut out = String::with_capacity(message.len().min(MAX_MESSAGE_CHARS + 64));
     let mut number = String::new();
     let flush = |number: &mut String, out: &mut String| {
         let digits = number.bytes().filter(u8::is_ascii_digit).count();
         match number.parse::<f64>() {
-            Ok(v) if digits > 17 && v.is_finite() => out.push_str(&format!("{v:e}")),
+            Ok(v) if digits > 24 && v.is_finite() => out.push_str(&format!("{v:e}")),
             _ => out.push_str(number),
         }
         number.clear();
@@ -145,6 +145,10 @@ mod tests {
         let huge = format!("value {}", 1e308);
         assert_eq!(one_line(&huge), "value 1e308");
         assert_eq!(one_line("frame 12, bird 3: 0.75"), "frame 12, bird 3: 0.75");
+        assert_eq!(
+            one_line("got 18446744073709551615"),
+            "got 18446744073709551615"
+        );
         let long = one_line(&"x".repeat(10_000_000));
         assert!(
             long.chars().count() < MAX_MESSAGE_CHARS + 40,

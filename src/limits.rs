@@ -59,6 +59,11 @@ pub fn check_shape_size(what: &str, birds: usize) -> crate::Result<()> {
     Ok(())
 }
 
+/// Most RANSAC samples per model and frame (`extract --max-samples`). Each sample costs a pass
+/// over the frame's birds, so the limit bounds a frame of 1000 birds to about 3·10⁸ distance
+/// evaluations (three families), well under a second; the default is 2000.
+pub const MAX_RANSAC_SAMPLES: usize = 100_000;
+
 /// Most birds marked in one annotated frame (matching ids across frames is cubic in this).
 pub const MAX_ANNOTATED_BIRDS: usize = 1_000;
 

@@ -575,6 +575,27 @@ fn size_limits_are_refused_early() {
     );
     assert!(took < Duration::from_secs(20), "render took {took:?}");
 
+    // Native annotations with one frame of 10⁶ birds (18 MB): counted before they are parsed,
+    // refused in the memory of the text (the parsed tree would take about 1.2 GB).
+    let pts = vec!["[1,2]"; n].join(",");
+    std::fs::write(
+        dir.join("crowd.json"),
+        format!("{{\"wingspan_px\": 30, \"frames\": [{{\"index\": 0, \"birds\": [{pts}]}}]}}"),
+    )
+    .unwrap();
+    let (o, took) = run_capped(
+        &dir,
+        300_000,
+        None,
+        &["extract", "crowd.json", "-o", "p.json"],
+    );
+    assert_refused(
+        &o,
+        "crowd.json: frames[0]: more than 1000 birds marked",
+        "crowd",
+    );
+    assert!(took < Duration::from_secs(10), "crowd took {took:?}");
+
     // Values beyond f32 range in an animation file name the frame and field.
     let small = std::fs::read_to_string(data("tests/data/flock_small.json")).unwrap();
     let mut v: serde_json::Value = serde_json::from_str(&small).unwrap();

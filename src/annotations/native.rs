@@ -103,23 +103,59 @@ pub(crate) fn check_counts(path: &Path, text: &str) -> Result<()> {
         #[allow(dead_code)]
         birds: Option<Birds>,
     }
+    /// The number of frames; fails with `TOO_MANY k` at the first frame `k` over the limit.
+    struct Frames(usize);
+    impl<'de> serde::Deserialize<'de> for Frames {
+        fn deserialize<D: Deserializer<'de>>(d: D) -> std::result::Result<Frames, D::Error> {
+            struct Each;
+            impl<'de> Visitor<'de> for Each {
+                type Value = Frames;
+                fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                    f.write_str("an array of frames")
+                }
+                fn visit_seq<A: SeqAccess<'de>>(
+                    self,
+                    mut seq: A,
+                ) -> std::result::Result<Frames, A::Error> {
+                    let mut k = 0usize;
+                    loop {
+                        match seq.next_element::<Frame>() {
+                            Ok(Some(_)) => k += 1,
+                            Ok(None) => return Ok(Frames(k)),
+                            Err(e) if e.to_string().starts_with(TOO_MANY) => {
+                                return Err(serde::de::Error::custom(format!("{TOO_MANY} {k}")))
+                            }
+                            Err(e) => return Err(e),
+                        }
+                    }
+                }
+            }
+            d.deserialize_seq(Each)
+        }
+    }
     #[derive(serde::Deserialize)]
     struct File {
-        frames: Vec<Frame>,
+        frames: Frames,
     }
     match serde_json::from_str::<File>(text) {
-        Err(e) if e.to_string().starts_with(TOO_MANY) => Err(Error::format(
-            path,
-            format!(
-                "line {}: a frame with more than {MAX_ANNOTATED_BIRDS} birds marked, at most {MAX_ANNOTATED_BIRDS} per frame",
-                e.line()
-            ),
-        )),
-        Ok(f) if f.frames.len() > MAX_ANNOTATED_FRAMES => Err(Error::format(
+        Err(e) if e.to_string().starts_with(TOO_MANY) => {
+            let k = e.to_string()[TOO_MANY.len()..]
+                .split_whitespace()
+                .next()
+                .unwrap_or("?")
+                .to_string();
+            Err(Error::format(
+                path,
+                format!(
+                    "frames[{k}]: more than {MAX_ANNOTATED_BIRDS} birds marked, at most {MAX_ANNOTATED_BIRDS} per frame"
+                ),
+            ))
+        }
+        Ok(f) if f.frames.0 > MAX_ANNOTATED_FRAMES => Err(Error::format(
             path,
             format!(
                 "{} annotated frames, at most {MAX_ANNOTATED_FRAMES}; annotate a subset (a few dozen frames are plenty)",
-                f.frames.len()
+                f.frames.0
             ),
         )),
         _ => Ok(()),
