@@ -693,3 +693,34 @@ fn messages_quote_file_content_safely() {
     assert!(e.len() < 300, "{e}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Found probing further: a DLTdv header of 200 000 points was matched quadratically (minutes)
+/// before the bird limit; it is now refused while the header is read.
+#[test]
+fn a_wide_dltdv_header_is_refused_at_once() {
+    let dir = scratch("wide-dltdv");
+    let mut cols = Vec::new();
+    for n in 1..=200_000 {
+        cols.push(format!("pt{n}_cam1_X"));
+        cols.push(format!("pt{n}_cam1_Y"));
+    }
+    let ones = vec!["1"; cols.len()].join(",");
+    std::fs::write(
+        dir.join("wide.csv"),
+        format!("{}\n{ones}\n", cols.join(",")),
+    )
+    .unwrap();
+    let (o, took) = run_capped(
+        &dir,
+        1_000_000,
+        None,
+        &["extract", "wide.csv", "-o", "p.json", "--wingspan-px", "30"],
+    );
+    assert_refused(
+        &o,
+        "wide.csv: header: more than 1000 points per camera",
+        "wide header",
+    );
+    assert!(took < Duration::from_secs(10), "took {took:?}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -263,13 +263,26 @@ fn parse_dltdv(path: &Path, rdr: &mut csv::Reader<&[u8]>, hdr: &[String]) -> Res
     let cam = cols.iter().map(|c| c.1).min().unwrap_or(1);
     // (point number, x column, y column) of the chosen camera.
     let mut points: Vec<(usize, Option<usize>, Option<usize>)> = Vec::new();
+    // Point number → position in `points` (a linear search made a wide header quadratic).
+    let mut point_pos: std::collections::HashMap<usize, usize> = std::collections::HashMap::new();
     for (ci, &(n, m, is_x)) in cols.iter().enumerate() {
         if m != cam {
             continue;
         }
-        let p = match points.iter().position(|p| p.0 == n) {
-            Some(p) => p,
+        let p = match point_pos.get(&n) {
+            Some(&p) => p,
             None => {
+                if points.len() == crate::limits::MAX_ANNOTATED_BIRDS {
+                    return Err(Error::format(
+                        path,
+                        format!(
+                            "header: more than {} points per camera, at most {} birds per frame",
+                            crate::limits::MAX_ANNOTATED_BIRDS,
+                            crate::limits::MAX_ANNOTATED_BIRDS
+                        ),
+                    ));
+                }
+                point_pos.insert(n, points.len());
                 points.push((n, None, None));
                 points.len() - 1
             }
