@@ -56,6 +56,7 @@ pub fn run(args: SolveArgs, _g: Global) -> Result<()> {
     };
     opts.validate()?;
     let target: Target = formation::io::read_json(&args.target)?;
+    formation::limits::check_shape_size(&format!("{}: x", args.target.display()), target.x.len())?;
     let rep = solve(&target.x, &target.xi, target.y.as_deref(), &opts)
         .map_err(|e| in_file(&args.target, e))?;
     if !rep.converged && !args.keep_unconverged {

@@ -104,13 +104,23 @@ pub fn run(args: SteadyArgs, g: Global) -> Result<()> {
     };
     config.steady_options()?;
     config.wingbeat.validate()?;
-    formation::export::plan_outputs(&args.output)?;
+    let plan = formation::export::plan_outputs(&args.output)?;
     if let Some(r) = &args.report {
-        // The report is not an `-o` output: name its own flag.
-        OutputKind::from_path(r, &[OutputKind::Json]).map_err(|e| match e {
-            Error::Parameter { message, .. } => Error::parameter("--report", message),
-            other => other,
-        })?;
+        OutputKind::for_flag("--report", r, &[OutputKind::Json])?;
+        formation::io::check_output_dir("--report", r)?;
+        let id = formation::io::output_identity(r);
+        if plan
+            .iter()
+            .any(|o| formation::io::output_identity(&o.path) == id)
+        {
+            return Err(formation::Error::parameter(
+                "--report",
+                format!(
+                    "{}: is also given to -o; the report needs a file of its own",
+                    r.display()
+                ),
+            ));
+        }
     }
     let params = read_params(&args.params)?;
     let progress = TermProgress::new(g.quiet);
