@@ -1,8 +1,9 @@
-//! `formation animate`: the whole chain in one command (issue 6). Annotations (any format) or a
-//! params file → §4 extraction → §5 steady flight → §6 initiation → wingbeats → every output the
-//! `-o` extensions ask for. Each stage draws from its own seeded stream (`rng::stream(seed,
-//! stage)`), so `animate` gives exactly what `extract`, `steady` and `initiate` give when run one
-//! after the other with the same `--seed`.
+//! `formation animate`: the whole chain in one command (issue 6). The flags become a library
+//! `pipeline::Config`; `pipeline::Pipeline::from_path(INPUT).run_with` does annotations (any
+//! format) or a params file → §4 extraction → §5 steady flight → §6 initiation → wingbeats, and
+//! `export::write_outputs` every output the `-o` extensions ask for. Each stage draws from its own
+//! seeded stream (`rng::Stream`), so `animate` gives exactly what `extract`, `steady` and
+//! `initiate` give when run one after the other with the same `--seed`.
 
 use std::path::PathBuf;
 

@@ -1,5 +1,6 @@
-//! Command-line definitions (clap derive). Flags are parsed into plain structs, validated once,
-//! and handed to library functions that never print and never exit.
+//! Command-line definitions (clap derive) and dispatch. Flags are parsed into the library's
+//! options structs (their defaults come from those structs' `Default`), the library validates and
+//! runs, and [`flags`] turns the option paths its errors name into this command's flags.
 
 use clap::{Parser, Subcommand};
 use formation::Result;
