@@ -27,7 +27,8 @@ pub struct AnimateArgs {
     /// Number of birds to animate (N ≥ 2; any number, whatever the movie had).
     #[arg(long)]
     pub birds: usize,
-    /// Outputs by extension: .gif, DIR/ (numbered PNG frames), .glb, .csv, .json; may be repeated.
+    /// Outputs by extension: .gif, DIR/ (numbered PNG frames), .mp4, .webm (through ffmpeg), .glb,
+    /// .csv, .json; may be repeated.
     #[arg(short = 'o', long = "output", required = true)]
     pub output: Vec<PathBuf>,
     /// Length of the steady flight, seconds (the initiation before it lasts as long as the flock
@@ -47,6 +48,8 @@ pub struct AnimateArgs {
         allow_negative_numbers = true
     )]
     pub picture_fps: Option<f64>,
+    #[command(flatten)]
+    pub shot: super::render::ShotArgs,
     #[command(flatten)]
     pub read: ReadArgs,
     #[command(flatten)]
@@ -82,12 +85,13 @@ pub fn run(args: AnimateArgs, g: Global) -> Result<()> {
     let steady_opts = args.steady.options(args.birds, frames, g.seed)?;
     let init_opts = args.initiate.options(g.seed, args.birds)?;
     let wing = args.wingbeat.options()?;
-    let render = RenderOptions {
+    let mut render = RenderOptions {
         width: args.size.0,
         height: args.size.1,
         fps: args.picture_fps,
         ..RenderOptions::default()
     };
+    args.shot.apply(&mut render)?;
     render.validate()?;
     formation::export::plan_outputs(&args.output)?;
 
