@@ -12,7 +12,7 @@
 //!   the hand further about the wrist, so a wing seen from above or below spans
 //!   `L_a cos δ + L_h cos(δ + δ_h)` instead of `L_a + L_h` (foreshortening of the beat);
 //! - `sweep` turns the whole wing about the shoulder's vertical axis (forward positive);
-//! - `spread` s < 1 flexes the wrist: the hand folds back by `(1 − s) · 70°` and the arm by a
+//! - `spread` s < 1 flexes the wrist: the hand folds back by `(1 − s) · 90°` and the arm by a
 //!   third of that, so the wing shortens and narrows on the upstroke (wing flex).
 //!
 //! The bank angle φ (right wing down positive, SPEC §4.4) rolls the whole bird about `y`:
@@ -52,12 +52,12 @@ pub fn plumage(species: Species) -> Plumage {
             hand: [30, 30, 34],
             head: [40, 40, 44],
         },
-        // Brown pelican: grey-brown, darker primaries, pale head, yellowish bill.
+        // Brown pelican: grey-brown, darker primaries, pale head and a yellowish bill.
         Species::Pelican => Plumage {
             body: [96, 88, 80],
-            arm: [110, 102, 94],
+            arm: [118, 110, 100],
             hand: [46, 42, 40],
-            head: [214, 204, 178],
+            head: [206, 186, 128],
         },
     }
 }
@@ -108,8 +108,8 @@ struct Build {
 fn build(species: Species) -> Build {
     match species {
         Species::Goose => Build {
-            body_w: 0.055,
-            body_back: -0.16,
+            body_w: 0.07,
+            body_back: -0.19,
             body_front: 0.14,
             neck: 0.17,
             neck_w: 0.018,
@@ -121,13 +121,13 @@ fn build(species: Species) -> Build {
             tail_w0: 0.035,
             tail_w1: 0.025,
             legs: 0.0,
-            arm_chord: 0.15,
-            wrist_chord: 0.12,
+            arm_chord: 0.2,
+            wrist_chord: 0.17,
             arm_frac: 0.45,
             fingers: false,
         },
         Species::Crane => Build {
-            body_w: 0.045,
+            body_w: 0.055,
             body_back: -0.13,
             body_front: 0.11,
             neck: 0.27,
@@ -140,28 +140,28 @@ fn build(species: Species) -> Build {
             tail_w0: 0.03,
             tail_w1: 0.02,
             legs: 0.3,
-            arm_chord: 0.16,
-            wrist_chord: 0.13,
+            arm_chord: 0.2,
+            wrist_chord: 0.18,
             arm_frac: 0.5,
             fingers: true,
         },
         Species::Pelican => Build {
-            body_w: 0.065,
-            body_back: -0.15,
+            body_w: 0.08,
+            body_back: -0.17,
             body_front: 0.11,
             // Head drawn back onto the shoulders: almost no neck shows.
             neck: 0.02,
             neck_w: 0.03,
             head: 0.05,
             head_w: 0.03,
-            bill: 0.2,
-            bill_w: 0.026,
+            bill: 0.22,
+            bill_w: 0.032,
             tail: 0.05,
             tail_w0: 0.04,
             tail_w1: 0.035,
             legs: 0.0,
-            arm_chord: 0.16,
-            wrist_chord: 0.14,
+            arm_chord: 0.22,
+            wrist_chord: 0.19,
             arm_frac: 0.52,
             fingers: true,
         },
@@ -265,7 +265,7 @@ pub fn pieces(species: Species, pose: &WingPose, bank: f64) -> Vec<Piece> {
         }
     }
     // Wings.
-    let flex = (1.0 - pose.spread.clamp(0.0, 1.0)) as f32 * 70f32.to_radians();
+    let flex = (1.0 - pose.spread.clamp(0.0, 1.0)) as f32 * 90f32.to_radians();
     let (dih, hdih, sweep) = (
         pose.dihedral as f32,
         pose.hand_dihedral as f32,
@@ -277,32 +277,37 @@ pub fn pieces(species: Species, pose: &WingPose, bank: f64) -> Vec<Piece> {
         // Build the right wing (x > 0) flat, then move it; mirror x for the left one.
         let root = [b.body_w * 0.6, 0.0, 0.0];
         let lead = b.arm_chord * 0.35;
+        // Arm: leading edge bowing forward to the wrist (the carpal joint leads the wing),
+        // trailing edge of the secondaries slightly concave.
         let arm_flat = [
             [root[0], lead, 0.0],
-            [root[0] + la, b.wrist_chord * 0.35, 0.0],
-            [root[0] + la, -b.wrist_chord * 0.65, 0.0],
+            [root[0] + 0.5 * la, b.arm_chord * 0.42, 0.0],
+            [root[0] + la, b.wrist_chord * 0.45, 0.0],
+            [root[0] + la, -b.wrist_chord * 0.55, 0.0],
+            [root[0] + 0.5 * la, -b.arm_chord * 0.58, 0.0],
             [root[0], -b.arm_chord * 0.65, 0.0],
         ];
         let wrist = [root[0] + la, 0.0, 0.0];
-        let mut hand_flat: Vec<[f32; 3]> = vec![[wrist[0], b.wrist_chord * 0.35, 0.0]];
+        let mut hand_flat: Vec<[f32; 3]> = vec![[wrist[0], b.wrist_chord * 0.45, 0.0]];
         if b.fingers {
             // Slotted tip: five primaries spread like fingers.
             let tip_chord = b.wrist_chord * 0.8;
-            hand_flat.push([wrist[0] + lh * 0.75, b.wrist_chord * 0.25, 0.0]);
+            hand_flat.push([wrist[0] + lh * 0.7, b.wrist_chord * 0.3, 0.0]);
             for k in 0..5 {
                 let f = k as f32 / 4.0;
-                let len = lh * (1.0 - 0.12 * f);
-                let y = b.wrist_chord * 0.2 - tip_chord * f;
+                let len = lh * (1.0 - 0.15 * f);
+                let y = b.wrist_chord * 0.25 - tip_chord * f;
                 hand_flat.push([wrist[0] + len, y, 0.0]);
-                hand_flat.push([wrist[0] + len * 0.86, y - tip_chord * 0.12, 0.0]);
+                hand_flat.push([wrist[0] + len * 0.85, y - tip_chord * 0.13, 0.0]);
             }
         } else {
-            // Pointed goose hand.
-            hand_flat.push([wrist[0] + lh * 0.8, b.wrist_chord * 0.15, 0.0]);
-            hand_flat.push([wrist[0] + lh, -b.wrist_chord * 0.15, 0.0]);
-            hand_flat.push([wrist[0] + lh * 0.7, -b.wrist_chord * 0.5, 0.0]);
+            // Pointed goose hand, swept back to the tip.
+            hand_flat.push([wrist[0] + lh * 0.55, b.wrist_chord * 0.3, 0.0]);
+            hand_flat.push([wrist[0] + lh, -b.wrist_chord * 0.2, 0.0]);
+            hand_flat.push([wrist[0] + lh * 0.8, -b.wrist_chord * 0.42, 0.0]);
+            hand_flat.push([wrist[0] + lh * 0.4, -b.wrist_chord * 0.55, 0.0]);
         }
-        hand_flat.push([wrist[0], -b.wrist_chord * 0.65, 0.0]);
+        hand_flat.push([wrist[0], -b.wrist_chord * 0.55, 0.0]);
         let arm_move = |p: [f32; 3]| {
             let p = yaw_z(p, root, -flex / 3.0 + sweep);
             roll_y(p, root, dih)
@@ -380,7 +385,7 @@ mod tests {
         for s in Species::ALL {
             let full = span(&pieces(s, &WingPose::EXTENDED, 0.0));
             assert!(span(&pieces(s, &up, 0.0)) < full * 0.9);
-            assert!(span(&pieces(s, &flexed, 0.0)) < full * 0.9);
+            assert!(span(&pieces(s, &flexed, 0.0)) < full * 0.93);
             let banked = pieces(s, &WingPose::EXTENDED, 0.3);
             let right_tip = banked
                 .iter()
