@@ -9,7 +9,10 @@ use std::process::{Command, Output};
 use formation::export::{Background, CameraKind, Film, RenderOptions};
 use formation::Animation;
 
-const GEESE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/examples_data/barnacle_geese_v.json");
+const GEESE: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/examples_data/barnacle_geese_v.json"
+);
 const FIXTURE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/flock_small.json");
 
 fn formation(args: &[&str]) -> Output {
@@ -40,7 +43,11 @@ fn s(p: &Path) -> &str {
 fn assert_usage_error(out: &Output, needles: &[&str]) {
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "stderr: {err}");
-    assert_eq!(err.trim_end().lines().count(), 1, "one line expected: {err}");
+    assert_eq!(
+        err.trim_end().lines().count(),
+        1,
+        "one line expected: {err}"
+    );
     for n in needles {
         assert!(err.contains(n), "{err:?} should mention {n:?}");
     }
@@ -60,7 +67,11 @@ fn animate(birds: usize, d: &Path) -> Animation {
         s(&json),
         "--quiet",
     ]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     Animation::read(&json).unwrap()
 }
 
@@ -190,7 +201,11 @@ fn background_none_writes_transparent_sky_and_opaque_birds() {
         "320x180",
         "--quiet",
     ]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let png = image::open(d.join("frames/frame_00010.png")).unwrap();
     assert_eq!(png.color(), image::ColorType::Rgba8);
     let px = png.to_rgba8();
@@ -213,7 +228,9 @@ fn background_none_writes_transparent_sky_and_opaque_birds() {
         "--quiet",
     ]);
     assert!(out.status.success());
-    let px = image::open(d.join("flat/frame_00010.png")).unwrap().to_rgb8();
+    let px = image::open(d.join("flat/frame_00010.png"))
+        .unwrap()
+        .to_rgb8();
     assert_eq!(px.get_pixel(0, 0).0, [0x10, 0x20, 0x30]);
     std::fs::remove_dir_all(&d).unwrap();
 }
@@ -227,7 +244,9 @@ fn bad_camera_background_view_and_video_requests_exit_2_with_one_line() {
     assert_usage_error(&out, &["--camera", "orbit", "follow, ground or fixed"]);
     let out = formation(&["render", FIXTURE, "-o", g, "--background", "blue"]);
     assert_usage_error(&out, &["--background", "blue"]);
-    let out = formation(&["render", FIXTURE, "-o", g, "--camera", "fixed", "--view", "0,0,0,5"]);
+    let out = formation(&[
+        "render", FIXTURE, "-o", g, "--camera", "fixed", "--view", "0,0,0,5",
+    ]);
     assert_usage_error(&out, &["--view", "zero"]);
     let out = formation(&["render", FIXTURE, "-o", g, "--camera", "fixed"]);
     assert_usage_error(&out, &["--view"]);
@@ -275,7 +294,11 @@ fn probe(path: &Path) -> serde_json::Value {
         .arg(path)
         .output()
         .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     serde_json::from_slice(&out.stdout).unwrap()
 }
 
@@ -300,7 +323,11 @@ fn ffprobe_agrees_with_frame_count_and_rate() {
         "24",
         "--quiet",
     ]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let anim = Animation::read(Path::new(FIXTURE)).unwrap();
     let frames = formation::export::sample::output_count(&anim, 24.0);
     for (p, codec) in [(&mp4, "h264"), (&webm, "vp9")] {
@@ -344,7 +371,11 @@ fn ground_camera_sees_the_flock_pass_overhead() {
         .filter(|&(c, r, _)| (0.0..960.0).contains(&c) && (0.0..540.0).contains(&r))
         .map(|(_, _, s)| s)
         .collect();
-    assert!(seen.len() >= 7, "only {} birds in view at the pass", seen.len());
+    assert!(
+        seen.len() >= 7,
+        "only {} birds in view at the pass",
+        seen.len()
+    );
     assert!(seen.iter().cloned().fold(0.0, f64::max) > 12.0);
     std::fs::remove_dir_all(&d).unwrap();
 }

@@ -363,9 +363,9 @@ pub fn ground_eye(states: &[Vec<BirdState>], height: usize, g: &GroundParams) ->
     zs.sort_by(f64::total_cmp);
     let z = zs.get(zs.len() / 2).copied().unwrap_or(0.0);
     // Mean heading (circular) of the flock there.
-    let (hs, hc) = s
-        .iter()
-        .fold((0.0, 0.0), |(a, b), q| (a + q.heading.sin(), b + q.heading.cos()));
+    let (hs, hc) = s.iter().fold((0.0, 0.0), |(a, b), q| {
+        (a + q.heading.sin(), b + q.heading.cos())
+    });
     let (hs, hc) = if hs.hypot(hc) < 1e-9 {
         (0.0, 1.0)
     } else {
@@ -462,9 +462,9 @@ fn follow(
 /// farthest along the flock's mean heading) and as much of the flock behind it as fits: the box
 /// of the birds within reach of the leader, shifted so that the leader stays inside.
 fn lead_centre(s: &[BirdState], ax: f64, ay: f64) -> (f64, f64) {
-    let (hs, hc) = s
-        .iter()
-        .fold((0.0, 0.0), |(a, b), q| (a + q.heading.sin(), b + q.heading.cos()));
+    let (hs, hc) = s.iter().fold((0.0, 0.0), |(a, b), q| {
+        (a + q.heading.sin(), b + q.heading.cos())
+    });
     let lead = s
         .iter()
         .max_by(|a, b| (a.x * hs + a.y * hc).total_cmp(&(b.x * hs + b.y * hc)))
@@ -508,14 +508,22 @@ mod tests {
         // Eye at the origin looking due north, 30° up; vertical field of view 90° over 200 px,
         // so F = 100 px. Forward f = (0, cos 30°, sin 30°), right r = f × ẑ = (cos 30°, 0, 0)
         // normalised = (1, 0, 0), up u = r × f = (0, −sin 30°, cos 30°).
-        let eye = Eye::looking([0.0, 0.0, 0.0], [0.0, 0.866_025_403_784_438_6, 0.5], 90.0, 200);
+        let eye = Eye::looking(
+            [0.0, 0.0, 0.0],
+            [0.0, 0.866_025_403_784_438_6, 0.5],
+            90.0,
+            200,
+        );
         assert!((eye.focal_px - 100.0).abs() < 1e-9);
         let v = View::Ground(eye);
         // The point (2, 10, 8): depth = 10·0.8660 + 8·0.5 = 12.6603, right = 2,
         // up = −10·0.5 + 8·0.8660 = 1.9282.
         let (c, r, s) = v.project([2.0, 10.0, 8.0], 300, 200).unwrap();
         assert!((c - (150.0 + 100.0 * 2.0 / 12.660_254)).abs() < 1e-4, "{c}");
-        assert!((r - (100.0 - 100.0 * 1.928_203 / 12.660_254)).abs() < 1e-4, "{r}");
+        assert!(
+            (r - (100.0 - 100.0 * 1.928_203 / 12.660_254)).abs() < 1e-4,
+            "{r}"
+        );
         assert!((s - 100.0 / 12.660_254).abs() < 1e-6);
         // Behind the eye: not drawn.
         assert!(v.project([0.0, -10.0, -1.0], 300, 200).is_none());

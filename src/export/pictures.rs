@@ -265,7 +265,13 @@ fn crop_changed(delta: &[u8], width: usize) -> (usize, usize, usize, usize, Vec<
         let Some(first) = row.iter().position(|&v| v != TRANSPARENT) else {
             continue;
         };
-        let last = width - 1 - row.iter().rev().position(|&v| v != TRANSPARENT).unwrap_or(0);
+        let last = width
+            - 1
+            - row
+                .iter()
+                .rev()
+                .position(|&v| v != TRANSPARENT)
+                .unwrap_or(0);
         x0 = x0.min(first);
         x1 = x1.max(last);
         y0 = y0.min(y);
@@ -283,19 +289,32 @@ fn crop_changed(delta: &[u8], width: usize) -> (usize, usize, usize, usize, Vec<
 }
 
 /// One step of the tolerant differencing for a run of pixels: `shown` (palette indices the viewer
-/// sees, updated in place; `None` before the first frame) and the frame's true colours `rgba`;
-/// writes the sub-frame indices (or [`TRANSPARENT`]) to `out`. Only pixels that must change
+/// sees, updated in place; `first` for the first frame), the frame's true colours `rgba` and the
+/// previous frame's `prev`; writes the sub-frame indices (or [`TRANSPARENT`]) to `out`. Only pixels that must change
 /// are looked up in the palette.
+#[allow(clippy::too_many_arguments)]
 fn delta_step(
     shown: &mut [u8],
     first: bool,
     rgba: &[u8],
+    prev: &[u8],
     out: &mut [u8],
     lookup: &mut Lookup,
     palette: &Palette,
     tolerance: i32,
 ) {
-    for ((s, p), o) in shown.iter_mut().zip(rgba.chunks_exact(4)).zip(out.iter_mut()) {
+    for (((s, p), o), q) in shown
+        .iter_mut()
+        .zip(rgba.chunks_exact(4))
+        .zip(out.iter_mut())
+        .zip(prev.chunks_exact(4))
+    {
+        // Same true colour as in the previous frame: what is shown was within the tolerance of
+        // it then (or set to it), so it still is.
+        if !first && p == q {
+            *o = TRANSPARENT;
+            continue;
+        }
         if first {
             let q = lookup.index([p[0], p[1], p[2]]);
             *s = q;
@@ -342,9 +361,13 @@ pub fn write_gif(film: &Film, path: &Path, threads: usize, progress: &dyn Progre
         let band = h.div_ceil(threads.max(1)).max(1) * w;
         let mut shown = vec![0u8; w * h];
         let mut lookups: Vec<Lookup> = shown.chunks(band).map(|_| Lookup::new(&palette)).collect();
+        // The previous frame's picture, the batch's sub-frames, and spare picture buffers.
+        let mut last = vec![0u8; w * h * 4];
+        let mut deltas: Vec<Vec<u8>> = vec![vec![TRANSPARENT; w * h]; GIF_BATCH];
+        let pool: std::sync::Mutex<Vec<Vec<u8>>> = std::sync::Mutex::new(Vec::new());
         for start in (0..film.len()).step_by(GIF_BATCH) {
             let count = GIF_BATCH.min(film.len() - start);
-            // 1. Draw the batch in parallel.
+            // 1. Draw the batch in parallel (into buffers reused from earlier batches).
             let mut drawn: Vec<Vec<u8>> = Vec::with_capacity(count);
             run_frames(
                 count,
@@ -352,7 +375,15 @@ pub fn write_gif(film: &Film, path: &Path, threads: usize, progress: &dyn Progre
                 || (Canvas::new(w, h), Mask::new()),
                 |k, (canvas, mask): &mut (Canvas, Mask)| {
                     film.draw(start + k, canvas, mask, true);
-                    Ok(canvas.rgba.clone())
+                    let mut buf = pool
+                        .lock()
+                        .map(|mut p| p.pop())
+                        .ok()
+                        .flatten()
+                        .unwrap_or_default();
+                    buf.clear();
+                    buf.extend_from_slice(&canvas.rgba);
+                    Ok(buf)
                 },
                 |_, d| {
                     drawn.push(d);
@@ -360,12 +391,12 @@ pub fn write_gif(film: &Film, path: &Path, threads: usize, progress: &dyn Progre
                 },
             )?;
             // 2. Tolerant differencing against what is shown, in parallel over bands of rows.
-            let mut deltas: Vec<Vec<u8>> = vec![vec![TRANSPARENT; w * h]; count];
             {
                 let mut outs: Vec<std::slice::ChunksMut<u8>> =
                     deltas.iter_mut().map(|d| d.chunks_mut(band)).collect();
                 let drawn = &drawn;
                 let palette = &palette;
+                let last = &last;
                 std::thread::scope(|scope| {
                     for (b, (s, lookup)) in shown.chunks_mut(band).zip(&mut lookups).enumerate() {
                         let mine: Vec<&mut [u8]> =
@@ -373,11 +404,13 @@ pub fn write_gif(film: &Film, path: &Path, threads: usize, progress: &dyn Progre
                         scope.spawn(move || {
                             let lo = b * band;
                             let hi = lo + s.len();
-                            for (k, o) in mine.into_iter().enumerate() {
+                            for (k, o) in mine.into_iter().take(count).enumerate() {
+                                let prev = if k == 0 { last } else { &drawn[k - 1] };
                                 delta_step(
                                     s,
                                     start + k == 0,
                                     &drawn[k][lo * 4..hi * 4],
+                                    &prev[lo * 4..hi * 4],
                                     o,
                                     lookup,
                                     palette,
@@ -388,7 +421,15 @@ pub fn write_gif(film: &Film, path: &Path, threads: usize, progress: &dyn Progre
                     }
                 });
             }
-            drop(drawn);
+            // Keep the batch's last picture for the next batch; recycle the others.
+            let mut drawn = drawn;
+            if let Some(l) = drawn.pop() {
+                let old = std::mem::replace(&mut last, l);
+                drawn.push(old);
+            }
+            if let Ok(mut p) = pool.lock() {
+                p.extend(drawn);
+            }
             // 3. Crop to the changed box and LZW-compress in parallel.
             let mut frames = Vec::with_capacity(count);
             let deltas = &deltas;
@@ -624,7 +665,11 @@ pub fn write_video(
     let status = child.wait().map_err(|e| ff_err(e.to_string()))?;
     let said = messages.join().unwrap_or_default();
     if !status.success() {
-        let last = said.lines().rev().find(|l| !l.trim().is_empty()).unwrap_or("");
+        let last = said
+            .lines()
+            .rev()
+            .find(|l| !l.trim().is_empty())
+            .unwrap_or("");
         return Err(ff_err(format!("failed ({status}): {last}")));
     }
     piped?;

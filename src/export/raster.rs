@@ -172,7 +172,12 @@ mod tests {
     #[test]
     fn pixel_aligned_square_is_solid_inside_and_untouched_outside() {
         let mut c = opaque(10, 10);
-        c.fill(&[square(2.0, 2.0, 6.0, 5.0)], [200, 100, 50], 1.0, &mut Mask::new());
+        c.fill(
+            &[square(2.0, 2.0, 6.0, 5.0)],
+            [200, 100, 50],
+            1.0,
+            &mut Mask::new(),
+        );
         assert_eq!(c.pixel(3, 3), [200, 100, 50, 255]);
         assert_eq!(c.pixel(2, 2), [200, 100, 50, 255]);
         assert_eq!(c.pixel(6, 3), [0, 0, 0, 255]);
@@ -206,7 +211,12 @@ mod tests {
     #[test]
     fn transparent_canvas_gets_alpha_only_where_drawn() {
         let mut c = Canvas::new(6, 6);
-        c.fill(&[square(1.0, 1.0, 3.5, 3.0)], [40, 80, 120], 1.0, &mut Mask::new());
+        c.fill(
+            &[square(1.0, 1.0, 3.5, 3.0)],
+            [40, 80, 120],
+            1.0,
+            &mut Mask::new(),
+        );
         assert_eq!(c.pixel(0, 0)[3], 0);
         assert_eq!(c.pixel(2, 2), [40, 80, 120, 255]);
         let edge = c.pixel(3, 2);
@@ -218,9 +228,19 @@ mod tests {
     #[test]
     fn shapes_outside_or_partly_outside_are_clipped() {
         let mut c = opaque(5, 5);
-        c.fill(&[square(-10.0, -10.0, -2.0, -2.0)], [255; 3], 1.0, &mut Mask::new());
+        c.fill(
+            &[square(-10.0, -10.0, -2.0, -2.0)],
+            [255; 3],
+            1.0,
+            &mut Mask::new(),
+        );
         assert!(c.rgba.chunks_exact(4).all(|p| p[0] == 0));
-        c.fill(&[square(-3.0, -3.0, 2.0, 8.0)], [255; 3], 1.0, &mut Mask::new());
+        c.fill(
+            &[square(-3.0, -3.0, 2.0, 8.0)],
+            [255; 3],
+            1.0,
+            &mut Mask::new(),
+        );
         assert_eq!(c.pixel(0, 0), [255, 255, 255, 255]);
         assert_eq!(c.pixel(1, 4), [255, 255, 255, 255]);
         assert_eq!(c.pixel(2, 4), [0, 0, 0, 255]);

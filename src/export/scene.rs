@@ -417,7 +417,10 @@ impl Backdrop {
         let mut line = vec![[0i32; 3]; gw];
         for r in 0..h {
             let (gy, fy) = (r / GRID, (r % GRID) as i32);
-            let (a, b) = (&grid[gy * gw..(gy + 1) * gw], &grid[(gy + 1) * gw..(gy + 2) * gw]);
+            let (a, b) = (
+                &grid[gy * gw..(gy + 1) * gw],
+                &grid[(gy + 1) * gw..(gy + 2) * gw],
+            );
             for (x, l) in line.iter_mut().enumerate() {
                 for k in 0..3 {
                     l[k] = (a[x][k] << SH) + (b[x][k] - a[x][k]) * fy;

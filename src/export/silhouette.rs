@@ -233,7 +233,10 @@ pub fn pieces(species: Species, pose: &WingPose, bank: f64) -> Vec<Piece> {
     let neck_end = b.body_front + b.neck;
     out.push(symmetric(
         Part::Body,
-        &[(b.neck_w * 1.6, b.body_front - 0.04), (b.neck_w, neck_end + 0.01)],
+        &[
+            (b.neck_w * 1.6, b.body_front - 0.04),
+            (b.neck_w, neck_end + 0.01),
+        ],
     ));
     // Head and bill.
     let head_end = neck_end + b.head;
@@ -415,7 +418,10 @@ mod tests {
             let r = radius(s) as f32;
             for p in pieces(s, &WingPose::EXTENDED, 0.4) {
                 for q in p.points {
-                    assert!((q[0] * q[0] + q[1] * q[1] + q[2] * q[2]).sqrt() <= r, "{s:?}");
+                    assert!(
+                        (q[0] * q[0] + q[1] * q[1] + q[2] * q[2]).sqrt() <= r,
+                        "{s:?}"
+                    );
                 }
             }
         }
