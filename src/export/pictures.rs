@@ -422,7 +422,6 @@ pub fn write_gif(film: &Film, path: &Path, threads: usize, progress: &dyn Progre
                 });
             }
             // Keep the batch's last picture for the next batch; recycle the others.
-            let mut drawn = drawn;
             if let Some(l) = drawn.pop() {
                 let old = std::mem::replace(&mut last, l);
                 drawn.push(old);
