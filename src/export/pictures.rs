@@ -517,8 +517,13 @@ pub fn write_png_dir(
                     .collect();
                 (rgb, image::ExtendedColorType::Rgb8)
             };
-            image::ImageEncoder::write_image(enc, &bytes, w as u32, h as u32, colour)
-                .map_err(|e| Error::Internal(format!("{}: PNG encoder: {e}", target.display())))?;
+            image::ImageEncoder::write_image(enc, &bytes, w as u32, h as u32, colour).map_err(
+                |e| match e {
+                    // A full disk or a file-size limit: the user's problem with the output, exit 2.
+                    image::ImageError::IoError(e) => Error::io(path, e),
+                    other => Error::Internal(format!("{}: PNG encoder: {other}", path.display())),
+                },
+            )?;
             out.flush().map_err(|e| Error::io(path, e))?;
             Ok(())
         },
