@@ -41,7 +41,7 @@ pub struct AnimateArgs {
     /// Picture size WIDTHxHEIGHT in pixels (GIF and PNG frames).
     #[arg(long, value_name = "WxH", default_value = "960x540", value_parser = super::render::parse_size)]
     pub size: (u32, u32),
-    /// Frame rate of the pictures [default: 25 for GIF, the animation's --fps for PNG frames].
+    /// Frame rate of the pictures [default: 25 for GIF, the animation's --fps for PNG frames and video].
     #[arg(
         long = "picture-fps",
         value_name = "FPS",

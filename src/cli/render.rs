@@ -71,7 +71,7 @@ pub struct PictureArgs {
     #[arg(long, value_name = "WxH", default_value = "960x540", value_parser = parse_size)]
     pub size: (u32, u32),
     /// Frame rate of the pictures, frames per second [default: 25 for GIF (rounded to whole
-    /// 1/100 s per frame, at most 50), the animation's own rate for PNG frames]. JSON, CSV and glTF
+    /// 1/100 s per frame, at most 50), the animation's own rate for PNG frames and video]. JSON, CSV and glTF
     /// keep the animation's frames.
     #[arg(long, value_name = "FPS", allow_negative_numbers = true)]
     pub fps: Option<f64>,

@@ -66,8 +66,8 @@ pub struct RenderOptions {
     pub width: u32,
     /// Picture height, pixels.
     pub height: u32,
-    /// Frame rate of the pictures (GIF, PNG frames), frames per second; `None` = 25 for GIF, the
-    /// animation's own rate for PNG frames.
+    /// Frame rate of the pictures (GIF, PNG frames, video), frames per second; `None` = 25 for
+    /// GIF, the animation's own rate for PNG frames and video.
     pub fps: Option<f64>,
     /// Bird wingspan for the `.glb` and the written `.json`, metres; `None` = the animation's.
     pub wingspan_m: Option<f64>,
