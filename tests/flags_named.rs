@@ -17,6 +17,7 @@ const SWITCHES: &[&str] = &[
     "--json",
     "--keep-unconverged",
     "--no-initiation",
+    "--sun",
 ];
 
 /// The flags `formation ARGS --help` lists.
@@ -117,6 +118,13 @@ fn commands() -> Vec<Command> {
         ("--start-depth", "0", None),
         ("--heading-spread", "200", None),
     ];
+    let shot: Vec<(&str, &str, Option<String>)> = vec![
+        ("--camera", "orbit", None),
+        ("--view", "0,0,10,10", None),
+        ("--background", "plaid", None),
+        ("--min-bird-px", "-1", None),
+        ("--gif-tolerance", "-1", None),
+    ];
     let seed = ("--seed", "x", None);
     let o = |ext: &'static str| ("-o", ext, None);
     let cat = |parts: Vec<Vec<(&'static str, &'static str, Option<String>)>>| {
@@ -191,6 +199,7 @@ fn commands() -> Vec<Command> {
                 steady_flags.clone(),
                 initiate.clone(),
                 wingbeat.clone(),
+                shot.clone(),
                 vec![
                     ("--seconds", "-1", None),
                     ("--size", "0x0", None),
@@ -203,13 +212,16 @@ fn commands() -> Vec<Command> {
         Command {
             name: &["render"],
             base: strings(&["render", &flock, "-o", "OUT/r.json"]),
-            cases: vec![
-                ("--size", "0x0", None),
-                ("--fps", "0", None),
-                ("--wingspan-m", "0", None),
-                o("OUT/r.txt"),
-                seed.clone(),
-            ],
+            cases: cat(vec![
+                shot,
+                vec![
+                    ("--size", "0x0", None),
+                    ("--fps", "0", None),
+                    ("--wingspan-m", "0", None),
+                    o("OUT/r.txt"),
+                    seed.clone(),
+                ],
+            ]),
         },
         Command {
             name: &["plot", "power"],

@@ -30,7 +30,8 @@ pub struct AnimateArgs {
     /// Number of birds to animate (N ≥ 2; any number, whatever the movie had).
     #[arg(long)]
     pub birds: usize,
-    /// Outputs by extension: .gif, DIR/ (numbered PNG frames), .glb, .csv, .json; may be repeated.
+    /// Outputs by extension: .gif, DIR/ (numbered PNG frames), .mp4, .webm (through ffmpeg), .glb,
+    /// .csv, .json; may be repeated.
     #[arg(short = 'o', long = "output", required = true)]
     pub output: Vec<PathBuf>,
     /// Length of the steady flight, seconds (the initiation before it lasts as long as the flock
@@ -44,13 +45,15 @@ pub struct AnimateArgs {
     #[arg(long, value_name = "WxH", default_value_t = Size::of(&RenderOptions::default()), value_parser = super::render::parse_size)]
     pub size: Size,
     /// Frame rate of the pictures, frames per second (default: the GIF rate for GIF, the
-    /// animation's --fps for PNG frames).
+    /// animation's --fps for PNG frames and video).
     #[arg(
         long = "picture-fps",
         value_name = "FPS",
         allow_negative_numbers = true
     )]
     pub picture_fps: Option<f64>,
+    #[command(flatten)]
+    pub shot: super::render::ShotArgs,
     #[command(flatten)]
     pub read: ReadArgs,
     #[command(flatten)]
@@ -63,7 +66,7 @@ pub struct AnimateArgs {
 
 /// Runs `formation animate`.
 pub fn run(args: AnimateArgs, g: Global) -> Result<()> {
-    let config = Config {
+    let mut config = Config {
         seed: g.seed,
         seconds: Some(args.seconds),
         initiation: !args.no_initiation,
@@ -79,6 +82,7 @@ pub fn run(args: AnimateArgs, g: Global) -> Result<()> {
             ..RenderOptions::default()
         },
     };
+    args.shot.apply(&mut config.render)?;
     // Everything that can be checked is checked before any work.
     config.validate()?;
     formation::export::plan_outputs(&args.output)?;

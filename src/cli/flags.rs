@@ -127,6 +127,11 @@ pub const FLAGS: &[(&str, &str, &[Cmd])] = &[
     ("render.fps", "--fps", &[Render]),
     ("render.fps", "--picture-fps", &[Animate]),
     ("render.wingspan_m", "--wingspan-m", &[Render]),
+    ("render.camera", "--camera", PICTURES),
+    ("render.camera.fixed", "--view", PICTURES),
+    ("render.background", "--background", PICTURES),
+    ("render.min_bird_px", "--min-bird-px", PICTURES),
+    ("render.gif_tolerance", "--gif-tolerance", PICTURES),
     // Chart selections (`plot::power::PowerOf`, `plot::shape::ShapeChart::from_params`).
     ("plot.key", "--key", &[PlotPower]),
     ("plot.frame", "--frame", &[PlotPower, PlotShape]),
