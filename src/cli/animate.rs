@@ -55,6 +55,8 @@ pub struct AnimateArgs {
     pub initiate: InitiateFlags,
     #[command(flatten)]
     pub wingbeat: WingbeatFlags,
+    #[command(flatten)]
+    pub scene: super::render::SceneArgs,
 }
 
 /// Runs `formation animate`.
@@ -86,6 +88,8 @@ pub fn run(args: AnimateArgs, g: Global) -> Result<()> {
         width: args.size.0,
         height: args.size.1,
         fps: args.picture_fps,
+        keys: args.scene.keys,
+        bird_model: args.scene.bird_model.clone(),
         ..RenderOptions::default()
     };
     render.validate()?;

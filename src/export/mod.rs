@@ -12,8 +12,10 @@
 //! [`pictures::GIF_FPS`] = 25 fps by default (GIF delays are whole 1/100 s); PNG frames at the
 //! animation's frame rate. [`RenderOptions::fps`] overrides both picture rates.
 
+pub mod bird;
 pub mod camera;
 pub mod gltf;
+pub mod keys;
 pub mod palette;
 pub mod pictures;
 pub mod raster;
@@ -54,7 +56,7 @@ pub const MAX_GIF_FPS: f64 = 50.0;
 pub const MAX_FRAMES: usize = 200_000;
 
 /// How to render; every field is checked by [`RenderOptions::validate`].
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct RenderOptions {
     /// Picture width, pixels.
     pub width: u32,
@@ -67,6 +69,11 @@ pub struct RenderOptions {
     pub wingspan_m: Option<f64>,
     /// Worker threads for pictures; 0 = one per core.
     pub threads: usize,
+    /// Keyframes of the `.glb` and `.usda`: every frame, or reduced within the documented
+    /// tolerances ([`keys::Tolerance`]).
+    pub keys: keys::KeyMode,
+    /// The user's bird (`.glb`) for the `.glb` and `.usda`; `None` = the built-in bird.
+    pub bird_model: Option<PathBuf>,
 }
 
 impl Default for RenderOptions {
@@ -77,6 +84,8 @@ impl Default for RenderOptions {
             fps: None,
             wingspan_m: None,
             threads: 0,
+            keys: keys::KeyMode::All,
+            bird_model: None,
         }
     }
 }
@@ -289,6 +298,11 @@ pub fn write_outputs(
         }
     }
     let wingspan_m = opts.wingspan_m.unwrap_or(anim.wingspan_m);
+    let scene = gltf::SceneOptions {
+        keys: opts.keys,
+        tolerance: keys::Tolerance::default(),
+        asset: None,
+    };
     let threads = pictures::worker_count(opts.threads);
     let (w, h) = (opts.width as usize, opts.height as usize);
     for o in &plan {
@@ -306,7 +320,7 @@ pub fn write_outputs(
             }
             OutputKind::Glb => {
                 progress.start("glb", 1);
-                let bytes = gltf::glb_bytes(anim, wingspan_m)?;
+                let bytes = gltf::glb_bytes_with(anim, wingspan_m, &scene)?;
                 write_bytes_atomic(&o.path, &bytes)?;
                 progress.advance(1);
                 progress.finish();
