@@ -808,6 +808,7 @@ fn glb(mut json_bytes: Vec<u8>, bin: Vec<u8>) -> Vec<u8> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use glam::Vec3;
 
     #[test]
     fn heading_east_faces_glb_plus_x() {

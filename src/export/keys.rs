@@ -98,11 +98,7 @@ impl Curve<'_> {
     fn within(&self, a: usize, b: usize, k: usize, u: f32) -> bool {
         match *self {
             Curve::Vec3(v, tol) => (v[a].lerp(v[b], u) - v[k]).length() <= tol,
-            Curve::Quat(q, tol) => {
-                let i = q[a].slerp(q[b], u);
-                let d = i.dot(q[k]).abs().min(1.0);
-                2.0 * d.acos() <= tol
-            }
+            Curve::Quat(q, tol) => angle(q[a].slerp(q[b], u), q[k]) <= tol,
             Curve::Stored { exact, stored, tol } => {
                 let i = stored[a].slerp(stored[b], u);
                 angle(i, exact[k]) <= tol
@@ -112,9 +108,11 @@ impl Curve<'_> {
     }
 }
 
-/// Angle between two unit rotations, radians.
+/// Angle between two unit rotations, radians: `2 atan2(|d_xyz|, |d_w|)` of `d = a⁻¹ b`, which
+/// keeps full precision for small angles (where `2 acos(a·b)` in f32 bottoms out near 0.03°).
 pub fn angle(a: Quat, b: Quat) -> f32 {
-    2.0 * a.dot(b).abs().min(1.0).acos()
+    let d = a.conjugate() * b;
+    2.0 * d.xyz().length().atan2(d.w.abs())
 }
 
 /// A unit rotation quantised to normalised signed bytes (glTF's `BYTE` normalised rotation
