@@ -94,6 +94,9 @@ pub fn run(args: AnimateArgs, g: Global) -> Result<()> {
     };
     render.validate()?;
     formation::export::plan_outputs(&args.output)?;
+    if let Some(p) = &args.scene.bird_model {
+        formation::export::bird_model::load(p, wing.species)?;
+    }
 
     let progress = TermProgress::new(g.quiet);
     let params = extract::params_from_path(

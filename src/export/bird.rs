@@ -498,6 +498,37 @@ impl SkinnedMesh {
         }
     }
 
+    /// Adds a vertex with up to four `(joint, weight)` influences (renormalised); returns its index.
+    pub(crate) fn push_vertex(&mut self, p: Vec3, influences: &[(usize, f32)]) -> u32 {
+        let mut infl: Vec<(usize, f32)> = influences.to_vec();
+        infl.sort_by(|a, b| b.1.total_cmp(&a.1));
+        if infl.iter().all(|i| i.1 <= 1e-4) {
+            infl = vec![(BODY, 1.0)];
+        }
+        self.vertex(p, &infl)
+    }
+
+    /// Area-weighted normals of the vertices of triangles `idx` from those triangles.
+    pub(crate) fn face_normals(&mut self, idx: &[u32]) {
+        for t in idx.chunks_exact(3) {
+            let [a, b, c] = [t[0], t[1], t[2]].map(|i| self.positions[i as usize]);
+            let f = (b - a).cross(c - a);
+            for &i in t {
+                self.normals[i as usize] += f;
+            }
+        }
+        for &i in idx {
+            let n = &mut self.normals[i as usize];
+            *n = n.try_normalize().unwrap_or(Vec3::Y);
+        }
+    }
+
+    /// Sets the triangle groups and their colours (one material each).
+    pub(crate) fn set_parts(&mut self, parts: Vec<(Part, Vec<u32>)>, colours: Vec<[f32; 3]>) {
+        self.parts = parts;
+        self.colours = colours;
+    }
+
     /// Area-weighted vertex normals from the triangles.
     fn smooth_normals(&mut self) {
         for n in &mut self.normals {

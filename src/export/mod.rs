@@ -13,6 +13,7 @@
 //! animation's frame rate. [`RenderOptions::fps`] overrides both picture rates.
 
 pub mod bird;
+pub mod bird_model;
 pub mod camera;
 pub mod gltf;
 pub mod keys;
@@ -298,10 +299,18 @@ pub fn write_outputs(
         }
     }
     let wingspan_m = opts.wingspan_m.unwrap_or(anim.wingspan_m);
+    // The user's bird is checked before any output is written (exit 2 with the reason).
+    let asset = match &opts.bird_model {
+        Some(p) => Some(bird_model::load(
+            p,
+            crate::wingbeat::WingbeatOptions::for_animation(anim).species,
+        )?),
+        None => None,
+    };
     let scene = gltf::SceneOptions {
         keys: opts.keys,
         tolerance: keys::Tolerance::default(),
-        asset: None,
+        asset,
     };
     let threads = pictures::worker_count(opts.threads);
     let (w, h) = (opts.width as usize, opts.height as usize);
