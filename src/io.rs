@@ -110,6 +110,8 @@ pub enum OutputKind {
     Svg,
     /// `.glb`
     Glb,
+    /// `.usda` (text USD)
+    Usda,
     /// A directory of numbered PNG frames.
     Directory,
 }
@@ -133,6 +135,7 @@ impl OutputKind {
                 Some("png") => Some(OutputKind::Png),
                 Some("svg") => Some(OutputKind::Svg),
                 Some("glb") => Some(OutputKind::Glb),
+                Some("usda") => Some(OutputKind::Usda),
                 _ => None,
             }
         };
@@ -161,6 +164,7 @@ impl OutputKind {
             OutputKind::Png => ".png",
             OutputKind::Svg => ".svg",
             OutputKind::Glb => ".glb",
+            OutputKind::Usda => ".usda",
             OutputKind::Directory => "a directory (DIR/)",
         }
     }

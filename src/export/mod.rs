@@ -1,6 +1,6 @@
 //! Outputs of an animation (issue 6): the animation file (`.json`), the long CSV (`.csv`), an
 //! animated GIF (`.gif`), a directory of numbered PNG frames (`DIR/`) and a glTF 2.0 binary
-//! (`.glb`). [`write_outputs`] is the one entry point of `formation render` and
+//! (`.glb`) and text USD with UsdSkel (`.usda`). [`write_outputs`] is the one entry point of `formation render` and
 //! `formation animate`: it checks every output path and option before doing any work, then writes
 //! each output atomically (no partial file on failure).
 //!
@@ -25,6 +25,7 @@ pub mod sample;
 pub mod scene;
 pub mod synthetic;
 pub mod table;
+pub mod usd;
 
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
@@ -37,10 +38,11 @@ use crate::progress::Progress;
 pub use pictures::{Film, GIF_FPS};
 
 /// Output kinds `render` and `animate` accept.
-pub const OUTPUT_KINDS: [OutputKind; 5] = [
+pub const OUTPUT_KINDS: [OutputKind; 6] = [
     OutputKind::Gif,
     OutputKind::Directory,
     OutputKind::Glb,
+    OutputKind::Usda,
     OutputKind::Csv,
     OutputKind::Json,
 ];
@@ -331,6 +333,16 @@ pub fn write_outputs(
                 progress.start("glb", 1);
                 let bytes = gltf::glb_bytes_with(anim, wingspan_m, &scene)?;
                 write_bytes_atomic(&o.path, &bytes)?;
+                progress.advance(1);
+                progress.finish();
+            }
+            OutputKind::Usda => {
+                progress.start("usda", 1);
+                // Streamed into the temporary file (a 100-bird minute is tens of MB of text).
+                let mut f = AtomicFile::create(&o.path)?;
+                usd::write_usda(anim, wingspan_m, &scene, f.writer())
+                    .map_err(|e| Error::io(&o.path, e))?;
+                f.commit()?;
                 progress.advance(1);
                 progress.finish();
             }
