@@ -279,10 +279,10 @@ fn reduced_keys_stay_within_the_documented_tolerances_and_shrink_the_file() {
     let g = Glb::parse(&red);
     let tol = Tolerance::default();
     let skins = g.json["skins"].as_array().unwrap().clone();
-    for bird in 0..anim.birds {
+    for (bird, skin) in skins.iter().enumerate() {
         let root = g.node_named(&format!("bird_{bird:03}"))[0];
-        let body = skins[bird]["joints"][bird::BODY].as_u64().unwrap() as usize;
-        let wing = skins[bird]["joints"][4].as_u64().unwrap() as usize;
+        let body = skin["joints"][bird::BODY].as_u64().unwrap() as usize;
+        let wing = skin["joints"][4].as_u64().unwrap() as usize;
         let exact = formation::export::gltf::bird_track(
             &anim,
             &Flapper::from_animation(&anim),

@@ -27,7 +27,8 @@ pub struct AnimateArgs {
     /// Number of birds to animate (N ≥ 2; any number, whatever the movie had).
     #[arg(long)]
     pub birds: usize,
-    /// Outputs by extension: .gif, DIR/ (numbered PNG frames), .glb, .csv, .json; may be repeated.
+    /// Outputs by extension: .gif, DIR/ (numbered PNG frames), .glb, .usda, .csv, .json; may be
+    /// repeated.
     #[arg(short = 'o', long = "output", required = true)]
     pub output: Vec<PathBuf>,
     /// Length of the steady flight, seconds (the initiation before it lasts as long as the flock

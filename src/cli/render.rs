@@ -15,7 +15,8 @@ use super::Global;
 pub struct RenderArgs {
     /// An animation file (SPEC §4.4).
     pub animation: PathBuf,
-    /// Outputs by extension: .gif, DIR/ (numbered PNG frames), .glb, .csv, .json; may be repeated.
+    /// Outputs by extension: .gif, DIR/ (numbered PNG frames), .glb, .usda, .csv, .json; may be
+    /// repeated.
     #[arg(short = 'o', long = "output", required = true)]
     pub output: Vec<PathBuf>,
     #[command(flatten)]

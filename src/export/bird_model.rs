@@ -28,7 +28,7 @@ use std::path::Path;
 use glam::{Mat4, Quat, Vec3};
 use gltf_json as json;
 
-use super::bird::{self, BirdAsset, Part, Skeleton, SkinnedMesh, JOINTS, PARENT};
+use super::bird::{self, BirdAsset, Part, Skeleton, SkinnedMesh, JOINTS};
 use crate::error::{Error, Result};
 use crate::wingbeat::Species;
 
@@ -117,6 +117,10 @@ struct Reader<'a> {
     root: &'a json::Root,
     bin: &'a [u8],
 }
+
+/// A skin mapped to the convention: our joint for every skin slot, and the bind (model-space)
+/// matrix of each of our joints the skin has.
+type Convention = (Vec<usize>, [Option<Mat4>; 7]);
 
 /// One triangle primitive gathered from the file, in model space.
 struct Prim {
@@ -405,7 +409,7 @@ impl Reader<'_> {
 
     /// The skin of node `n` mapped to the convention: per skin slot our joint, and the bind
     /// (model-space) matrix of each of our joints found. `None` when the convention is not met.
-    fn convention(&self, skin: &json::Skin) -> Result<Option<(Vec<usize>, [Option<Mat4>; 7])>> {
+    fn convention(&self, skin: &json::Skin) -> Result<Option<Convention>> {
         let names: Vec<String> = JOINTS.iter().map(|n| norm_name(n)).collect();
         let ibm: Vec<Mat4> = match skin.inverse_bind_matrices {
             Some(a) => {
@@ -413,9 +417,7 @@ impl Reader<'_> {
                 if w != 16 || v.len() / 16 < skin.joints.len() {
                     return Err(self.err("skin: inverse bind matrices are not one MAT4 per joint"));
                 }
-                v.chunks_exact(16)
-                    .map(|c| Mat4::from_cols_slice(c))
-                    .collect()
+                v.chunks_exact(16).map(Mat4::from_cols_slice).collect()
             }
             None => vec![Mat4::IDENTITY; skin.joints.len()],
         };
@@ -473,7 +475,7 @@ impl Reader<'_> {
     fn asset(&self, species: Species) -> Result<BirdAsset> {
         let world = self.world()?;
         // A skinned mesh whose skin follows the convention?
-        for (&ni, _) in &world {
+        for &ni in world.keys() {
             let n = &self.root.nodes[ni];
             let (Some(mi), Some(si)) = (n.mesh, n.skin) else {
                 continue;
@@ -580,21 +582,15 @@ impl Reader<'_> {
         let wingbeat = bind.is_some();
         if let Some(bind) = bind {
             let body = bind[bird::BODY].unwrap_or(Mat4::IDENTITY);
-            for j in 0..JOINTS.len() {
-                let m = place * bind[j].unwrap_or(body);
+            for (j, b) in bind.iter().enumerate() {
+                let m = place * b.unwrap_or(body);
                 let (_, r, t) = m.to_scale_rotation_translation();
                 skel.bind_pos[j] = t;
                 skel.bind_rot[j] = r.normalize();
             }
-        } else {
-            // Static: the body joint at the centre, so bank turns the model about it.
-            for j in 0..JOINTS.len() {
-                skel.bind_pos[j] = match PARENT[j] {
-                    None => Vec3::ZERO,
-                    Some(_) => skel.bind_pos[j],
-                };
-            }
         }
+        // A static model keeps the species' skeleton: `body` at the centre, so bank turns the
+        // model about the centre of its bounding box.
         Ok(BirdAsset {
             source: self.path.display().to_string(),
             skeleton: skel,

@@ -172,9 +172,8 @@ pub fn bird_track(
     let mut joints: Vec<[Quat; 7]> = Vec::with_capacity(ours.len());
     for q in ours {
         let mut l: [Quat; 7] = std::array::from_fn(|j| {
-            if !asset.wingbeat && j != bird::BODY {
-                skel.rest_rotation(j)
-            } else if j == bird::NECK {
+            // The neck never moves; a static model moves only its body.
+            if j == bird::NECK || (!asset.wingbeat && j != bird::BODY) {
                 skel.rest_rotation(j)
             } else {
                 skel.local_rotation(j, q[j])

@@ -1,11 +1,11 @@
-//! Outputs of an animation (issue 6): the animation file (`.json`), the long CSV (`.csv`), an
-//! animated GIF (`.gif`), a directory of numbered PNG frames (`DIR/`) and a glTF 2.0 binary
-//! (`.glb`) and text USD with UsdSkel (`.usda`). [`write_outputs`] is the one entry point of `formation render` and
-//! `formation animate`: it checks every output path and option before doing any work, then writes
+//! Outputs of an animation (issues 6 and 14): the animation file (`.json`), the long CSV
+//! (`.csv`), an animated GIF (`.gif`), a directory of numbered PNG frames (`DIR/`), a glTF 2.0
+//! binary (`.glb`) and text USD with UsdSkel (`.usda`). [`write_outputs`] is the one entry point
+//! of `formation render` and `formation animate`: it checks every output path and option before doing any work, then writes
 //! each output atomically (no partial file on failure).
 //!
-//! Units: the animation is in wingspans (world frame `x` east, `y` north, `z` up); the `.glb` is in
-//! metres (`wingspan_m`) on glTF's Y-up axes (see [`gltf`]); the pictures are a top-down view,
+//! Units: the animation is in wingspans (world frame `x` east, `y` north, `z` up); the `.glb` and
+//! `.usda` are in metres (`wingspan_m`) on glTF's Y-up axes (see [`gltf`], [`usd`]); the pictures are a top-down view,
 //! north up, that follows the flock (see [`camera`], [`scene`]).
 //!
 //! Frame rates: `.json`, `.csv` and `.glb` keep the animation's own frames. The GIF is sampled at
