@@ -19,6 +19,9 @@ fn usda_has_the_stage_metadata_and_the_flight_of_every_bird() {
     assign_phases(&mut anim, &WingbeatOptions::default()).unwrap();
     let mut out = Vec::new();
     write_usda(&anim, 1.5, &SceneOptions::default(), &mut out).unwrap();
+    let mut again = Vec::new();
+    write_usda(&anim, 1.5, &SceneOptions::default(), &mut again).unwrap();
+    assert!(out == again, "equal inputs give byte-identical .usda");
     let text = String::from_utf8(out).unwrap();
     assert!(text.starts_with("#usda 1.0\n"));
     let n = anim.frames.len();
