@@ -55,6 +55,17 @@ pub struct SceneArgs {
     pub bird_model: Option<PathBuf>,
 }
 
+impl SceneArgs {
+    /// Default render options with these flags.
+    pub fn options(&self) -> RenderOptions {
+        RenderOptions {
+            keys: self.keys,
+            bird_model: self.bird_model.clone(),
+            ..RenderOptions::default()
+        }
+    }
+}
+
 impl PictureArgs {
     /// The library options for these flags.
     pub fn options(&self) -> RenderOptions {
