@@ -113,6 +113,13 @@ impl PartialEq<&str> for StageName {
     }
 }
 
+impl std::ops::Deref for StageName {
+    type Target = str;
+    fn deref(&self) -> &str {
+        self.as_str()
+    }
+}
+
 impl std::fmt::Display for StageName {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(self.as_str())

@@ -125,6 +125,10 @@ fn commands() -> Vec<Command> {
         ("--min-bird-px", "-1", None),
         ("--gif-tolerance", "-1", None),
     ];
+    let scene: Vec<(&str, &str, Option<String>)> = vec![
+        ("--keys", "some", None),
+        ("--bird-model", "OUT/no-bird.glb", None),
+    ];
     let seed = ("--seed", "x", None);
     let o = |ext: &'static str| ("-o", ext, None);
     let cat = |parts: Vec<Vec<(&'static str, &'static str, Option<String>)>>| {
@@ -165,6 +169,7 @@ fn commands() -> Vec<Command> {
             cases: cat(vec![
                 steady_flags.clone(),
                 wingbeat.clone(),
+                scene.clone(),
                 vec![
                     ("--frames", "0", None),
                     ("--report", "OUT/r.txt", None),
@@ -179,6 +184,7 @@ fn commands() -> Vec<Command> {
             cases: cat(vec![
                 initiate.clone(),
                 wingbeat.clone(),
+                scene.clone(),
                 vec![o("OUT/i.txt"), seed.clone()],
             ]),
         },
@@ -200,6 +206,7 @@ fn commands() -> Vec<Command> {
                 initiate.clone(),
                 wingbeat.clone(),
                 shot.clone(),
+                scene.clone(),
                 vec![
                     ("--seconds", "-1", None),
                     ("--size", "0x0", None),
@@ -214,6 +221,7 @@ fn commands() -> Vec<Command> {
             base: strings(&["render", &flock, "-o", "OUT/r.json"]),
             cases: cat(vec![
                 shot,
+                scene,
                 vec![
                     ("--size", "0x0", None),
                     ("--fps", "0", None),

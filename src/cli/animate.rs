@@ -31,7 +31,7 @@ pub struct AnimateArgs {
     #[arg(long)]
     pub birds: usize,
     /// Outputs by extension: .gif, DIR/ (numbered PNG frames), .mp4, .webm (through ffmpeg), .glb,
-    /// .csv, .json; may be repeated.
+    /// .usda, .csv, .json; may be repeated.
     #[arg(short = 'o', long = "output", required = true)]
     pub output: Vec<PathBuf>,
     /// Length of the steady flight, seconds (the initiation before it lasts as long as the flock
@@ -62,6 +62,8 @@ pub struct AnimateArgs {
     pub initiate: InitiateFlags,
     #[command(flatten)]
     pub wingbeat: WingbeatFlags,
+    #[command(flatten)]
+    pub scene: super::render::SceneArgs,
 }
 
 /// Runs `formation animate`.
@@ -79,6 +81,8 @@ pub fn run(args: AnimateArgs, g: Global) -> Result<()> {
             width: args.size.width,
             height: args.size.height,
             fps: args.picture_fps,
+            keys: args.scene.keys,
+            bird_model: args.scene.bird_model.clone(),
             ..RenderOptions::default()
         },
     };
@@ -86,6 +90,9 @@ pub fn run(args: AnimateArgs, g: Global) -> Result<()> {
     // Everything that can be checked is checked before any work.
     config.validate()?;
     formation::export::plan_outputs(&args.output)?;
+    if let Some(p) = &config.render.bird_model {
+        formation::export::bird_model::load(p, config.wingbeat.species)?;
+    }
     let progress = TermProgress::new(g.quiet);
     let (anim, _report) = Pipeline::from_path(&args.input).run_with(&config, &progress)?;
     super::write_animation(&anim, &args.output, &config.render, g)

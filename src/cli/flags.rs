@@ -43,6 +43,7 @@ const STEADY: &[Cmd] = &[Steady, Animate];
 const INITIATE: &[Cmd] = &[Initiate, Animate];
 const WINGBEAT: &[Cmd] = &[Steady, Initiate, Animate];
 const PICTURES: &[Cmd] = &[Render, Animate];
+const SCENE: &[Cmd] = &[Steady, Initiate, Animate, Render];
 const ALL: &[Cmd] = &[
     Extract,
     Power,
@@ -127,6 +128,8 @@ pub const FLAGS: &[(&str, &str, &[Cmd])] = &[
     ("render.fps", "--fps", &[Render]),
     ("render.fps", "--picture-fps", &[Animate]),
     ("render.wingspan_m", "--wingspan-m", &[Render]),
+    ("render.keys", "--keys", SCENE),
+    ("render.bird_model", "--bird-model", SCENE),
     ("render.camera", "--camera", PICTURES),
     ("render.camera.fixed", "--view", PICTURES),
     ("render.background", "--background", PICTURES),

@@ -36,6 +36,8 @@ pub struct SteadyArgs {
     pub steady: SteadyFlags,
     #[command(flatten)]
     pub wingbeat: super::wingbeat::WingbeatFlags,
+    #[command(flatten)]
+    pub scene: super::render::SceneArgs,
     /// Also write the run's report (correspondence, ranges, solve statistics) as JSON here.
     #[arg(long)]
     pub report: Option<PathBuf>,
@@ -126,7 +128,7 @@ pub fn run(args: SteadyArgs, g: Global) -> Result<()> {
     let progress = TermProgress::new(g.quiet);
     let (mut anim, report) = steady_stage(&params, &config, &progress)?;
     formation::wingbeat::assign_phases(&mut anim, &config.wingbeat)?;
-    super::write_animation(&anim, &args.output, &Default::default(), g)?;
+    super::write_animation(&anim, &args.output, &args.scene.options(), g)?;
     if let Some(r) = &args.report {
         write_json_atomic(r, &report)?;
     }
