@@ -95,6 +95,10 @@ pub struct Frame {
     /// Relative power reduction ξ_i of the current shape (absent when undefined).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub xi: Option<Vec<f64>>,
+    /// Bank (roll) angle, radians, right wing down positive (coordinated turns; 0 in straight
+    /// flight). Absent in files that do not carry it (then level).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bank: Option<Vec<f64>>,
     /// Wingbeat phase, radians in [0, 2π), 0 = start of the downstroke.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub wing_phase: Option<Vec<f64>>,
@@ -176,7 +180,7 @@ impl Animation {
                     format!("frames[{k}].t: not a finite number"),
                 ));
             }
-            let arrays: [(&str, Option<&Vec<f64>>); 8] = [
+            let arrays: [(&str, Option<&Vec<f64>>); 9] = [
                 ("x", Some(&f.x)),
                 ("y", Some(&f.y)),
                 ("z", Some(&f.z)),
@@ -184,6 +188,7 @@ impl Animation {
                 ("speed", Some(&f.speed)),
                 ("e", f.e.as_ref()),
                 ("xi", f.xi.as_ref()),
+                ("bank", f.bank.as_ref()),
                 ("wing_phase", f.wing_phase.as_ref()),
             ];
             for (name, arr) in arrays {

@@ -6,7 +6,8 @@ use std::path::PathBuf;
 use clap::{Args, ValueEnum};
 use formation::animation::Animation;
 use formation::initiate::{
-    self, InitiateOptions, PerceptionMode, Start, StartRegion, StartState, HPR_GAMMA_DEFAULT,
+    self, GroundStart, InitiateOptions, PerceptionMode, Start, StartRegion, StartState,
+    HPR_GAMMA_DEFAULT,
 };
 use formation::io::OutputKind;
 use formation::{Error, Result};
@@ -44,9 +45,21 @@ pub struct InitiateArgs {
 /// Initiation flags shared by `initiate` and `animate`.
 #[derive(Debug, Clone, Args)]
 pub struct InitiateFlags {
-    /// Step limit (one step = one frame); no convergence within it fails with exit 1.
-    #[arg(long, default_value_t = 9000)]
+    /// Frame limit of the take-off at the output --fps (the time limit is also at most 300 s of
+    /// flight); no convergence within it fails with exit 1.
+    #[arg(long, default_value_t = InitiateOptions::default().max_steps)]
     pub max_steps: usize,
+    /// Take-off duration, seconds: about this long (within a quarter), by scaling the take-off
+    /// area, the departures and how hard the birds drive [default: about 8 s for 9 birds, 9 s
+    /// for 14, 14 s for 100, 21 s for 300; `formation initiate --json` reports it].
+    #[arg(long, allow_negative_numbers = true)]
+    pub takeoff: Option<f64>,
+    /// Cruise altitude of the steady flight above the ground (`z`), wingspans.
+    #[arg(long, allow_negative_numbers = true, default_value_t = InitiateOptions::default().cruise_altitude)]
+    pub cruise_altitude: f64,
+    /// Largest climb rate after lift-off, wingspans per second.
+    #[arg(long, allow_negative_numbers = true, default_value_t = InitiateOptions::default().climb_rate)]
+    pub climb_rate: f64,
     /// Occlusion model.
     #[arg(long, value_enum, default_value_t = PerceptionArg::Hpr)]
     pub perception: PerceptionArg,
@@ -92,20 +105,24 @@ pub struct InitiateFlags {
     /// Convergence: for this long, seconds (also the hand-over blend window) [default: 1].
     #[arg(long)]
     pub hold: Option<f64>,
-    /// Start file: JSON {"x": [...], "y": [...], "heading": [...], "speed": [...]} (world frame,
+    /// Start: `ground` (at rest in a take-off area, leaving one after another, climbing to the
+    /// cruise altitude), `air` (the paper's: scattered in the air at the cruise altitude), or a
+    /// start file: JSON {"x": [...], "y": [...], "heading": [...], "speed": [...]} (world frame,
     /// wingspans, radians clockwise from north, wingspans per second; heading and speed optional).
-    #[arg(long, conflicts_with_all = ["start_width", "start_depth", "heading_spread"])]
-    pub start: Option<PathBuf>,
-    /// Width of the random start region across the cruise heading, wingspans
-    /// (default 30, or 6√N for large flocks).
-    #[arg(long)]
+    #[arg(long, default_value = "ground")]
+    pub start: String,
+    /// Width of the take-off area (ground) or start region (air) across the cruise heading,
+    /// wingspans [default: from --takeoff; air: 30, or 6√N for large flocks].
+    #[arg(long, allow_negative_numbers = true)]
     pub start_width: Option<f64>,
-    /// Depth of the random start region along the cruise heading, wingspans (default: the width).
-    #[arg(long)]
+    /// Depth of the take-off area or start region along the cruise heading, wingspans
+    /// [default: from --takeoff; air: the width].
+    #[arg(long, allow_negative_numbers = true)]
     pub start_depth: Option<f64>,
-    /// Start headings are uniform within this many degrees of the cruise heading (180: any).
-    #[arg(long, default_value_t = 180.0)]
-    pub heading_spread: f64,
+    /// Start headings are uniform within this many degrees of the cruise heading [default: 10
+    /// on the ground, 180 (any) in the air].
+    #[arg(long)]
+    pub heading_spread: Option<f64>,
 }
 
 impl InitiateFlags {
@@ -139,21 +156,49 @@ impl InitiateFlags {
         set(&mut o.avoid_distance, self.avoid_distance);
         set(&mut o.tolerance, self.tolerance);
         set(&mut o.hold, self.hold);
-        o.start = match &self.start {
-            Some(path) => Start::Given(StartState::read(path, birds)?),
-            None => Start::Random(StartRegion {
+        o.takeoff = self.takeoff;
+        o.cruise_altitude = self.cruise_altitude;
+        o.climb_rate = self.climb_rate;
+        if let Some(h) = self.heading_spread {
+            if !(h.is_finite() && (0.0..=180.0).contains(&h)) {
+                return Err(Error::parameter(
+                    "--heading-spread",
+                    format!("must be in [0, 180] degrees, got {h}"),
+                ));
+            }
+        }
+        o.start = match self.start.as_str() {
+            "ground" => {
+                let d = GroundStart::default();
+                Start::Ground(GroundStart {
+                    width: self.start_width,
+                    depth: self.start_depth,
+                    heading_spread: self.heading_spread.map_or(d.heading_spread, f64::to_radians),
+                    ..d
+                })
+            }
+            "air" => Start::Random(StartRegion {
                 width: self.start_width,
                 depth: self.start_depth,
-                heading_spread: self.heading_spread.to_radians(),
+                heading_spread: self.heading_spread.map_or(std::f64::consts::PI, f64::to_radians),
                 ..Default::default()
             }),
+            path => {
+                for (flag, given) in [
+                    ("--start-width", self.start_width.is_some()),
+                    ("--start-depth", self.start_depth.is_some()),
+                    ("--heading-spread", self.heading_spread.is_some()),
+                ] {
+                    if given {
+                        return Err(Error::parameter(
+                            flag,
+                            "does not apply to a start file (--start FILE); give --start ground or air",
+                        ));
+                    }
+                }
+                Start::Given(StartState::read(std::path::Path::new(path), birds)?)
+            }
         };
-        if !(self.heading_spread.is_finite() && (0.0..=180.0).contains(&self.heading_spread)) {
-            return Err(Error::parameter(
-                "--heading-spread",
-                format!("must be in [0, 180] degrees, got {}", self.heading_spread),
-            ));
-        }
         o.validate()?;
         formation::initiate::check_size(birds, 0, self.max_steps)?;
         Ok(o)
