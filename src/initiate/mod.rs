@@ -134,6 +134,15 @@ pub struct InitiateOptions {
     /// Eq. (5)'s √|r − v_j τ| is replaced by its chord within this distance of the fixed point,
     /// wingspans.
     pub linear_zone: f64,
+    /// Beyond this distance from its fixed point, eq. (5)'s √|r − v_j τ| grows linearly, so a bird
+    /// far behind catches up in seconds, wingspans. `takeoff` scales it.
+    pub catchup_distance: f64,
+    /// Eq. (5) on the longitudinal gap to the target (along the reference's heading) instead of
+    /// the whole distance r: lateral errors are eq. (6)'s (docs/initiation.md).
+    pub gap_speed: bool,
+    /// Speed of the leader while flockmates are still on the ground or running, as a fraction
+    /// of the cruise speed (at least the minimum speed).
+    pub gather_speed: f64,
     /// Convergence: distance of every bird from its slot and from the cruise altitude, wingspans.
     pub tolerance: f64,
     /// Convergence: heading difference from the cruise heading, radians.
@@ -169,8 +178,8 @@ impl Default for InitiateOptions {
             max_turn_accel: 540f64.to_radians(),
             turn_lag: 0.1,
             max_accel: 4.0,
-            max_jerk: 20.0,
-            speed_lag: 0.25,
+            max_jerk: 40.0,
+            speed_lag: 0.1,
             min_speed: 0.5,
             max_speed: 1.6,
             max_roll_rate: 180f64.to_radians(),
@@ -191,6 +200,9 @@ impl Default for InitiateOptions {
             reference_memory: None,
             turn_distance_cap: 5.0,
             linear_zone: 0.25,
+            catchup_distance: 1.5,
+            gap_speed: true,
+            gather_speed: 0.6,
             tolerance: 0.1,
             heading_tolerance: 2f64.to_radians(),
             speed_tolerance: 0.02,
@@ -258,6 +270,8 @@ pub struct TakeoffPlan {
     pub stagger: f64,
     /// |K| of eq. (5) used, per √wingspan.
     pub k: f64,
+    /// Catch-up distance of eq. (5) used, wingspans.
+    pub catchup_distance: f64,
 }
 
 impl TakeoffPlan {
@@ -295,7 +309,8 @@ impl TakeoffPlan {
             width,
             depth,
             stagger,
-            k: opts.k * s.powf(-1.0).clamp(0.25, 4.0),
+            k: opts.k,
+            catchup_distance: opts.catchup_distance * s.clamp(0.25, 4.0),
         }
     }
 }
@@ -628,6 +643,8 @@ impl InitiateOptions {
         pos("lost speed factor", self.lost_speed_factor)?;
         pos("--turn-distance-cap", self.turn_distance_cap)?;
         pos("--linear-zone", self.linear_zone)?;
+        pos("initiate.catchup_distance", self.catchup_distance)?;
+        pos("initiate.gather_speed", self.gather_speed)?;
         let memory = self.reference_memory();
         if !(memory.is_finite() && (0.0..=60.0).contains(&memory)) {
             return Err(Error::parameter(
@@ -750,7 +767,7 @@ impl InitiateOptions {
 
     /// The simulation's parameters for a cruise (heading, speed, wingspan) and a drive gain
     /// `k` (per √wingspan; the take-off plan's).
-    pub fn step_params(&self, cruise: &Cruise, k: f64) -> StepParams {
+    pub fn step_params(&self, cruise: &Cruise, k: f64, catchup: f64) -> StepParams {
         let vc = cruise.speed;
         StepParams {
             perception: self.perception,
@@ -787,6 +804,9 @@ impl InitiateOptions {
             reference_memory: (self.reference_memory() / self.reaction_time).round() as u32,
             turn_distance_cap: self.turn_distance_cap,
             linear_zone: self.linear_zone,
+            catchup_distance: catchup,
+            gap_speed: self.gap_speed,
+            gather_speed: self.gather_speed * vc,
         }
     }
 
@@ -1038,7 +1058,7 @@ pub fn start_simulation(
     }
     let n = target.len();
     let plan = TakeoffPlan::new(n, opts);
-    let mut params = opts.step_params(cruise, plan.k);
+    let mut params = opts.step_params(cruise, plan.k, plan.catchup_distance);
     if opts.widen_field {
         let field = &mut params.perception.fov_per_eye;
         *field = field.max(target.required_field(FIELD_MARGIN));

@@ -112,6 +112,12 @@ pub struct StepParams {
     pub turn_distance_cap: f64,
     /// Half-width of the linear zone of eq. (5)'s √|r − v_j τ| around its fixed point, wingspans.
     pub linear_zone: f64,
+    /// Beyond this distance eq. (5)'s √|r − v_j τ| grows linearly (catch-up), wingspans.
+    pub catchup_distance: f64,
+    /// Eq. (5) with the longitudinal gap to the target instead of the whole distance.
+    pub gap_speed: bool,
+    /// Speed of the leader while flockmates are still on the ground, wingspans per second.
+    pub gather_speed: f64,
 }
 
 impl StepParams {
@@ -814,7 +820,16 @@ impl Simulation {
         let mut unseen = 0;
         let (turn, want_speed, reference, side, branch) = if i == f.leader {
             let dd = wrap_angle(p.cruise_heading - f.heading[i]);
-            (p.alpha * dd / tau, p.cruise_speed, None, None, None)
+            // While flockmates are still on the ground the leader flies at the gathering speed
+            // (a fraction of the cruise speed), so that the last to leave is not left far behind.
+            let v = if self.departed.len() < f.pos.len()
+                || f.phase.iter().any(|&ph| ph != Phase::Airborne)
+            {
+                p.gather_speed.max(p.min_speed)
+            } else {
+                p.cruise_speed
+            };
+            (p.alpha * dd / tau, v, None, None, None)
         } else {
             // Perception: departed flockmates within the visual range.
             self.grid.within(&f.pos, f.pos[i], p.visual_range, near);
@@ -946,9 +961,34 @@ impl Simulation {
         // The distance is signed (negative ahead of the target): with |r − v_j τ| alone a bird one
         // step *ahead* of its target would sit at a second fixed point of eq. (5).
         let signed_r = if behind >= 0.0 { r } else { -r };
-        let u = (signed_r - step_j).abs();
+        // With `gap_speed`, the distance is the longitudinal gap alone: the lateral error is the
+        // heading's business (eq. 6), and with the full distance K's sign flip at the target
+        // (|u| ≈ the lateral error there) is a jump of 2 K φ v_j in the wanted speed.
+        let (k, u) = if p.gap_speed {
+            let g = behind - step_j;
+            let k = if g <= 0.0 {
+                -p.k
+            } else if dd.abs() < std::f64::consts::FRAC_PI_2 {
+                p.k
+            } else {
+                0.0
+            };
+            (k, g.abs())
+        } else {
+            (k, (signed_r - step_j).abs())
+        };
         let z = p.linear_zone;
-        let root = if u < z { u / z.sqrt() } else { u.sqrt() };
+        // Far from the fixed point (beyond the catch-up distance u₁) the term grows linearly,
+        // √u₁ · u/u₁, so that a bird far behind closes the gap in seconds, not tens of seconds
+        // (eq. 5's √ alone closes 25 wingspans in 1/(v_j K) ≈ 17 s at 10 wingspans/s).
+        let far = p.catchup_distance;
+        let root = if u < z {
+            u / z.sqrt()
+        } else if u > far {
+            u / far.sqrt()
+        } else {
+            u.sqrt()
+        };
         let mut v = vj * (1.0 - dd.abs() / std::f64::consts::PI + k * root);
         // Braking distance: close on the target no faster than the speed that can still be shed
         // before reaching it, v ≤ v_j + √(2 a g) with g the longitudinal gap (no overshoot); the
