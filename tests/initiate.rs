@@ -31,7 +31,7 @@ fn convergence(n: usize, seeds: u64, opts: &InitiateOptions) -> (u64, f64, f64, 
     let mut steps = Vec::new();
     for seed in 0..seeds {
         let mut r = rng::seeded(seed);
-        let run = initiate::simulate(&t, 30.0, 0.0, 10.0, opts, &mut r, &Silent).unwrap();
+        let run = initiate::simulate(&t, 30.0, &initiate::Cruise::new(0.0, 10.0), opts, &mut r, &Silent).unwrap();
         if run.stats.converged {
             ok += 1;
             steps.push(run.stats.steps);
@@ -151,7 +151,13 @@ fn hand_over_has_no_jump() {
 #[test]
 fn heading_changes_stay_within_the_turn_rate() {
     let st = steady(&v_shape(9, 1.0, 0.6), 30, 30.0, 10.0);
-    let (a, _) = run_initiate(&st, 5);
+    // The paper's airborne start, headings in every direction: birds must turn hard.
+    let opts = InitiateOptions {
+        seed: 5,
+        start: Start::Random(Default::default()),
+        ..Default::default()
+    };
+    let (a, _) = initiate::initiate(&st, &opts, &mut rng::seeded(5), &Silent).unwrap();
     let limit = InitiateOptions::default().max_turn_rate / 30.0;
     let k = a.stage("initiation").unwrap().end;
     let mut largest = 0.0f64;
@@ -231,7 +237,8 @@ fn no_convergence_within_the_step_limit_is_an_error() {
     let e = initiate::initiate(&st, &opts, &mut r, &Silent).unwrap_err();
     assert!(matches!(e, Error::NotConverged(_)), "{e}");
     assert_eq!(e.exit_code(), 1);
-    assert!(e.to_string().contains("50 steps"), "{e}");
+    // 50 frames at 30 fps: a time limit of 1.7 s.
+    assert!(e.to_string().contains("within 2 s of flight"), "{e}");
 }
 
 #[test]

@@ -97,12 +97,11 @@ struct Outcome {
 }
 
 fn run(a: &Animation, seed: u64, opts: &InitiateOptions) -> Outcome {
-    let (t, h, v) = initiate::steady_target(a).unwrap();
+    let (t, cruise) = initiate::steady_target(a).unwrap();
     let r = initiate::simulate(
         &t,
         a.fps,
-        h,
-        v,
+        &cruise,
         opts,
         &mut rng::stream(seed, "initiate"),
         &Silent,
@@ -148,12 +147,11 @@ fn example_flocks_converge_from_random_starts() {
         for &n in ns {
             for seed in 0..n_seeds {
                 let a = steady(&p, n, seed);
-                let (t, h, v) = initiate::steady_target(&a).unwrap();
+                let (t, cruise) = initiate::steady_target(&a).unwrap();
                 let r = initiate::simulate(
                     &t,
                     a.fps,
-                    h,
-                    v,
+                    &cruise,
                     &opts,
                     &mut rng::stream(seed, "initiate"),
                     &Silent,
@@ -378,10 +376,10 @@ fn diagnose() {
     let seed = env_u("SEED").unwrap_or(0);
     let steps = env_u("STEPS").unwrap_or(9000) as usize;
     let a = steady(&params(ex), n, seed);
-    let (t, h, v) = initiate::steady_target(&a).unwrap();
+    let (t, cruise) = initiate::steady_target(&a).unwrap();
     let opts = InitiateOptions::default();
-    let mut sim =
-        initiate::start_simulation(&t, a.fps, h, v, &opts, &mut rng::stream(seed, "initiate"))
+    let (mut sim, _) =
+        initiate::start_simulation(&t, &cruise, &opts, &mut rng::stream(seed, "initiate"))
             .unwrap();
     let sp = sim.params;
     let mut held = 0;
@@ -415,9 +413,9 @@ fn diagnose() {
                 }
             }
         }
-        if sim.in_formation(opts.tolerance, opts.heading_tolerance, opts.speed_tolerance) {
+        if sim.in_formation(&opts.tolerances()) {
             held += 1;
-            if held > 30 {
+            if held > 120 {
                 break;
             }
         } else {

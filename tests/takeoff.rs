@@ -149,12 +149,13 @@ fn trace() {
             })
             .collect();
         println!(
-            "t={:3} in_slot {:2} leader {} v_lead {:.1} form {} | {}",
+            "t={:3} in_slot {:2} leader {} v_lead {:.1} form {} stray {:.1} | {}",
             sec + 1,
             sim.birds_in_slot(opts.tolerance),
             f.leader,
             f.speed[f.leader],
             sim.in_formation(&tol),
+            sim.stray_distance(),
             worst.join(" | ")
         );
     }

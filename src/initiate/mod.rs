@@ -249,8 +249,8 @@ impl Default for GroundStart {
         GroundStart {
             width: None,
             depth: None,
-            heading_spread: 10f64.to_radians(),
-            min_spacing: 1.5,
+            heading_spread: 5f64.to_radians(),
+            min_spacing: 2.0,
             stagger: None,
         }
     }
@@ -290,12 +290,13 @@ impl TakeoffPlan {
         let root = (n.max(1) as f64).sqrt();
         let (width, depth, stagger) = match &opts.start {
             Start::Ground(g) => {
-                // About 2.5 wingspans per bird at the automatic duration, spread with √s.
-                let base = (2.5 * root).max(4.0 * g.min_spacing);
+                // About 10 square wingspans per bird (1.6 times what random packing of birds
+                // `min_spacing` = 2 apart needs) at the automatic duration, spread with √s.
+                let base = (1.6 * g.min_spacing * root).max(4.0 * g.min_spacing);
                 (
                     g.width.unwrap_or(1.4 * base * s.sqrt()),
                     g.depth.unwrap_or(0.7 * base * s.sqrt()),
-                    g.stagger.unwrap_or(0.25 * seconds),
+                    g.stagger.unwrap_or(0.12 * seconds),
                 )
             }
             Start::Random(r) => {

@@ -847,18 +847,44 @@ impl Simulation {
                     let c = self.departed.iter().map(|&j| f.pos[j]).sum::<DVec2>()
                         / self.departed.len().max(1) as f64;
                     let dd = bearing(f.heading[i], c - f.pos[i]);
-                    (p.alpha * dd / tau, p.cruise_speed, None, None, None)
+                    (p.alpha * dd / tau, p.max_speed, None, None, None)
                 }
                 None => {
-                    // Lost: turn toward the cruise heading and slow a little.
-                    let dd = wrap_angle(p.cruise_heading - f.heading[i]);
-                    (
-                        p.alpha * dd / tau,
-                        p.lost_speed_factor * p.cruise_speed,
-                        None,
-                        None,
-                        None,
-                    )
+                    let d = direction(f.heading[i]);
+                    let nearest = visible
+                        .iter()
+                        .map(|&j| (f.pos[j] - f.pos[i], j))
+                        .min_by(|a, b| a.0.length_squared().total_cmp(&b.0.length_squared()));
+                    match nearest {
+                        // Lost behind the flock (every visible bird ahead, the nearest farther
+                        // than the separation distance): close on the nearest, a little faster
+                        // than the cruise, instead of falling back ever farther.
+                        Some((rel, _))
+                            if rel.length() > p.separation_distance
+                                && visible.iter().all(|&j| (f.pos[j] - f.pos[i]).dot(d) > 0.0) =>
+                        {
+                            let dd = bearing(f.heading[i], rel);
+                            let gain = (0.02 * (rel.length() - p.separation_distance)).min(0.3);
+                            (
+                                p.alpha * dd / (p.turn_distance_cap * tau),
+                                p.cruise_speed * (1.0 + gain),
+                                None,
+                                None,
+                                None,
+                            )
+                        }
+                        _ => {
+                            // Lost: turn toward the cruise heading and slow a little.
+                            let dd = wrap_angle(p.cruise_heading - f.heading[i]);
+                            (
+                                p.alpha * dd / tau,
+                                p.lost_speed_factor * p.cruise_speed,
+                                None,
+                                None,
+                                None,
+                            )
+                        }
+                    }
                 }
             }
         };
