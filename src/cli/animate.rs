@@ -30,8 +30,9 @@ pub struct AnimateArgs {
     /// Outputs by extension: .gif, DIR/ (numbered PNG frames), .glb, .csv, .json; may be repeated.
     #[arg(short = 'o', long = "output", required = true)]
     pub output: Vec<PathBuf>,
-    /// Length of the steady flight, seconds (the take-off before it lasts about --takeoff
-    /// seconds: by default about 8 s for 9 birds, 9 s for 14, 14 s for 100, 21 s for 300).
+    /// Length of the steady flight, seconds (the take-off before it lasts as long as the flock
+    /// needs to form, by default about 7 + 1.1 × birds seconds: 17 s for 9 birds, 22 s for 14,
+    /// 52 s for 41; see --takeoff).
     #[arg(long, default_value_t = 20.0, allow_negative_numbers = true)]
     pub seconds: f64,
     /// Skip the take-off: the animation is the steady flight alone.

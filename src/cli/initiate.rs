@@ -49,9 +49,9 @@ pub struct InitiateFlags {
     /// flight); no convergence within it fails with exit 1.
     #[arg(long, default_value_t = InitiateOptions::default().max_steps)]
     pub max_steps: usize,
-    /// Take-off duration, seconds: about this long (within a quarter), by scaling the take-off
-    /// area, the departures and how hard the birds drive [default: about 8 s for 9 birds, 9 s
-    /// for 14, 14 s for 100, 21 s for 300; `formation initiate --json` reports it].
+    /// Take-off duration, seconds: a longer take-off than the flock's natural one stretches the
+    /// departures; a shorter one is not possible yet (warned) [default: the natural one, about
+    /// 7 + 1.1 × birds seconds: 17 s for 9 birds, 22 s for 14, 52 s for 41; `--json` reports it].
     #[arg(long, allow_negative_numbers = true)]
     pub takeoff: Option<f64>,
     /// Cruise altitude of the steady flight above the ground (`z`), wingspans.
@@ -157,6 +157,14 @@ impl InitiateFlags {
         set(&mut o.tolerance, self.tolerance);
         set(&mut o.hold, self.hold);
         o.takeoff = self.takeoff;
+        if let Some(t) = self.takeoff {
+            let natural = formation::initiate::TakeoffPlan::natural_seconds(birds);
+            if t.is_finite() && t > 0.0 && t < 0.8 * natural {
+                eprintln!(
+                    "warning: --takeoff {t}: {birds} birds need about {natural:.0} s to form with these rules (docs/initiation.md); the take-off will last about that long"
+                );
+            }
+        }
         o.cruise_altitude = self.cruise_altitude;
         o.climb_rate = self.climb_rate;
         if let Some(h) = self.heading_spread {

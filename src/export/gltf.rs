@@ -12,7 +12,8 @@
 //! ```math
 //! q_\text{bird} = R_Y(\pi - \theta)\,R_Z(\phi), \qquad \phi = \operatorname{atan}(v\,\dot\theta / g)
 //! ```
-//! with a bank φ into turns (v speed, θ̇ turn rate, g gravity in wingspans/s², φ clamped to ±45°).
+//! with a bank φ into turns: the file's `bank` when it has one, else φ = atan(v θ̇ / g) (v speed,
+//! θ̇ turn rate, g gravity in wingspans/s², clamped to ±45°).
 
 use std::collections::BTreeMap;
 use std::f32::consts::PI;
@@ -110,7 +111,11 @@ pub fn glb_bytes(anim: &Animation, wingspan_m: f64) -> Result<Vec<u8>> {
             } else {
                 0.0
             };
-            let bank = (at(&f.speed) * rate / g).atan().clamp(-PI / 4.0, PI / 4.0);
+            // The file's bank when it has one (the take-off writes it), else a coordinated turn.
+            let bank = match f.bank.as_ref().and_then(|b| b.get(bird)) {
+                Some(&b) => b as f32,
+                None => (at(&f.speed) * rate / g).atan().clamp(-PI / 4.0, PI / 4.0),
+            };
             let q = continuous(
                 prev_body,
                 Quat::from_rotation_y(PI - theta) * Quat::from_rotation_z(bank),

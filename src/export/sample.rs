@@ -20,6 +20,8 @@ pub struct BirdState {
     pub z: f64,
     /// Heading, radians clockwise from north.
     pub heading: f64,
+    /// Bank, radians, right wing down positive (0 when the file has none).
+    pub bank: f64,
     /// Wing joint angles.
     pub pose: WingPose,
 }
@@ -115,6 +117,10 @@ pub fn state_at(anim: &Animation, flapper: &Flapper, t: f64) -> Vec<BirdState> {
                 y: g(&fa.y, &fb.y),
                 z: g(&fa.z, &fb.z),
                 heading: ha + angle_diff(ha, hb) * w,
+                bank: match (&fa.bank, &fb.bank) {
+                    (Some(ba), Some(bb)) => g(ba, bb),
+                    _ => 0.0,
+                },
                 pose: lerp_pose(&flapper.pose(i, b), &flapper.pose(j, b), w),
             }
         })

@@ -248,9 +248,12 @@ pub fn draw_birds(
         let (sin, cos) = (b.heading.sin() as f32, b.heading.cos() as f32);
         // Ground-plane (right, forward) → pixels: forward is (sin θ, cos θ) east/north, right is
         // (cos θ, −sin θ); screen rows grow southward.
+        // A banked bird seen from above shows its wings foreshortened by cos φ.
+        let across = b.bank.cos().abs() as f32;
         let place = |p: &[f32; 2]| {
-            let e = p[0] * cos + p[1] * sin;
-            let n = -p[0] * sin + p[1] * cos;
+            let (r, f) = (p[0] * across, p[1]);
+            let e = r * cos + f * sin;
+            let n = -r * sin + f * cos;
             [px as f32 + e * s, py as f32 - n * s]
         };
         let outlines = rig::top_view(&b.pose);

@@ -70,7 +70,7 @@ pub struct InitiateOptions {
     pub visual_range: f64,
     /// α of eq. (6), dimensionless (paper: 0.2).
     pub alpha: f64,
-    /// |K| of eq. (5), per √wingspan (paper: 0.06). `takeoff` scales it.
+    /// |K| of eq. (5), per √wingspan (paper: 0.06).
     pub k: f64,
     /// Reaction time: a bird decides once per this many seconds (the paper's time step), seconds.
     pub reaction_time: f64,
@@ -82,6 +82,8 @@ pub struct InitiateOptions {
     pub max_turn_accel: f64,
     /// Time constant of the turn rate following the bird's request, seconds.
     pub turn_lag: f64,
+    /// Maximum rate of change of the turn rate's change, radians per second cubed.
+    pub max_turn_jerk: f64,
     /// Maximum change of speed (acceleration), wingspans per second squared.
     pub max_accel: f64,
     /// Maximum change of the acceleration (jerk), wingspans per second cubed.
@@ -105,9 +107,9 @@ pub struct InitiateOptions {
     pub vertical_accel: f64,
     /// Acceleration of the take-off run on the ground, wingspans per second squared.
     pub run_accel: f64,
-    /// Wanted take-off duration, seconds (`None`: automatic, about 8–10 s for 9–14 birds, see
-    /// [`TakeoffPlan`]). Scales the take-off area, the departure stagger and the drive gain;
-    /// the simulation is never cut.
+    /// Wanted take-off duration, seconds (`None`: the natural one of the flock size, see
+    /// [`TakeoffPlan::natural_seconds`]). A longer one stretches the departures; the simulation
+    /// is never cut.
     pub takeoff: Option<f64>,
     /// Separation drive threshold, wingspans (paper: 10).
     pub separation_distance: f64,
@@ -135,7 +137,7 @@ pub struct InitiateOptions {
     /// wingspans.
     pub linear_zone: f64,
     /// Beyond this distance from its fixed point, eq. (5)'s √|r − v_j τ| grows linearly, so a bird
-    /// far behind catches up in seconds, wingspans. `takeoff` scales it.
+    /// far behind catches up in seconds, wingspans.
     pub catchup_distance: f64,
     /// Eq. (5) on the longitudinal gap to the target (along the reference's heading) instead of
     /// the whole distance r: lateral errors are eq. (6)'s (docs/initiation.md).
@@ -177,13 +179,14 @@ impl Default for InitiateOptions {
             max_turn_rate: PI / 2.0,
             max_turn_accel: 540f64.to_radians(),
             turn_lag: 0.1,
+            max_turn_jerk: 10000f64.to_radians(),
             max_accel: 4.0,
             max_jerk: 40.0,
             speed_lag: 0.1,
             min_speed: 0.5,
             max_speed: 1.6,
             max_roll_rate: 180f64.to_radians(),
-            roll_lag: 0.1,
+            roll_lag: 0.2,
             cruise_altitude: 10.0,
             climb_rate: 2.0,
             vertical_accel: 1.5,
@@ -275,28 +278,36 @@ pub struct TakeoffPlan {
 }
 
 impl TakeoffPlan {
-    /// The automatic take-off duration of `n` birds, seconds.
-    pub fn auto_seconds(n: usize) -> f64 {
-        let n = n.max(1) as f64;
-        (5.5 + 0.9 * n.sqrt()).min(40.0)
+    /// The shortest take-off the rules give `n` birds from the ground, about, seconds: measured
+    /// medians 17 s for 9 birds, 22 s for 14, 53 s for 41 (docs/initiation.md; arms fill one bird
+    /// at a time, so it grows with the flock size).
+    pub fn natural_seconds(n: usize) -> f64 {
+        7.0 + 1.1 * n.max(1) as f64
     }
 
-    /// The plan for `n` birds under `opts` (its `takeoff`, or the automatic duration).
+    /// The automatic take-off duration of `n` birds, seconds: the natural one.
+    pub fn auto_seconds(n: usize) -> f64 {
+        Self::natural_seconds(n)
+    }
+
+    /// The plan for `n` birds under `opts` (its `takeoff`, or the automatic duration). A longer
+    /// take-off than the natural one stretches the departures (each second of stagger beyond
+    /// the first adds about 1.3 s, measured); a shorter one cannot be had from these rules and
+    /// gets the natural plan (the CLI warns).
     pub fn new(n: usize, opts: &InitiateOptions) -> TakeoffPlan {
-        let auto = Self::auto_seconds(n);
-        let seconds = opts.takeoff.unwrap_or(auto);
-        // Relative to the automatic plan of this flock size.
-        let s = seconds / auto;
+        let natural = Self::natural_seconds(n);
+        let seconds = opts.takeoff.unwrap_or(natural);
         let root = (n.max(1) as f64).sqrt();
         let (width, depth, stagger) = match &opts.start {
             Start::Ground(g) => {
                 // About 10 square wingspans per bird (1.6 times what random packing of birds
-                // `min_spacing` = 2 apart needs) at the automatic duration, spread with √s.
+                // `min_spacing` = 2 apart needs).
                 let base = (1.6 * g.min_spacing * root).max(4.0 * g.min_spacing);
                 (
-                    g.width.unwrap_or(1.4 * base * s.sqrt()),
-                    g.depth.unwrap_or(0.7 * base * s.sqrt()),
-                    g.stagger.unwrap_or(0.12 * seconds),
+                    g.width.unwrap_or(1.4 * base),
+                    g.depth.unwrap_or(0.7 * base),
+                    g.stagger
+                        .unwrap_or(1.0 + (seconds - natural).max(0.0) / 1.3),
                 )
             }
             Start::Random(r) => {
@@ -306,12 +317,12 @@ impl TakeoffPlan {
             Start::Given(_) => (0.0, 0.0, 0.0),
         };
         TakeoffPlan {
-            seconds,
+            seconds: seconds.max(natural),
             width,
             depth,
             stagger,
             k: opts.k,
-            catchup_distance: opts.catchup_distance * s.clamp(0.25, 4.0),
+            catchup_distance: opts.catchup_distance,
         }
     }
 }
@@ -552,6 +563,7 @@ impl InitiateOptions {
         pos("--max-accel", self.max_accel)?;
         pos("initiate.max_turn_accel", self.max_turn_accel)?;
         pos("initiate.max_jerk", self.max_jerk)?;
+        pos("initiate.max_turn_jerk", self.max_turn_jerk)?;
         pos("initiate.max_roll_rate", self.max_roll_rate)?;
         pos("--climb-rate", self.climb_rate)?;
         pos("initiate.vertical_accel", self.vertical_accel)?;
@@ -780,6 +792,7 @@ impl InitiateOptions {
             max_turn: self.max_turn_rate,
             max_turn_accel: self.max_turn_accel,
             turn_lag: self.turn_lag,
+            max_turn_jerk: self.max_turn_jerk,
             max_accel: self.max_accel,
             max_jerk: self.max_jerk,
             speed_lag: self.speed_lag,
@@ -1279,7 +1292,7 @@ pub fn initiate(
     let run = simulate(&target, steady.fps, &cruise, opts, rng, progress)?;
     if !run.stats.converged {
         return Err(Error::NotConverged(format!(
-            "the flock did not converge into the key shape within {:.0} s of flight ({} of {} birds within {} wingspans of their slots, last lift-off at {:.1} s); raise --max-steps or --takeoff, or start from a smaller area",
+            "the flock did not converge into the key shape within {:.0} s of flight ({} of {} birds within {} wingspans of their slots, last lift-off at {:.1} s); the time limit is the smaller of initiate.max_time and --max-steps / fps",
             opts.time_limit(steady.fps),
             run.stats.birds_in_slot,
             run.stats.birds,

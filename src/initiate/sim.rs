@@ -38,6 +38,10 @@ use super::target::{Side, TargetShape};
 /// fraction of the cruise speed (unless they are already closer than the avoidance distance).
 pub const AVOID_MIN_RELATIVE_SPEED: f64 = 0.08;
 
+/// Collision avoidance scores a candidate turn rate by the heading it gives after this long,
+/// seconds.
+pub const AVOID_COMMIT: f64 = 0.3;
+
 /// Parameters of the drives, actions and flight dynamics, in seconds (derived from
 /// [`super::InitiateOptions`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -60,6 +64,8 @@ pub struct StepParams {
     pub max_turn_accel: f64,
     /// Time constant of the turn rate following its request, seconds.
     pub turn_lag: f64,
+    /// Maximum rate of change of the turn rate's change, radians per second cubed.
+    pub max_turn_jerk: f64,
     /// Maximum acceleration (and deceleration), wingspans per second squared.
     pub max_accel: f64,
     /// Maximum change of the acceleration, wingspans per second cubed.
@@ -157,6 +163,8 @@ struct Decision {
     turn_rate: f64,
     /// Requested speed, wingspans per second.
     speed: f64,
+    /// Requested altitude offset, wingspans.
+    alt_offset: f64,
     reference: Option<usize>,
     side: Option<Side>,
     branch: Option<usize>,
@@ -176,6 +184,8 @@ pub struct Flock {
     pub heading: Vec<f64>,
     /// Turn rates, radians per second (positive: turning right).
     pub turn_rate: Vec<f64>,
+    /// Rates of change of the turn rates, radians per second squared.
+    pub turn_accel: Vec<f64>,
     /// Horizontal speeds, wingspans per second.
     pub speed: Vec<f64>,
     /// Accelerations, wingspans per second squared.
@@ -188,6 +198,8 @@ pub struct Flock {
     pub depart: Vec<f64>,
     /// Requested turn rate (rad/s) and speed (wingspans/s) of each bird, from its last decision.
     pub request: Vec<(f64, f64)>,
+    /// Requested altitude offset from the cruise altitude (collision avoidance), wingspans.
+    pub alt_offset: Vec<f64>,
     /// Reference bird of each bird (`None` for the leader and for lost birds).
     pub reference: Vec<Option<usize>>,
     /// Side of each bird relative to its reference bird.
@@ -335,6 +347,8 @@ pub struct BirdState {
     pub heading: f64,
     /// Turn rate, radians per second.
     pub turn_rate: f64,
+    /// Rate of change of the turn rate, radians per second squared.
+    pub turn_accel: f64,
     /// Speed, wingspans per second.
     pub speed: f64,
     /// Acceleration, wingspans per second squared.
@@ -353,11 +367,31 @@ fn approach(x: f64, target: f64, max_step: f64) -> f64 {
 /// limits of [`StepParams`] hold by construction: |Δω| ≤ ω̇_max dt, |Δa| ≤ j_max dt,
 /// |a| ≤ a_max, |Δφ| ≤ p_max dt, |Δw| ≤ a_z dt.
 pub fn fly(s: &BirdState, want_turn: f64, want_speed: f64, p: &StepParams, dt: f64) -> BirdState {
+    fly_at(s, want_turn, want_speed, p.cruise_altitude, p, dt)
+}
+
+/// As [`fly`], climbing towards altitude `want_z` (wingspans) instead of the cruise altitude.
+pub fn fly_at(
+    s: &BirdState,
+    want_turn: f64,
+    want_speed: f64,
+    want_z: f64,
+    p: &StepParams,
+    dt: f64,
+) -> BirdState {
     let mut n = *s;
-    // Turn rate: first-order lag on the request, the rate of change bounded.
+    // Turn rate: it follows the request with a lag, (ω* − ω)/τ_ω, its change bounded and
+    // itself changing at a bounded rate (so the turn rate cannot flip sign from one frame to the
+    // next); near the request the change is the braking one, ω̇² = 2 j |ω* − ω|, so it arrives
+    // without overshoot.
     let w_req = want_turn.clamp(-p.max_turn, p.max_turn);
-    let dw = ((w_req - s.turn_rate) / p.turn_lag).clamp(-p.max_turn_accel, p.max_turn_accel);
-    n.turn_rate = (s.turn_rate + dw * dt).clamp(-p.max_turn, p.max_turn);
+    let err = w_req - s.turn_rate;
+    let brake = (2.0 * p.max_turn_jerk * err.abs()).sqrt();
+    let a_turn = (err / p.turn_lag)
+        .clamp(-p.max_turn_accel, p.max_turn_accel)
+        .clamp(-brake, brake);
+    n.turn_accel = approach(s.turn_accel, a_turn, p.max_turn_jerk * dt);
+    n.turn_rate = (s.turn_rate + n.turn_accel * dt).clamp(-p.max_turn, p.max_turn);
     // Speed: the acceleration follows (v* − v)/τ_v with bounded jerk. Near the speed limits the
     // wanted acceleration is the braking one (a² = 2 j Δv), so the bound is met without a kink.
     let v_req = want_speed.clamp(p.min_speed, p.max_speed);
@@ -376,7 +410,7 @@ pub fn fly(s: &BirdState, want_turn: f64, want_speed: f64, p: &StepParams, dt: f
     let dphi = ((phi_t - s.bank) / p.roll_lag).clamp(-p.max_roll_rate, p.max_roll_rate);
     n.bank = s.bank + dphi * dt;
     // Climb: towards the cruise altitude, arriving with zero climb rate.
-    let dz = p.cruise_altitude - s.z;
+    let dz = want_z - s.z;
     let w_t = (2.0 * p.vertical_accel * dz.abs()).sqrt().min(p.climb_rate) * dz.signum();
     n.climb = approach(s.climb, w_t, p.vertical_accel * dt);
     n.z = s.z + 0.5 * (s.climb + n.climb) * dt;
@@ -430,12 +464,14 @@ impl Simulation {
                 climb: vec![0.0; n],
                 heading,
                 turn_rate: vec![0.0; n],
+                turn_accel: vec![0.0; n],
                 speed,
                 accel: vec![0.0; n],
                 bank: vec![0.0; n],
                 phase,
                 depart,
                 request,
+                alt_offset: vec![0.0; n],
                 reference: vec![None; n],
                 side: vec![None; n],
                 branch: vec![None; n],
@@ -508,6 +544,7 @@ impl Simulation {
             climb: f.climb[i],
             heading: f.heading[i],
             turn_rate: f.turn_rate[i],
+            turn_accel: f.turn_accel[i],
             speed: f.speed[i],
             accel: f.accel[i],
             bank: f.bank[i],
@@ -521,6 +558,7 @@ impl Simulation {
         f.climb[i] = s.climb;
         f.heading[i] = s.heading;
         f.turn_rate[i] = s.turn_rate;
+        f.turn_accel[i] = s.turn_accel;
         f.speed[i] = s.speed;
         f.accel[i] = s.accel;
         f.bank[i] = s.bank;
@@ -691,7 +729,8 @@ impl Simulation {
                 }
                 Phase::Airborne => {
                     let (w, v) = self.flock.request[i];
-                    fly(&s, w, v, &p, dt)
+                    let z = p.cruise_altitude + self.flock.alt_offset[i];
+                    fly_at(&s, w, v, z, &p, dt)
                 }
             };
             self.set_bird(i, &next);
@@ -785,6 +824,7 @@ impl Simulation {
                 continue;
             }
             f.request[i] = (d.turn_rate, d.speed);
+            f.alt_offset[i] = d.alt_offset;
             self.next_reference[i] = d.reference;
             self.next_side[i] = d.side;
             self.next_branch[i] = d.branch;
@@ -890,8 +930,10 @@ impl Simulation {
         };
         let (mut w, mut v) = (turn.clamp(-p.max_turn, p.max_turn), want_speed);
         self.grid.within(&f.pos, f.pos[i], p.avoid_range, near);
-        if let Some((turn, slow)) = self.avoidance(i, w, near) {
+        let mut alt_offset = 0.0;
+        if let Some((turn, slow, dz)) = self.avoidance(i, w, near) {
             w = turn;
+            alt_offset = dz;
             if slow {
                 v = v.min(f.speed[i] - p.max_accel * p.speed_lag);
             }
@@ -899,6 +941,7 @@ impl Simulation {
         Decision {
             turn_rate: w.clamp(-p.max_turn, p.max_turn),
             speed: v.clamp(p.min_speed, p.max_speed),
+            alt_offset,
             reference,
             side,
             branch,
@@ -1035,7 +1078,7 @@ impl Simulation {
     /// time (the requested turn wins whenever it is safe, then the one nearest to it), and slows
     /// if the nearest threat is ahead. Birds flying in parallel (V neighbours) are no threat.
     /// Returns the turn rate (rad/s) and whether to slow.
-    fn avoidance(&self, i: usize, want: f64, near: &[usize]) -> Option<(f64, bool)> {
+    fn avoidance(&self, i: usize, want: f64, near: &[usize]) -> Option<(f64, bool, f64)> {
         let p = &self.params;
         let f = &self.flock;
         let pi = DVec3::new(f.pos[i].x, f.pos[i].y, f.z[i]);
@@ -1051,7 +1094,7 @@ impl Simulation {
             (dp + dv * tau).length()
         };
         let at = |k: usize| DVec3::new(f.pos[k].x, f.pos[k].y, f.z[k]);
-        let mut threat: Option<(f64, DVec3)> = None;
+        let mut threat: Option<(f64, DVec3, usize)> = None;
         for &k in near {
             if k == i {
                 continue;
@@ -1063,13 +1106,15 @@ impl Simulation {
             let d = dp.length();
             if (closing && m < p.avoid_distance) || d < p.avoid_distance {
                 if threat.is_none_or(|t| d < t.0) {
-                    threat = Some((d, dp));
+                    threat = Some((d, dp, k));
                 }
             }
         }
-        let (_, nearest) = threat?;
+        let (_, nearest, other) = threat?;
         let score = |w: f64| -> f64 {
-            let h = direction(f.heading[i] + w * p.reaction_time) * f.speed[i];
+            // The heading after holding that turn rate for the avoidance commitment time (a
+            // turn takes effect over a fraction of a second, not one reaction time).
+            let h = direction(f.heading[i] + w * AVOID_COMMIT) * f.speed[i];
             let vnew = DVec3::new(h.x, h.y, vi.z);
             let mut worst = f64::INFINITY;
             for &k in near {
@@ -1092,7 +1137,20 @@ impl Simulation {
             }
         }
         let ahead = nearest.truncate().dot(direction(f.heading[i])) > 0.0;
-        Some((best.1, ahead))
+        // In 3-D a bird can also pass above or below: the higher of the two (the one with the
+        // higher index when level) climbs, the other dives, by 1.5 avoidance distances, while the
+        // threat lasts (airborne birds only; the hand-over needs the cruise altitude back).
+        let above = f.z[i] > f.z[other] || (f.z[i] == f.z[other] && i > other);
+        let dz = if f.phase[other] == Phase::Airborne && f.z[i] > 0.5 * p.avoid_distance {
+            if above {
+                1.5 * p.avoid_distance
+            } else {
+                -1.5 * p.avoid_distance
+            }
+        } else {
+            0.0
+        };
+        Some((best.1, ahead, dz))
     }
 
     /// Positions of the slots in the world if the leader were exactly in its slot and the flock
