@@ -4,7 +4,7 @@
 //! - one simulation step of 1000 airborne birds: one decision of every bird (perception through
 //!   the grid, drives, avoidance) and the integration steps up to the next decision, i.e. one
 //!   reaction time (1/30 s) of flight;
-//! - whole ground take-offs of 100 and 300 birds, from rest to convergence.
+//! - a whole ground take-off of 100 birds, from rest to convergence (or the time limit).
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use formation::initiate::{
@@ -86,7 +86,9 @@ fn step_1000(c: &mut Criterion) {
 fn whole(c: &mut Criterion) {
     let mut group = c.benchmark_group("takeoff");
     group.sample_size(10);
-    for n in [100usize, 300] {
+    // 300 birds do not converge yet (they fly to the 300 s limit, about 100 s of wall time per
+    // run): measured once from the command line, docs/performance.md.
+    for n in [100usize] {
         let target = TargetShape::new(&v_shape(n)).expect("shape");
         let opts = InitiateOptions::default();
         group.bench_function(format!("whole_{n}_birds"), |b| {
