@@ -88,7 +88,8 @@ fn whole(c: &mut Criterion) {
     group.sample_size(10);
     // 300 birds do not converge yet (they fly to the 300 s limit, about 100 s of wall time per
     // run): measured once from the command line, docs/performance.md.
-    for n in [100usize] {
+    {
+        let n = 100usize;
         let target = TargetShape::new(&v_shape(n)).expect("shape");
         let opts = InitiateOptions::default();
         group.bench_function(format!("whole_{n}_birds"), |b| {

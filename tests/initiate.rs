@@ -31,7 +31,15 @@ fn convergence(n: usize, seeds: u64, opts: &InitiateOptions) -> (u64, f64, f64, 
     let mut steps = Vec::new();
     for seed in 0..seeds {
         let mut r = rng::seeded(seed);
-        let run = initiate::simulate(&t, 30.0, &initiate::Cruise::new(0.0, 10.0), opts, &mut r, &Silent).unwrap();
+        let run = initiate::simulate(
+            &t,
+            30.0,
+            &initiate::Cruise::new(0.0, 10.0),
+            opts,
+            &mut r,
+            &Silent,
+        )
+        .unwrap();
         if run.stats.converged {
             ok += 1;
             steps.push(run.stats.steps);

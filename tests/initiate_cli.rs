@@ -113,13 +113,28 @@ fn bad_input_is_exit_2_with_one_line() {
             "--start-width/--start-depth: a take-off area of 2.0",
         ),
         (
-            vec!["initiate", s, "-o", o, "--start", "air", "--start-width", "2"],
+            vec![
+                "initiate",
+                s,
+                "-o",
+                o,
+                "--start",
+                "air",
+                "--start-width",
+                "2",
+            ],
             "region",
         ),
         (vec!["initiate", s, "-o", o, "--takeoff", "0"], "--takeoff"),
         (vec!["initiate", s, "-o", o, "--takeoff", "-4"], "--takeoff"),
-        (vec!["initiate", s, "-o", o, "--takeoff", "NaN"], "--takeoff"),
-        (vec!["initiate", s, "-o", o, "--takeoff", "inf"], "--takeoff"),
+        (
+            vec!["initiate", s, "-o", o, "--takeoff", "NaN"],
+            "--takeoff",
+        ),
+        (
+            vec!["initiate", s, "-o", o, "--takeoff", "inf"],
+            "--takeoff",
+        ),
         (vec!["initiate", s, "-o", o, "--hold", "NaN"], "--hold"),
         (vec!["initiate", s, "-o", o, "--hold=-1"], "--hold"),
         (
@@ -131,7 +146,16 @@ fn bad_input_is_exit_2_with_one_line() {
             "--climb-rate",
         ),
         (
-            vec!["initiate", s, "-o", o, "--start", "air", "--heading-spread", "200"],
+            vec![
+                "initiate",
+                s,
+                "-o",
+                o,
+                "--start",
+                "air",
+                "--heading-spread",
+                "200",
+            ],
             "--heading-spread",
         ),
         (

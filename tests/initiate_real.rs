@@ -382,8 +382,7 @@ fn diagnose() {
     let (t, cruise) = initiate::steady_target(&a).unwrap();
     let opts = InitiateOptions::default();
     let (mut sim, _) =
-        initiate::start_simulation(&t, &cruise, &opts, &mut rng::stream(seed, "initiate"))
-            .unwrap();
+        initiate::start_simulation(&t, &cruise, &opts, &mut rng::stream(seed, "initiate")).unwrap();
     let sp = sim.params;
     let mut held = 0;
     let mut trace: Vec<Vec<Option<usize>>> = Vec::new();

@@ -24,7 +24,15 @@ fn rate(label: &str, shape: &[(f64, f64)], seeds: u64, opts: &InitiateOptions) {
     for seed in 0..seeds {
         let mut r = rng::seeded(seed);
         let heading = env_f("HEADING").unwrap_or(0.0).to_radians();
-        let run = initiate::simulate(&t, 30.0, &initiate::Cruise::new(heading, 10.0), opts, &mut r, &Silent).unwrap();
+        let run = initiate::simulate(
+            &t,
+            30.0,
+            &initiate::Cruise::new(heading, 10.0),
+            opts,
+            &mut r,
+            &Silent,
+        )
+        .unwrap();
         if run.stats.converged {
             ok += 1;
             steps.push(run.stats.steps);
@@ -142,7 +150,11 @@ fn diagnose() {
     } else {
         initiate_support::v_shape(n, 1.0, 0.6)
     });
-    let params = opts.step_params(&initiate::Cruise::new(0.0, 10.0), opts.k, opts.catchup_distance);
+    let params = opts.step_params(
+        &initiate::Cruise::new(0.0, 10.0),
+        opts.k,
+        opts.catchup_distance,
+    );
     let mut r = rng::seeded(seed);
     let region = match &opts.start {
         initiate::Start::Random(r) => *r,
@@ -203,7 +215,11 @@ fn near_misses() {
         .unwrap_or(50);
     let opts = env_opts();
     let t = target(&initiate_support::v_shape(n, 1.0, 0.6));
-    let params = opts.step_params(&initiate::Cruise::new(0.0, 10.0), opts.k, opts.catchup_distance);
+    let params = opts.step_params(
+        &initiate::Cruise::new(0.0, 10.0),
+        opts.k,
+        opts.catchup_distance,
+    );
     let region = match &opts.start {
         initiate::Start::Random(r) => *r,
         _ => initiate::StartRegion::default(),
@@ -281,7 +297,11 @@ fn hpr_agreement() {
         .and_then(|s| s.parse().ok())
         .unwrap_or(40);
     let opts = InitiateOptions::default();
-    let params = opts.step_params(&initiate::Cruise::new(0.0, 10.0), opts.k, opts.catchup_distance);
+    let params = opts.step_params(
+        &initiate::Cruise::new(0.0, 10.0),
+        opts.k,
+        opts.catchup_distance,
+    );
     let cone = 0.35 * std::f64::consts::PI;
     for n in [9usize, 14, 41] {
         // Configurations: random take-off clusters, and the flock 5 s and 20 s into an initiation.

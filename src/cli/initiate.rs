@@ -181,14 +181,18 @@ impl InitiateFlags {
                 Start::Ground(GroundStart {
                     width: self.start_width,
                     depth: self.start_depth,
-                    heading_spread: self.heading_spread.map_or(d.heading_spread, f64::to_radians),
+                    heading_spread: self
+                        .heading_spread
+                        .map_or(d.heading_spread, f64::to_radians),
                     ..d
                 })
             }
             "air" => Start::Random(StartRegion {
                 width: self.start_width,
                 depth: self.start_depth,
-                heading_spread: self.heading_spread.map_or(std::f64::consts::PI, f64::to_radians),
+                heading_spread: self
+                    .heading_spread
+                    .map_or(std::f64::consts::PI, f64::to_radians),
                 ..Default::default()
             }),
             path => {

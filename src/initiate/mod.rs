@@ -606,10 +606,7 @@ impl InitiateOptions {
             if t > self.max_time {
                 return Err(Error::parameter(
                     "--takeoff",
-                    format!(
-                        "{t} s is longer than the time limit of {} s",
-                        self.max_time
-                    ),
+                    format!("{t} s is longer than the time limit of {} s", self.max_time),
                 ));
             }
         }
@@ -1099,10 +1096,7 @@ pub fn start_simulation(
                     .zip(&s.y)
                     .map(|(&x, &y)| DVec2::new(x, y))
                     .collect();
-            let heading = s
-                .heading
-                .clone()
-                .unwrap_or_else(|| vec![cruise.heading; n]);
+            let heading = s.heading.clone().unwrap_or_else(|| vec![cruise.heading; n]);
             let speed = match &s.speed {
                 Some(v) => v
                     .iter()
@@ -1165,19 +1159,34 @@ pub fn simulate(
     };
     let mut prev: Vec<sim::BirdState> = (0..n).map(|i| sim.bird(i)).collect();
     let push = |run: &mut InitiationRun, a: &[sim::BirdState], b: &[sim::BirdState], u: f64| {
-        run.pos.push(a.iter().zip(b).map(|(a, b)| a.pos.lerp(b.pos, u)).collect());
-        run.z
-            .push(a.iter().zip(b).map(|(a, b)| a.z + u * (b.z - a.z)).collect());
+        run.pos
+            .push(a.iter().zip(b).map(|(a, b)| a.pos.lerp(b.pos, u)).collect());
+        run.z.push(
+            a.iter()
+                .zip(b)
+                .map(|(a, b)| a.z + u * (b.z - a.z))
+                .collect(),
+        );
         run.heading.push(
             a.iter()
                 .zip(b)
-                .map(|(a, b)| sim::wrap_angle(a.heading + u * sim::wrap_angle(b.heading - a.heading)))
+                .map(|(a, b)| {
+                    sim::wrap_angle(a.heading + u * sim::wrap_angle(b.heading - a.heading))
+                })
                 .collect(),
         );
-        run.speed
-            .push(a.iter().zip(b).map(|(a, b)| a.speed + u * (b.speed - a.speed)).collect());
-        run.bank
-            .push(a.iter().zip(b).map(|(a, b)| a.bank + u * (b.bank - a.bank)).collect());
+        run.speed.push(
+            a.iter()
+                .zip(b)
+                .map(|(a, b)| a.speed + u * (b.speed - a.speed))
+                .collect(),
+        );
+        run.bank.push(
+            a.iter()
+                .zip(b)
+                .map(|(a, b)| a.bank + u * (b.bank - a.bank))
+                .collect(),
+        );
     };
     push(&mut run, &prev, &prev, 0.0);
     let total = (limit / dt).ceil() as u64;
@@ -1494,7 +1503,12 @@ pub fn hand_over(
 /// The bank of every bird in every steady frame: the coordinated-turn bank tan φ = v ω / g of the
 /// steady flight's own turns (ω from the headings of neighbouring frames, g in wingspans/s²),
 /// followed with the roll lag and roll-rate limit from a level start. Straight flight gives 0.
-pub fn steady_banks(steady: &Animation, g: f64, max_roll_rate: f64, roll_lag: f64) -> Vec<Vec<f64>> {
+pub fn steady_banks(
+    steady: &Animation,
+    g: f64,
+    max_roll_rate: f64,
+    roll_lag: f64,
+) -> Vec<Vec<f64>> {
     let n = steady.birds;
     let fr = &steady.frames;
     let mut out = Vec::with_capacity(fr.len());
@@ -1516,7 +1530,11 @@ pub fn steady_banks(steady: &Animation, g: f64, max_roll_rate: f64, roll_lag: f6
                 let rate = ((target - *phi) / roll_lag).clamp(-max_roll_rate, max_roll_rate);
                 // An exact step to the target when the lag would overshoot it.
                 let next = *phi + rate * h;
-                *phi = if (next - target) * (*phi - target) < 0.0 { target } else { next };
+                *phi = if (next - target) * (*phi - target) < 0.0 {
+                    target
+                } else {
+                    next
+                };
             }
         }
         out.push(phi.clone());

@@ -321,6 +321,10 @@ pub struct Simulation {
     pub leader_changes: usize,
     /// Birds that have left their place on the ground (running or airborne), in index order.
     departed: Vec<usize>,
+    /// Birds by the slot they take, for this decision: slot `s` holds
+    /// `holders[holder_start[s]..holder_start[s + 1]]` (increasing bird index).
+    holders: Vec<usize>,
+    holder_start: Vec<usize>,
     perceiver: Perceiver,
     visible: Vec<usize>,
     near: Vec<usize>,
@@ -483,6 +487,8 @@ impl Simulation {
             time: 0.0,
             leader_changes: 0,
             departed: Vec::new(),
+            holders: Vec::new(),
+            holder_start: Vec::new(),
             perceiver: Perceiver::new(),
             visible: Vec::new(),
             near: Vec::new(),
@@ -514,16 +520,17 @@ impl Simulation {
 
     fn update_departed(&mut self) {
         self.departed.clear();
-        self.departed.extend(
-            (0..self.len()).filter(|&i| self.flock.phase[i] != Phase::Waiting),
-        );
+        self.departed
+            .extend((0..self.len()).filter(|&i| self.flock.phase[i] != Phase::Waiting));
     }
 
     /// The departed bird farthest along `dir` (ties to the lower index).
     fn front_most(&self, dir: DVec2) -> Option<usize> {
         let mut best: Option<usize> = None;
         for &i in &self.departed {
-            if best.is_none_or(|b| self.flock.pos[i].dot(dir) > self.flock.pos[b].dot(dir)) {
+            if best.map_or(true, |b| {
+                self.flock.pos[i].dot(dir) > self.flock.pos[b].dot(dir)
+            }) {
                 best = Some(i);
             }
         }
@@ -656,8 +663,12 @@ impl Simulation {
             let holds =
                 f.reference[i] == Some(j) && f.side[i] == Some(side) && f.slot[i] == Some(c);
             let margin = if holds { 0.0 } else { SLOT_CLAIM_MARGIN };
-            let taken = visible.iter().any(|&k| {
+            // Birds that take slot `c` (a short list, from the per-decision table), of those
+            // the visible ones (`visible` is sorted).
+            let holders = &self.holders[self.holder_start[c]..self.holder_start[c + 1]];
+            let taken = holders.iter().any(|&k| {
                 k != i
+                    && visible.binary_search(&k).is_ok()
                     && f.reference[k] == Some(j)
                     && f.side[k] == Some(side)
                     && f.slot[k] == Some(c)
@@ -754,14 +765,14 @@ impl Simulation {
             let lead_gone = self.flock.phase[lead] == Phase::Waiting;
             if front != lead
                 && (lead_gone
-                    || (self.flock.pos[front] - self.flock.pos[lead]).dot(dc)
-                        > p.leader_hysteresis)
+                    || (self.flock.pos[front] - self.flock.pos[lead]).dot(dc) > p.leader_hysteresis)
             {
                 self.flock.leader = front;
                 self.leader_changes += 1;
                 self.match_slots();
             }
         }
+        self.build_holders();
         let mut vel = std::mem::take(&mut self.vel);
         vel.clear();
         vel.extend((0..n).map(|i| {
@@ -777,7 +788,11 @@ impl Simulation {
         // queries cover as many cells as the visual range needs.
         let mut grid = std::mem::take(&mut self.grid);
         let all: Vec<usize> = (0..n).collect();
-        grid.build(&self.flock.pos, &all, p.avoid_range.max(p.visual_range / 4.0));
+        grid.build(
+            &self.flock.pos,
+            &all,
+            p.avoid_range.max(p.visual_range / 4.0),
+        );
         self.grid = grid;
         let mut decisions = std::mem::take(&mut self.decisions);
         decisions.clear();
@@ -844,6 +859,32 @@ impl Simulation {
         std::mem::swap(&mut f.branch, &mut self.next_branch);
         std::mem::swap(&mut f.unseen, &mut self.next_unseen);
         self.match_slots();
+    }
+
+    /// The table of birds by slot the decisions read (counting sort, O(N)).
+    fn build_holders(&mut self) {
+        let slots = self.target.len();
+        self.holder_start.clear();
+        self.holder_start.resize(slots + 1, 0);
+        for s in self.flock.slot.iter().flatten() {
+            if *s < slots {
+                self.holder_start[*s + 1] += 1;
+            }
+        }
+        for s in 0..slots {
+            self.holder_start[s + 1] += self.holder_start[s];
+        }
+        self.holders.clear();
+        self.holders.resize(self.holder_start[slots], 0);
+        let mut fill = self.holder_start.clone();
+        for (i, s) in self.flock.slot.iter().enumerate() {
+            if let Some(s) = *s {
+                if s < slots {
+                    self.holders[fill[s]] = i;
+                    fill[s] += 1;
+                }
+            }
+        }
     }
 
     /// The decision of airborne bird `i`, from the current state only.
@@ -1104,10 +1145,9 @@ impl Simulation {
             let closing = dv.length() >= AVOID_MIN_RELATIVE_SPEED * p.cruise_speed;
             let m = miss(dp, dv);
             let d = dp.length();
-            if (closing && m < p.avoid_distance) || d < p.avoid_distance {
-                if threat.is_none_or(|t| d < t.0) {
-                    threat = Some((d, dp, k));
-                }
+            let is_threat = (closing && m < p.avoid_distance) || d < p.avoid_distance;
+            if is_threat && threat.map_or(true, |t| d < t.0) {
+                threat = Some((d, dp, k));
             }
         }
         let (_, nearest, other) = threat?;
