@@ -330,6 +330,7 @@ fn bank_is_the_coordinated_turn_in_a_steady_turn() {
             speed: v,
             accel: 0.0,
             bank: 0.0,
+            roll_rate: 0.0,
         };
         let mut prev = s;
         for _ in 0..(5.0 / dt) as usize {

@@ -98,6 +98,8 @@ pub struct InitiateOptions {
     pub max_roll_rate: f64,
     /// Time constant of the bank following the coordinated-turn bank, seconds.
     pub roll_lag: f64,
+    /// Maximum roll acceleration, radians per second squared.
+    pub max_roll_accel: f64,
     /// Cruise altitude: `z` of the steady flight above the ground, wingspans (the steady flight's
     /// own `z` is added to it).
     pub cruise_altitude: f64,
@@ -179,7 +181,7 @@ impl Default for InitiateOptions {
             max_turn_rate: PI / 2.0,
             max_turn_accel: 540f64.to_radians(),
             turn_lag: 0.1,
-            max_turn_jerk: 10000f64.to_radians(),
+            max_turn_jerk: 6000f64.to_radians(),
             max_accel: 4.0,
             max_jerk: 40.0,
             speed_lag: 0.1,
@@ -187,6 +189,7 @@ impl Default for InitiateOptions {
             max_speed: 1.6,
             max_roll_rate: 180f64.to_radians(),
             roll_lag: 0.2,
+            max_roll_accel: 400f64.to_radians(),
             cruise_altitude: 10.0,
             climb_rate: 2.0,
             vertical_accel: 1.5,
@@ -565,6 +568,7 @@ impl InitiateOptions {
         pos("initiate.max_jerk", self.max_jerk)?;
         pos("initiate.max_turn_jerk", self.max_turn_jerk)?;
         pos("initiate.max_roll_rate", self.max_roll_rate)?;
+        pos("initiate.max_roll_accel", self.max_roll_accel)?;
         pos("--climb-rate", self.climb_rate)?;
         pos("initiate.vertical_accel", self.vertical_accel)?;
         pos("initiate.run_accel", self.run_accel)?;
@@ -803,6 +807,7 @@ impl InitiateOptions {
             gravity: cruise.gravity(),
             max_roll_rate: self.max_roll_rate,
             roll_lag: self.roll_lag,
+            max_roll_accel: self.max_roll_accel,
             run_accel: self.run_accel,
             separation_distance: self.separation_distance,
             lookahead: self.lookahead,

@@ -92,6 +92,8 @@ pub struct StepParams {
     pub max_roll_rate: f64,
     /// Time constant of the bank following the coordinated-turn bank, seconds.
     pub roll_lag: f64,
+    /// Maximum roll acceleration, radians per second squared.
+    pub max_roll_accel: f64,
     /// Acceleration of the take-off run, wingspans per second squared.
     pub run_accel: f64,
     /// Separation drive: two birds sharing a reference within this distance → the rear one
@@ -192,6 +194,8 @@ pub struct Flock {
     pub accel: Vec<f64>,
     /// Bank angles, radians (right wing down positive).
     pub bank: Vec<f64>,
+    /// Roll rates, radians per second.
+    pub roll_rate: Vec<f64>,
     /// Take-off phase of each bird.
     pub phase: Vec<Phase>,
     /// Departure time of each bird, seconds.
@@ -359,6 +363,8 @@ pub struct BirdState {
     pub accel: f64,
     /// Bank, radians.
     pub bank: f64,
+    /// Roll rate, radians per second.
+    pub roll_rate: f64,
 }
 
 /// `x` moved towards `target` by at most `max_step`.
@@ -410,9 +416,16 @@ pub fn fly_at(
     n.speed = (s.speed + n.accel * dt).clamp(p.min_speed.min(s.speed), p.max_speed.max(s.speed));
     n.heading = wrap_angle(s.heading + n.turn_rate * dt);
     // Coordinated turn: tan φ = v ω / g.
+    // The roll rate follows (φ* − φ)/τ_φ with a bounded roll acceleration, braking near φ*, so
+    // the bank cannot swing back and forth from frame to frame.
     let phi_t = (n.speed * n.turn_rate / p.gravity).atan();
-    let dphi = ((phi_t - s.bank) / p.roll_lag).clamp(-p.max_roll_rate, p.max_roll_rate);
-    n.bank = s.bank + dphi * dt;
+    let e = phi_t - s.bank;
+    let brake = (2.0 * p.max_roll_accel * e.abs()).sqrt();
+    let p_want = (e / p.roll_lag)
+        .clamp(-p.max_roll_rate, p.max_roll_rate)
+        .clamp(-brake, brake);
+    n.roll_rate = approach(s.roll_rate, p_want, p.max_roll_accel * dt);
+    n.bank = s.bank + n.roll_rate * dt;
     // Climb: towards the cruise altitude, arriving with zero climb rate.
     let dz = want_z - s.z;
     let w_t = (2.0 * p.vertical_accel * dz.abs()).sqrt().min(p.climb_rate) * dz.signum();
@@ -472,6 +485,7 @@ impl Simulation {
                 speed,
                 accel: vec![0.0; n],
                 bank: vec![0.0; n],
+                roll_rate: vec![0.0; n],
                 phase,
                 depart,
                 request,
@@ -555,6 +569,7 @@ impl Simulation {
             speed: f.speed[i],
             accel: f.accel[i],
             bank: f.bank[i],
+            roll_rate: f.roll_rate[i],
         }
     }
 
@@ -569,6 +584,7 @@ impl Simulation {
         f.speed[i] = s.speed;
         f.accel[i] = s.accel;
         f.bank[i] = s.bank;
+        f.roll_rate[i] = s.roll_rate;
     }
 
     /// §6.2.1 correspondence: the leader takes the leader slot; a bird whose reference bird is
