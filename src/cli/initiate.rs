@@ -112,14 +112,15 @@ pub struct InitiateFlags {
     #[arg(long, default_value = "ground")]
     pub start: String,
     /// Width of the take-off area (ground) or start region (air) across the cruise heading,
-    /// wingspans [default: from --takeoff; air: 30, or 6√N for large flocks].
+    /// wingspans [default: ground 4.5√N (with the depth, about 10 square wingspans per bird);
+    /// air 30, or 6√N for large flocks].
     #[arg(long, allow_negative_numbers = true)]
     pub start_width: Option<f64>,
     /// Depth of the take-off area or start region along the cruise heading, wingspans
-    /// [default: from --takeoff; air: the width].
+    /// [default: ground 2.2√N; air the width].
     #[arg(long, allow_negative_numbers = true)]
     pub start_depth: Option<f64>,
-    /// Start headings are uniform within this many degrees of the cruise heading [default: 10
+    /// Start headings are uniform within this many degrees of the cruise heading [default: 5
     /// on the ground, 180 (any) in the air].
     #[arg(long)]
     pub heading_spread: Option<f64>,
