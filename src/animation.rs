@@ -89,16 +89,16 @@ pub struct Frame {
     pub heading: Vec<f64>,
     /// Ground speed, wingspans per second.
     pub speed: Vec<f64>,
+    /// Bank angle, radians, right wing down positive (coordinated turns; 0 in straight flight).
+    /// Absent in files that do not carry it (then level).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bank: Option<Vec<f64>>,
     /// Power reduction e_i of the current shape (absent when undefined, e.g. during initiation).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub e: Option<Vec<f64>>,
     /// Relative power reduction ξ_i of the current shape (absent when undefined).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub xi: Option<Vec<f64>>,
-    /// Bank (roll) angle, radians, right wing down positive (coordinated turns; 0 in straight
-    /// flight). Absent in files that do not carry it (then level).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub bank: Option<Vec<f64>>,
     /// Wingbeat phase, radians in [0, 2π), 0 = start of the downstroke.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub wing_phase: Option<Vec<f64>>,

@@ -202,8 +202,8 @@ fn a_bad_second_output_writes_nothing_and_keeps_existing_files() {
     let d = tmpdir("keep");
     let csv = d.join("keep.csv");
     std::fs::write(&csv, "old").unwrap();
-    let out = formation(&["render", FIXTURE, "-o", s(&csv), "-o", s(&d.join("x.mp4"))]);
-    assert_usage_error(&out, &["x.mp4"]);
+    let out = formation(&["render", FIXTURE, "-o", s(&csv), "-o", s(&d.join("x.avi"))]);
+    assert_usage_error(&out, &["x.avi"]);
     assert_eq!(std::fs::read_to_string(&csv).unwrap(), "old");
     // A frames directory holding someone else's files is refused, not replaced.
     std::fs::create_dir_all(d.join("mine")).unwrap();
