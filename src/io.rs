@@ -183,6 +183,8 @@ pub enum OutputKind {
     Svg,
     /// `.glb`
     Glb,
+    /// `.usda` (text USD)
+    Usda,
     /// A directory of numbered PNG frames.
     Directory,
     /// `.mp4` (H.264 video through the system ffmpeg)
@@ -218,6 +220,7 @@ impl OutputKind {
             Some("glb") => Some(OutputKind::Glb),
             Some("mp4") => Some(OutputKind::Mp4),
             Some("webm") => Some(OutputKind::Webm),
+            Some("usda") => Some(OutputKind::Usda),
             _ => None,
         };
         let kind = if s.ends_with('/') || s.ends_with(std::path::MAIN_SEPARATOR) {
@@ -265,6 +268,7 @@ impl OutputKind {
             OutputKind::Png => ".png",
             OutputKind::Svg => ".svg",
             OutputKind::Glb => ".glb",
+            OutputKind::Usda => ".usda",
             OutputKind::Directory => "a directory (DIR/)",
             OutputKind::Mp4 => ".mp4",
             OutputKind::Webm => ".webm",

@@ -181,6 +181,18 @@ fn bad_options_and_paths_exit_2_with_one_line_and_no_file() {
             vec!["-o".into(), g.into(), "--wingspan-m".into(), "0".into()],
             vec!["--wingspan-m"],
         ),
+        (
+            vec!["-o".into(), s(&d.join("missing/flock.usda")).into()],
+            vec!["flock.usda", "does not exist"],
+        ),
+        (
+            vec!["-o".into(), g.into(), "--keys".into(), "some".into()],
+            vec!["--keys"],
+        ),
+        (
+            vec!["-o".into(), g.into(), "--bird-model".into(), FIXTURE.into()],
+            vec!["--bird-model", "not a binary .glb"],
+        ),
     ];
     for (extra, needles) in cases {
         let mut args = vec!["render", FIXTURE];

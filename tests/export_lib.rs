@@ -132,9 +132,14 @@ fn every_output_opens_in_an_independent_reader() {
     let jlen = u32::from_le_bytes(glb[12..16].try_into().unwrap()) as usize;
     assert_eq!(jlen % 4, 0);
     let root = gltf_json::Root::from_slice(&glb[20..20 + jlen]).unwrap();
-    assert_eq!(root.animations.len(), 1);
-    assert_eq!(root.animations[0].channels.len(), anim.birds * 6);
-    assert_eq!(root.nodes.len(), anim.birds * 5 + 1);
+    // One clip per stage; per bird: root translation and rotation, body (bank), tail and the
+    // four wing joints. Nodes: per bird a root, seven joints and a skinned mesh node; plus `flock`.
+    assert_eq!(root.animations.len(), anim.stages.len());
+    for a in &root.animations {
+        assert_eq!(a.channels.len(), anim.birds * 8);
+    }
+    assert_eq!(root.nodes.len(), anim.birds * 9 + 1);
+    assert_eq!(root.skins.len(), anim.birds);
     let bin_len = u32::from_le_bytes(glb[20 + jlen..24 + jlen].try_into().unwrap()) as u64;
     assert_eq!(root.buffers[0].byte_length.0, bin_len);
     std::fs::remove_dir_all(&d).unwrap();

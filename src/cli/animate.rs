@@ -28,7 +28,7 @@ pub struct AnimateArgs {
     #[arg(long)]
     pub birds: usize,
     /// Outputs by extension: .gif, DIR/ (numbered PNG frames), .mp4, .webm (through ffmpeg), .glb,
-    /// .csv, .json; may be repeated.
+    /// .usda, .csv, .json; may be repeated.
     #[arg(short = 'o', long = "output", required = true)]
     pub output: Vec<PathBuf>,
     /// Length of the steady flight, seconds (the take-off before it lasts as long as the flock
@@ -59,6 +59,8 @@ pub struct AnimateArgs {
     pub initiate: InitiateFlags,
     #[command(flatten)]
     pub wingbeat: WingbeatFlags,
+    #[command(flatten)]
+    pub scene: super::render::SceneArgs,
 }
 
 /// Runs `formation animate`.
@@ -90,11 +92,16 @@ pub fn run(args: AnimateArgs, g: Global) -> Result<()> {
         width: args.size.0,
         height: args.size.1,
         fps: args.picture_fps,
+        keys: args.scene.keys,
+        bird_model: args.scene.bird_model.clone(),
         ..RenderOptions::default()
     };
     args.shot.apply(&mut render)?;
     render.validate()?;
     formation::export::plan_outputs(&args.output)?;
+    if let Some(p) = &args.scene.bird_model {
+        formation::export::bird_model::load(p, wing.species)?;
+    }
 
     let progress = TermProgress::new(g.quiet);
     let params = extract::params_from_path(

@@ -16,7 +16,7 @@ pub struct RenderArgs {
     /// An animation file (SPEC §4.4).
     pub animation: PathBuf,
     /// Outputs by extension: .gif, DIR/ (numbered PNG frames), .mp4, .webm (through ffmpeg),
-    /// .glb, .csv, .json; may be repeated.
+    /// .glb, .usda, .csv, .json; may be repeated.
     #[arg(short = 'o', long = "output", required = true)]
     pub output: Vec<PathBuf>,
     #[command(flatten)]
@@ -79,6 +79,32 @@ pub struct PictureArgs {
     /// animation's, 1.5 for a goose].
     #[arg(long, value_name = "M", allow_negative_numbers = true)]
     pub wingspan_m: Option<f64>,
+    #[command(flatten)]
+    pub scene: SceneArgs,
+}
+
+/// Flags of the 3D outputs (.glb, .usda), shared by `render` and `animate`.
+#[derive(Debug, Clone, Args)]
+pub struct SceneArgs {
+    /// Keyframes of .glb and .usda: `all` (every frame) or `reduced` (only the keys needed to
+    /// stay within 1 mm and 0.1° of every frame for the flight, 1° for the wingbeat).
+    #[arg(long, value_name = "all|reduced", default_value_t = RenderOptions::default().keys)]
+    pub keys: formation::export::keys::KeyMode,
+    /// Your own bird (.glb) on every bird of the .glb and .usda: a static mesh flies and banks, a
+    /// skinned one whose joints follow the naming convention (docs/export.md) also flaps.
+    #[arg(long, value_name = "FILE.glb")]
+    pub bird_model: Option<PathBuf>,
+}
+
+impl SceneArgs {
+    /// Default render options with these flags.
+    pub fn options(&self) -> RenderOptions {
+        RenderOptions {
+            keys: self.keys,
+            bird_model: self.bird_model.clone(),
+            ..RenderOptions::default()
+        }
+    }
 }
 
 impl PictureArgs {
@@ -89,6 +115,8 @@ impl PictureArgs {
             height: self.size.1,
             fps: self.fps,
             wingspan_m: self.wingspan_m,
+            keys: self.scene.keys,
+            bird_model: self.scene.bird_model.clone(),
             ..RenderOptions::default()
         }
     }

@@ -1,20 +1,24 @@
-//! Outputs of an animation (issue 6): the animation file (`.json`), the long CSV (`.csv`), an
-//! animated GIF (`.gif`), a directory of numbered PNG frames (`DIR/`), a video (`.mp4`, `.webm`,
-//! through the system ffmpeg) and a glTF 2.0 binary (`.glb`). [`write_outputs`] is the one entry point of `formation render` and
+//! Outputs of an animation (issues 6, 14 and 15): the animation file (`.json`), the long CSV
+//! (`.csv`), an animated GIF (`.gif`), a directory of numbered PNG frames (`DIR/`), a video
+//! (`.mp4`, `.webm`, through the system ffmpeg), a glTF 2.0 binary (`.glb`) and text USD with
+//! UsdSkel (`.usda`). [`write_outputs`] is the one entry point of `formation render` and
 //! `formation animate`: it checks every output path and option before doing any work, then writes
 //! each output atomically (no partial file on failure).
 //!
-//! Units: the animation is in wingspans (world frame `x` east, `y` north, `z` up); the `.glb` is in
-//! metres (`wingspan_m`) on glTF's Y-up axes (see [`gltf`]); the pictures are drawn by one of
-//! the [`camera`]s (top-down following the flock by default, a ground observer, or a fixed view)
-//! over a procedural sky (see [`scene`], [`silhouette`]).
+//! Units: the animation is in wingspans (world frame `x` east, `y` north, `z` up); the `.glb` and
+//! `.usda` are in metres (`wingspan_m`) on glTF's Y-up axes (see [`gltf`], [`usd`]); the pictures
+//! are drawn by one of the [`camera`]s (top-down following the flock by default, a ground
+//! observer, or a fixed view) over a procedural sky (see [`scene`], [`silhouette`]).
 //!
 //! Frame rates: `.json`, `.csv` and `.glb` keep the animation's own frames. The GIF is sampled at
 //! [`pictures::GIF_FPS`] = 25 fps by default (GIF delays are whole 1/100 s); PNG frames and video
 //! at the animation's frame rate. [`RenderOptions::fps`] overrides every picture rate.
 
+pub mod bird;
+pub mod bird_model;
 pub mod camera;
 pub mod gltf;
+pub mod keys;
 pub mod palette;
 pub mod pictures;
 pub mod raster;
@@ -24,6 +28,7 @@ pub mod scene;
 pub mod silhouette;
 pub mod synthetic;
 pub mod table;
+pub mod usd;
 
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
@@ -38,12 +43,13 @@ pub use pictures::{Film, GIF_FPS};
 pub use scene::Background;
 
 /// Output kinds `render` and `animate` accept.
-pub const OUTPUT_KINDS: [OutputKind; 7] = [
+pub const OUTPUT_KINDS: [OutputKind; 8] = [
     OutputKind::Gif,
     OutputKind::Directory,
     OutputKind::Mp4,
     OutputKind::Webm,
     OutputKind::Glb,
+    OutputKind::Usda,
     OutputKind::Csv,
     OutputKind::Json,
 ];
@@ -60,7 +66,7 @@ pub const MAX_GIF_FPS: f64 = 50.0;
 pub const MAX_FRAMES: usize = 200_000;
 
 /// How to render; every field is checked by [`RenderOptions::validate`].
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct RenderOptions {
     /// Picture width, pixels.
     pub width: u32,
@@ -85,6 +91,11 @@ pub struct RenderOptions {
     /// Largest colour error a GIF pixel may show before it is redrawn, 8-bit levels per
     /// channel (0 = redraw every changed palette index).
     pub gif_tolerance: f64,
+    /// Keyframes of the `.glb` and `.usda`: every frame, or reduced within the documented
+    /// tolerances ([`keys::Tolerance`]).
+    pub keys: keys::KeyMode,
+    /// The user's bird (`.glb`) for the `.glb` and `.usda`; `None` = the built-in bird.
+    pub bird_model: Option<PathBuf>,
 }
 
 impl Default for RenderOptions {
@@ -100,6 +111,8 @@ impl Default for RenderOptions {
             background: Background::Sky,
             sun: false,
             gif_tolerance: 10.0,
+            keys: keys::KeyMode::All,
+            bird_model: None,
         }
     }
 }
@@ -336,6 +349,19 @@ pub fn write_outputs(
         }
     }
     let wingspan_m = opts.wingspan_m.unwrap_or(anim.wingspan_m);
+    // The user's bird is checked before any output is written (exit 2 with the reason).
+    let asset = match &opts.bird_model {
+        Some(p) => Some(bird_model::load(
+            p,
+            crate::wingbeat::WingbeatOptions::for_animation(anim).species,
+        )?),
+        None => None,
+    };
+    let scene = gltf::SceneOptions {
+        keys: opts.keys,
+        tolerance: keys::Tolerance::default(),
+        asset,
+    };
     let threads = pictures::worker_count(opts.threads);
     for o in &plan {
         match o.kind {
@@ -352,8 +378,18 @@ pub fn write_outputs(
             }
             OutputKind::Glb => {
                 progress.start("glb", 1);
-                let bytes = gltf::glb_bytes(anim, wingspan_m)?;
+                let bytes = gltf::glb_bytes_with(anim, wingspan_m, &scene)?;
                 write_bytes_atomic(&o.path, &bytes)?;
+                progress.advance(1);
+                progress.finish();
+            }
+            OutputKind::Usda => {
+                progress.start("usda", 1);
+                // Streamed into the temporary file (a 100-bird minute is tens of MB of text).
+                let mut f = AtomicFile::create(&o.path)?;
+                usd::write_usda(anim, wingspan_m, &scene, f.writer())
+                    .map_err(|e| Error::io(&o.path, e))?;
+                f.commit()?;
                 progress.advance(1);
                 progress.finish();
             }
