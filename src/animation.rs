@@ -161,7 +161,8 @@ pub struct Frame {
     pub heading: Vec<f64>,
     /// Ground speed, wingspans per second.
     pub speed: Vec<f64>,
-    /// Bank angle, radians, right wing down positive.
+    /// Bank angle, radians, right wing down positive (coordinated turns; 0 in straight flight).
+    /// Absent in files that do not carry it (then level).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub bank: Option<Vec<f64>>,
     /// Power reduction e_i of the current shape (absent when undefined, e.g. during initiation).
@@ -260,7 +261,7 @@ impl Animation {
                     ),
                 ));
             }
-            let arrays: [(&str, Option<&Vec<f64>>); 8] = [
+            let arrays: [(&str, Option<&Vec<f64>>); 9] = [
                 ("x", Some(&f.x)),
                 ("y", Some(&f.y)),
                 ("z", Some(&f.z)),
@@ -268,6 +269,7 @@ impl Animation {
                 ("speed", Some(&f.speed)),
                 ("e", f.e.as_ref()),
                 ("xi", f.xi.as_ref()),
+                ("bank", f.bank.as_ref()),
                 ("wing_phase", f.wing_phase.as_ref()),
             ];
             for (name, arr) in arrays {

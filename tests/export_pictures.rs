@@ -55,14 +55,19 @@ fn assert_usage_error(out: &Output, needles: &[&str]) {
 
 /// A real animation (extraction, steady flight, take-off) of `birds` geese.
 fn animate(birds: usize, d: &Path) -> Animation {
-    let json = d.join(format!("flock{birds}.json"));
+    animate_for(birds, d, "6")
+}
+
+/// As [`animate`], with `seconds` of steady flight after the take-off.
+fn animate_for(birds: usize, d: &Path, seconds: &str) -> Animation {
+    let json = d.join(format!("flock{birds}_{seconds}.json"));
     let out = formation(&[
         "animate",
         GEESE,
         "--birds",
         &birds.to_string(),
         "--seconds",
-        "6",
+        seconds,
         "-o",
         s(&json),
         "--quiet",
@@ -356,7 +361,9 @@ fn ground_camera_sees_the_flock_pass_overhead() {
     // The observer stands under the course: the flock is in the picture at the pass time, and
     // nearer birds are drawn larger than far ones.
     let d = tmpdir("ground");
-    let anim = animate(14, &d);
+    // The pass (70 % of the picture) falls in the steady flight, after the ground take-off
+    // (about 16 s for 14 birds), when the flock is formed.
+    let anim = animate_for(14, &d, "40");
     let opts = RenderOptions {
         camera: CameraKind::Ground,
         background: Background::Sky,

@@ -111,7 +111,10 @@ fn commands() -> Vec<Command> {
         ("--separation", "0", None),
         ("--avoid-distance", "0", None),
         ("--tolerance", "0", None),
-        ("--hold", "-1", None),
+        ("--hold", "nan", None),
+        ("--takeoff", "0", None),
+        ("--cruise-altitude", "1e9", None),
+        ("--climb-rate", "0", None),
         // A start file that does not exist is named by its path.
         ("--start", "OUT/no-start.json", Some("no-start.json".into())),
         ("--start-width", "0", None),

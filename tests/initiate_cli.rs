@@ -108,7 +108,56 @@ fn bad_input_is_exit_2_with_one_line() {
             vec!["initiate", s, "-o", o, "--start-width=-3"],
             "--start-width",
         ),
-        (vec!["initiate", s, "-o", o, "--start-width", "2"], "region"),
+        (
+            vec!["initiate", s, "-o", o, "--start-width", "2"],
+            "--start-width/--start-depth: a take-off area of 2.0",
+        ),
+        (
+            vec![
+                "initiate",
+                s,
+                "-o",
+                o,
+                "--start",
+                "air",
+                "--start-width",
+                "2",
+            ],
+            "region",
+        ),
+        (vec!["initiate", s, "-o", o, "--takeoff", "0"], "--takeoff"),
+        (vec!["initiate", s, "-o", o, "--takeoff", "-4"], "--takeoff"),
+        (
+            vec!["initiate", s, "-o", o, "--takeoff", "NaN"],
+            "--takeoff",
+        ),
+        (
+            vec!["initiate", s, "-o", o, "--takeoff", "inf"],
+            "--takeoff",
+        ),
+        (vec!["initiate", s, "-o", o, "--hold", "NaN"], "--hold"),
+        (vec!["initiate", s, "-o", o, "--hold=-1"], "--hold"),
+        (
+            vec!["initiate", s, "-o", o, "--cruise-altitude", "-2"],
+            "--cruise-altitude",
+        ),
+        (
+            vec!["initiate", s, "-o", o, "--climb-rate", "0"],
+            "--climb-rate",
+        ),
+        (
+            vec![
+                "initiate",
+                s,
+                "-o",
+                o,
+                "--start",
+                "air",
+                "--heading-spread",
+                "200",
+            ],
+            "--heading-spread",
+        ),
         (
             vec!["initiate", s, "-o", o, "--start-width", "1e300"],
             "--start-width",

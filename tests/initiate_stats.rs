@@ -24,7 +24,15 @@ fn rate(label: &str, shape: &[(f64, f64)], seeds: u64, opts: &InitiateOptions) {
     for seed in 0..seeds {
         let mut r = rng::seeded(seed);
         let heading = env_f("HEADING").unwrap_or(0.0).to_radians();
-        let run = initiate::simulate(&t, 30.0, heading, 10.0, opts, &mut r, &Silent).unwrap();
+        let run = initiate::simulate(
+            &t,
+            30.0,
+            &initiate::Cruise::new(heading, 10.0),
+            opts,
+            &mut r,
+            &Silent,
+        )
+        .unwrap();
         if run.stats.converged {
             ok += 1;
             steps.push(run.stats.steps);
@@ -45,6 +53,19 @@ fn rate(label: &str, shape: &[(f64, f64)], seeds: u64, opts: &InitiateOptions) {
     );
 }
 
+/// A simulation of an airborne start (the paper's) at the cruise altitude.
+fn air_sim(
+    t: TargetShape,
+    params: initiate::StepParams,
+    p: Vec<DVec2>,
+    h: Vec<f64>,
+    v: Vec<f64>,
+) -> initiate::Simulation {
+    let n = p.len();
+    let z = vec![params.cruise_altitude; n];
+    initiate::Simulation::new(t, params, p, z, h, v, vec![0.0; n])
+}
+
 fn env_f(name: &str) -> Option<f64> {
     std::env::var(name).ok().and_then(|s| s.parse().ok())
 }
@@ -52,6 +73,10 @@ fn env_f(name: &str) -> Option<f64> {
 /// Defaults, overridden by environment variables for parameter sweeps.
 fn env_opts() -> InitiateOptions {
     let mut o = InitiateOptions::default();
+    // The paper's airborne start unless GROUND is set.
+    if std::env::var("GROUND").is_err() {
+        o.start = initiate::Start::Random(Default::default());
+    }
     if let Some(v) = env_f("AVOID") {
         o.avoid_distance = v;
     }
@@ -125,14 +150,18 @@ fn diagnose() {
     } else {
         initiate_support::v_shape(n, 1.0, 0.6)
     });
-    let params = opts.step_params(30.0, 0.0, 10.0);
+    let params = opts.step_params(
+        &initiate::Cruise::new(0.0, 10.0),
+        opts.k,
+        opts.catchup_distance,
+    );
     let mut r = rng::seeded(seed);
     let region = match &opts.start {
         initiate::Start::Random(r) => *r,
-        _ => unreachable!(),
+        _ => initiate::StartRegion::default(),
     };
     let (p, h, v) = initiate::random_start(n, &region, &params, &mut r).unwrap();
-    let mut sim = initiate::Simulation::new(t, params, p, h, v);
+    let mut sim = air_sim(t, params, p, h, v);
     let steps: usize = std::env::var("STEPS")
         .ok()
         .and_then(|s| s.parse().ok())
@@ -186,15 +215,19 @@ fn near_misses() {
         .unwrap_or(50);
     let opts = env_opts();
     let t = target(&initiate_support::v_shape(n, 1.0, 0.6));
-    let params = opts.step_params(30.0, 0.0, 10.0);
+    let params = opts.step_params(
+        &initiate::Cruise::new(0.0, 10.0),
+        opts.k,
+        opts.catchup_distance,
+    );
     let region = match &opts.start {
         initiate::Start::Random(r) => *r,
-        _ => unreachable!(),
+        _ => initiate::StartRegion::default(),
     };
     for seed in 0..seeds {
         let mut r = rng::seeded(seed);
         let (p, h, v) = initiate::random_start(n, &region, &params, &mut r).unwrap();
-        let mut sim = initiate::Simulation::new(t.clone(), params, p, h, v);
+        let mut sim = air_sim(t.clone(), params, p, h, v);
         let mut prev: Option<initiate::sim::Flock> = None;
         for step in 0..2500 {
             sim.step();
@@ -264,7 +297,11 @@ fn hpr_agreement() {
         .and_then(|s| s.parse().ok())
         .unwrap_or(40);
     let opts = InitiateOptions::default();
-    let params = opts.step_params(30.0, 0.0, 10.0);
+    let params = opts.step_params(
+        &initiate::Cruise::new(0.0, 10.0),
+        opts.k,
+        opts.catchup_distance,
+    );
     let cone = 0.35 * std::f64::consts::PI;
     for n in [9usize, 14, 41] {
         // Configurations: random take-off clusters, and the flock 5 s and 20 s into an initiation.
@@ -276,10 +313,10 @@ fn hpr_agreement() {
                     .unwrap();
             configs.push((p.clone(), h.clone()));
             let t = target(&initiate_support::v_shape(n, 1.0, 0.6));
-            let mut sim = initiate::Simulation::new(t, params, p, h, v);
-            for step in 1..=600 {
+            let mut sim = air_sim(t, params, p, h, v);
+            for step in 1..=2400 {
                 sim.step();
-                if step == 150 || step == 600 {
+                if step == 600 || step == 2400 {
                     configs.push((sim.flock.pos.clone(), sim.flock.heading.clone()));
                 }
             }

@@ -34,8 +34,9 @@ pub struct AnimateArgs {
     /// .usda, .csv, .json; may be repeated.
     #[arg(short = 'o', long = "output", required = true)]
     pub output: Vec<PathBuf>,
-    /// Length of the steady flight, seconds (the initiation before it lasts as long as the flock
-    /// needs to converge, typically 2–6 s).
+    /// Length of the steady flight, seconds (the take-off before it lasts as long as the flock
+    /// needs to form, by default about 7 + 1.1 × birds seconds: 17 s for 9 birds, 22 s for 14,
+    /// 52 s for 41; see --takeoff).
     #[arg(long, default_value_t = formation::pipeline::DEFAULT_SECONDS, allow_negative_numbers = true)]
     pub seconds: f64,
     /// Skip the take-off: the animation is the steady flight alone.
@@ -75,16 +76,19 @@ pub fn run(args: AnimateArgs, g: Global) -> Result<()> {
         read: args.read.options(),
         extract: ExtractOptions::default(),
         steady: args.steady.options(args.birds),
-        initiate: args.initiate.options(args.birds)?,
-        wingbeat: args.wingbeat.options()?,
-        render: RenderOptions {
-            width: args.size.width,
-            height: args.size.height,
-            fps: args.picture_fps,
-            keys: args.scene.keys,
-            bird_model: args.scene.bird_model.clone(),
-            ..RenderOptions::default()
-        },
+        ..Config::default()
+    };
+    // In the order the stages run: the steady flight's options are checked first.
+    config.steady_options()?;
+    config.initiate = args.initiate.options(g.seed, args.birds)?;
+    config.wingbeat = args.wingbeat.options()?;
+    config.render = RenderOptions {
+        width: args.size.width,
+        height: args.size.height,
+        fps: args.picture_fps,
+        keys: args.scene.keys,
+        bird_model: args.scene.bird_model.clone(),
+        ..RenderOptions::default()
     };
     args.shot.apply(&mut config.render)?;
     // Everything that can be checked is checked before any work.

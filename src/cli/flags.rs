@@ -109,6 +109,21 @@ pub const FLAGS: &[(&str, &str, &[Cmd])] = &[
     ("initiate.tolerance", "--tolerance", INITIATE),
     ("initiate.hold", "--hold", INITIATE),
     ("initiate.start", "--start", INITIATE),
+    ("initiate.takeoff", "--takeoff", INITIATE),
+    ("initiate.cruise_altitude", "--cruise-altitude", INITIATE),
+    ("initiate.climb_rate", "--climb-rate", INITIATE),
+    (
+        "initiate.start.ground.width/initiate.start.ground.depth",
+        "--start-width/--start-depth",
+        INITIATE,
+    ),
+    ("initiate.start.ground.width", "--start-width", INITIATE),
+    ("initiate.start.ground.depth", "--start-depth", INITIATE),
+    (
+        "initiate.start.ground.heading_spread",
+        "--heading-spread",
+        INITIATE,
+    ),
     ("initiate.start.random.width", "--start-width", INITIATE),
     ("initiate.start.random.depth", "--start-depth", INITIATE),
     (

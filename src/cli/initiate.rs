@@ -6,10 +6,10 @@ use std::path::PathBuf;
 use clap::{Args, ValueEnum};
 use formation::animation::Animation;
 use formation::initiate::{
-    self, InitiateOptions, PerceptionMode, Start, StartRegion, StartState, HPR_GAMMA_DEFAULT,
+    self, GroundStart, InitiateOptions, PerceptionMode, Start, StartRegion, StartState,
+    HPR_GAMMA_DEFAULT,
 };
 use formation::io::OutputKind;
-use formation::pipeline::{initiate_stage, Config};
 use formation::{Error, Result};
 
 use super::progress::TermProgress;
@@ -44,99 +44,99 @@ pub struct InitiateArgs {
     pub json: bool,
 }
 
-/// Initiation flags shared by `initiate` and `animate` (the `initiate` section of the library's
-/// `Config`; defaults from `InitiateOptions::default()`, angles shown in degrees).
+/// Initiation flags shared by `initiate` and `animate`.
 #[derive(Debug, Clone, Args)]
 pub struct InitiateFlags {
-    /// Step limit (one step = one frame); no convergence within it fails with exit 1.
+    /// Frame limit of the take-off at the output --fps (the time limit is also at most 300 s of
+    /// flight); no convergence within it fails with exit 1.
     #[arg(long, default_value_t = InitiateOptions::default().max_steps)]
     pub max_steps: usize,
+    /// Take-off duration, seconds: a longer take-off than the flock's natural one stretches the
+    /// departures; a shorter one is not possible yet (warned) [default: the natural one, about
+    /// 7 + 1.1 × birds seconds: 17 s for 9 birds, 22 s for 14, 52 s for 41; `--json` reports it].
+    #[arg(long, allow_negative_numbers = true)]
+    pub takeoff: Option<f64>,
+    /// Cruise altitude of the steady flight above the ground (`z`), wingspans.
+    #[arg(long, allow_negative_numbers = true, default_value_t = InitiateOptions::default().cruise_altitude)]
+    pub cruise_altitude: f64,
+    /// Largest climb rate after lift-off, wingspans per second.
+    #[arg(long, allow_negative_numbers = true, default_value_t = InitiateOptions::default().climb_rate)]
+    pub climb_rate: f64,
     /// Occlusion model.
-    #[arg(long, value_enum, default_value_t = PerceptionArg::of(InitiateOptions::default().perception.mode))]
+    #[arg(long, value_enum, default_value_t = PerceptionArg::Hpr)]
     pub perception: PerceptionArg,
-    /// HPR radius exponent γ: R = (distance of the farthest bird) · 10^γ, dimensionless.
-    #[arg(long, default_value_t = HPR_GAMMA_DEFAULT, allow_negative_numbers = true)]
+    /// HPR radius exponent γ: R = (distance of the farthest bird) · 10^γ.
+    #[arg(long, default_value_t = HPR_GAMMA_DEFAULT)]
     pub hpr_gamma: f64,
     /// Visual field per eye, degrees from straight ahead (paper: 90); widened when the key shape
-    /// needs it (see docs/initiation.md).
-    #[arg(long, default_value_t = InitiateOptions::default().perception.fov_per_eye.to_degrees(), allow_negative_numbers = true)]
+    /// needs it for a bird to see its reference from its slot (docs/initiation.md).
+    #[arg(long, default_value_t = 90.0)]
     pub fov: f64,
     /// Cone per eye in which the closest visible bird is the preferred reference, degrees
-    /// (paper: 0.35π).
-    #[arg(long, default_value_t = InitiateOptions::default().perception.reference_cone.to_degrees(), allow_negative_numbers = true)]
+    /// (paper: 0.35π = 63).
+    #[arg(long, default_value_t = 63.0)]
     pub reference_cone: f64,
-    /// α of eq. (6) (heading gain), dimensionless.
-    #[arg(long, default_value_t = InitiateOptions::default().alpha, allow_negative_numbers = true)]
+    /// α of eq. (6) (heading gain).
+    #[arg(long, default_value_t = 0.2)]
     pub alpha: f64,
-    /// |K| of eq. (5) (speed gain), per √wingspan.
-    #[arg(long, default_value_t = InitiateOptions::default().k, allow_negative_numbers = true)]
+    /// |K| of eq. (5) (speed gain).
+    #[arg(long, default_value_t = 0.06)]
     pub k: f64,
     /// Maximum turn rate, degrees per second.
-    #[arg(long, default_value_t = InitiateOptions::default().max_turn_rate.to_degrees(), allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 90.0)]
     pub max_turn_rate: f64,
-    /// Maximum acceleration, wingspans per second squared.
-    #[arg(long, default_value_t = InitiateOptions::default().max_accel, allow_negative_numbers = true)]
-    pub max_accel: f64,
-    /// Minimum flight speed, fraction of the cruise speed.
-    #[arg(long, default_value_t = InitiateOptions::default().min_speed, allow_negative_numbers = true)]
-    pub min_speed: f64,
-    /// Maximum flight speed, fraction of the cruise speed.
-    #[arg(long, default_value_t = InitiateOptions::default().max_speed, allow_negative_numbers = true)]
-    pub max_speed: f64,
-    /// Separation drive distance, wingspans (the paper's).
-    #[arg(long, default_value_t = InitiateOptions::default().separation_distance, allow_negative_numbers = true)]
-    pub separation: f64,
-    /// Collision avoidance: predicted closest approach that triggers evasion, wingspans.
-    #[arg(long, default_value_t = InitiateOptions::default().avoid_distance, allow_negative_numbers = true)]
-    pub avoid_distance: f64,
-    /// Convergence: every bird within this distance of its slot, wingspans.
-    #[arg(long, default_value_t = InitiateOptions::default().tolerance, allow_negative_numbers = true)]
-    pub tolerance: f64,
-    /// Convergence: for this long, seconds (also the hand-over blend window).
-    #[arg(long, default_value_t = InitiateOptions::default().hold, allow_negative_numbers = true)]
-    pub hold: f64,
-    /// Start file: JSON {"x": [...], "y": [...], "heading": [...], "speed": [...]} (world frame,
+    /// Maximum acceleration, wingspans per second squared [default: 4].
+    #[arg(long)]
+    pub max_accel: Option<f64>,
+    /// Minimum flight speed, fraction of the cruise speed [default: 0.5].
+    #[arg(long)]
+    pub min_speed: Option<f64>,
+    /// Maximum flight speed, fraction of the cruise speed [default: 1.6].
+    #[arg(long)]
+    pub max_speed: Option<f64>,
+    /// Separation drive distance, wingspans [default: 10, as in the paper].
+    #[arg(long)]
+    pub separation: Option<f64>,
+    /// Collision avoidance: predicted closest approach that triggers evasion, wingspans
+    /// [default: 0.8].
+    #[arg(long)]
+    pub avoid_distance: Option<f64>,
+    /// Convergence: every bird within this distance of its slot, wingspans [default: 0.1].
+    #[arg(long)]
+    pub tolerance: Option<f64>,
+    /// Convergence: for this long, seconds (also the hand-over blend window) [default: 1].
+    #[arg(long)]
+    pub hold: Option<f64>,
+    /// Start: `ground` (at rest in a take-off area, leaving one after another, climbing to the
+    /// cruise altitude), `air` (the paper's: scattered in the air at the cruise altitude), or a
+    /// start file: JSON {"x": [...], "y": [...], "heading": [...], "speed": [...]} (world frame,
     /// wingspans, radians clockwise from north, wingspans per second; heading and speed optional).
-    #[arg(long, conflicts_with_all = ["start_width", "start_depth", "heading_spread"])]
-    pub start: Option<PathBuf>,
-    /// Width of the random start region across the cruise heading, wingspans (default: grows
-    /// with the flock, see docs/initiation.md).
+    #[arg(long, default_value = "ground")]
+    pub start: String,
+    /// Width of the take-off area (ground) or start region (air) across the cruise heading,
+    /// wingspans [default: ground 4.5√N (with the depth, about 10 square wingspans per bird);
+    /// air 30, or 6√N for large flocks].
     #[arg(long, allow_negative_numbers = true)]
     pub start_width: Option<f64>,
-    /// Depth of the random start region along the cruise heading, wingspans (default: the width).
+    /// Depth of the take-off area or start region along the cruise heading, wingspans
+    /// [default: ground 2.2√N; air the width].
     #[arg(long, allow_negative_numbers = true)]
     pub start_depth: Option<f64>,
-    /// Start headings are uniform within this many degrees of the cruise heading (180: any).
-    #[arg(long, default_value_t = StartRegion::default().heading_spread.to_degrees(), allow_negative_numbers = true)]
-    pub heading_spread: f64,
-}
-
-impl PerceptionArg {
-    /// The flag value of a library perception mode.
-    pub fn of(mode: PerceptionMode) -> PerceptionArg {
-        match mode {
-            PerceptionMode::Hpr { .. } => PerceptionArg::Hpr,
-            PerceptionMode::Exact => PerceptionArg::Exact,
-        }
-    }
+    /// Start headings are uniform within this many degrees of the cruise heading [default: 5
+    /// on the ground, 180 (any) in the air].
+    #[arg(long)]
+    pub heading_spread: Option<f64>,
 }
 
 impl InitiateFlags {
-    /// The library options these flags describe, for `birds` birds (a start file is read and
-    /// checked against that count; the options are validated by the library).
-    pub fn options(&self, birds: usize) -> Result<InitiateOptions> {
+    /// The library options these flags describe (validated by the library).
+    pub fn options(&self, seed: u64, birds: usize) -> Result<InitiateOptions> {
         let mut o = InitiateOptions {
+            seed,
             max_steps: self.max_steps,
             alpha: self.alpha,
             k: self.k,
             max_turn_rate: self.max_turn_rate.to_radians(),
-            max_accel: self.max_accel,
-            min_speed: self.min_speed,
-            max_speed: self.max_speed,
-            separation_distance: self.separation,
-            avoid_distance: self.avoid_distance,
-            tolerance: self.tolerance,
-            hold: self.hold,
             ..Default::default()
         };
         o.perception.fov_per_eye = self.fov.to_radians();
@@ -147,35 +147,90 @@ impl InitiateFlags {
             },
             PerceptionArg::Exact => PerceptionMode::Exact,
         };
-        o.start = match &self.start {
-            Some(path) => Start::Given(StartState::read(path, birds)?),
-            None => Start::Random(StartRegion {
+        let set = |field: &mut f64, v: Option<f64>| {
+            if let Some(v) = v {
+                *field = v;
+            }
+        };
+        set(&mut o.max_accel, self.max_accel);
+        set(&mut o.min_speed, self.min_speed);
+        set(&mut o.max_speed, self.max_speed);
+        set(&mut o.separation_distance, self.separation);
+        set(&mut o.avoid_distance, self.avoid_distance);
+        set(&mut o.tolerance, self.tolerance);
+        set(&mut o.hold, self.hold);
+        o.takeoff = self.takeoff;
+        if let Some(t) = self.takeoff {
+            let natural = formation::initiate::TakeoffPlan::natural_seconds(birds);
+            if t.is_finite() && t > 0.0 && t < 0.8 * natural {
+                eprintln!(
+                    "warning: --takeoff {t}: {birds} birds need about {natural:.0} s to form with these rules (docs/initiation.md); the take-off will last about that long"
+                );
+            }
+        }
+        o.cruise_altitude = self.cruise_altitude;
+        o.climb_rate = self.climb_rate;
+        if let Some(h) = self.heading_spread {
+            if !(h.is_finite() && (0.0..=180.0).contains(&h)) {
+                return Err(Error::parameter(
+                    "--heading-spread",
+                    format!("must be in [0, 180] degrees, got {h}"),
+                ));
+            }
+        }
+        o.start = match self.start.as_str() {
+            "ground" => {
+                let d = GroundStart::default();
+                Start::Ground(GroundStart {
+                    width: self.start_width,
+                    depth: self.start_depth,
+                    heading_spread: self
+                        .heading_spread
+                        .map_or(d.heading_spread, f64::to_radians),
+                    ..d
+                })
+            }
+            "air" => Start::Random(StartRegion {
                 width: self.start_width,
                 depth: self.start_depth,
-                heading_spread: self.heading_spread.to_radians(),
+                heading_spread: self
+                    .heading_spread
+                    .map_or(std::f64::consts::PI, f64::to_radians),
                 ..Default::default()
             }),
+            path => {
+                for (flag, given) in [
+                    ("--start-width", self.start_width.is_some()),
+                    ("--start-depth", self.start_depth.is_some()),
+                    ("--heading-spread", self.heading_spread.is_some()),
+                ] {
+                    if given {
+                        return Err(Error::parameter(
+                            flag,
+                            "does not apply to a start file (--start FILE); give --start ground or air",
+                        ));
+                    }
+                }
+                Start::Given(StartState::read(std::path::Path::new(path), birds)?)
+            }
         };
+        o.validate()?;
+        formation::initiate::check_size(birds, 0, self.max_steps)?;
         Ok(o)
     }
 }
 
 /// Runs `formation initiate`.
 pub fn run(args: InitiateArgs, g: Global) -> Result<()> {
-    let wingbeat = args.wingbeat.options()?;
-    wingbeat.validate()?;
+    let wing = args.wingbeat.options()?;
     formation::export::plan_outputs(&args.output)?;
     let steady = Animation::read(&args.steady)?;
     initiate::check_steady(&steady, &args.steady)?;
-    let config = Config {
-        seed: g.seed,
-        initiate: args.initiate.options(steady.birds)?,
-        wingbeat,
-        ..Config::default()
-    };
+    let opts = args.initiate.options(g.seed, steady.birds)?;
+    let mut rng = formation::rng::stream(g.seed, "initiate");
     let progress = TermProgress::new(g.quiet);
-    let (mut anim, stats) = initiate_stage(&steady, &config, &progress)?;
-    formation::wingbeat::assign_phases(&mut anim, &config.wingbeat)?;
+    let (mut anim, stats) = initiate::initiate(&steady, &opts, &mut rng, &progress)?;
+    formation::wingbeat::assign_phases(&mut anim, &wing)?;
     super::write_animation(&anim, &args.output, &args.scene.options(), g)?;
     if args.json {
         let text = formation::finite::to_json_pretty("statistics", &stats)?;

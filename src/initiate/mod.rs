@@ -1,17 +1,21 @@
-//! §6 flock initiation: birds take off from random positions (or a start file) and, each
-//! following its own perception, drives and actions, converge into the first key shape of a
-//! steady-flight animation; the result is that animation with an `initiation` stage in front.
+//! §6 flock initiation, as a take-off: birds leave the ground (or start scattered in the air)
+//! and, each following its own perception, drives and actions, converge into the first key shape
+//! of a steady-flight animation while they climb to the cruise altitude; the result is that
+//! animation with an `initiation` stage in front.
 //!
 //! Takes a [`crate::Animation`] (SPEC §4.4) whose `key_shapes[0]` (formation frame, wingspans) is
 //! the target and whose frames are the steady flight (world frame, wingspans, wingspans per
 //! second, headings radians clockwise from +y). Gives the combined animation: frames `0..k` of
-//! initiation, then the steady frames translated in space and time so that position, heading and
-//! speed continue without a jump. One simulation step is one animation frame (1/fps s).
+//! initiation, then the steady frames translated in space (to the cruise altitude) and time so
+//! that position, heading, speed and bank continue without a jump.
+//!
+//! Behaviour is in seconds: the simulation runs with a fixed internal step (see [`sim`]) and the
+//! output frames are samples of it, so the same seed gives the same take-off at any frame rate.
 //!
 //! - [`perception`]: visual field, Hidden Point Removal or exact disc occlusion, reference bird.
 //! - [`hull`]: the robust orientation predicate and convex hull HPR needs.
 //! - [`target`]: the target shape as a tree of slots (leader, left and right arms).
-//! - [`sim`]: drives and actions (eqs. 5–6, separation, collision avoidance), the step loop.
+//! - [`sim`]: drives and actions (eqs. 5–6, separation, collision avoidance), flight dynamics.
 //!
 //! The rules as implemented and every choice the paper leaves open: `docs/initiation.md`.
 
@@ -23,7 +27,7 @@ pub mod target;
 use std::f64::consts::PI;
 use std::path::Path;
 
-use glam::DVec2;
+use glam::{DVec2, DVec3};
 use rand::Rng;
 use serde::{Deserialize, Serialize};
 
@@ -32,7 +36,7 @@ use crate::error::{Error, Result};
 use crate::progress::Progress;
 
 pub use perception::{PerceptionMode, PerceptionParams, HPR_GAMMA_DEFAULT};
-pub use sim::{Simulation, StepParams};
+pub use sim::{Phase, Simulation, StepParams, Tolerances};
 pub use target::{Side, TargetShape};
 
 /// Margin between the largest bearing of a reference slot and the edge of the visual field when
@@ -43,13 +47,17 @@ pub const FIELD_MARGIN: f64 = 15.0 * PI / 180.0;
 /// distance is kept ([`random_start`]).
 pub const START_DRAWS: usize = 100;
 
-/// Largest accepted step limit (9¼ hours of flight at 30 fps).
+/// Largest accepted frame limit of the initiation.
 pub const MAX_STEPS_LIMIT: usize = 1_000_000;
 
 /// Largest accepted width or depth of the random start region, wingspans.
 pub const MAX_START_EXTENT: f64 = 1e6;
 
-/// Parameters of the initiation (units per second; converted to per-step values at the file's fps).
+/// Gravity, metres per second squared.
+pub const GRAVITY_M_S2: f64 = 9.81;
+
+/// Parameters of the initiation. Every rule is in seconds (rates per second), independent of the
+/// output frame rate.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct InitiateOptions {
@@ -59,18 +67,53 @@ pub struct InitiateOptions {
     /// at which a bird in its slot sees its reference bird plus [`FIELD_MARGIN`] (the paper:
     /// "90° per eye, though it may be wider for real birds"); never narrows it.
     pub widen_field: bool,
+    /// Visual range: flockmates farther away are not perceived, wingspans.
+    pub visual_range: f64,
     /// α of eq. (6), dimensionless (paper: 0.2).
     pub alpha: f64,
     /// |K| of eq. (5), per √wingspan (paper: 0.06).
     pub k: f64,
+    /// Reaction time: a bird decides once per this many seconds (the paper's time step), seconds.
+    pub reaction_time: f64,
+    /// Internal integration steps per reaction time (dimensionless).
+    pub substeps: u32,
     /// Maximum turn rate, radians per second.
     pub max_turn_rate: f64,
-    /// Maximum change of speed, wingspans per second squared.
+    /// Maximum change of the turn rate, radians per second squared.
+    pub max_turn_accel: f64,
+    /// Time constant of the turn rate following the bird's request, seconds.
+    pub turn_lag: f64,
+    /// Maximum rate of change of the turn rate's change, radians per second cubed.
+    pub max_turn_jerk: f64,
+    /// Maximum change of speed (acceleration), wingspans per second squared.
     pub max_accel: f64,
-    /// Minimum flight speed, as a fraction of the cruise speed.
+    /// Maximum change of the acceleration (jerk), wingspans per second cubed.
+    pub max_jerk: f64,
+    /// Time constant of the speed following the bird's request, seconds.
+    pub speed_lag: f64,
+    /// Minimum flight speed (also the lift-off speed), as a fraction of the cruise speed.
     pub min_speed: f64,
     /// Maximum flight speed, as a fraction of the cruise speed.
     pub max_speed: f64,
+    /// Maximum roll rate of the bank, radians per second.
+    pub max_roll_rate: f64,
+    /// Time constant of the bank following the coordinated-turn bank, seconds.
+    pub roll_lag: f64,
+    /// Maximum roll acceleration, radians per second squared.
+    pub max_roll_accel: f64,
+    /// Cruise altitude: `z` of the steady flight above the ground, wingspans (the steady flight's
+    /// own `z` is added to it).
+    pub cruise_altitude: f64,
+    /// Largest climb rate, wingspans per second.
+    pub climb_rate: f64,
+    /// Largest vertical acceleration, wingspans per second squared.
+    pub vertical_accel: f64,
+    /// Acceleration of the take-off run on the ground, wingspans per second squared.
+    pub run_accel: f64,
+    /// Wanted take-off duration, seconds (`None`: the natural one of the flock size, see
+    /// [`TakeoffPlan::natural_seconds`]). A longer one stretches the departures; the simulation
+    /// is never cut.
+    pub takeoff: Option<f64>,
     /// Separation drive threshold, wingspans (paper: 10).
     pub separation_distance: f64,
     /// Look-ahead of a bird near or ahead of its target, wingspans.
@@ -93,10 +136,19 @@ pub struct InitiateOptions {
     pub reference_memory: Option<f64>,
     /// Upper bound of the distance divisor max(r, 1) of eq. (6), wingspans.
     pub turn_distance_cap: f64,
-    /// Eq. (5)'s √|r − v_j| is replaced by its chord within this distance of the fixed point,
+    /// Eq. (5)'s √|r − v_j τ| is replaced by its chord within this distance of the fixed point,
     /// wingspans.
     pub linear_zone: f64,
-    /// Convergence: distance of every bird from its slot, wingspans.
+    /// Beyond this distance from its fixed point, eq. (5)'s √|r − v_j τ| grows linearly, so a bird
+    /// far behind catches up in seconds, wingspans.
+    pub catchup_distance: f64,
+    /// Eq. (5) on the longitudinal gap to the target (along the reference's heading) instead of
+    /// the whole distance r: lateral errors are eq. (6)'s (docs/initiation.md).
+    pub gap_speed: bool,
+    /// Speed of the leader while flockmates are still on the ground or running, as a fraction
+    /// of the cruise speed (at least the minimum speed).
+    pub gather_speed: f64,
+    /// Convergence: distance of every bird from its slot and from the cruise altitude, wingspans.
     pub tolerance: f64,
     /// Convergence: heading difference from the cruise heading, radians.
     pub heading_tolerance: f64,
@@ -105,7 +157,11 @@ pub struct InitiateOptions {
     /// Convergence: how long the flock must stay in formation, seconds. The hand-over blend
     /// to the exact steady-flight state uses the same window.
     pub hold: f64,
-    /// Step limit; no convergence within it is [`Error::NotConverged`].
+    /// Time limit of the simulation, seconds; no convergence within it is
+    /// [`Error::NotConverged`].
+    pub max_time: f64,
+    /// Frame limit of the initiation at the output frame rate (bounds memory); the time limit is
+    /// the smaller of `max_time` and `max_steps / fps`.
     pub max_steps: usize,
     /// Where and how the birds start.
     pub start: Start,
@@ -118,12 +174,28 @@ impl Default for InitiateOptions {
         InitiateOptions {
             perception: PerceptionParams::default(),
             widen_field: true,
+            visual_range: 60.0,
             alpha: 0.2,
             k: 0.06,
+            reaction_time: 1.0 / 30.0,
+            substeps: 4,
             max_turn_rate: PI / 2.0,
+            max_turn_accel: 540f64.to_radians(),
+            turn_lag: 0.1,
+            max_turn_jerk: 6000f64.to_radians(),
             max_accel: 4.0,
+            max_jerk: 40.0,
+            speed_lag: 0.1,
             min_speed: 0.5,
             max_speed: 1.6,
+            max_roll_rate: 180f64.to_radians(),
+            roll_lag: 0.2,
+            max_roll_accel: 400f64.to_radians(),
+            cruise_altitude: 10.0,
+            climb_rate: 2.0,
+            vertical_accel: 1.5,
+            run_accel: 3.0,
+            takeoff: None,
             separation_distance: 10.0,
             lookahead: 4.0,
             avoid_distance: 0.8,
@@ -135,12 +207,16 @@ impl Default for InitiateOptions {
             reference_memory: None,
             turn_distance_cap: 5.0,
             linear_zone: 0.25,
+            catchup_distance: 1.5,
+            gap_speed: true,
+            gather_speed: 0.6,
             tolerance: 0.1,
             heading_tolerance: 2f64.to_radians(),
             speed_tolerance: 0.02,
             hold: 1.0,
+            max_time: 300.0,
             max_steps: 9000,
-            start: Start::Random(StartRegion::default()),
+            start: Start::Ground(GroundStart::default()),
             seed: 0,
         }
     }
@@ -150,10 +226,111 @@ impl Default for InitiateOptions {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Start {
-    /// Random positions, headings and speeds in a region.
+    /// At rest on the ground (or water) in a take-off area, leaving in a staggered order.
+    Ground(GroundStart),
+    /// The paper's start: scattered in the air, random positions, headings and speeds in a
+    /// region, at the cruise altitude.
     Random(StartRegion),
-    /// Given positions (and optionally headings and speeds).
+    /// Given positions (and optionally headings and speeds), in the air at the cruise altitude.
     Given(StartState),
+}
+
+/// A take-off from the ground: birds at rest in a rectangle centred on the origin (its width
+/// across and its depth along the cruise heading), at least `min_spacing` apart, facing within
+/// `heading_spread` of the cruise heading; they leave front to back over the stagger window.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct GroundStart {
+    /// Width across the cruise heading, wingspans (`None`: from the take-off plan).
+    pub width: Option<f64>,
+    /// Depth along the cruise heading, wingspans (`None`: from the take-off plan).
+    pub depth: Option<f64>,
+    /// Half-width of the heading distribution around the cruise heading, radians.
+    pub heading_spread: f64,
+    /// Minimum distance between two birds on the ground, wingspans.
+    pub min_spacing: f64,
+    /// Time between the first and the last departure, seconds (`None`: from the take-off plan).
+    pub stagger: Option<f64>,
+}
+
+impl Default for GroundStart {
+    fn default() -> Self {
+        GroundStart {
+            width: None,
+            depth: None,
+            heading_spread: 5f64.to_radians(),
+            min_spacing: 2.0,
+            stagger: None,
+        }
+    }
+}
+
+/// What the take-off duration sets: the start area, the departure stagger and the drive gain.
+/// Derived by [`TakeoffPlan::new`] from the flock size and [`InitiateOptions::takeoff`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TakeoffPlan {
+    /// The take-off duration aimed at, seconds.
+    pub seconds: f64,
+    /// Width of the start area across the cruise heading, wingspans.
+    pub width: f64,
+    /// Depth of the start area along the cruise heading, wingspans.
+    pub depth: f64,
+    /// Time between the first and the last departure (ground start), seconds.
+    pub stagger: f64,
+    /// |K| of eq. (5) used, per √wingspan.
+    pub k: f64,
+    /// Catch-up distance of eq. (5) used, wingspans.
+    pub catchup_distance: f64,
+}
+
+impl TakeoffPlan {
+    /// The shortest take-off the rules give `n` birds from the ground, about, seconds: measured
+    /// medians 17 s for 9 birds, 22 s for 14, 53 s for 41 (docs/initiation.md; arms fill one bird
+    /// at a time, so it grows with the flock size).
+    pub fn natural_seconds(n: usize) -> f64 {
+        7.0 + 1.1 * n.max(1) as f64
+    }
+
+    /// The automatic take-off duration of `n` birds, seconds: the natural one.
+    pub fn auto_seconds(n: usize) -> f64 {
+        Self::natural_seconds(n)
+    }
+
+    /// The plan for `n` birds under `opts` (its `takeoff`, or the automatic duration). A longer
+    /// take-off than the natural one stretches the departures (each second of stagger beyond
+    /// the first adds about 1.3 s, measured); a shorter one cannot be had from these rules and
+    /// gets the natural plan (the CLI warns).
+    pub fn new(n: usize, opts: &InitiateOptions) -> TakeoffPlan {
+        let natural = Self::natural_seconds(n);
+        let seconds = opts.takeoff.unwrap_or(natural);
+        let root = (n.max(1) as f64).sqrt();
+        let (width, depth, stagger) = match &opts.start {
+            Start::Ground(g) => {
+                // About 10 square wingspans per bird (1.6 times what random packing of birds
+                // `min_spacing` = 2 apart needs).
+                let base = (1.6 * g.min_spacing * root).max(4.0 * g.min_spacing);
+                (
+                    g.width.unwrap_or(1.4 * base),
+                    g.depth.unwrap_or(0.7 * base),
+                    g.stagger
+                        .unwrap_or(1.0 + (seconds - natural).max(0.0) / 1.3),
+                )
+            }
+            Start::Random(r) => {
+                let (w, d) = r.size(n);
+                (w, d, 0.0)
+            }
+            Start::Given(_) => (0.0, 0.0, 0.0),
+        };
+        TakeoffPlan {
+            seconds: seconds.max(natural),
+            width,
+            depth,
+            stagger,
+            k: opts.k,
+            catchup_distance: opts.catchup_distance,
+        }
+    }
 }
 
 /// A random take-off: positions uniform in a rectangle centred on the origin, its width across
@@ -255,20 +432,35 @@ impl StartState {
         Ok(s)
     }
 }
-
 /// What happened during an initiation.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct InitiateStats {
     /// Number of birds.
     pub birds: usize,
-    /// Simulation steps until convergence (or the step limit).
+    /// Output frame intervals of the initiation (frames − 1).
     pub steps: usize,
+    /// Simulated time until convergence (or the time limit), seconds.
+    pub seconds: f64,
+    /// The take-off duration aimed at, seconds ([`TakeoffPlan`]).
+    pub planned_seconds: f64,
     /// Whether the flock converged.
     pub converged: bool,
-    /// Smallest distance between two birds over the whole initiation (start included), wingspans.
+    /// Smallest 3-D distance between two birds over the whole initiation (start included),
+    /// wingspans.
     pub min_distance: f64,
-    /// Largest heading change of a bird in one step, radians per second.
+    /// Largest turn rate of a bird, radians per second.
     pub max_turn_rate: f64,
+    /// Largest change of a bird's turn rate, radians per second squared.
+    pub max_turn_accel: f64,
+    /// Largest change of a bird's speed, wingspans per second squared.
+    pub max_accel: f64,
+    /// Largest bank of a bird, radians.
+    pub max_bank: f64,
+    /// Largest distance of a bird from the nearest slot of the formed flock, once every bird
+    /// is airborne, wingspans.
+    pub max_stray: f64,
+    /// Time at which the last bird left the ground, seconds (0 for an airborne start).
+    pub last_liftoff: f64,
     /// How often the leader changed.
     pub leader_changes: usize,
     /// Birds within the tolerance of a slot of their own at the end.
@@ -277,19 +469,55 @@ pub struct InitiateStats {
     pub field_per_eye: f64,
 }
 
-/// The simulated initiation before the hand-over: per-step states in simulation bird order.
+/// The simulated initiation before the hand-over: states sampled at the output frame rate, in
+/// simulation bird order.
 #[derive(Debug, Clone)]
 pub struct InitiationRun {
-    /// Positions of every step (index 0 = start), wingspans.
+    /// Output frame rate of the samples, frames per second.
+    pub fps: f64,
+    /// Horizontal positions of every frame (index 0 = start), wingspans.
     pub pos: Vec<Vec<DVec2>>,
-    /// Headings of every step, radians.
+    /// Altitudes of every frame, wingspans.
+    pub z: Vec<Vec<f64>>,
+    /// Headings of every frame, radians.
     pub heading: Vec<Vec<f64>>,
-    /// Speeds of every step, wingspans per step.
+    /// Speeds of every frame, wingspans per second.
     pub speed: Vec<Vec<f64>>,
+    /// Bank angles of every frame, radians (right wing down positive).
+    pub bank: Vec<Vec<f64>>,
     /// Slot of every bird at the end (meaningful when converged: a permutation).
     pub slot: Vec<Option<usize>>,
     /// Statistics.
     pub stats: InitiateStats,
+}
+
+/// The steady flight the flock converges into: the leader's cruise heading (radians) and speed
+/// (wingspans per second), and the wingspan in metres (for gravity in wingspans/s²).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Cruise {
+    /// Cruise heading, radians clockwise from +y.
+    pub heading: f64,
+    /// Cruise speed, wingspans per second.
+    pub speed: f64,
+    /// Wingspan, metres.
+    pub wingspan_m: f64,
+}
+
+impl Cruise {
+    /// A cruise along `heading` (radians) at `speed` (wingspans per second) of birds with a
+    /// wingspan of 1.5 m.
+    pub fn new(heading: f64, speed: f64) -> Cruise {
+        Cruise {
+            heading,
+            speed,
+            wingspan_m: 1.5,
+        }
+    }
+
+    /// Gravity in wingspans per second squared.
+    pub fn gravity(&self) -> f64 {
+        GRAVITY_M_S2 / self.wingspan_m
+    }
 }
 
 impl InitiateOptions {
@@ -343,6 +571,80 @@ impl InitiateOptions {
         pos("initiate.k", self.k)?;
         pos("initiate.max_turn_rate", self.max_turn_rate)?;
         pos("initiate.max_accel", self.max_accel)?;
+        pos("initiate.max_turn_accel", self.max_turn_accel)?;
+        pos("initiate.max_jerk", self.max_jerk)?;
+        pos("initiate.max_turn_jerk", self.max_turn_jerk)?;
+        pos("initiate.max_roll_rate", self.max_roll_rate)?;
+        pos("initiate.max_roll_accel", self.max_roll_accel)?;
+        pos("initiate.climb_rate", self.climb_rate)?;
+        pos("initiate.vertical_accel", self.vertical_accel)?;
+        pos("initiate.run_accel", self.run_accel)?;
+        pos("initiate.visual_range", self.visual_range)?;
+        for (name, v) in [
+            ("initiate.turn_lag", self.turn_lag),
+            ("initiate.speed_lag", self.speed_lag),
+            ("initiate.roll_lag", self.roll_lag),
+        ] {
+            if !(v.is_finite() && (0.001..=10.0).contains(&v)) {
+                return Err(Error::parameter(
+                    name,
+                    format!("must be between 0.001 and 10 seconds, got {v}"),
+                ));
+            }
+        }
+        if !(self.reaction_time.is_finite() && (0.001..=1.0).contains(&self.reaction_time)) {
+            return Err(Error::parameter(
+                "initiate.reaction_time",
+                format!(
+                    "must be between 0.001 and 1 second, got {}",
+                    self.reaction_time
+                ),
+            ));
+        }
+        if !(1..=64).contains(&self.substeps) {
+            return Err(Error::parameter(
+                "initiate.substeps",
+                format!("must be between 1 and 64, got {}", self.substeps),
+            ));
+        }
+        if let Some(t) = self.takeoff {
+            if !(t.is_finite() && t > 0.0) {
+                return Err(Error::parameter(
+                    "initiate.takeoff",
+                    format!("must be a positive number of seconds, got {t}"),
+                ));
+            }
+            if t > self.max_time {
+                return Err(Error::parameter(
+                    "initiate.takeoff",
+                    format!("{t} s is longer than the time limit of {} s", self.max_time),
+                ));
+            }
+        }
+        if !(self.cruise_altitude.is_finite() && self.cruise_altitude >= 0.0) {
+            return Err(Error::parameter(
+                "initiate.cruise_altitude",
+                format!(
+                    "must be a number of wingspans at or above the ground (0), got {}",
+                    self.cruise_altitude
+                ),
+            ));
+        }
+        if self.cruise_altitude > 1e5 {
+            return Err(Error::parameter(
+                "initiate.cruise_altitude",
+                format!("at most 1e5 wingspans, got {:e}", self.cruise_altitude),
+            ));
+        }
+        if !(self.max_time.is_finite() && self.max_time > 0.0) {
+            return Err(Error::parameter(
+                "initiate.max_time",
+                format!(
+                    "must be a positive number of seconds, got {}",
+                    self.max_time
+                ),
+            ));
+        }
         pos("initiate.min_speed", self.min_speed)?;
         pos("initiate.max_speed", self.max_speed)?;
         if self.min_speed >= 1.0 || self.max_speed <= 1.0 {
@@ -362,6 +664,8 @@ impl InitiateOptions {
         pos("initiate.lost_speed_factor", self.lost_speed_factor)?;
         pos("initiate.turn_distance_cap", self.turn_distance_cap)?;
         pos("initiate.linear_zone", self.linear_zone)?;
+        pos("initiate.catchup_distance", self.catchup_distance)?;
+        pos("initiate.gather_speed", self.gather_speed)?;
         let memory = self.reference_memory();
         if !(memory.is_finite() && (0.0..=60.0).contains(&memory)) {
             return Err(Error::parameter(
@@ -411,6 +715,44 @@ impl InitiateOptions {
                 ),
             ));
         }
+        if let Start::Ground(g) = &self.start {
+            for (name, v) in [
+                ("initiate.start.ground.width", g.width),
+                ("initiate.start.ground.depth", g.depth),
+            ] {
+                if let Some(v) = v {
+                    pos(name, v)?;
+                    if v > MAX_START_EXTENT {
+                        return Err(Error::parameter(
+                            name,
+                            format!("at most {MAX_START_EXTENT} wingspans, got {v:e}"),
+                        ));
+                    }
+                }
+            }
+            if let Some(w) = g.stagger {
+                if !(w.is_finite() && w >= 0.0 && w <= self.max_time) {
+                    return Err(Error::parameter(
+                        "initiate.stagger",
+                        format!(
+                            "must be a number of seconds between 0 and the time limit, got {w}"
+                        ),
+                    ));
+                }
+            }
+            if !(g.heading_spread.is_finite() && (0.0..=PI).contains(&g.heading_spread)) {
+                return Err(Error::parameter(
+                    "initiate.start.ground.heading_spread",
+                    "must be in [0, 180] degrees",
+                ));
+            }
+            if !(g.min_spacing.is_finite() && g.min_spacing > 0.0) {
+                return Err(Error::parameter(
+                    "initiate.start.ground.min_spacing",
+                    "must be a positive number of wingspans",
+                ));
+            }
+        }
         if let Start::Random(r) = &self.start {
             for (name, v) in [
                 ("initiate.start.random.width", r.width),
@@ -453,34 +795,71 @@ impl InitiateOptions {
         })
     }
 
-    /// Per-step parameters at `fps` for a cruise heading (radians) and speed (wingspans per second).
-    pub fn step_params(&self, fps: f64, cruise_heading: f64, cruise_speed: f64) -> StepParams {
-        let vc = cruise_speed / fps;
+    /// The simulation's parameters for a cruise (heading, speed, wingspan) and a drive gain
+    /// `k` (per √wingspan; the take-off plan's).
+    pub fn step_params(&self, cruise: &Cruise, k: f64, catchup: f64) -> StepParams {
+        let vc = cruise.speed;
         StepParams {
             perception: self.perception,
+            visual_range: self.visual_range,
             alpha: self.alpha,
-            k: self.k,
-            max_turn: self.max_turn_rate / fps,
-            max_dv: self.max_accel / fps / fps,
+            k,
+            reaction_time: self.reaction_time,
+            substeps: self.substeps,
+            max_turn: self.max_turn_rate,
+            max_turn_accel: self.max_turn_accel,
+            turn_lag: self.turn_lag,
+            max_turn_jerk: self.max_turn_jerk,
+            max_accel: self.max_accel,
+            max_jerk: self.max_jerk,
+            speed_lag: self.speed_lag,
             min_speed: self.min_speed * vc,
             max_speed: self.max_speed * vc,
-            cruise_heading,
+            cruise_heading: cruise.heading,
             cruise_speed: vc,
+            cruise_altitude: self.cruise_altitude,
+            climb_rate: self.climb_rate,
+            vertical_accel: self.vertical_accel,
+            gravity: cruise.gravity(),
+            max_roll_rate: self.max_roll_rate,
+            roll_lag: self.roll_lag,
+            max_roll_accel: self.max_roll_accel,
+            run_accel: self.run_accel,
             separation_distance: self.separation_distance,
             lookahead: self.lookahead,
             avoid_distance: self.avoid_distance,
             avoid_range: self.avoid_range,
-            avoid_horizon: self.avoid_horizon * fps,
+            avoid_horizon: self.avoid_horizon,
             lost_speed_factor: self.lost_speed_factor,
             leader_hysteresis: self.leader_hysteresis,
             sticky_reference: self.sticky_reference,
-            reference_memory: (self.reference_memory() * fps).round() as u32,
+            reference_memory: (self.reference_memory() / self.reaction_time).round() as u32,
             turn_distance_cap: self.turn_distance_cap,
             linear_zone: self.linear_zone,
+            catchup_distance: catchup,
+            gap_speed: self.gap_speed,
+            gather_speed: self.gather_speed * vc,
         }
     }
-}
 
+    /// The convergence tolerances: the options' distance, heading and speed, and steady flight
+    /// (turn rate ≤ 2°/s, acceleration ≤ 0.2 wingspans/s², climb rate ≤ 0.1 wingspans/s).
+    pub fn tolerances(&self) -> Tolerances {
+        Tolerances {
+            distance: self.tolerance,
+            heading: self.heading_tolerance,
+            speed: self.speed_tolerance,
+            turn_rate: 2f64.to_radians(),
+            accel: 0.2,
+            climb: 0.1,
+        }
+    }
+
+    /// The time limit at `fps`: the smaller of `max_time` and `max_steps / fps`, seconds.
+    pub fn time_limit(&self, fps: f64) -> f64 {
+        self.max_time.min(self.max_steps as f64 / fps)
+    }
+}
 /// Checks that `steady` can be initiated into: at least one key shape, a first frame, a positive
 /// cruise speed. `origin` names the file in messages.
 pub fn check_steady(steady: &Animation, origin: &Path) -> Result<()> {
@@ -532,7 +911,7 @@ pub fn check_steady(steady: &Animation, origin: &Path) -> Result<()> {
     Ok(())
 }
 
-/// Random start positions, headings and speeds (wingspans, radians, wingspans per step):
+/// Random start positions, headings and speeds (wingspans, radians, wingspans per second):
 /// positions uniform in the region at least `min_spacing` apart; headings uniform within the
 /// spread and speeds between the minimum and the cruise speed, redrawn while two birds would,
 /// flying straight, come closer than the avoidance distance within the time a quarter turn takes
@@ -627,35 +1006,105 @@ pub fn random_start(
     Ok((pos, heading, speed))
 }
 
-/// The simulation at its first step: parameters at `fps` for the cruise heading (radians) and
-/// speed (wingspans per second), the visual field widened for `target` if asked, and the start
-/// positions, headings and speeds (random ones drawn from `rng`).
+/// A take-off area: positions uniform in the plan's rectangle at least `min_spacing` apart, at
+/// rest (speed 0, z = 0), facing within the spread of the cruise heading, with departure times
+/// front to back over the stagger window (the front-most bird leaves at 0 and leads; a small
+/// random jitter of a tenth of the window mixes neighbours). An area too small for the flock is
+/// an error naming the flags.
+pub fn ground_start(
+    n: usize,
+    g: &GroundStart,
+    plan: &TakeoffPlan,
+    params: &StepParams,
+    rng: &mut impl Rng,
+) -> Result<(Vec<DVec2>, Vec<f64>, Vec<f64>)> {
+    let (w, d) = (plan.width, plan.depth);
+    // Random packing of discs reaches about half the area (random sequential adsorption: 0.547).
+    let capacity = 0.5 * w * d / (PI / 4.0 * g.min_spacing * g.min_spacing);
+    if (n as f64) > capacity.max(1.0) {
+        let need = (n as f64 * PI / 4.0 * g.min_spacing * g.min_spacing / 0.5).sqrt();
+        return Err(Error::parameter(
+            "initiate.start.ground.width/initiate.start.ground.depth",
+            format!(
+                "a take-off area of {w:.1} × {d:.1} wingspans is too small for {n} birds {} wingspans apart; give at least about {need:.0} × {need:.0}",
+                g.min_spacing
+            ),
+        ));
+    }
+    let region = StartRegion {
+        width: Some(w),
+        depth: Some(d),
+        heading_spread: 0.0,
+        min_spacing: g.min_spacing,
+    };
+    let (pos, _, _) = random_start(n, &region, params, rng)?;
+    let heading: Vec<f64> = (0..n)
+        .map(|_| {
+            let h = if g.heading_spread > 0.0 {
+                rng.random_range(-g.heading_spread..=g.heading_spread)
+            } else {
+                0.0
+            };
+            sim::wrap_angle(params.cruise_heading + h)
+        })
+        .collect();
+    let dc = perception::direction(params.cruise_heading);
+    let along: Vec<f64> = pos.iter().map(|p| p.dot(dc)).collect();
+    let front = along.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let span = (front - along.iter().copied().fold(f64::INFINITY, f64::min)).max(1e-9);
+    let w = plan.stagger;
+    let depart: Vec<f64> = along
+        .iter()
+        .map(|&a| {
+            let jitter: f64 = rng.random_range(0.0..1.0);
+            if a >= front {
+                0.0
+            } else {
+                w * (0.9 * (front - a) / span + 0.1 * jitter)
+            }
+        })
+        .collect();
+    Ok((pos, heading, depart))
+}
+
+/// The simulation at its first instant: parameters for the cruise, the visual field widened for
+/// `target` if asked, and the start (random ones drawn from `rng`). Also gives the take-off plan.
 pub fn start_simulation(
     target: &TargetShape,
-    fps: f64,
-    cruise_heading: f64,
-    cruise_speed: f64,
+    cruise: &Cruise,
     opts: &InitiateOptions,
     rng: &mut impl Rng,
-) -> Result<Simulation> {
+) -> Result<(Simulation, TakeoffPlan)> {
     opts.validate()?;
-    if !(fps.is_finite() && fps > 0.0) {
-        return Err(Error::parameter("fps", "must be a positive number"));
-    }
-    if !(cruise_speed.is_finite() && cruise_speed > 0.0 && cruise_heading.is_finite()) {
+    if !(cruise.speed.is_finite() && cruise.speed > 0.0 && cruise.heading.is_finite()) {
         return Err(Error::parameter(
             "cruise speed",
             "the leader's speed must be a positive number",
         ));
     }
+    if !(cruise.wingspan_m.is_finite() && cruise.wingspan_m > 0.0) {
+        return Err(Error::parameter(
+            "wingspan_m",
+            "must be a positive number of metres",
+        ));
+    }
     let n = target.len();
-    let mut params = opts.step_params(fps, cruise_heading, cruise_speed);
+    let plan = TakeoffPlan::new(n, opts);
+    let mut params = opts.step_params(cruise, plan.k, plan.catchup_distance);
     if opts.widen_field {
         let field = &mut params.perception.fov_per_eye;
         *field = field.max(target.required_field(FIELD_MARGIN));
     }
-    let (pos, heading, speed) = match &opts.start {
-        Start::Random(region) => random_start(n, region, &params, rng)?,
+    let alt = opts.cruise_altitude;
+    let (pos, z, heading, speed, depart) = match &opts.start {
+        Start::Ground(g) => {
+            let (pos, heading, depart) = ground_start(n, g, &plan, &params, rng)?;
+            (pos, vec![0.0; n], heading, vec![0.0; n], depart)
+        }
+        Start::Random(region) => {
+            let (pos, heading, speed) = random_start(n, region, &params, rng)?;
+            (pos, vec![alt; n], heading, speed, vec![0.0; n])
+        }
         Start::Given(s) => {
             if s.x.len() != n || s.y.len() != n {
                 return Err(Error::parameter(
@@ -668,86 +1117,169 @@ pub fn start_simulation(
                     .zip(&s.y)
                     .map(|(&x, &y)| DVec2::new(x, y))
                     .collect();
-            let heading = s.heading.clone().unwrap_or_else(|| vec![cruise_heading; n]);
+            let heading = s.heading.clone().unwrap_or_else(|| vec![cruise.heading; n]);
             let speed = match &s.speed {
                 Some(v) => v
                     .iter()
-                    .map(|v| (v / fps).clamp(params.min_speed, params.max_speed))
+                    .map(|v| v.clamp(params.min_speed, params.max_speed))
                     .collect(),
                 None => vec![params.min_speed; n],
             };
-            (pos, heading, speed)
+            (pos, vec![alt; n], heading, speed, vec![0.0; n])
         }
     };
-    Ok(Simulation::new(target.clone(), params, pos, heading, speed))
+    let sim = Simulation::new(target.clone(), params, pos, z, heading, speed, depart);
+    Ok((sim, plan))
 }
 
-/// Runs the simulation until convergence or the step limit, without the hand-over. The flock's
-/// target is `target`; cruise heading (radians) and speed (wingspans per second) are those of the
-/// steady flight's leader; `fps` sets the step length.
+/// Runs the simulation until convergence or the time limit, without the hand-over, sampling the
+/// state at `fps` frames per second (frame k at k/fps s, linear interpolation between internal
+/// steps). The flock's target is `target`, the steady flight's cruise `cruise`.
 pub fn simulate(
     target: &TargetShape,
     fps: f64,
-    cruise_heading: f64,
-    cruise_speed: f64,
+    cruise: &Cruise,
     opts: &InitiateOptions,
     rng: &mut impl Rng,
     progress: &dyn Progress,
 ) -> Result<InitiationRun> {
-    let mut sim = start_simulation(target, fps, cruise_heading, cruise_speed, opts, rng)?;
+    if !(fps.is_finite() && fps > 0.0) {
+        return Err(Error::parameter("fps", "must be a positive number"));
+    }
+    let (mut sim, plan) = start_simulation(target, cruise, opts, rng)?;
     let n = target.len();
     let params = sim.params;
-    let hold_steps = (opts.hold * fps).round() as usize;
+    let dt = params.dt();
+    let limit = opts.time_limit(fps);
+    let tol = opts.tolerances();
     let mut run = InitiationRun {
-        pos: vec![sim.flock.pos.clone()],
-        heading: vec![sim.flock.heading.clone()],
-        speed: vec![sim.flock.speed.clone()],
+        fps,
+        pos: Vec::new(),
+        z: Vec::new(),
+        heading: Vec::new(),
+        speed: Vec::new(),
+        bank: Vec::new(),
         slot: Vec::new(),
         stats: InitiateStats {
             birds: n,
             steps: 0,
+            seconds: 0.0,
+            planned_seconds: plan.seconds,
             converged: false,
             min_distance: sim.min_distance(),
             max_turn_rate: 0.0,
+            max_turn_accel: 0.0,
+            max_accel: 0.0,
+            max_bank: 0.0,
+            max_stray: 0.0,
+            last_liftoff: 0.0,
             leader_changes: 0,
             birds_in_slot: 0,
             field_per_eye: params.perception.fov_per_eye,
         },
     };
-    progress.start("initiate", opts.max_steps as u64);
-    let mut in_formation = 0usize;
+    let mut prev: Vec<sim::BirdState> = (0..n).map(|i| sim.bird(i)).collect();
+    let push = |run: &mut InitiationRun, a: &[sim::BirdState], b: &[sim::BirdState], u: f64| {
+        run.pos
+            .push(a.iter().zip(b).map(|(a, b)| a.pos.lerp(b.pos, u)).collect());
+        run.z.push(
+            a.iter()
+                .zip(b)
+                .map(|(a, b)| a.z + u * (b.z - a.z))
+                .collect(),
+        );
+        run.heading.push(
+            a.iter()
+                .zip(b)
+                .map(|(a, b)| {
+                    sim::wrap_angle(a.heading + u * sim::wrap_angle(b.heading - a.heading))
+                })
+                .collect(),
+        );
+        run.speed.push(
+            a.iter()
+                .zip(b)
+                .map(|(a, b)| a.speed + u * (b.speed - a.speed))
+                .collect(),
+        );
+        run.bank.push(
+            a.iter()
+                .zip(b)
+                .map(|(a, b)| a.bank + u * (b.bank - a.bank))
+                .collect(),
+        );
+    };
+    push(&mut run, &prev, &prev, 0.0);
+    let total = (limit / dt).ceil() as u64;
+    progress.start("initiate", total);
+    let mut in_formation_since: Option<f64> = None;
     let mut converged = false;
-    while sim.steps < opts.max_steps {
+    let mut liftoff_done = sim.all_airborne();
+    let mut cur: Vec<sim::BirdState> = prev.clone();
+    while sim.time < limit {
         sim.step();
-        run.pos.push(sim.flock.pos.clone());
-        run.heading.push(sim.flock.heading.clone());
-        run.speed.push(sim.flock.speed.clone());
+        for (i, c) in cur.iter_mut().enumerate() {
+            *c = sim.bird(i);
+        }
+        // Limits of the motion, per internal step.
+        for (a, b) in prev.iter().zip(&cur) {
+            let s = &mut run.stats;
+            s.max_turn_rate = s.max_turn_rate.max(b.turn_rate.abs());
+            s.max_turn_accel = s.max_turn_accel.max((b.turn_rate - a.turn_rate).abs() / dt);
+            s.max_accel = s.max_accel.max((b.speed - a.speed).abs() / dt);
+            s.max_bank = s.max_bank.max(b.bank.abs());
+        }
+        // Output samples between the previous and this internal step.
+        let t0 = sim.time - dt;
+        loop {
+            let k = run.pos.len();
+            let tk = k as f64 / fps;
+            if tk > sim.time + 1e-9 {
+                break;
+            }
+            let u = ((tk - t0) / dt).clamp(0.0, 1.0);
+            push(&mut run, &prev, &cur, u);
+        }
+        std::mem::swap(&mut prev, &mut cur);
+        if sim.steps % params.substeps as usize != 0 {
+            continue;
+        }
         run.stats.min_distance = run.stats.min_distance.min(sim.min_distance());
-        if sim.in_formation(opts.tolerance, opts.heading_tolerance, opts.speed_tolerance) {
-            in_formation += 1;
+        if !liftoff_done && sim.all_airborne() {
+            liftoff_done = true;
+            run.stats.last_liftoff = sim.time;
+        }
+        if liftoff_done && sim.steps % (8 * params.substeps as usize) == 0 {
+            run.stats.max_stray = run.stats.max_stray.max(sim.stray_distance());
+        }
+        if sim.in_formation(&tol) {
+            let since = *in_formation_since.get_or_insert(sim.time);
+            if sim.time - since >= opts.hold - 1e-9 {
+                converged = true;
+            }
         } else {
-            in_formation = 0;
+            in_formation_since = None;
         }
-        if sim.steps % 64 == 0 {
-            progress.advance(64);
+        if sim.steps % 256 == 0 {
+            progress.advance(256 * params.substeps as u64);
         }
-        if in_formation > hold_steps {
-            converged = true;
+        if converged {
             break;
         }
     }
     progress.finish();
     run.slot = sim.flock.slot.clone();
-    run.stats.steps = sim.steps;
+    run.stats.steps = run.pos.len() - 1;
+    run.stats.seconds = sim.time;
     run.stats.converged = converged;
-    run.stats.max_turn_rate = sim.max_heading_change * fps;
     run.stats.leader_changes = sim.leader_changes;
     run.stats.birds_in_slot = sim.birds_in_slot(opts.tolerance);
     Ok(run)
 }
 
-/// The target shape and cruise heading/speed (radians, wingspans per second) of a steady flight.
-pub fn steady_target(steady: &Animation) -> Result<(TargetShape, f64, f64)> {
+/// The target shape and cruise of a steady flight (the leader's heading and speed in the first
+/// frame, the file's wingspan).
+pub fn steady_target(steady: &Animation) -> Result<(TargetShape, Cruise)> {
     let ks = steady.key_shapes.first().ok_or_else(|| {
         Error::parameter(
             "key_shapes",
@@ -762,12 +1294,20 @@ pub fn steady_target(steady: &Animation) -> Result<(TargetShape, f64, f64)> {
         .ok_or_else(|| Error::parameter("frames", "the steady flight has no frames"))?;
     let heading = f0.heading.get(target.leader).copied().unwrap_or(0.0);
     let speed = f0.speed.get(target.leader).copied().unwrap_or(0.0);
-    Ok((target, heading, speed))
+    Ok((
+        target,
+        Cruise {
+            heading,
+            speed,
+            wingspan_m: steady.wingspan_m,
+        },
+    ))
 }
 
 /// §6 initiation into the first key shape of `steady`: the combined animation (an `initiation`
-/// stage, then the steady frames translated so the hand-over has no jump) and its statistics.
-/// A flock that does not converge within `opts.max_steps` is [`Error::NotConverged`].
+/// stage, then the steady frames moved to the cruise altitude and translated so the hand-over
+/// has no jump) and its statistics. A flock that does not converge within the time limit is
+/// [`Error::NotConverged`].
 pub fn initiate(
     steady: &Animation,
     opts: &InitiateOptions,
@@ -775,21 +1315,19 @@ pub fn initiate(
     progress: &dyn Progress,
 ) -> Result<(Animation, InitiateStats)> {
     check_steady(steady, Path::new("steady flight"))?;
-    check_size(steady.birds, steady.frames.len(), opts.max_steps)?;
-    let (target, cruise_heading, cruise_speed) = steady_target(steady)?;
-    let run = simulate(
-        &target,
-        steady.fps,
-        cruise_heading,
-        cruise_speed,
-        opts,
-        rng,
-        progress,
-    )?;
+    opts.validate()?;
+    let frames_limit = ((opts.time_limit(steady.fps) * steady.fps).ceil() as usize).max(1);
+    check_size(steady.birds, steady.frames.len(), frames_limit)?;
+    let (target, cruise) = steady_target(steady)?;
+    let run = simulate(&target, steady.fps, &cruise, opts, rng, progress)?;
     if !run.stats.converged {
         return Err(Error::NotConverged(format!(
-            "the flock did not converge into the key shape within {} steps ({} of {} birds within {} wingspans of their slots); raise initiate.max_steps, or start from a smaller region",
-            opts.max_steps, run.stats.birds_in_slot, run.stats.birds, opts.tolerance
+            "the flock did not converge into the key shape within {:.0} s of flight ({} of {} birds within {} wingspans of their slots, last lift-off at {:.1} s); the time limit is the smaller of initiate.max_time and initiate.max_steps / fps",
+            opts.time_limit(steady.fps),
+            run.stats.birds_in_slot,
+            run.stats.birds,
+            opts.tolerance,
+            run.stats.last_liftoff
         )));
     }
     hand_over(steady, &run, opts)
@@ -822,7 +1360,9 @@ pub fn check_size(birds: usize, steady_frames: usize, max_steps: usize) -> Resul
 
 /// Joins a converged run to the steady flight: birds are renumbered by their final slot, the last
 /// `hold` seconds of the initiation are blended (smoothstep) into the backward extrapolation of the
-/// steady flight's first frame, and the steady frames are translated and delayed to follow on.
+/// steady flight's first frame, and the steady frames are translated (horizontally, and up to the
+/// cruise altitude) and delayed to follow on. Every frame gets a `bank`: the simulation's in the
+/// initiation, the coordinated-turn bank of the steady flight's own turns after it.
 pub fn hand_over(
     steady: &Animation,
     run: &InitiationRun,
@@ -851,6 +1391,9 @@ pub fn hand_over(
         }
     }
     let last = run.pos.len() - 1;
+    let alt = opts.cruise_altitude;
+    let g = GRAVITY_M_S2 / steady.wingspan_m;
+    let steady_bank = steady_banks(steady, g, opts.max_roll_rate, opts.roll_lag);
     let step_of = |s: usize| perception::direction(f0.heading[s]) * (f0.speed[s] / fps);
     let s0 = |s: usize| DVec2::new(f0.x[s], f0.y[s]);
     // Translation of the steady flight: least squares over birds of the one-step continuation.
@@ -881,6 +1424,7 @@ pub fn hand_over(
             z: vec![0.0; n],
             heading: vec![0.0; n],
             speed: vec![0.0; n],
+            bank: Some(vec![0.0; n]),
             ..Default::default()
         };
         // Blend weight: 0 before the window, smoothstep up to 1 at the last initiation frame.
@@ -896,12 +1440,15 @@ pub fn hand_over(
             let p = run.pos[t][b].lerp(ideal, w);
             let h = run.heading[t][b];
             let h = sim::wrap_angle(h + w * sim::wrap_angle(f0.heading[s] - h));
-            let v = run.speed[t][b] * fps * (1.0 - w) + f0.speed[s] * w;
+            let v = run.speed[t][b] * (1.0 - w) + f0.speed[s] * w;
             fr.x[s] = p.x;
             fr.y[s] = p.y;
-            fr.z[s] = f0.z[s];
+            fr.z[s] = run.z[t][b] * (1.0 - w) + (f0.z[s] + alt) * w;
             fr.heading[s] = h;
             fr.speed[s] = v;
+            if let Some(bank) = fr.bank.as_mut() {
+                bank[s] = run.bank[t][b] * (1.0 - w) + steady_bank[0][s] * w;
+            }
         }
         if let (Some(rate), Some(ph0)) = (&wing_rate, f0.wing_phase.as_ref()) {
             let back = (last + 1 - t) as f64;
@@ -916,7 +1463,7 @@ pub fn hand_over(
     let offset = frames.len();
     let t_start = offset as f64 / fps;
     let t0 = f0.t;
-    for f in &steady.frames {
+    for (f, bank) in steady.frames.iter().zip(steady_bank) {
         let mut g = f.clone();
         g.t = t_start + (f.t - t0);
         for s in 0..n {
@@ -924,7 +1471,11 @@ pub fn hand_over(
                 *x += shift.x;
                 *y += shift.y;
             }
+            if let Some(z) = g.z.get_mut(s) {
+                *z += alt;
+            }
         }
+        g.bank = Some(bank);
         frames.push(g);
     }
     let mut out = Animation::new(opts.seed, fps, steady.wingspan_m, n);
@@ -958,18 +1509,56 @@ pub fn hand_over(
         })
         .collect();
     out.frames = frames;
-    // Closest approach in the written initiation frames (after the blend).
+    // Closest approach (3-D) in the written initiation frames (after the blend).
     let mut stats = run.stats.clone();
     stats.min_distance = out.frames[..offset]
         .iter()
         .map(|f| {
-            let pts: Vec<DVec2> =
-                f.x.iter()
-                    .zip(&f.y)
-                    .map(|(&x, &y)| DVec2::new(x, y))
-                    .collect();
+            let pts: Vec<DVec3> = (0..n).map(|i| DVec3::new(f.x[i], f.y[i], f.z[i])).collect();
             sim::min_pair_distance(&pts)
         })
-        .fold(f64::INFINITY, f64::min);
+        .fold(stats.min_distance, f64::min);
     Ok((out, stats))
+}
+
+/// The bank of every bird in every steady frame: the coordinated-turn bank tan φ = v ω / g of the
+/// steady flight's own turns (ω from the headings of neighbouring frames, g in wingspans/s²),
+/// followed with the roll lag and roll-rate limit from a level start. Straight flight gives 0.
+pub fn steady_banks(
+    steady: &Animation,
+    g: f64,
+    max_roll_rate: f64,
+    roll_lag: f64,
+) -> Vec<Vec<f64>> {
+    let n = steady.birds;
+    let fr = &steady.frames;
+    let mut out = Vec::with_capacity(fr.len());
+    let mut phi = vec![0.0; n];
+    for k in 0..fr.len() {
+        let (a, b) = (k.saturating_sub(1), (k + 1).min(fr.len() - 1));
+        let dt = fr[b].t - fr[a].t;
+        for (s, phi) in phi.iter_mut().enumerate() {
+            let w = if dt > 0.0 {
+                sim::wrap_angle(fr[b].heading[s] - fr[a].heading[s]) / dt
+            } else {
+                0.0
+            };
+            let target = (fr[k].speed[s] * w / g).atan();
+            if k == 0 {
+                *phi = 0.0;
+            } else {
+                let h = fr[k].t - fr[k - 1].t;
+                let rate = ((target - *phi) / roll_lag).clamp(-max_roll_rate, max_roll_rate);
+                // An exact step to the target when the lag would overshoot it.
+                let next = *phi + rate * h;
+                *phi = if (next - target) * (*phi - target) < 0.0 {
+                    target
+                } else {
+                    next
+                };
+            }
+        }
+        out.push(phi.clone());
+    }
+    out
 }

@@ -124,6 +124,22 @@ impl Perceiver {
         params: &PerceptionParams,
         out: &mut Vec<usize>,
     ) {
+        let pool: Vec<usize> = (0..positions.len()).collect();
+        self.visible_among(viewer, positions, &pool, heading, params, out);
+    }
+
+    /// As [`Perceiver::visible`], among the flockmates `pool` only (indices into `positions`,
+    /// increasing: e.g. those within the visual range, from a grid query). Birds outside the
+    /// pool neither are seen nor hide anyone.
+    pub fn visible_among(
+        &mut self,
+        viewer: usize,
+        positions: &[DVec2],
+        pool: &[usize],
+        heading: f64,
+        params: &PerceptionParams,
+        out: &mut Vec<usize>,
+    ) {
         out.clear();
         let Some(&p) = positions.get(viewer) else {
             return;
@@ -132,7 +148,8 @@ impl Perceiver {
         let d = direction(heading);
         let cos_fov = params.fov_per_eye.cos() - 1e-12;
         let all_round = params.fov_per_eye >= std::f64::consts::PI;
-        for (j, &q) in positions.iter().enumerate() {
+        for &j in pool {
+            let Some(&q) = positions.get(j) else { continue };
             let rel = q - p;
             let len2 = rel.length_squared();
             if j == viewer || len2 <= 0.0 || !len2.is_finite() {
@@ -147,7 +164,7 @@ impl Perceiver {
         match params.mode {
             PerceptionMode::Hpr { gamma } => self.hpr(p, positions, gamma, out),
             PerceptionMode::Exact => {
-                self.exact(viewer, p, positions, heading, params.bird_radius, out)
+                self.exact(viewer, p, positions, pool, heading, params.bird_radius, out)
             }
         }
         out.sort_unstable();
@@ -212,19 +229,22 @@ impl Perceiver {
         }
     }
 
+    #[allow(clippy::too_many_arguments)]
     fn exact(
         &mut self,
         viewer: usize,
         p: DVec2,
         positions: &[DVec2],
+        pool: &[usize],
         heading: f64,
         radius: f64,
         out: &mut Vec<usize>,
     ) {
-        // Occluders are all other birds (a bird just outside the field can still cover part of
-        // it); candidates are those inside the field. Nearest first.
+        // Occluders are all other birds of the pool (a bird just outside the field can still
+        // cover part of it); candidates are those inside the field. Nearest first.
         self.by_dist.clear();
-        for (j, &q) in positions.iter().enumerate() {
+        for &j in pool {
+            let Some(&q) = positions.get(j) else { continue };
             if j != viewer {
                 let d = (q - p).length();
                 if d > 0.0 && d.is_finite() {

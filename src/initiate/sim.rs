@@ -1,14 +1,33 @@
-//! The §6 simulation loop: one call of [`Simulation::step`] advances every bird by one animation
-//! frame. Each bird perceives the flock as it was at the previous step (Jacobi update), chooses its
-//! reference bird and side, derives its target position from the correspondence with the target
-//! shape, and changes speed (eq. 5) and heading (eq. 6) within its limits; short-range collision
-//! avoidance may override the heading change.
+//! The §6 simulation in physical time. The paper's rules are decisions a bird takes once per
+//! *reaction time* τ (a fixed number of seconds, independent of the output frame rate); between
+//! decisions the bird's motion is integrated with a fixed internal step `dt` (τ = `substeps` · dt).
+//! Output frames are samples of this one simulation, so the same seed gives the same take-off at
+//! any output frame rate.
 //!
-//! Internal units: wingspans, radians, *steps* (one step = one frame = 1/fps s), so speeds are in
-//! wingspans per step and turn rates in radians per step. [`StepParams`] holds the per-step values
-//! derived from the user's per-second [`super::InitiateOptions`].
+//! Each decision: every departed bird perceives the departed flock as it was (Jacobi update), in
+//! the horizontal plane; it chooses its reference bird and side, derives its target position
+//! from the correspondence with the target shape and asks for a turn rate (eq. 6 as a rate,
+//! ω = α Δd / (max(r, 1) τ)) and a speed (eq. 5, with the predicted reference position
+//! P_j + v_j τ d_j). Short-range collision avoidance, in 3-D, may override the turn.
+//!
+//! Between decisions every bird *flies* what it asked for, smoothly:
+//! - turn rate ω follows the request with a lag, ω̇ = clamp((ω* − ω)/τ_ω, ±ω̇_max), |ω| ≤ ω_max;
+//! - acceleration a follows (v* − v)/τ_v (within ±a_max) with a bounded jerk, so speed never
+//!   flips between speeding up and slowing down from one frame to the next;
+//! - bank is the coordinated turn, tan φ* = v ω / g (g in wingspans/s²), reached with a lag and
+//!   a bounded roll rate;
+//! - climb rate w follows min(w_max, √(2 a_z Δz)) towards the cruise altitude with |ẇ| ≤ a_z.
+//!
+//! A bird on the ground waits for its departure time, then runs straight ahead, accelerating
+//! (with the same jerk limit) to its lift-off speed; only then is it airborne and do the paper's
+//! rules act on it. Waiting birds are not part of the flock (not perceived, not followed).
+//!
+//! Units: wingspans, seconds, radians (speeds wingspans/s, turn rates rad/s). Neighbour queries go
+//! through a uniform grid ([`Grid`]): perception within the visual range, avoidance within its
+//! range. Decisions of large flocks are computed in parallel; every decision reads only the
+//! previous state, so the result does not depend on the number of threads.
 
-use glam::DVec2;
+use glam::{DVec2, DVec3};
 
 use super::perception::{
     bearing, choose_reference, direction, right_of, Perceiver, PerceptionParams,
@@ -19,27 +38,64 @@ use super::target::{Side, TargetShape};
 /// fraction of the cruise speed (unless they are already closer than the avoidance distance).
 pub const AVOID_MIN_RELATIVE_SPEED: f64 = 0.08;
 
-/// Per-step parameters of the drives and actions (derived from [`super::InitiateOptions`]).
+/// Collision avoidance scores a candidate turn rate by the heading it gives after this long,
+/// seconds.
+pub const AVOID_COMMIT: f64 = 0.3;
+
+/// Parameters of the drives, actions and flight dynamics, in seconds (derived from
+/// [`super::InitiateOptions`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StepParams {
     /// Perception model.
     pub perception: PerceptionParams,
+    /// Visual range: flockmates farther than this are not perceived, wingspans.
+    pub visual_range: f64,
     /// α of eq. (6), dimensionless.
     pub alpha: f64,
     /// |K| of eq. (5), per √wingspan.
     pub k: f64,
-    /// Maximum heading change, radians per step.
+    /// Reaction time τ: one decision per τ; the paper's "one time step", seconds.
+    pub reaction_time: f64,
+    /// Internal integration steps per decision.
+    pub substeps: u32,
+    /// Maximum turn rate, radians per second.
     pub max_turn: f64,
-    /// Maximum speed change, wingspans per step per step.
-    pub max_dv: f64,
-    /// Minimum flight speed, wingspans per step.
+    /// Maximum change of the turn rate, radians per second squared.
+    pub max_turn_accel: f64,
+    /// Time constant of the turn rate following its request, seconds.
+    pub turn_lag: f64,
+    /// Maximum rate of change of the turn rate's change, radians per second cubed.
+    pub max_turn_jerk: f64,
+    /// Maximum acceleration (and deceleration), wingspans per second squared.
+    pub max_accel: f64,
+    /// Maximum change of the acceleration, wingspans per second cubed.
+    pub max_jerk: f64,
+    /// Time constant of the speed following its request, seconds.
+    pub speed_lag: f64,
+    /// Minimum flight speed (lift-off speed), wingspans per second.
     pub min_speed: f64,
-    /// Maximum flight speed, wingspans per step.
+    /// Maximum flight speed, wingspans per second.
     pub max_speed: f64,
     /// Cruise heading, radians clockwise from +y.
     pub cruise_heading: f64,
-    /// Cruise speed, wingspans per step.
+    /// Cruise speed, wingspans per second.
     pub cruise_speed: f64,
+    /// Cruise altitude (`z`), wingspans above the ground.
+    pub cruise_altitude: f64,
+    /// Largest climb (and descent) rate, wingspans per second.
+    pub climb_rate: f64,
+    /// Largest vertical acceleration, wingspans per second squared.
+    pub vertical_accel: f64,
+    /// Gravity, wingspans per second squared (9.81 m/s² / wingspan in metres).
+    pub gravity: f64,
+    /// Maximum roll rate, radians per second.
+    pub max_roll_rate: f64,
+    /// Time constant of the bank following the coordinated-turn bank, seconds.
+    pub roll_lag: f64,
+    /// Maximum roll acceleration, radians per second squared.
+    pub max_roll_accel: f64,
+    /// Acceleration of the take-off run, wingspans per second squared.
+    pub run_accel: f64,
     /// Separation drive: two birds sharing a reference within this distance → the rear one
     /// chooses another, wingspans (paper: 10).
     pub separation_distance: f64,
@@ -50,7 +106,7 @@ pub struct StepParams {
     pub avoid_distance: f64,
     /// Collision avoidance: only birds nearer than this are considered, wingspans.
     pub avoid_range: f64,
-    /// Collision avoidance: prediction horizon, steps.
+    /// Collision avoidance: prediction horizon, seconds.
     pub avoid_horizon: f64,
     /// Speed factor of a bird without a reference bird (slows a little until it sees the flock).
     pub lost_speed_factor: f64,
@@ -58,12 +114,25 @@ pub struct StepParams {
     pub leader_hysteresis: f64,
     /// Keep the current reference bird while it stays visible and acceptable.
     pub sticky_reference: bool,
-    /// A kept reference hidden for at most this many steps is kept all the same.
+    /// A kept reference hidden for at most this many decisions is kept all the same.
     pub reference_memory: u32,
     /// Upper bound of the distance divisor of eq. (6), wingspans.
     pub turn_distance_cap: f64,
-    /// Half-width of the linear zone of eq. (5)'s √|r − v_j| around its fixed point, wingspans.
+    /// Half-width of the linear zone of eq. (5)'s √|r − v_j τ| around its fixed point, wingspans.
     pub linear_zone: f64,
+    /// Beyond this distance eq. (5)'s √|r − v_j τ| grows linearly (catch-up), wingspans.
+    pub catchup_distance: f64,
+    /// Eq. (5) with the longitudinal gap to the target instead of the whole distance.
+    pub gap_speed: bool,
+    /// Speed of the leader while flockmates are still on the ground, wingspans per second.
+    pub gather_speed: f64,
+}
+
+impl StepParams {
+    /// The integration step, seconds: τ / substeps.
+    pub fn dt(&self) -> f64 {
+        self.reaction_time / self.substeps.max(1) as f64
+    }
 }
 
 /// A bird claims a slot already held by a visible bird only when it is nearer the slot's target
@@ -76,15 +145,28 @@ pub const SLOT_CLAIM_MARGIN: f64 = 1.0;
 pub const SETTLED_DISTANCE: f64 = 1.0;
 
 /// Flocks at least this large decide in parallel (one thread per core).
-pub const PARALLEL_MIN_BIRDS: usize = 256;
+pub const PARALLEL_MIN_BIRDS: usize = 128;
 
-/// What one bird does in the next step.
+/// Where a bird is in its take-off.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Phase {
+    /// At rest on the ground, waiting for its departure time.
+    Waiting,
+    /// Running along the ground to lift-off speed.
+    Running,
+    /// Airborne: the paper's rules act on it.
+    Airborne,
+}
+
+/// What one bird asks for until the next decision.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 struct Decision {
-    /// Heading change, radians.
-    turn: f64,
-    /// New speed, wingspans per step.
+    /// Requested turn rate, radians per second.
+    turn_rate: f64,
+    /// Requested speed, wingspans per second.
     speed: f64,
+    /// Requested altitude offset, wingspans.
+    alt_offset: f64,
     reference: Option<usize>,
     side: Option<Side>,
     branch: Option<usize>,
@@ -94,12 +176,34 @@ struct Decision {
 /// The state of every bird (world frame).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Flock {
-    /// Positions, wingspans.
+    /// Horizontal positions, wingspans.
     pub pos: Vec<DVec2>,
+    /// Altitudes above the ground (`z`), wingspans.
+    pub z: Vec<f64>,
+    /// Climb rates, wingspans per second.
+    pub climb: Vec<f64>,
     /// Headings, radians clockwise from +y.
     pub heading: Vec<f64>,
-    /// Speeds, wingspans per step.
+    /// Turn rates, radians per second (positive: turning right).
+    pub turn_rate: Vec<f64>,
+    /// Rates of change of the turn rates, radians per second squared.
+    pub turn_accel: Vec<f64>,
+    /// Horizontal speeds, wingspans per second.
     pub speed: Vec<f64>,
+    /// Accelerations, wingspans per second squared.
+    pub accel: Vec<f64>,
+    /// Bank angles, radians (right wing down positive).
+    pub bank: Vec<f64>,
+    /// Roll rates, radians per second.
+    pub roll_rate: Vec<f64>,
+    /// Take-off phase of each bird.
+    pub phase: Vec<Phase>,
+    /// Departure time of each bird, seconds.
+    pub depart: Vec<f64>,
+    /// Requested turn rate (rad/s) and speed (wingspans/s) of each bird, from its last decision.
+    pub request: Vec<(f64, f64)>,
+    /// Requested altitude offset from the cruise altitude (collision avoidance), wingspans.
+    pub alt_offset: Vec<f64>,
     /// Reference bird of each bird (`None` for the leader and for lost birds).
     pub reference: Vec<Option<usize>>,
     /// Side of each bird relative to its reference bird.
@@ -107,12 +211,101 @@ pub struct Flock {
     /// The follower slot of its reference's slot each bird aims for (where the target tree
     /// branches, a reference slot has several).
     pub branch: Vec<Option<usize>>,
-    /// Steps since each bird last saw its reference bird (0: visible now).
+    /// Decisions since each bird last saw its reference bird (0: visible now).
     pub unseen: Vec<u32>,
     /// Slot of the target shape each bird corresponds to (§6.2.1), if matched.
     pub slot: Vec<Option<usize>>,
-    /// The leader: the front-most bird along the cruise heading.
+    /// The leader: the front-most departed bird along the cruise heading.
     pub leader: usize,
+}
+
+/// A uniform grid of square cells over the horizontal plane, for neighbour queries.
+#[derive(Debug, Clone, Default)]
+pub struct Grid {
+    cell: f64,
+    origin: DVec2,
+    nx: usize,
+    ny: usize,
+    /// Start of each cell's run in `items` (prefix sums; length nx·ny + 1).
+    start: Vec<usize>,
+    items: Vec<usize>,
+}
+
+impl Grid {
+    /// Rebuilds the grid over the points `pos[i]` for the `members` (cells of `cell` wingspans).
+    pub fn build(&mut self, pos: &[DVec2], members: &[usize], cell: f64) {
+        self.cell = cell.max(1e-6);
+        let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
+        for &i in members {
+            lo = lo.min(pos[i]);
+            hi = hi.max(pos[i]);
+        }
+        if members.is_empty() {
+            lo = DVec2::ZERO;
+            hi = DVec2::ZERO;
+        }
+        self.origin = lo;
+        // Cap the cell count so a bird far away cannot make the grid huge.
+        let span = (hi - lo) / self.cell;
+        let cap = (4 * members.len()).max(16) as f64;
+        let scale = ((span.x + 1.0) * (span.y + 1.0) / cap).max(1.0).sqrt();
+        self.cell *= scale;
+        self.nx = ((hi.x - lo.x) / self.cell).floor() as usize + 1;
+        self.ny = ((hi.y - lo.y) / self.cell).floor() as usize + 1;
+        let cells = self.nx * self.ny;
+        self.start.clear();
+        self.start.resize(cells + 1, 0);
+        for &i in members {
+            let c = self.cell_of(pos[i]);
+            self.start[c + 1] += 1;
+        }
+        for c in 0..cells {
+            self.start[c + 1] += self.start[c];
+        }
+        self.items.clear();
+        self.items.resize(members.len(), 0);
+        let mut fill = self.start.clone();
+        for &i in members {
+            let c = self.cell_of(pos[i]);
+            self.items[fill[c]] = i;
+            fill[c] += 1;
+        }
+    }
+
+    fn cell_of(&self, p: DVec2) -> usize {
+        let cx = (((p.x - self.origin.x) / self.cell).floor().max(0.0) as usize).min(self.nx - 1);
+        let cy = (((p.y - self.origin.y) / self.cell).floor().max(0.0) as usize).min(self.ny - 1);
+        cy * self.nx + cx
+    }
+
+    /// Members within `radius` of `p` (horizontal distance), in increasing index order.
+    pub fn within(&self, pos: &[DVec2], p: DVec2, radius: f64, out: &mut Vec<usize>) {
+        out.clear();
+        if self.nx == 0 {
+            return;
+        }
+        let r2 = radius * radius;
+        let lo = ((p - DVec2::splat(radius) - self.origin) / self.cell).floor();
+        let hi = ((p + DVec2::splat(radius) - self.origin) / self.cell).floor();
+        if hi.x < 0.0 || hi.y < 0.0 || lo.x >= self.nx as f64 || lo.y >= self.ny as f64 {
+            return;
+        }
+        let x0 = lo.x.max(0.0) as usize;
+        let y0 = lo.y.max(0.0) as usize;
+        let x1 = (hi.x as usize).min(self.nx - 1);
+        let y1 = (hi.y as usize).min(self.ny - 1);
+        for cy in y0..=y1 {
+            for cx in x0..=x1 {
+                let c = cy * self.nx + cx;
+                for &i in &self.items[self.start[c]..self.start[c + 1]] {
+                    if (pos[i] - p).length_squared() <= r2 {
+                        out.push(i);
+                    }
+                }
+            }
+        }
+        out.sort_unstable();
+    }
 }
 
 /// The simulation: target shape, parameters, flock and scratch buffers.
@@ -120,19 +313,27 @@ pub struct Flock {
 pub struct Simulation {
     /// Target shape (slot tree).
     pub target: TargetShape,
-    /// Per-step parameters.
+    /// Parameters.
     pub params: StepParams,
     /// Current state.
     pub flock: Flock,
-    /// Steps done so far.
+    /// Integration steps done so far.
     pub steps: usize,
-    /// Largest heading change of any bird in any step so far, radians.
-    pub max_heading_change: f64,
+    /// Simulated time, seconds.
+    pub time: f64,
     /// Number of times the leader changed.
     pub leader_changes: usize,
+    /// Birds that have left their place on the ground (running or airborne), in index order.
+    departed: Vec<usize>,
+    /// Birds by the slot they take, for this decision: slot `s` holds
+    /// `holders[holder_start[s]..holder_start[s + 1]]` (increasing bird index).
+    holders: Vec<usize>,
+    holder_start: Vec<usize>,
     perceiver: Perceiver,
     visible: Vec<usize>,
-    vel: Vec<DVec2>,
+    near: Vec<usize>,
+    grid: Grid,
+    vel: Vec<DVec3>,
     dir: Vec<DVec2>,
     decisions: Vec<Decision>,
     next_reference: Vec<Option<usize>>,
@@ -141,38 +342,171 @@ pub struct Simulation {
     next_unseen: Vec<u32>,
 }
 
+/// The state of a bird a flight dynamics step starts from and gives.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BirdState {
+    /// Horizontal position, wingspans.
+    pub pos: DVec2,
+    /// Altitude, wingspans.
+    pub z: f64,
+    /// Climb rate, wingspans per second.
+    pub climb: f64,
+    /// Heading, radians.
+    pub heading: f64,
+    /// Turn rate, radians per second.
+    pub turn_rate: f64,
+    /// Rate of change of the turn rate, radians per second squared.
+    pub turn_accel: f64,
+    /// Speed, wingspans per second.
+    pub speed: f64,
+    /// Acceleration, wingspans per second squared.
+    pub accel: f64,
+    /// Bank, radians.
+    pub bank: f64,
+    /// Roll rate, radians per second.
+    pub roll_rate: f64,
+}
+
+/// `x` moved towards `target` by at most `max_step`.
+fn approach(x: f64, target: f64, max_step: f64) -> f64 {
+    x + (target - x).clamp(-max_step, max_step)
+}
+
+/// One integration step of `dt` seconds of an airborne bird asking for turn rate `want_turn`
+/// (rad/s) and speed `want_speed` (wingspans/s), climbing towards the cruise altitude. The
+/// limits of [`StepParams`] hold by construction: |Δω| ≤ ω̇_max dt, |Δa| ≤ j_max dt,
+/// |a| ≤ a_max, |Δφ| ≤ p_max dt, |Δw| ≤ a_z dt.
+pub fn fly(s: &BirdState, want_turn: f64, want_speed: f64, p: &StepParams, dt: f64) -> BirdState {
+    fly_at(s, want_turn, want_speed, p.cruise_altitude, p, dt)
+}
+
+/// As [`fly`], climbing towards altitude `want_z` (wingspans) instead of the cruise altitude.
+pub fn fly_at(
+    s: &BirdState,
+    want_turn: f64,
+    want_speed: f64,
+    want_z: f64,
+    p: &StepParams,
+    dt: f64,
+) -> BirdState {
+    let mut n = *s;
+    // Turn rate: it follows the request with a lag, (ω* − ω)/τ_ω, its change bounded and
+    // itself changing at a bounded rate (so the turn rate cannot flip sign from one frame to the
+    // next); near the request the change is the braking one, ω̇² = 2 j |ω* − ω|, so it arrives
+    // without overshoot.
+    let w_req = want_turn.clamp(-p.max_turn, p.max_turn);
+    let err = w_req - s.turn_rate;
+    let brake = (2.0 * p.max_turn_jerk * err.abs()).sqrt();
+    let a_turn = (err / p.turn_lag)
+        .clamp(-p.max_turn_accel, p.max_turn_accel)
+        .clamp(-brake, brake);
+    n.turn_accel = approach(s.turn_accel, a_turn, p.max_turn_jerk * dt);
+    n.turn_rate = (s.turn_rate + n.turn_accel * dt).clamp(-p.max_turn, p.max_turn);
+    // Speed: the acceleration follows (v* − v)/τ_v with bounded jerk. Near the speed limits the
+    // wanted acceleration is the braking one (a² = 2 j Δv), so the bound is met without a kink.
+    let v_req = want_speed.clamp(p.min_speed, p.max_speed);
+    let a_lag = (v_req - s.speed) / p.speed_lag;
+    let room_up = (p.max_speed - s.speed).max(0.0);
+    let room_down = (s.speed - p.min_speed).max(0.0);
+    let a_want = a_lag
+        .clamp(-p.max_accel, p.max_accel)
+        .min((2.0 * p.max_jerk * room_up).sqrt())
+        .max(-(2.0 * p.max_jerk * room_down).sqrt());
+    n.accel = approach(s.accel, a_want, p.max_jerk * dt).clamp(-p.max_accel, p.max_accel);
+    n.speed = (s.speed + n.accel * dt).clamp(p.min_speed.min(s.speed), p.max_speed.max(s.speed));
+    n.heading = wrap_angle(s.heading + n.turn_rate * dt);
+    // Coordinated turn: tan φ = v ω / g.
+    // The roll rate follows (φ* − φ)/τ_φ with a bounded roll acceleration, braking near φ*, so
+    // the bank cannot swing back and forth from frame to frame.
+    let phi_t = (n.speed * n.turn_rate / p.gravity).atan();
+    let e = phi_t - s.bank;
+    let brake = (2.0 * p.max_roll_accel * e.abs()).sqrt();
+    let p_want = (e / p.roll_lag)
+        .clamp(-p.max_roll_rate, p.max_roll_rate)
+        .clamp(-brake, brake);
+    n.roll_rate = approach(s.roll_rate, p_want, p.max_roll_accel * dt);
+    n.bank = s.bank + n.roll_rate * dt;
+    // Climb: towards the cruise altitude, arriving with zero climb rate.
+    let dz = want_z - s.z;
+    let w_t = (2.0 * p.vertical_accel * dz.abs()).sqrt().min(p.climb_rate) * dz.signum();
+    n.climb = approach(s.climb, w_t, p.vertical_accel * dt);
+    n.z = s.z + 0.5 * (s.climb + n.climb) * dt;
+    n.pos = s.pos + direction(n.heading) * (0.5 * (s.speed + n.speed) * dt);
+    n
+}
+
+/// One integration step of a bird on its take-off run: straight ahead, level, accelerating at
+/// the run acceleration (bounded jerk) until the lift-off speed.
+pub fn run(s: &BirdState, p: &StepParams, dt: f64) -> BirdState {
+    let mut n = *s;
+    n.accel = approach(s.accel, p.run_accel, p.max_jerk * dt);
+    n.speed = s.speed + n.accel * dt;
+    n.pos = s.pos + direction(s.heading) * (0.5 * (s.speed + n.speed) * dt);
+    n
+}
+
 impl Simulation {
-    /// A simulation starting from `pos`, `heading`, `speed` (wingspans, radians, wingspans per
-    /// step); the leader is the front-most bird.
+    /// A simulation starting from `pos`, `z`, `heading`, `speed` (wingspans, radians, wingspans
+    /// per second), each bird leaving at `depart[i]` seconds (a bird that starts with a speed of
+    /// at least the minimum speed, or above the ground, is airborne from the start; one at rest
+    /// on the ground waits, then runs to lift-off). The leader is the front-most departed bird.
     pub fn new(
         target: TargetShape,
         params: StepParams,
         pos: Vec<DVec2>,
+        z: Vec<f64>,
         heading: Vec<f64>,
         speed: Vec<f64>,
+        depart: Vec<f64>,
     ) -> Simulation {
         let n = pos.len();
-        let dc = direction(params.cruise_heading);
-        let leader = front_most(&pos, dc);
+        let phase: Vec<Phase> = (0..n)
+            .map(|i| {
+                if z[i] > 0.0 || speed[i] >= params.min_speed {
+                    Phase::Airborne
+                } else if depart[i] <= 0.0 {
+                    Phase::Running
+                } else {
+                    Phase::Waiting
+                }
+            })
+            .collect();
+        let request = (0..n).map(|i| (0.0, speed[i])).collect();
         let mut sim = Simulation {
             target,
             params,
             flock: Flock {
                 pos,
+                z,
+                climb: vec![0.0; n],
                 heading,
+                turn_rate: vec![0.0; n],
+                turn_accel: vec![0.0; n],
                 speed,
+                accel: vec![0.0; n],
+                bank: vec![0.0; n],
+                roll_rate: vec![0.0; n],
+                phase,
+                depart,
+                request,
+                alt_offset: vec![0.0; n],
                 reference: vec![None; n],
                 side: vec![None; n],
                 branch: vec![None; n],
                 unseen: vec![0; n],
                 slot: vec![None; n],
-                leader,
+                leader: 0,
             },
             steps: 0,
-            max_heading_change: 0.0,
+            time: 0.0,
             leader_changes: 0,
+            departed: Vec::new(),
+            holders: Vec::new(),
+            holder_start: Vec::new(),
             perceiver: Perceiver::new(),
             visible: Vec::new(),
+            near: Vec::new(),
+            grid: Grid::default(),
             vel: Vec::new(),
             dir: Vec::new(),
             decisions: Vec::new(),
@@ -181,6 +515,9 @@ impl Simulation {
             next_branch: vec![None; n],
             next_unseen: vec![0; n],
         };
+        sim.update_departed();
+        let dc = direction(sim.params.cruise_heading);
+        sim.flock.leader = sim.front_most(dc).unwrap_or(0);
         sim.match_slots();
         sim
     }
@@ -193,6 +530,61 @@ impl Simulation {
     /// True when there are no birds.
     pub fn is_empty(&self) -> bool {
         self.flock.pos.is_empty()
+    }
+
+    fn update_departed(&mut self) {
+        self.departed.clear();
+        self.departed
+            .extend((0..self.len()).filter(|&i| self.flock.phase[i] != Phase::Waiting));
+    }
+
+    /// The departed bird farthest along `dir` (ties to the lower index).
+    fn front_most(&self, dir: DVec2) -> Option<usize> {
+        let mut best: Option<usize> = None;
+        for &i in &self.departed {
+            if best.map_or(true, |b| {
+                self.flock.pos[i].dot(dir) > self.flock.pos[b].dot(dir)
+            }) {
+                best = Some(i);
+            }
+        }
+        best
+    }
+
+    /// True when every bird is airborne.
+    pub fn all_airborne(&self) -> bool {
+        self.flock.phase.iter().all(|&p| p == Phase::Airborne)
+    }
+
+    /// The state of bird `i`.
+    pub fn bird(&self, i: usize) -> BirdState {
+        let f = &self.flock;
+        BirdState {
+            pos: f.pos[i],
+            z: f.z[i],
+            climb: f.climb[i],
+            heading: f.heading[i],
+            turn_rate: f.turn_rate[i],
+            turn_accel: f.turn_accel[i],
+            speed: f.speed[i],
+            accel: f.accel[i],
+            bank: f.bank[i],
+            roll_rate: f.roll_rate[i],
+        }
+    }
+
+    fn set_bird(&mut self, i: usize, s: &BirdState) {
+        let f = &mut self.flock;
+        f.pos[i] = s.pos;
+        f.z[i] = s.z;
+        f.climb[i] = s.climb;
+        f.heading[i] = s.heading;
+        f.turn_rate[i] = s.turn_rate;
+        f.turn_accel[i] = s.turn_accel;
+        f.speed[i] = s.speed;
+        f.accel[i] = s.accel;
+        f.bank[i] = s.bank;
+        f.roll_rate[i] = s.roll_rate;
     }
 
     /// §6.2.1 correspondence: the leader takes the leader slot; a bird whose reference bird is
@@ -251,16 +643,16 @@ impl Simulation {
     }
 
     /// The target position of a follower of bird `j` at formation-frame `offset` (Δx right,
-    /// Δy behind), one step ahead: T = P_j + v_j d_j + Δx r_j − Δy d_j.
+    /// Δy behind), one reaction time ahead: T = P_j + v_j τ d_j + Δx r_j − Δy d_j.
     fn target_point(&self, j: usize, offset: DVec2) -> DVec2 {
         let f = &self.flock;
         let d = self.dir_of(j);
         // Right of d = (sin θ, cos θ) is (cos θ, −sin θ).
         let r = DVec2::new(d.y, -d.x);
-        f.pos[j] + d * f.speed[j] + r * offset.x - d * offset.y
+        f.pos[j] + d * (f.speed[j] * self.params.reaction_time) + r * offset.x - d * offset.y
     }
 
-    /// Flight direction of bird `j` (cached for the current step).
+    /// Flight direction of bird `j` (cached for the current decision).
     fn dir_of(&self, j: usize) -> DVec2 {
         match self.dir.get(j) {
             Some(d) if self.dir.len() == self.flock.pos.len() => *d,
@@ -287,8 +679,12 @@ impl Simulation {
             let holds =
                 f.reference[i] == Some(j) && f.side[i] == Some(side) && f.slot[i] == Some(c);
             let margin = if holds { 0.0 } else { SLOT_CLAIM_MARGIN };
-            let taken = visible.iter().any(|&k| {
+            // Birds that take slot `c` (a short list, from the per-decision table), of those
+            // the visible ones (`visible` is sorted).
+            let holders = &self.holders[self.holder_start[c]..self.holder_start[c + 1]];
+            let taken = holders.iter().any(|&k| {
                 k != i
+                    && visible.binary_search(&k).is_ok()
                     && f.reference[k] == Some(j)
                     && f.side[k] == Some(side)
                     && f.slot[k] == Some(c)
@@ -327,36 +723,97 @@ impl Simulation {
         [Some(own.unwrap_or(geometric)), None]
     }
 
-    /// Advances the flock by one step.
+    /// Advances the flock by one integration step (`dt` seconds); every `substeps`-th step
+    /// starts with a decision of every airborne bird.
     pub fn step(&mut self) {
         let n = self.len();
         if n == 0 {
             return;
         }
         let p = self.params;
-        let dc = direction(p.cruise_heading);
-        // The leader is the front-most bird (with hysteresis against flip-flopping).
-        let front = front_most(&self.flock.pos, dc);
-        let lead = self.flock.leader;
-        if front != lead
-            && (self.flock.pos[front] - self.flock.pos[lead]).dot(dc) > p.leader_hysteresis
-        {
-            self.flock.leader = front;
-            self.leader_changes += 1;
-            self.match_slots();
+        let dt = p.dt();
+        if self.steps % p.substeps.max(1) as usize == 0 {
+            self.decide_all();
         }
-        // Velocities of the previous step, shared by every bird's decisions.
+        for i in 0..n {
+            let s = self.bird(i);
+            let next = match self.flock.phase[i] {
+                Phase::Waiting => {
+                    if self.time + 0.5 * dt >= self.flock.depart[i] {
+                        self.flock.phase[i] = Phase::Running;
+                        run(&s, &p, dt)
+                    } else {
+                        s
+                    }
+                }
+                Phase::Running => {
+                    let r = run(&s, &p, dt);
+                    if r.speed >= p.min_speed {
+                        self.flock.phase[i] = Phase::Airborne;
+                        self.flock.request[i] = (0.0, r.speed);
+                    }
+                    r
+                }
+                Phase::Airborne => {
+                    let (w, v) = self.flock.request[i];
+                    let z = p.cruise_altitude + self.flock.alt_offset[i];
+                    fly_at(&s, w, v, z, &p, dt)
+                }
+            };
+            self.set_bird(i, &next);
+        }
+        self.steps += 1;
+        self.time = self.steps as f64 * dt;
+    }
+
+    /// One decision of every bird from the current state (Jacobi: all read the same state).
+    fn decide_all(&mut self) {
+        let n = self.len();
+        let p = self.params;
+        self.update_departed();
+        if self.departed.is_empty() {
+            return;
+        }
+        let dc = direction(p.cruise_heading);
+        // The leader is the front-most departed bird (with hysteresis against flip-flopping).
+        let lead = self.flock.leader;
+        if let Some(front) = self.front_most(dc) {
+            let lead_gone = self.flock.phase[lead] == Phase::Waiting;
+            if front != lead
+                && (lead_gone
+                    || (self.flock.pos[front] - self.flock.pos[lead]).dot(dc) > p.leader_hysteresis)
+            {
+                self.flock.leader = front;
+                self.leader_changes += 1;
+                self.match_slots();
+            }
+        }
+        self.build_holders();
         let mut vel = std::mem::take(&mut self.vel);
         vel.clear();
-        vel.extend((0..n).map(|i| direction(self.flock.heading[i]) * self.flock.speed[i]));
+        vel.extend((0..n).map(|i| {
+            let h = direction(self.flock.heading[i]) * self.flock.speed[i];
+            DVec3::new(h.x, h.y, self.flock.climb[i])
+        }));
         self.vel = vel;
         let mut dir = std::mem::take(&mut self.dir);
         dir.clear();
         dir.extend(self.flock.heading.iter().map(|&h| direction(h)));
         self.dir = dir;
+        // One grid for perception and avoidance: cells of the avoidance range, perception
+        // queries cover as many cells as the visual range needs.
+        let mut grid = std::mem::take(&mut self.grid);
+        let all: Vec<usize> = (0..n).collect();
+        grid.build(
+            &self.flock.pos,
+            &all,
+            p.avoid_range.max(p.visual_range / 4.0),
+        );
+        self.grid = grid;
         let mut decisions = std::mem::take(&mut self.decisions);
+        decisions.clear();
         decisions.resize(n, Decision::default());
-        let threads = if n >= PARALLEL_MIN_BIRDS {
+        let threads = if self.departed.len() >= PARALLEL_MIN_BIRDS {
             std::thread::available_parallelism().map_or(1, |t| t.get().min(8))
         } else {
             1
@@ -364,14 +821,16 @@ impl Simulation {
         if threads <= 1 {
             let mut perceiver = std::mem::take(&mut self.perceiver);
             let mut visible = std::mem::take(&mut self.visible);
+            let mut near = std::mem::take(&mut self.near);
             for (i, d) in decisions.iter_mut().enumerate() {
-                *d = self.decide(i, &mut perceiver, &mut visible);
+                if self.flock.phase[i] == Phase::Airborne {
+                    *d = self.decide(i, &mut perceiver, &mut visible, &mut near);
+                }
             }
             self.perceiver = perceiver;
             self.visible = visible;
+            self.near = near;
         } else {
-            // Every decision reads only the previous state, so birds can be split across
-            // threads; the result does not depend on the split.
             let chunk = n.div_ceil(threads);
             let this = &*self;
             std::thread::scope(|scope| {
@@ -379,8 +838,12 @@ impl Simulation {
                     scope.spawn(move || {
                         let mut perceiver = Perceiver::new();
                         let mut visible = Vec::new();
+                        let mut near = Vec::new();
                         for (k, d) in out.iter_mut().enumerate() {
-                            *d = this.decide(c * chunk + k, &mut perceiver, &mut visible);
+                            let i = c * chunk + k;
+                            if this.flock.phase[i] == Phase::Airborne {
+                                *d = this.decide(i, &mut perceiver, &mut visible, &mut near);
+                            }
                         }
                     });
                 }
@@ -388,65 +851,154 @@ impl Simulation {
         }
         let f = &mut self.flock;
         for (i, d) in decisions.iter().enumerate() {
-            self.max_heading_change = self.max_heading_change.max(d.turn.abs());
-            f.heading[i] = wrap_angle(f.heading[i] + d.turn);
-            f.speed[i] = d.speed;
-            f.pos[i] += direction(f.heading[i]) * f.speed[i];
+            if f.phase[i] != Phase::Airborne {
+                continue;
+            }
+            f.request[i] = (d.turn_rate, d.speed);
+            f.alt_offset[i] = d.alt_offset;
             self.next_reference[i] = d.reference;
             self.next_side[i] = d.side;
             self.next_branch[i] = d.branch;
             self.next_unseen[i] = d.unseen;
+        }
+        for i in 0..n {
+            if f.phase[i] != Phase::Airborne {
+                self.next_reference[i] = None;
+                self.next_side[i] = None;
+                self.next_branch[i] = None;
+                self.next_unseen[i] = 0;
+            }
         }
         self.decisions = decisions;
         std::mem::swap(&mut f.reference, &mut self.next_reference);
         std::mem::swap(&mut f.side, &mut self.next_side);
         std::mem::swap(&mut f.branch, &mut self.next_branch);
         std::mem::swap(&mut f.unseen, &mut self.next_unseen);
-        self.steps += 1;
         self.match_slots();
     }
 
-    /// The decision of bird `i` for the next step, from the current state only.
-    fn decide(&self, i: usize, perceiver: &mut Perceiver, visible: &mut Vec<usize>) -> Decision {
+    /// The table of birds by slot the decisions read (counting sort, O(N)).
+    fn build_holders(&mut self) {
+        let slots = self.target.len();
+        self.holder_start.clear();
+        self.holder_start.resize(slots + 1, 0);
+        for s in self.flock.slot.iter().flatten() {
+            if *s < slots {
+                self.holder_start[*s + 1] += 1;
+            }
+        }
+        for s in 0..slots {
+            self.holder_start[s + 1] += self.holder_start[s];
+        }
+        self.holders.clear();
+        self.holders.resize(self.holder_start[slots], 0);
+        let mut fill = self.holder_start.clone();
+        for (i, s) in self.flock.slot.iter().enumerate() {
+            if let Some(s) = *s {
+                if s < slots {
+                    self.holders[fill[s]] = i;
+                    fill[s] += 1;
+                }
+            }
+        }
+    }
+
+    /// The decision of airborne bird `i`, from the current state only.
+    fn decide(
+        &self,
+        i: usize,
+        perceiver: &mut Perceiver,
+        visible: &mut Vec<usize>,
+        near: &mut Vec<usize>,
+    ) -> Decision {
         let p = &self.params;
         let f = &self.flock;
+        let tau = p.reaction_time;
         let mut unseen = 0;
-        let (want_heading, want_speed, reference, side, branch) = if i == f.leader {
-            (p.cruise_heading, p.cruise_speed, None, None, None)
+        let (turn, want_speed, reference, side, branch) = if i == f.leader {
+            let dd = wrap_angle(p.cruise_heading - f.heading[i]);
+            // While flockmates are still on the ground the leader flies at the gathering speed
+            // (a fraction of the cruise speed), so that the last to leave is not left far behind.
+            let v = if self.departed.len() < f.pos.len()
+                || f.phase.iter().any(|&ph| ph != Phase::Airborne)
+            {
+                p.gather_speed.max(p.min_speed)
+            } else {
+                p.cruise_speed
+            };
+            (p.alpha * dd / tau, v, None, None, None)
         } else {
-            perceiver.visible(i, &f.pos, f.heading[i], &p.perception, visible);
+            // Perception: departed flockmates within the visual range.
+            self.grid.within(&f.pos, f.pos[i], p.visual_range, near);
+            near.retain(|&j| f.phase[j] != Phase::Waiting);
+            perceiver.visible_among(i, &f.pos, near, f.heading[i], &p.perception, visible);
             match self.choose(i, visible) {
                 Some((j, side, c, u)) => {
                     unseen = u;
-                    let (h, v) = self.pursue(i, j, c);
-                    (h, v, Some(j), Some(side), Some(c))
+                    let (w, v) = self.pursue(i, j, c);
+                    (w, v, Some(j), Some(side), Some(c))
+                }
+                None if near.is_empty() => {
+                    // Nobody within the visual range: head for the flock, which is seen from
+                    // much farther as a whole (its centroid), at cruise speed.
+                    let c = self.departed.iter().map(|&j| f.pos[j]).sum::<DVec2>()
+                        / self.departed.len().max(1) as f64;
+                    let dd = bearing(f.heading[i], c - f.pos[i]);
+                    (p.alpha * dd / tau, p.max_speed, None, None, None)
                 }
                 None => {
-                    // Lost: turn toward the cruise heading and slow a little.
-                    let dd = wrap_angle(p.cruise_heading - f.heading[i]);
-                    (
-                        f.heading[i] + p.alpha * dd,
-                        p.lost_speed_factor * p.cruise_speed,
-                        None,
-                        None,
-                        None,
-                    )
+                    let d = direction(f.heading[i]);
+                    let nearest = visible
+                        .iter()
+                        .map(|&j| (f.pos[j] - f.pos[i], j))
+                        .min_by(|a, b| a.0.length_squared().total_cmp(&b.0.length_squared()));
+                    match nearest {
+                        // Lost behind the flock (every visible bird ahead, the nearest farther
+                        // than the separation distance): close on the nearest, a little faster
+                        // than the cruise, instead of falling back ever farther.
+                        Some((rel, _))
+                            if rel.length() > p.separation_distance
+                                && visible.iter().all(|&j| (f.pos[j] - f.pos[i]).dot(d) > 0.0) =>
+                        {
+                            let dd = bearing(f.heading[i], rel);
+                            let gain = (0.02 * (rel.length() - p.separation_distance)).min(0.3);
+                            (
+                                p.alpha * dd / (p.turn_distance_cap * tau),
+                                p.cruise_speed * (1.0 + gain),
+                                None,
+                                None,
+                                None,
+                            )
+                        }
+                        _ => {
+                            // Lost: turn toward the cruise heading and slow a little.
+                            let dd = wrap_angle(p.cruise_heading - f.heading[i]);
+                            (
+                                p.alpha * dd / tau,
+                                p.lost_speed_factor * p.cruise_speed,
+                                None,
+                                None,
+                                None,
+                            )
+                        }
+                    }
                 }
             }
         };
-        let (mut dh, mut v) = (wrap_angle(want_heading - f.heading[i]), want_speed);
-        if let Some((turn, slow)) = self.avoidance(i, dh.clamp(-p.max_turn, p.max_turn)) {
-            dh = turn;
+        let (mut w, mut v) = (turn.clamp(-p.max_turn, p.max_turn), want_speed);
+        self.grid.within(&f.pos, f.pos[i], p.avoid_range, near);
+        let mut alt_offset = 0.0;
+        if let Some((turn, slow, dz)) = self.avoidance(i, w, near) {
+            w = turn;
+            alt_offset = dz;
             if slow {
-                v = v.min(f.speed[i] - p.max_dv);
+                v = v.min(f.speed[i] - p.max_accel * p.speed_lag);
             }
         }
-        let v0 = f.speed[i];
         Decision {
-            turn: dh.clamp(-p.max_turn, p.max_turn),
-            speed: v
-                .clamp(v0 - p.max_dv, v0 + p.max_dv)
-                .clamp(p.min_speed, p.max_speed),
+            turn_rate: w.clamp(-p.max_turn, p.max_turn),
+            speed: v.clamp(p.min_speed, p.max_speed),
+            alt_offset,
             reference,
             side,
             branch,
@@ -492,11 +1044,14 @@ impl Simulation {
         reference.zip(chosen).map(|(j, (side, c))| (j, side, c, 0))
     }
 
-    /// Eqs. (5) and (6) with the fixes of docs/initiation.md: desired heading and speed of bird `i`
-    /// following `j` into slot `c` (a follower slot of `j`'s slot).
+    /// Eqs. (5) and (6) with the fixes of docs/initiation.md, in physical time: requested turn
+    /// rate (rad/s) and speed (wingspans/s) of bird `i` following `j` into slot `c` (a follower
+    /// slot of `j`'s slot). With τ the reaction time, eq. (6) θ' = θ + α Δd / max(r, 1) per step
+    /// becomes ω = α Δd / (max(r, 1) τ), and eq. (5)'s v_j (a distance per step) is v_j τ.
     fn pursue(&self, i: usize, j: usize, c: usize) -> (f64, f64) {
         let p = &self.params;
         let f = &self.flock;
+        let tau = p.reaction_time;
         let offset = match f.slot[j] {
             Some(sj) => self.target.offset(sj, c),
             None => self.target.mean_offset,
@@ -517,9 +1072,10 @@ impl Simulation {
         let to_aim = aim - f.pos[i];
         let dd = bearing(f.heading[i], to_aim);
         let vj = f.speed[j];
+        let step_j = vj * tau;
         // Eq. (5): K > 0 only when behind the target by more than one step of the reference, and
         // not while facing away from it (a far bird flying the wrong way must not speed up).
-        let k = if behind <= vj {
+        let k = if behind <= step_j {
             -p.k
         } else if dd.abs() < std::f64::consts::FRAC_PI_2 {
             p.k
@@ -528,38 +1084,64 @@ impl Simulation {
         };
         // √|u| has an infinite slope at the fixed point u = 0, which with a bounded acceleration
         // makes a speed limit cycle; within `linear_zone` use its chord |u|/√u₀ instead.
-        // The distance is signed (negative ahead of the target): with |r − v_j| alone a bird one
+        // The distance is signed (negative ahead of the target): with |r − v_j τ| alone a bird one
         // step *ahead* of its target would sit at a second fixed point of eq. (5).
         let signed_r = if behind >= 0.0 { r } else { -r };
-        let u = (signed_r - vj).abs();
+        // With `gap_speed`, the distance is the longitudinal gap alone: the lateral error is the
+        // heading's business (eq. 6), and with the full distance K's sign flip at the target
+        // (|u| ≈ the lateral error there) is a jump of 2 K φ v_j in the wanted speed.
+        let (k, u) = if p.gap_speed {
+            let g = behind - step_j;
+            let k = if g <= 0.0 {
+                -p.k
+            } else if dd.abs() < std::f64::consts::FRAC_PI_2 {
+                p.k
+            } else {
+                0.0
+            };
+            (k, g.abs())
+        } else {
+            (k, (signed_r - step_j).abs())
+        };
         let z = p.linear_zone;
-        let root = if u < z { u / z.sqrt() } else { u.sqrt() };
+        // Far from the fixed point (beyond the catch-up distance u₁) the term grows linearly,
+        // √u₁ · u/u₁, so that a bird far behind closes the gap in seconds, not tens of seconds
+        // (eq. 5's √ alone closes 25 wingspans in 1/(v_j K) ≈ 17 s at 10 wingspans/s).
+        let far = p.catchup_distance;
+        let root = if u < z {
+            u / z.sqrt()
+        } else if u > far {
+            u / far.sqrt()
+        } else {
+            u.sqrt()
+        };
         let mut v = vj * (1.0 - dd.abs() / std::f64::consts::PI + k * root);
         // Braking distance: close on the target no faster than the speed that can still be shed
-        // before reaching it, v ≤ v_j + √(2 a g) with g the longitudinal gap (no overshoot).
-        let gap = (behind - vj).max(0.0);
-        v = v.min(vj + (2.0 * p.max_dv * gap).sqrt());
-        // Eq. (6), with the divisor capped so that a far bird can still turn toward its target.
-        let h = f.heading[i] + p.alpha * dd / r.clamp(1.0, p.turn_distance_cap);
-        (h, v)
+        // before reaching it, v ≤ v_j + √(2 a g) with g the longitudinal gap (no overshoot); the
+        // speed lag adds a distance v τ_v, taken off the gap.
+        let gap = (behind - step_j - (f.speed[i] - vj).max(0.0) * p.speed_lag).max(0.0);
+        v = v.min(vj + (2.0 * p.max_accel * gap).sqrt());
+        // Eq. (6) as a rate, the divisor capped so that a far bird can still turn to its target.
+        let w = p.alpha * dd / (r.clamp(1.0, p.turn_distance_cap) * tau);
+        (w, v)
     }
 
-    /// Short-range collision avoidance, all around (not limited to the visual field). A threat is
-    /// a flockmate within `avoid_range` whose predicted closest approach (both flying straight)
-    /// within the horizon is below `avoid_distance`, or one already that close. When there is a
-    /// threat, the bird picks among its desired turn `want` and five turns across the turn-rate
-    /// range the one that maximises the smallest predicted miss distance to every flockmate in
-    /// range (the desired turn wins whenever it is safe, then the one nearest to it), and slows if
-    /// the nearest threat is ahead. Birds flying in parallel (V neighbours) are no threat, so they
-    /// are left alone. Returns the heading change (radians) and whether to slow.
-    fn avoidance(&self, i: usize, want: f64) -> Option<(f64, bool)> {
+    /// Short-range collision avoidance in 3-D, all around (not limited to the visual field). A
+    /// threat is a flockmate among `near` (within `avoid_range` horizontally) whose predicted
+    /// closest approach (both flying straight, climb rates included) within the horizon is below
+    /// `avoid_distance`, or one already that close. When there is a threat, the bird picks among
+    /// its requested turn rate `want` and five across the turn-rate range the one that maximises
+    /// the smallest predicted miss distance, its heading changed by that rate over one reaction
+    /// time (the requested turn wins whenever it is safe, then the one nearest to it), and slows
+    /// if the nearest threat is ahead. Birds flying in parallel (V neighbours) are no threat.
+    /// Returns the turn rate (rad/s) and whether to slow.
+    fn avoidance(&self, i: usize, want: f64, near: &[usize]) -> Option<(f64, bool, f64)> {
         let p = &self.params;
         let f = &self.flock;
-        let pi = f.pos[i];
+        let pi = DVec3::new(f.pos[i].x, f.pos[i].y, f.z[i]);
         let vel = &self.vel;
         let vi = vel[i];
-        let range2 = p.avoid_range * p.avoid_range;
-        let miss = |dp: DVec2, dv: DVec2| -> f64 {
+        let miss = |dp: DVec3, dv: DVec3| -> f64 {
             let vv = dv.length_squared();
             let tau = if vv > 1e-12 {
                 (-dp.dot(dv) / vv).clamp(0.0, p.avoid_horizon)
@@ -568,54 +1150,63 @@ impl Simulation {
             };
             (dp + dv * tau).length()
         };
-        let mut threat: Option<(f64, DVec2)> = None;
-        for (k, &pk) in f.pos.iter().enumerate() {
+        let at = |k: usize| DVec3::new(f.pos[k].x, f.pos[k].y, f.z[k]);
+        let mut threat: Option<(f64, DVec3, usize)> = None;
+        for &k in near {
             if k == i {
                 continue;
             }
-            let dp = pk - pi;
-            if dp.length_squared() > range2 {
-                continue;
-            }
+            let dp = at(k) - pi;
             let dv = vel[k] - vi;
             let closing = dv.length() >= AVOID_MIN_RELATIVE_SPEED * p.cruise_speed;
             let m = miss(dp, dv);
-            if (closing && m < p.avoid_distance) || dp.length() < p.avoid_distance {
-                let d = dp.length();
-                if threat.map_or(true, |t| d < t.0) {
-                    threat = Some((d, dp));
-                }
+            let d = dp.length();
+            let is_threat = (closing && m < p.avoid_distance) || d < p.avoid_distance;
+            if is_threat && threat.map_or(true, |t| d < t.0) {
+                threat = Some((d, dp, k));
             }
         }
-        let (_, nearest) = threat?;
-        // Score of a heading change: the smallest predicted miss distance over the neighbours.
-        let score = |dh: f64| -> f64 {
-            let vnew = direction(f.heading[i] + dh) * f.speed[i];
+        let (_, nearest, other) = threat?;
+        let score = |w: f64| -> f64 {
+            // The heading after holding that turn rate for the avoidance commitment time (a
+            // turn takes effect over a fraction of a second, not one reaction time).
+            let h = direction(f.heading[i] + w * AVOID_COMMIT) * f.speed[i];
+            let vnew = DVec3::new(h.x, h.y, vi.z);
             let mut worst = f64::INFINITY;
-            for (k, &pk) in f.pos.iter().enumerate() {
-                let dp = pk - pi;
-                if k == i || dp.length_squared() > range2 {
-                    continue;
+            for &k in near {
+                if k != i {
+                    worst = worst.min(miss(at(k) - pi, vel[k] - vnew));
                 }
-                let dv = vel[k] - vnew;
-                worst = worst.min(miss(dp, dv));
             }
             worst
         };
         let m = p.max_turn;
         let mut best = (score(want), want);
         if best.0 < p.avoid_distance {
-            for dh in [-m, -0.5 * m, 0.0, 0.5 * m, m] {
-                let sc = score(dh);
+            for w in [-m, -0.5 * m, 0.0, 0.5 * m, m] {
+                let sc = score(w);
                 let better = sc > best.0 + 1e-9
-                    || ((sc - best.0).abs() <= 1e-9 && (dh - want).abs() < (best.1 - want).abs());
+                    || ((sc - best.0).abs() <= 1e-9 && (w - want).abs() < (best.1 - want).abs());
                 if better {
-                    best = (sc, dh);
+                    best = (sc, w);
                 }
             }
         }
-        let ahead = nearest.dot(direction(f.heading[i])) > 0.0;
-        Some((best.1, ahead))
+        let ahead = nearest.truncate().dot(direction(f.heading[i])) > 0.0;
+        // In 3-D a bird can also pass above or below: the higher of the two (the one with the
+        // higher index when level) climbs, the other dives, by 1.5 avoidance distances, while the
+        // threat lasts (airborne birds only; the hand-over needs the cruise altitude back).
+        let above = f.z[i] > f.z[other] || (f.z[i] == f.z[other] && i > other);
+        let dz = if f.phase[other] == Phase::Airborne && f.z[i] > 0.5 * p.avoid_distance {
+            if above {
+                1.5 * p.avoid_distance
+            } else {
+                -1.5 * p.avoid_distance
+            }
+        } else {
+            0.0
+        };
+        Some((best.1, ahead, dz))
     }
 
     /// Positions of the slots in the world if the leader were exactly in its slot and the flock
@@ -633,17 +1224,17 @@ impl Simulation {
             .collect()
     }
 
-    /// The convergence test of one step: the matching is one-to-one and every bird is within
-    /// `tolerance` wingspans of its slot, within `heading_tolerance` radians of the cruise heading
-    /// and within `speed_tolerance` (fraction) of the cruise speed.
-    pub fn in_formation(
-        &self,
-        tolerance: f64,
-        heading_tolerance: f64,
-        speed_tolerance: f64,
-    ) -> bool {
+    /// The convergence test at one instant: every bird is airborne, the matching is one-to-one
+    /// and every bird is within `tol.distance` wingspans of its slot (and of the cruise
+    /// altitude), within `tol.heading` radians of the cruise heading, within `tol.speed`
+    /// (fraction) of the cruise speed, and flying steadily (turn rate, acceleration and climb
+    /// rate small, so that the hand-over to the steady flight has no jerk).
+    pub fn in_formation(&self, tol: &Tolerances) -> bool {
         let n = self.len();
         let f = &self.flock;
+        if !self.all_airborne() {
+            return false;
+        }
         let mut taken = vec![false; n];
         for s in &f.slot {
             match s {
@@ -655,9 +1246,13 @@ impl Simulation {
         let p = &self.params;
         (0..n).all(|i| {
             let s = f.slot[i].unwrap_or(0);
-            (f.pos[i] - slots[s]).length() <= tolerance
-                && wrap_angle(f.heading[i] - p.cruise_heading).abs() <= heading_tolerance
-                && (f.speed[i] - p.cruise_speed).abs() <= speed_tolerance * p.cruise_speed
+            (f.pos[i] - slots[s]).length() <= tol.distance
+                && (f.z[i] - p.cruise_altitude).abs() <= tol.distance
+                && wrap_angle(f.heading[i] - p.cruise_heading).abs() <= tol.heading
+                && (f.speed[i] - p.cruise_speed).abs() <= tol.speed * p.cruise_speed
+                && f.turn_rate[i].abs() <= tol.turn_rate
+                && f.accel[i].abs() <= tol.accel
+                && f.climb[i].abs() <= tol.climb
         })
     }
 
@@ -679,14 +1274,66 @@ impl Simulation {
             .count()
     }
 
-    /// Smallest distance between two birds now, wingspans (∞ for fewer than two birds).
+    /// Largest distance of a bird beyond the formed flock: its horizontal distance from the
+    /// nearest slot position (slots placed behind the current leader), wingspans.
+    pub fn stray_distance(&self) -> f64 {
+        let slots = self.slot_positions();
+        let mut grid = Grid::default();
+        let all: Vec<usize> = (0..slots.len()).collect();
+        grid.build(&slots, &all, 8.0);
+        let mut out = Vec::new();
+        let mut worst = 0.0f64;
+        for &p in &self.flock.pos {
+            // Slots within a growing radius; the first hit bounds the nearest.
+            let mut r = 8.0;
+            let d = loop {
+                grid.within(&slots, p, r, &mut out);
+                if let Some(d) = out
+                    .iter()
+                    .map(|&s| (slots[s] - p).length())
+                    .reduce(f64::min)
+                {
+                    break d;
+                }
+                r *= 2.0;
+                if r > 1e7 {
+                    break r;
+                }
+            };
+            worst = worst.max(d);
+        }
+        worst
+    }
+
+    /// Smallest 3-D distance between two birds now, wingspans (∞ for fewer than two birds).
     pub fn min_distance(&self) -> f64 {
-        min_pair_distance(&self.flock.pos)
+        let f = &self.flock;
+        let pts: Vec<DVec3> = (0..self.len())
+            .map(|i| DVec3::new(f.pos[i].x, f.pos[i].y, f.z[i]))
+            .collect();
+        min_pair_distance(&pts)
     }
 }
 
+/// Convergence tolerances of [`Simulation::in_formation`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Tolerances {
+    /// Distance from the slot and from the cruise altitude, wingspans.
+    pub distance: f64,
+    /// Heading difference, radians.
+    pub heading: f64,
+    /// Speed difference, fraction of the cruise speed.
+    pub speed: f64,
+    /// Turn rate, radians per second.
+    pub turn_rate: f64,
+    /// Acceleration, wingspans per second squared.
+    pub accel: f64,
+    /// Climb rate, wingspans per second.
+    pub climb: f64,
+}
+
 /// Smallest distance between two points, wingspans (∞ for fewer than two). Sort-and-sweep on x.
-pub fn min_pair_distance(pos: &[DVec2]) -> f64 {
+pub fn min_pair_distance(pos: &[DVec3]) -> f64 {
     let mut order: Vec<usize> = (0..pos.len()).collect();
     order.sort_unstable_by(|&a, &b| pos[a].x.total_cmp(&pos[b].x));
     let mut best = f64::INFINITY;
@@ -696,17 +1343,6 @@ pub fn min_pair_distance(pos: &[DVec2]) -> f64 {
                 break;
             }
             best = best.min((pos[b] - pos[a]).length());
-        }
-    }
-    best
-}
-
-/// Index of the bird farthest along `dir` (ties to the lower index).
-fn front_most(pos: &[DVec2], dir: DVec2) -> usize {
-    let mut best = 0;
-    for (i, p) in pos.iter().enumerate() {
-        if p.dot(dir) > pos[best].dot(dir) {
-            best = i;
         }
     }
     best

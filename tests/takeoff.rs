@@ -1,0 +1,497 @@
+//! Issue 18's take-off: time-based (the same at any frame rate), smooth (turn-rate, speed and
+//! roll limits in every frame), short and settable (`takeoff`), from the ground, for any flock
+//! size. Long statistics are `#[ignore]`d: `cargo test --release --test takeoff -- --ignored`.
+
+mod initiate_support;
+
+use formation::initiate::{self, Cruise, InitiateOptions, InitiateStats, Start, TargetShape};
+use formation::progress::Silent;
+use formation::rng;
+use glam::DVec2;
+use initiate_support::v_shape;
+
+fn target(n: usize) -> TargetShape {
+    let pts: Vec<DVec2> = v_shape(n, 1.0, 0.6)
+        .iter()
+        .map(|&(x, y)| DVec2::new(x, y))
+        .collect();
+    TargetShape::new(&pts).unwrap()
+}
+
+fn env_u(name: &str) -> Option<u64> {
+    std::env::var(name).ok().and_then(|v| v.parse().ok())
+}
+
+fn run_stats(n: usize, seed: u64, opts: &InitiateOptions) -> InitiateStats {
+    let t = target(n);
+    let mut r = rng::seeded(seed);
+    initiate::simulate(&t, 30.0, &Cruise::new(0.0, 10.0), opts, &mut r, &Silent)
+        .unwrap()
+        .stats
+}
+
+/// Durations over seeds and sizes: `SEEDS=20 SIZES=9,14,41,100 TAKEOFF=... cargo test --release
+/// --test takeoff table -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn table() {
+    let seeds = env_u("SEEDS").unwrap_or(10);
+    let sizes: Vec<usize> = std::env::var("SIZES")
+        .unwrap_or_else(|_| "9,14,41,100".into())
+        .split(',')
+        .filter_map(|s| s.parse().ok())
+        .collect();
+    let mut opts = InitiateOptions::default();
+    if let Ok(t) = std::env::var("TAKEOFF") {
+        opts.takeoff = t.parse().ok();
+    }
+    if let Some(k) = std::env::var("K").ok().and_then(|v| v.parse().ok()) {
+        opts.k = k;
+    }
+    if let Some(k) = std::env::var("CATCHUP").ok().and_then(|v| v.parse().ok()) {
+        opts.catchup_distance = k;
+    }
+    if let Some(k) = std::env::var("LAG").ok().and_then(|v| v.parse().ok()) {
+        opts.speed_lag = k;
+    }
+    if let Some(k) = std::env::var("JERK").ok().and_then(|v| v.parse().ok()) {
+        opts.max_jerk = k;
+    }
+    if let Some(w) = std::env::var("STAGGER").ok().and_then(|v| v.parse().ok()) {
+        if let Start::Ground(g) = &mut opts.start {
+            g.stagger = Some(w);
+        }
+    }
+    if std::env::var("NOGAP").is_ok() {
+        opts.gap_speed = false;
+    }
+    if let Some(k) = std::env::var("GATHER").ok().and_then(|v| v.parse().ok()) {
+        opts.gather_speed = k;
+    }
+    if let Some(k) = std::env::var("TOL").ok().and_then(|v| v.parse().ok()) {
+        opts.tolerance = k;
+    }
+    if let Some(k) = std::env::var("CLIMB").ok().and_then(|v| v.parse().ok()) {
+        opts.climb_rate = k;
+        opts.vertical_accel = k;
+    }
+    if let Some(k) = std::env::var("ALT").ok().and_then(|v| v.parse().ok()) {
+        opts.cruise_altitude = k;
+    }
+    if std::env::var("AIR").is_ok() {
+        opts.start = Start::Random(Default::default());
+    }
+    for n in sizes {
+        let mut secs = Vec::new();
+        let (mut ok, mut mind, mut stray, mut lift) = (0, f64::INFINITY, 0.0f64, 0.0f64);
+        let mut planned = 0.0;
+        for seed in 0..seeds {
+            let s = run_stats(n, seed, &opts);
+            planned = s.planned_seconds;
+            if s.converged {
+                ok += 1;
+                secs.push(s.seconds);
+            }
+            mind = mind.min(s.min_distance);
+            stray = stray.max(s.max_stray);
+            lift = lift.max(s.last_liftoff);
+        }
+        secs.sort_by(f64::total_cmp);
+        let med = secs.get(secs.len() / 2).copied().unwrap_or(f64::NAN);
+        let max = secs.last().copied().unwrap_or(f64::NAN);
+        println!(
+            "N={n:4} planned {planned:5.1} s converged {ok}/{seeds} median {med:5.1} s max {max:5.1} s closest {mind:.3} stray {stray:.1} last lift-off {lift:.1}"
+        );
+    }
+}
+
+/// Per-second progress of one take-off: `N=14 SEED=0 cargo test --release --test takeoff trace
+/// -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn trace() {
+    let n = env_u("N").unwrap_or(14) as usize;
+    let seed = env_u("SEED").unwrap_or(0);
+    let mut opts = InitiateOptions::default();
+    if let Ok(t) = std::env::var("TAKEOFF") {
+        opts.takeoff = t.parse().ok();
+    }
+    if let Some(k) = std::env::var("K").ok().and_then(|v| v.parse().ok()) {
+        opts.k = k;
+    }
+    let t = target(n);
+    let mut r = rng::seeded(seed);
+    let (mut sim, plan) =
+        initiate::start_simulation(&t, &Cruise::new(0.0, 10.0), &opts, &mut r).unwrap();
+    println!("{plan:?}");
+    let tol = opts.tolerances();
+    let per_s = (1.0 / sim.params.dt()).round() as usize;
+    for sec in 0..40 {
+        for _ in 0..per_s {
+            sim.step();
+        }
+        let slots = sim.slot_positions();
+        let f = &sim.flock;
+        let mut errs: Vec<(f64, usize)> = (0..n)
+            .map(|i| match f.slot[i] {
+                Some(s) => ((f.pos[i] - slots[s]).length(), i),
+                None => (f64::INFINITY, i),
+            })
+            .collect();
+        errs.sort_by(|a, b| b.0.total_cmp(&a.0));
+        let worst: Vec<String> = errs[..4.min(n)]
+            .iter()
+            .map(|(e, i)| {
+                format!(
+                    "b{i} e{e:.2} v{:.1} z{:.1} ref{:?} slot{:?}",
+                    f.speed[*i], f.z[*i], f.reference[*i], f.slot[*i]
+                )
+            })
+            .collect();
+        println!(
+            "t={:3} in_slot {:2} leader {} v_lead {:.1} form {} stray {:.1} | {}",
+            sec + 1,
+            sim.birds_in_slot(opts.tolerance),
+            f.leader,
+            f.speed[f.leader],
+            sim.in_formation(&tol),
+            sim.stray_distance(),
+            worst.join(" | ")
+        );
+    }
+}
+
+use formation::animation::Animation;
+use formation::initiate::sim::{self, BirdState};
+use initiate_support::steady;
+use std::f64::consts::PI;
+
+fn wrap(a: f64) -> f64 {
+    (a + PI).rem_euclid(2.0 * PI) - PI
+}
+
+/// The smoothness limits of issue 18, checked in every frame of `a` (initiation and steady
+/// flight, hand-over included): turn-rate change ≤ 600°/s², speed change ≤ 5 wingspans/s², roll
+/// rate ≤ 200°/s, and no one-frame reversal (a rate whose sign flips and flips back on the next
+/// frame, each of the three rates above a visible size: 2°/s of turn, 10°/s of roll, 1
+/// wingspan/s² of acceleration) of heading, bank or speed. Returns the largest turn-rate change
+/// (rad/s²).
+fn check_limits(a: &Animation, label: &str) -> f64 {
+    let fps = a.fps;
+    let fr = &a.frames;
+    let mut largest = 0.0f64;
+    for b in 0..a.birds {
+        let rate = |k: usize, f: &dyn Fn(&formation::animation::Frame) -> f64, ang: bool| {
+            let d = f(&fr[k + 1]) - f(&fr[k]);
+            (if ang { wrap(d) } else { d }) / (fr[k + 1].t - fr[k].t)
+        };
+        let heading = |f: &formation::animation::Frame| f.heading[b];
+        let speed = |f: &formation::animation::Frame| f.speed[b];
+        let bank = |f: &formation::animation::Frame| f.bank.as_ref().map_or(0.0, |v| v[b]);
+        let w: Vec<f64> = (0..fr.len() - 1).map(|k| rate(k, &heading, true)).collect();
+        let acc: Vec<f64> = (0..fr.len() - 1).map(|k| rate(k, &speed, false)).collect();
+        let roll: Vec<f64> = (0..fr.len() - 1).map(|k| rate(k, &bank, false)).collect();
+        for k in 0..w.len() {
+            assert!(
+                acc[k].abs() <= 5.0,
+                "{label}: bird {b} frame {k}: speed changes at {:.2} wingspans/s²",
+                acc[k]
+            );
+            assert!(
+                roll[k].abs() <= 200f64.to_radians(),
+                "{label}: bird {b} frame {k}: rolls at {:.0}°/s",
+                roll[k].to_degrees()
+            );
+            if k + 1 < w.len() {
+                let dw = (w[k + 1] - w[k]) * fps;
+                largest = largest.max(dw.abs());
+                assert!(
+                    dw.abs() <= 600f64.to_radians(),
+                    "{label}: bird {b} frame {k}: turn rate {:.1} → {:.1}°/s ({:.0}°/s²)",
+                    w[k].to_degrees(),
+                    w[k + 1].to_degrees(),
+                    dw.to_degrees()
+                );
+            }
+            if k + 2 < w.len() {
+                // One-frame reversal: up, down, up (or down, up, down) with rates that matter.
+                for (name, r, floor) in [
+                    ("heading", &w, 2f64.to_radians()),
+                    ("bank", &roll, 10f64.to_radians()),
+                    ("speed", &acc, 1.0),
+                ] {
+                    let flips = r[k] * r[k + 1] < 0.0 && r[k + 1] * r[k + 2] < 0.0;
+                    let big =
+                        r[k].abs() > floor && r[k + 1].abs() > floor && r[k + 2].abs() > floor;
+                    assert!(
+                        !(flips && big),
+                        "{label}: bird {b} frames {k}..{}: {name} reverses for one frame ({:.3}, {:.3}, {:.3})",
+                        k + 3,
+                        r[k],
+                        r[k + 1],
+                        r[k + 2]
+                    );
+                }
+            }
+        }
+    }
+    largest
+}
+
+fn init(st: &Animation, opts: &InitiateOptions, seed: u64) -> (Animation, InitiateStats) {
+    let opts = InitiateOptions {
+        seed,
+        ..opts.clone()
+    };
+    initiate::initiate(st, &opts, &mut rng::seeded(seed), &Silent).unwrap()
+}
+
+fn stage_seconds(a: &Animation) -> f64 {
+    a.stage("initiation").unwrap().end as f64 / a.fps
+}
+
+#[test]
+fn the_same_take_off_at_24_30_and_60_fps() {
+    let shape = v_shape(9, 1.0, 0.6);
+    for (seed, start) in [
+        (0, Start::Ground(Default::default())),
+        (1, Start::Random(Default::default())),
+    ] {
+        let opts = InitiateOptions {
+            start,
+            ..Default::default()
+        };
+        let runs: Vec<(f64, Animation)> = [24.0, 30.0, 60.0]
+            .iter()
+            .map(|&fps| (fps, init(&steady(&shape, 30, fps, 10.0), &opts, seed).0))
+            .collect();
+        let d30 = stage_seconds(&runs[1].1);
+        for (fps, a) in &runs {
+            let d = stage_seconds(a);
+            assert!(
+                (d - d30).abs() <= 0.05 * d30,
+                "seed {seed}: {d:.2} s at {fps} fps, {d30:.2} s at 30 fps"
+            );
+            // Paths: every whole second of the take-off, the same positions.
+            for sec in 0..(d30 as usize).min(d as usize) {
+                let f = &a.frames[(sec as f64 * fps).round() as usize];
+                let g = &runs[1].1.frames[sec * 30];
+                for b in 0..a.birds {
+                    let dp = ((f.x[b] - g.x[b]).powi(2)
+                        + (f.y[b] - g.y[b]).powi(2)
+                        + (f.z[b] - g.z[b]).powi(2))
+                    .sqrt();
+                    assert!(
+                        dp < 0.05,
+                        "seed {seed}, {fps} fps, t = {sec} s, bird {b}: {dp:.3} wingspans from 30 fps"
+                    );
+                }
+            }
+            check_limits(a, &format!("seed {seed} at {fps} fps"));
+        }
+    }
+}
+
+#[test]
+fn smoothness_limits_hold_in_every_frame() {
+    for n in [9usize, 14] {
+        for seed in 0..3 {
+            for (fps, start) in [
+                (30.0, Start::Ground(Default::default())),
+                (24.0, Start::Random(Default::default())),
+            ] {
+                let opts = InitiateOptions {
+                    start,
+                    ..Default::default()
+                };
+                let (a, _) = init(&steady(&v_shape(n, 1.0, 0.6), 60, fps, 10.0), &opts, seed);
+                let largest = check_limits(&a, &format!("{n} birds, seed {seed}, {fps} fps"));
+                // The birds do turn: the limits are reached, not avoided by flying straight.
+                assert!(largest > 100f64.to_radians(), "{largest}");
+            }
+        }
+    }
+}
+
+#[test]
+fn bank_is_the_coordinated_turn_in_a_steady_turn() {
+    let opts = InitiateOptions::default();
+    let cruise = Cruise::new(0.0, 10.0);
+    let p = opts.step_params(&cruise, opts.k, opts.catchup_distance);
+    let dt = p.dt();
+    for (turn_deg, v) in [(20.0f64, 10.0), (-45.0, 8.0), (60.0, 12.0)] {
+        let mut s = BirdState {
+            pos: DVec2::ZERO,
+            z: p.cruise_altitude,
+            climb: 0.0,
+            heading: 0.0,
+            turn_rate: 0.0,
+            turn_accel: 0.0,
+            speed: v,
+            accel: 0.0,
+            bank: 0.0,
+            roll_rate: 0.0,
+        };
+        let mut prev = s;
+        for _ in 0..(5.0 / dt) as usize {
+            s = sim::fly(&s, turn_deg.to_radians(), v, &p, dt);
+            assert!((s.turn_rate - prev.turn_rate).abs() <= p.max_turn_accel * dt * (1.0 + 1e-9));
+            assert!((s.bank - prev.bank).abs() <= p.max_roll_rate * dt * (1.0 + 1e-9));
+            prev = s;
+        }
+        let g = 9.81 / 1.5;
+        let want = (s.speed * s.turn_rate / g).atan();
+        assert!((s.turn_rate - turn_deg.to_radians()).abs() < 1e-9);
+        assert!(
+            (s.bank - want).abs() < 1e-6,
+            "{turn_deg}°/s at {v}: bank {:.4}, V·ω/g gives {want:.4}",
+            s.bank
+        );
+        // Right turn, right wing down.
+        assert_eq!(s.bank > 0.0, turn_deg > 0.0);
+    }
+    // Straight and level: no bank at all.
+    let (a, _) = init(
+        &steady(&v_shape(9, 1.0, 0.6), 30, 30.0, 10.0),
+        &InitiateOptions::default(),
+        2,
+    );
+    let k = a.stage("initiation").unwrap().end;
+    for f in &a.frames[k..] {
+        assert!(f.bank.as_ref().unwrap().iter().all(|&b| b == 0.0));
+    }
+}
+
+#[test]
+fn ground_birds_start_at_rest_and_end_at_the_cruise_altitude() {
+    for alt in [10.0, 25.0] {
+        let opts = InitiateOptions {
+            cruise_altitude: alt,
+            ..Default::default()
+        };
+        let st = steady(&v_shape(14, 1.0, 0.6), 30, 30.0, 10.0);
+        let (a, stats) = init(&st, &opts, 4);
+        let f0 = &a.frames[0];
+        assert!(f0.z.iter().all(|&z| z == 0.0), "{:?}", f0.z);
+        assert!(f0.speed.iter().all(|&v| v == 0.0), "{:?}", f0.speed);
+        // Staggered: some birds are still at rest a moment later.
+        let f1 = &a.frames[15];
+        assert!(f1.speed.contains(&0.0) && f1.speed.iter().any(|&v| v > 0.0));
+        assert!(stats.last_liftoff > 0.5);
+        let k = a.stage("initiation").unwrap().end;
+        for f in &a.frames[k - 1..] {
+            for b in 0..a.birds {
+                assert!((f.z[b] - alt).abs() < 0.1, "frame z {} at {alt}", f.z[b]);
+            }
+        }
+        // The climb rate is plausible: at most the option's, i.e. 2 wingspans/s.
+        for w in a.frames.windows(2) {
+            for b in 0..a.birds {
+                let climb = (w[1].z[b] - w[0].z[b]) / (w[1].t - w[0].t);
+                assert!(climb <= opts.climb_rate + 1e-9, "{climb}");
+            }
+        }
+    }
+    // The airborne start is at the cruise altitude from the first frame.
+    let opts = InitiateOptions {
+        start: Start::Random(Default::default()),
+        ..Default::default()
+    };
+    let (a, _) = init(&steady(&v_shape(9, 1.0, 0.6), 30, 30.0, 10.0), &opts, 4);
+    assert!(a.frames[0].z.iter().all(|&z| z == opts.cruise_altitude));
+    assert!(a.frames[0].speed.iter().all(|&v| v > 0.0));
+}
+
+#[test]
+fn ground_take_offs_converge_without_collisions() {
+    let opts = InitiateOptions::default();
+    for n in [9usize, 14] {
+        let seeds = if cfg!(debug_assertions) { 2 } else { 10 };
+        for seed in 0..seeds {
+            let s = run_stats(n, seed, &opts);
+            assert!(s.converged, "{n} birds, seed {seed}: {s:?}");
+            assert!(
+                s.min_distance >= 0.3,
+                "{n} birds, seed {seed}: two birds came {:.3} wingspans close (3-D)",
+                s.min_distance
+            );
+            assert!(s.max_turn_accel <= opts.max_turn_accel * (1.0 + 1e-9));
+            assert!(s.max_accel <= opts.max_accel * (1.0 + 1e-9));
+        }
+    }
+}
+
+#[test]
+fn takeoff_longer_than_the_natural_one_is_met() {
+    for (n, want) in [(9usize, 25.0), (14, 30.0)] {
+        let opts = InitiateOptions {
+            takeoff: Some(want),
+            ..Default::default()
+        };
+        let mut secs: Vec<f64> = (0..5)
+            .map(|seed| run_stats(n, seed, &opts).seconds)
+            .collect();
+        secs.sort_by(f64::total_cmp);
+        let med = secs[2];
+        assert!(
+            (med - want).abs() <= 0.25 * want,
+            "{n} birds, --takeoff {want}: median {med:.1} s ({secs:?})"
+        );
+    }
+}
+
+#[test]
+#[ignore]
+fn dump() {
+    let seed = env_u("SEED").unwrap_or(1);
+    let fps = env_u("FPS").unwrap_or(24) as f64;
+    let b = env_u("BIRD").unwrap_or(4) as usize;
+    let from = env_u("FROM").unwrap_or(365) as usize;
+    let opts = InitiateOptions {
+        start: Start::Random(Default::default()),
+        ..Default::default()
+    };
+    let (a, _) = init(&steady(&v_shape(9, 1.0, 0.6), 60, fps, 10.0), &opts, seed);
+    println!("initiation ends at {}", a.stage("initiation").unwrap().end);
+    for k in from..from + 14 {
+        let f = &a.frames[k];
+        println!(
+            "{k} t {:.3} h {:.4} bank {:.4} v {:.3}",
+            f.t,
+            f.heading[b].to_degrees(),
+            f.bank.as_ref().unwrap()[b].to_degrees(),
+            f.speed[b]
+        );
+    }
+}
+
+#[test]
+#[ignore]
+fn closest() {
+    let n = env_u("N").unwrap_or(41) as usize;
+    for seed in 0..env_u("SEEDS").unwrap_or(10) {
+        let opts = InitiateOptions::default();
+        let t = target(n);
+        let (mut sim, _) =
+            initiate::start_simulation(&t, &Cruise::new(0.0, 10.0), &opts, &mut rng::seeded(seed))
+                .unwrap();
+        let mut best = (f64::INFINITY, 0.0, String::new());
+        while sim.time < 80.0 {
+            sim.step();
+            let f = &sim.flock;
+            for a in 0..n {
+                for b in a + 1..n {
+                    let d =
+                        ((f.pos[a] - f.pos[b]).length_squared() + (f.z[a] - f.z[b]).powi(2)).sqrt();
+                    if d < best.0 {
+                        best = (d, sim.time, format!(
+                            "{a}:{:?} z{:.2} v{:.1} h{:.0} ref{:?} | {b}:{:?} z{:.2} v{:.1} h{:.0} ref{:?}",
+                            f.phase[a], f.z[a], f.speed[a], f.heading[a].to_degrees(), f.reference[a],
+                            f.phase[b], f.z[b], f.speed[b], f.heading[b].to_degrees(), f.reference[b]));
+                    }
+                }
+            }
+        }
+        println!("seed {seed}: {:.3} at {:.2} s: {}", best.0, best.1, best.2);
+    }
+}
