@@ -19,7 +19,7 @@ pub struct PowerArgs {
     #[arg(long)]
     pub json: bool,
     /// Vortex core radius of Hummel's model, wingspans (docs/model.md).
-    #[arg(long, default_value_t = formation::aero::AeroOptions::default().core_radius)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = formation::aero::AeroOptions::default().core_radius)]
     pub core_radius: f64,
 }
 

@@ -26,7 +26,7 @@ pub struct SolveArgs {
     #[arg(long)]
     pub keep_unconverged: bool,
     /// Vortex core radius of Hummel's model, wingspans (docs/model.md).
-    #[arg(long, default_value_t = formation::aero::AeroOptions::default().core_radius)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = formation::aero::AeroOptions::default().core_radius)]
     pub core_radius: f64,
 }
 

@@ -246,9 +246,11 @@ fn attempt(
     stats: &mut KeyStats,
 ) -> Result<Attempt> {
     stats.solves += 1;
-    let report = match solve(x, target, Some(start), &opts.solve) {
+    // A predicted start may put two birds wing to wing; the solve starts from them separated.
+    let start = crate::keyshape::steady::separate(x, start, &opts.solve.aero);
+    let report = match solve(x, target, Some(&start), &opts.solve) {
         Ok(r) => r,
-        Err(Error::Unreachable(_)) | Err(Error::Collision { .. }) | Err(Error::NotConverged(_)) => {
+        Err(Error::Unreachable(_) | Error::Collision { .. } | Error::NotConverged(_)) => {
             stats.solve_errors += 1;
             return Ok(Attempt::Rejected);
         }

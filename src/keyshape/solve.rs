@@ -503,13 +503,13 @@ pub fn reachability_ordered(
     for i in 0..n {
         if !(target[i] > lo[i] + margin) {
             return Err(Error::Unreachable(format!(
-                "bird {i} asks for ξ = {:.6}, but its pairs give it at least {:.6} wherever it flies (with every other bird as far ahead as it can be); give it a larger share",
+                "bird {i} asks for ξ = {:.6}, but its pairs give it at least {:.6} wherever it flies (every other bird as far ahead as it can be, birds whose wings overlap it laterally kept on their side of it); give it a larger share",
                 target[i], lo[i]
             )));
         }
         if !(target[i] < hi[i] - margin) {
             return Err(Error::Unreachable(format!(
-                "bird {i} asks for ξ = {:.6}, more than all its pairs can give it (at most {:.6}, with every other bird as far behind as it can be)",
+                "bird {i} asks for ξ = {:.6}, more than all its pairs can give it (at most {:.6}: every other bird as far behind as it can be, birds whose wings overlap it laterally kept on their side of it)",
                 target[i], hi[i]
             )));
         }
