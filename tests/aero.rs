@@ -216,7 +216,10 @@ fn below_pi_over_4_g_is_the_absolute_value_formula_and_turns_negative() {
         for &y in &[-4.0, -1.0, -0.3, 0.3, 0.77, 1.24, 4.0] {
             let want = g_printed_abs(x, y);
             let got = IDEAL.g(x, y);
-            assert!((got - want).abs() < 1e-10 * want.abs().max(1.0), "x={x} y={y}: {got} vs {want}");
+            assert!(
+                (got - want).abs() < 1e-10 * want.abs().max(1.0),
+                "x={x} y={y}: {got} vs {want}"
+            );
         }
     }
     // The pair's total 2g(x, 0) is positive above a/√2 and negative below it.
@@ -286,7 +289,10 @@ fn limits_and_monotonicity_in_y_on_both_sides() {
     for opts in [IDEAL, cored()] {
         for &x in &[0.2, 0.5, 0.7, 0.79, 1.0, 2.0, 10.0, 300.0] {
             let g0 = opts.g0(x);
-            assert!(opts.g(x, -1e12).abs() < 1e-18, "bird far ahead gains nothing");
+            assert!(
+                opts.g(x, -1e12).abs() < 1e-18,
+                "bird far ahead gains nothing"
+            );
             assert!((opts.g(x, 1e12) - 2.0 * g0).abs() < 1e-15 * g0.abs().max(1.0));
             // Monotone in y on each side of the collision zone.
             for side in [-1.0, 1.0] {

@@ -39,7 +39,10 @@ fn power_table_and_json() {
     assert_eq!(code, 0, "{err}");
     assert!(out.contains("leader"));
     assert!(out.contains("flock saving") && out.contains('%'), "{out}");
-    assert!(out.contains("induced power"), "the table says what the saving is: {out}");
+    assert!(
+        out.contains("induced power"),
+        "the table says what the saving is: {out}"
+    );
     let (code, out, _) = run(&["power", &example("v9_shape.json"), "--json"]);
     assert_eq!(code, 0);
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();
@@ -241,11 +244,21 @@ fn core_radius_flag_is_checked() {
     }
     assert!(!Path::new("/tmp/formation-core-radius-never.json").exists());
     // A valid radius changes the numbers only slightly away from the vortex lines.
-    let (code, a, _) = run(&["power", &example("v9_shape.json"), "--json", "--core-radius", "0"]);
+    let (code, a, _) = run(&[
+        "power",
+        &example("v9_shape.json"),
+        "--json",
+        "--core-radius",
+        "0",
+    ]);
     assert_eq!(code, 0);
     let (_, b, _) = run(&["power", &example("v9_shape.json"), "--json"]);
-    let ta = serde_json::from_str::<serde_json::Value>(&a).unwrap()["total"].as_f64().unwrap();
-    let tb = serde_json::from_str::<serde_json::Value>(&b).unwrap()["total"].as_f64().unwrap();
+    let ta = serde_json::from_str::<serde_json::Value>(&a).unwrap()["total"]
+        .as_f64()
+        .unwrap();
+    let tb = serde_json::from_str::<serde_json::Value>(&b).unwrap()["total"]
+        .as_f64()
+        .unwrap();
     assert!((ta - tb).abs() < 1e-3 * ta, "{ta} vs {tb}");
 }
 

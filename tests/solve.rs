@@ -186,7 +186,13 @@ fn bad_inputs_are_typed_errors() {
         Err(Error::Unreachable(_))
     ));
     // A guess with colliding birds names them.
-    let err = solve(&[0.0, 0.7, 2.0], &[0.3, 0.4, 0.3], Some(&[0.0, 0.05, 1.0]), &o).unwrap_err();
+    let err = solve(
+        &[0.0, 0.7, 2.0],
+        &[0.3, 0.4, 0.3],
+        Some(&[0.0, 0.05, 1.0]),
+        &o,
+    )
+    .unwrap_err();
     assert!(err.to_string().contains("birds 0 and 1 collide"), "{err}");
     // Negative targets are allowed (a bird in downwash), but not a non-positive total.
     assert!(solve(&[0.0, 1.0], &[-0.5, 0.2], None, &o).is_err());

@@ -256,13 +256,13 @@ fn odd_movies_still_give_valid_flights() {
     let err = steady_flight_report(&tiny, &opts, &mut seeded(2), &Silent).unwrap_err();
     assert!(err.to_string().contains("lateral gap"), "{err}");
     assert_eq!(err.exit_code(), 2);
-    let opts = SteadyOptions {
-        birds: 17,
-        ..opts
-    };
+    let opts = SteadyOptions { birds: 17, ..opts };
     let (anim, rep) = steady_flight_report(&tiny, &opts, &mut seeded(2), &Silent).unwrap();
     check(&anim, &rep, &opts);
-    assert!(rep.feasible.min.iter().any(|&v| v < 0.0), "some birds in downwash");
+    assert!(
+        rep.feasible.min.iter().any(|&v| v < 0.0),
+        "some birds in downwash"
+    );
     for p in [&echelon, &two, &close] {
         for birds in [2, 3, 17] {
             let opts = SteadyOptions {

@@ -239,8 +239,7 @@ impl AeroOptions {
             let dtp = (qp - q0) / (tp + t0);
             let dtm = (qm - q0) / (tm + t0);
             let sigma_t = if small {
-                let base =
-                    k + ep / (sp + cp) + em / (sm + acm) - 2.0 * e0 / (s0 + x);
+                let base = k + ep / (sp + cp) + em / (sm + acm) - 2.0 * e0 / (s0 + x);
                 base + y2 * (1.0 / (tp + sp) + 1.0 / (tm + sm) - 2.0 / (t0 + s0))
             } else {
                 dtp + dtm
@@ -256,7 +255,8 @@ impl AeroOptions {
                     0.0
                 }
             };
-            let slope = sigma_over_y2 + corr(ep, rp, tp) + corr(em, rm, tm) - 2.0 * corr(e0, r0, t0);
+            let slope =
+                sigma_over_y2 + corr(ep, rp, tp) + corr(em, rm, tm) - 2.0 * corr(e0, r0, t0);
             (log_term, a_term, slope)
         };
         Pair {
@@ -332,7 +332,11 @@ impl AeroOptions {
         let mut tail = 0.0;
         for (c, w) in [(x + A, 1.0), (x - A, 1.0), (x, -2.0)] {
             let eps = self.core_excess(c);
-            let damp = if d2 > 0.0 && eps > 0.0 { 1.0 - eps / d2 } else { 1.0 };
+            let damp = if d2 > 0.0 && eps > 0.0 {
+                1.0 - eps / d2
+            } else {
+                1.0
+            };
             let rho2 = c * c + eps;
             let t = (rho2 + yy * yy).sqrt();
             let r = (c * c + yy * yy).sqrt();
@@ -345,7 +349,11 @@ impl AeroOptions {
         }
         let bound = if k_prime != 0.0 { k_prime / yy } else { 0.0 } - yy * tail;
         let front = front + bound;
-        let v = if y > 0.0 { 2.0 * a_prime - front } else { front };
+        let v = if y > 0.0 {
+            2.0 * a_prime - front
+        } else {
+            front
+        };
         TWO_OVER_PI2 * v
     }
 
@@ -748,7 +756,10 @@ mod tests {
     fn core_is_finite_on_the_singular_lines_and_negligible_away_from_them() {
         let core = AeroOptions::default();
         for &y in &[-3.0, -0.5, 0.2, 0.5, 3.0, 50.0] {
-            assert!(core.g(A, y).is_finite() && core.g(0.0, y).is_finite(), "y={y}");
+            assert!(
+                core.g(A, y).is_finite() && core.g(0.0, y).is_finite(),
+                "y={y}"
+            );
             assert!(core.dg_dy(A, y).is_finite() && core.dg_dy(A, y) > 0.0);
         }
         // |x − a| ≥ 0.1 and x ≥ 0.1: the core changes g by less than 1e-3 (in fact < 1.3e-4).
@@ -773,13 +784,19 @@ mod tests {
         assert!(o.collides(0.8, 0.1));
         assert!(!o.collides(0.8, 0.2));
         assert!(!o.collides(1.0, 0.0));
-        let err = o.power_reduction(&[0.0, 0.5, 2.0], &[0.0, 0.05, 2.0]).unwrap_err();
+        let err = o
+            .power_reduction(&[0.0, 0.5, 2.0], &[0.0, 0.05, 2.0])
+            .unwrap_err();
         assert!(matches!(err, Error::Collision { i: 0, j: 1, .. }), "{err}");
         let bad = AeroOptions {
             core_radius: -0.1,
             ..o
         };
-        assert!(bad.validate().unwrap_err().to_string().contains("aero.core_radius"));
+        assert!(bad
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .contains("aero.core_radius"));
         let nan = AeroOptions {
             core_radius: f64::NAN,
             ..o

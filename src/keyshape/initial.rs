@@ -214,20 +214,25 @@ pub fn positions_from_gaps(gaps: &[f64], leader: usize) -> Vec<f64> {
 /// The curve's `y` behind the leader at animated lateral offset `x` (leader on the curve).
 ///
 /// V and line curves are evaluated as they are (their arms keep their angle however many birds
-/// fly); U and J parabolas are evaluated at `x` scaled by the ratio of movie to animated birds on
-/// that side, so a larger flock makes a wider U of the movie's depth instead of a much deeper one.
+/// fly). A U or J parabola is mapped by rank: with s the ratio of movie to animated birds on that
+/// side, the animated bird at x takes the movie curve's slope at x·s, i.e.
+/// y = (curve(x·s) − curve(0))/s. Each bird then sits behind its lateral neighbour by what the
+/// movie bird of the same relative rank does (the footage's spacing, issue 12), and a flock with
+/// more birds per side makes a U of the movie's proportions that is deeper in proportion to its
+/// birds per side (with the movie's depth, the neighbours of a larger flock would crowd
+/// together fore and aft; with the unscaled parabola, its outer birds would string out).
 pub fn curve_y(model: &ShapeModel, x: f64, scale_left: f64, scale_right: f64) -> f64 {
-    let xs = match model {
+    match model {
         ShapeModel::U { .. } | ShapeModel::J { .. } => {
-            if x < 0.0 {
-                x * scale_left
+            let s = if x < 0.0 { scale_left } else { scale_right };
+            if s > 0.0 && s.is_finite() {
+                (model.y_at(x * s) - model.y_at(0.0)) / s
             } else {
-                x * scale_right
+                model.y_at(x) - model.y_at(0.0)
             }
         }
-        _ => x,
-    };
-    model.y_at(xs) - model.y_at(0.0)
+        _ => model.y_at(x) - model.y_at(0.0),
+    }
 }
 
 /// One initial shape per movie frame (§5 step 1): lateral gaps from N(μ_x, σ_x), `y` on the
@@ -433,8 +438,16 @@ mod tests {
         // Overlapping wingtips are kept: the sample mean and spread are the footage's.
         let mean = g.iter().sum::<f64>() / g.len() as f64;
         let sd = (g.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / g.len() as f64).sqrt();
-        assert!((mean - 0.77).abs() < 0.01 && (sd - 0.2).abs() < 0.01, "{mean} {sd}");
-        assert!(g.iter().filter(|&&v| v < std::f64::consts::FRAC_PI_4).count() > 2000);
+        assert!(
+            (mean - 0.77).abs() < 0.01 && (sd - 0.2).abs() < 0.01,
+            "{mean} {sd}"
+        );
+        assert!(
+            g.iter()
+                .filter(|&&v| v < std::f64::consts::FRAC_PI_4)
+                .count()
+                > 2000
+        );
         let g = lateral_gaps(&mut rng, 0.05, 0.0, 3, &opts);
         assert!(g.iter().all(|&v| v == opts.min_gap));
     }

@@ -62,7 +62,11 @@ impl XiRanges {
 /// e_i, ξ_i of every initial shape's longitudinal positions at the lateral positions `x_key`,
 /// leaving out the shapes in which two birds' wings would collide there (their ξ is not a
 /// placement the key shapes can take). Fails when every shape collides.
-pub fn power_at(x_key: &[f64], shapes: &[Shape], aero: &AeroOptions) -> Result<Vec<PowerReduction>> {
+pub fn power_at(
+    x_key: &[f64],
+    shapes: &[Shape],
+    aero: &AeroOptions,
+) -> Result<Vec<PowerReduction>> {
     let mut out = Vec::with_capacity(shapes.len());
     let mut last = None;
     for s in shapes {

@@ -82,7 +82,12 @@ pub struct SolveReport {
 }
 
 /// Validates the inputs of [`solve`] and returns the renormalised targets.
-fn validate(x: &[f64], xi_target: &[f64], y0: Option<&[f64]>, aero: &AeroOptions) -> Result<Vec<f64>> {
+fn validate(
+    x: &[f64],
+    xi_target: &[f64],
+    y0: Option<&[f64]>,
+    aero: &AeroOptions,
+) -> Result<Vec<f64>> {
     aero.validate()?;
     let n = x.len();
     if n < 2 {
@@ -168,7 +173,10 @@ pub fn default_starts(x: &[f64], target: &[f64], aero: &AeroOptions) -> Vec<Vec<
     for &i in &order {
         let lo = sorted_x.partition_point(|&v| v <= x[i] - COLLISION_SPAN);
         let mut yi: f64 = 0.0;
-        for &j in by_x[lo..].iter().take_while(|&&j| x[j] < x[i] + COLLISION_SPAN) {
+        for &j in by_x[lo..]
+            .iter()
+            .take_while(|&&j| x[j] < x[i] + COLLISION_SPAN)
+        {
             if j != i && y[j].is_finite() {
                 yi = yi.max(y[j] + step);
             }
@@ -286,7 +294,6 @@ pub fn solve(
     }
 }
 
-
 /// Builds the report for positions `y` (shifted so that the front-most bird is at 0).
 fn report(
     x: &[f64],
@@ -400,7 +407,11 @@ fn newton(x: &[f64], target: &[f64], total: f64, y0: &[f64], opts: &SolveOptions
                     alpha = alpha.min(0.9 * gap / closing);
                 }
             }
-            let trial: Vec<f64> = y.iter().zip(&full_step).map(|(v, s)| v + alpha * s).collect();
+            let trial: Vec<f64> = y
+                .iter()
+                .zip(&full_step)
+                .map(|(v, s)| v + alpha * s)
+                .collect();
             let (tr, tjac) = evaluate(&trial);
             evaluations += 1;
             let tnorm = merit(&tr);
@@ -759,8 +770,13 @@ mod tests {
             assert!((a - b).abs() < 1e-6, "{a} vs {b}");
         }
         // Bird 1 asking for 90 % of the flock's saving is more than its pairs can give it.
-        let err = solve(&x, &[0.02, 0.9, 0.02, 0.03, 0.03], None, &SolveOptions::default())
-            .unwrap_err();
+        let err = solve(
+            &x,
+            &[0.02, 0.9, 0.02, 0.03, 0.03],
+            None,
+            &SolveOptions::default(),
+        )
+        .unwrap_err();
         assert!(matches!(err, Error::Unreachable(_)), "{err}");
     }
 }

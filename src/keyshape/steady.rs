@@ -178,7 +178,10 @@ impl SteadyOptions {
             return Err(p("accept_residual", "must be positive".into()));
         }
         if !(self.min_gap.is_finite() && self.min_gap >= 0.0 && self.min_gap < 1.0) {
-            return Err(p("min_gap", "must be a number of wingspans in [0, 1)".into()));
+            return Err(p(
+                "min_gap",
+                "must be a number of wingspans in [0, 1)".into(),
+            ));
         }
         self.aero.validate()?;
         if !(self.max_depth_factor.is_finite() && self.max_depth_factor >= 1.0) {
@@ -260,14 +263,18 @@ pub fn separate(x: &[f64], y: &[f64], aero: &AeroOptions) -> Vec<f64> {
                 }
                 let far = |b: usize| ((x[b] - x[front]).abs(), b);
                 let rear = if y[i] != y[j] {
-                    if y[i] > y[j] { i } else { j }
+                    if y[i] > y[j] {
+                        i
+                    } else {
+                        j
+                    }
                 } else if far(i) > far(j) {
                     i
                 } else {
                     j
                 };
                 let other = if rear == i { j } else { i };
-                y[rear] = y[other] + 2.0 * chord.max(1e-9);
+                y[rear] = y[other] + 1.05 * chord.max(1e-9);
                 moved = true;
             }
         }
