@@ -44,6 +44,13 @@ pub struct SolveOptions {
     /// Largest flock whose reachability is checked before solving (the check is a dense maximum
     /// flow, O(N³) in the worst case), birds.
     pub check_limit: usize,
+    /// Largest flock solved with the exact dense Jacobian (one dense Cholesky per step, O(N³)),
+    /// birds. Larger flocks use [`SolveOptions::band_span`].
+    pub dense_limit: usize,
+    /// For flocks above `dense_limit`: the Newton steps use the Jacobian of the pairs less than
+    /// this far apart laterally (∂g/∂y decays like a²/R³), a banded matrix once the birds are
+    /// sorted by x, factorised in O(N·b²); the residual stays exact. Wingspans.
+    pub band_span: f64,
     /// The aerodynamic model's core radius and collision distance.
     pub aero: AeroOptions,
 }
@@ -55,6 +62,8 @@ impl Default for SolveOptions {
             patience: 100,
             check_reachable: true,
             check_limit: 200,
+            dense_limit: 300,
+            band_span: 120.0,
             aero: AeroOptions::default(),
         }
     }
@@ -263,7 +272,11 @@ pub fn solve(
                 continue;
             }
         }
-        let rep = newton(x, &target, total, &start, opts);
+        let rep = if n <= opts.dense_limit {
+            newton(x, &target, total, &start, opts)
+        } else {
+            newton_banded(x, &target, total, &start, opts)
+        };
         evaluations += rep.evaluations;
         if rep.converged {
             if let Err(e) = aero.check_shape(x, &rep.y) {
@@ -438,6 +451,194 @@ fn newton(x: &[f64], target: &[f64], total: f64, y0: &[f64], opts: &SolveOptions
         evaluations,
         opts,
         format!("symmetric Newton–Levenberg–Marquardt: {why}"),
+    )
+}
+
+/// Cholesky factor of a symmetric positive definite band matrix: `band[i * (b + 1) + k]` holds
+/// A[i][i − k] for k ≤ b (and i − k ≥ 0). Returns the factor in the same layout, or `None` when
+/// the matrix is not positive definite. O(m·b²).
+fn band_cholesky(band: &[f64], m: usize, b: usize) -> Option<Vec<f64>> {
+    let w = b + 1;
+    let mut l = vec![0.0; m * w];
+    for i in 0..m {
+        let j0 = i.saturating_sub(b);
+        for j in j0..=i {
+            // L[i][j] = (A[i][j] − Σ_{k<j} L[i][k] L[j][k]) / L[j][j]
+            let mut s = band[i * w + (i - j)];
+            let k0 = j0.max(j.saturating_sub(b));
+            for k in k0..j {
+                s -= l[i * w + (i - k)] * l[j * w + (j - k)];
+            }
+            if i == j {
+                if !(s > 0.0) {
+                    return None;
+                }
+                l[i * w] = s.sqrt();
+            } else {
+                l[i * w + (i - j)] = s / l[j * w];
+            }
+        }
+    }
+    Some(l)
+}
+
+/// Solves L Lᵀ z = r with the factor of [`band_cholesky`].
+fn band_solve(l: &[f64], m: usize, b: usize, r: &[f64]) -> Vec<f64> {
+    let w = b + 1;
+    let mut z = r.to_vec();
+    for i in 0..m {
+        let mut s = z[i];
+        for k in i.saturating_sub(b)..i {
+            s -= l[i * w + (i - k)] * z[k];
+        }
+        z[i] = s / l[i * w];
+    }
+    for i in (0..m).rev() {
+        let mut s = z[i];
+        for k in (i + 1)..(i + 1 + b).min(m) {
+            s -= l[k * w + (k - i)] * z[k];
+        }
+        z[i] = s / l[i * w];
+    }
+    z
+}
+
+/// [`newton`] for large flocks: the same damped Newton iteration on the exact residual, with
+/// the Jacobian restricted to the pairs less than `band_span` apart laterally. Sorted by x, that
+/// matrix is a weighted graph Laplacian with a narrow band, factorised in O(N·b²) instead of
+/// O(N³); the dropped entries (∂g/∂y ~ a²/R³ for distant pairs) make the step slightly too
+/// long for the flock's slowest modes, which the damping and a few more steps absorb.
+fn newton_banded(
+    x: &[f64],
+    target: &[f64],
+    total: f64,
+    y0: &[f64],
+    opts: &SolveOptions,
+) -> SolveReport {
+    let n = x.len();
+    let aero = &opts.aero;
+    let fixed = (0..n)
+        .min_by(|&a, &b| y0[a].total_cmp(&y0[b]).then(a.cmp(&b)))
+        .unwrap_or(0);
+    // Free birds in lateral order: position p ↔ bird free[p].
+    let mut free: Vec<usize> = (0..n).filter(|&i| i != fixed).collect();
+    free.sort_by(|&a, &b| x[a].total_cmp(&x[b]).then(a.cmp(&b)));
+    let m = free.len();
+    // Pairs kept in the Jacobian (free–free within the span) and the fixed bird's pairs (which
+    // only add to the diagonal).
+    let mut near: Vec<(usize, usize)> = Vec::new();
+    let mut b = 0;
+    for p in 0..m {
+        for q in (p + 1)..m {
+            if x[free[q]] - x[free[p]] >= opts.band_span {
+                break;
+            }
+            near.push((p, q));
+            b = b.max(q - p);
+        }
+    }
+    let w = b + 1;
+    let order = ordered_pairs(x, y0);
+    let merit = |r: &[f64]| -> f64 { free.iter().map(|&i| r[i] * r[i]).sum::<f64>().sqrt() };
+    let residual = |y: &[f64]| -> Vec<f64> {
+        aero.power_unchecked(x, y)
+            .iter()
+            .zip(target)
+            .map(|(e, t)| e / total - t)
+            .collect()
+    };
+    let inv = 1.0 / total;
+    let band_at = |y: &[f64]| -> Vec<f64> {
+        let mut band = vec![0.0; m * w];
+        for &(p, q) in &near {
+            let (i, j) = (free[p], free[q]);
+            let s = aero.dg_dy((x[i] - x[j]).abs(), y[i] - y[j]) * inv;
+            band[q * w + (q - p)] -= s;
+            band[p * w] += s;
+            band[q * w] += s;
+        }
+        for (p, &i) in free.iter().enumerate() {
+            if (x[i] - x[fixed]).abs() < opts.band_span {
+                band[p * w] += aero.dg_dy((x[i] - x[fixed]).abs(), y[i] - y[fixed]) * inv;
+            }
+        }
+        band
+    };
+    let mut y = y0.to_vec();
+    let mut r = residual(&y);
+    let mut norm = merit(&r);
+    let mut evaluations = 1;
+    let mut lambda = 1e-6;
+    let mut why = "iteration budget exhausted";
+    let stop = opts.tolerance * 1e-3;
+    'outer: for _ in 0..opts.patience.max(1) {
+        if norm <= stop {
+            why = "residual below tolerance";
+            break;
+        }
+        if !norm.is_finite() {
+            why = "the start has an infinite saving (birds abreast with overlapping wingtips)";
+            break;
+        }
+        let band = band_at(&y);
+        let mean_diag = (0..m).map(|p| band[p * w]).sum::<f64>() / m as f64;
+        let rhs: Vec<f64> = free.iter().map(|&i| -r[i]).collect();
+        loop {
+            let mut damped = band.clone();
+            for p in 0..m {
+                damped[p * w] += lambda * mean_diag;
+            }
+            let Some(l) = band_cholesky(&damped, m, b) else {
+                lambda *= 10.0;
+                if lambda > 1e12 {
+                    why = "damped Jacobian not positive definite";
+                    break 'outer;
+                }
+                continue;
+            };
+            let step = band_solve(&l, m, b, &rhs);
+            let mut full_step = vec![0.0; n];
+            for (p, &i) in free.iter().enumerate() {
+                full_step[i] = step[p];
+            }
+            let mut alpha: f64 = 1.0;
+            for &(f, bk) in &order {
+                let gap = y[bk] - y[f];
+                let closing = full_step[f] - full_step[bk];
+                if closing > 0.0 && closing * alpha >= 0.9 * gap {
+                    alpha = alpha.min(0.9 * gap / closing);
+                }
+            }
+            let trial: Vec<f64> = y
+                .iter()
+                .zip(&full_step)
+                .map(|(v, s)| v + alpha * s)
+                .collect();
+            let tr = residual(&trial);
+            evaluations += 1;
+            let tnorm = merit(&tr);
+            if tnorm.is_finite() && tnorm < norm {
+                y = trial;
+                r = tr;
+                norm = tnorm;
+                lambda = (lambda / 10.0).max(1e-15);
+                break;
+            }
+            lambda *= 10.0;
+            if lambda > 1e12 {
+                why = "no step lowers the residual";
+                break 'outer;
+            }
+        }
+    }
+    report(
+        x,
+        target,
+        total,
+        y,
+        evaluations,
+        opts,
+        format!("banded Newton–Levenberg–Marquardt (bandwidth {b}): {why}"),
     )
 }
 
