@@ -324,7 +324,7 @@ proptest! {
 
     #[test]
     fn stagger_symmetry_with_overlapping_wingtips(x in 0.0f64..50.0, y in -200.0f64..200.0) {
-        for o in [cored()] {
+        for o in [IDEAL, cored()] {
             let s = o.g(x, y) + o.g(x, -y);
             let g0 = o.g0(x);
             prop_assert!((s - 2.0 * g0).abs() < 1e-12 * g0.abs().max(1.0), "x={} y={}", x, y);

@@ -417,7 +417,7 @@ impl AeroOptions {
                 }
                 if self.collides(dx, y[i] - y[j]) {
                     let p = (i.min(j), i.max(j));
-                    if best.is_none_or(|b| p < b) {
+                    if best.map_or(true, |b| p < b) {
                         best = Some(p);
                     }
                 }

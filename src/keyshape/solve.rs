@@ -285,7 +285,7 @@ pub fn solve(
                 best = Some(rep);
                 break;
             }
-        } else if best.as_ref().is_none_or(|b| rep.residual < b.residual) {
+        } else if best.as_ref().map_or(true, |b| rep.residual < b.residual) {
             best = Some(rep);
         }
         if k == queue.len() && !tried_neutral {
