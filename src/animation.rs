@@ -153,13 +153,22 @@ impl Animation {
                 ),
             ));
         }
-        if !(self.fps.is_finite() && self.fps > 0.0) {
-            return Err(Error::format(origin, "fps: must be a positive number"));
-        }
-        if !(self.wingspan_m.is_finite() && self.wingspan_m > 0.0) {
+        use crate::limits::{MAX_COORDINATE, MAX_FPS, MAX_FRAME_VALUE, MAX_WINGSPAN_M};
+        if !(self.fps.is_finite() && self.fps > 0.0 && self.fps <= MAX_FPS) {
             return Err(Error::format(
                 origin,
-                "wingspan_m: must be a positive number",
+                format!("fps: must be a positive number of frames per second, at most {MAX_FPS}"),
+            ));
+        }
+        if !(self.wingspan_m.is_finite()
+            && self.wingspan_m > 0.0
+            && self.wingspan_m <= MAX_WINGSPAN_M)
+        {
+            return Err(Error::format(
+                origin,
+                format!(
+                    "wingspan_m: must be a positive number of metres, at most {MAX_WINGSPAN_M}"
+                ),
             ));
         }
         if self.birds == 0 {
@@ -168,12 +177,19 @@ impl Animation {
         if self.frames.is_empty() {
             return Err(Error::format(origin, "frames: no frames"));
         }
+        crate::limits::check_animation_size(
+            &origin.display().to_string(),
+            self.birds,
+            self.frames.len(),
+        )?;
         let n = self.birds;
         for (k, f) in self.frames.iter().enumerate() {
-            if !f.t.is_finite() {
+            if !(f.t.is_finite() && f.t.abs() <= MAX_FRAME_VALUE) {
                 return Err(Error::format(
                     origin,
-                    format!("frames[{k}].t: not a finite number"),
+                    format!(
+                        "frames[{k}].t: not a finite number of seconds within ±{MAX_FRAME_VALUE:e}"
+                    ),
                 ));
             }
             let arrays: [(&str, Option<&Vec<f64>>); 8] = [
@@ -203,6 +219,19 @@ impl Animation {
                         format!("frames[{k}].{name}[{i}]: not a finite number"),
                     ));
                 }
+                // Exports convert to f32 (glTF, USD): a value beyond these bounds would overflow
+                // or lose all precision there.
+                let bound = if matches!(name, "x" | "y" | "z") {
+                    MAX_COORDINATE
+                } else {
+                    MAX_FRAME_VALUE
+                };
+                if let Some(i) = arr.iter().position(|v| v.abs() > bound) {
+                    return Err(Error::format(
+                        origin,
+                        format!("frames[{k}].{name}[{i}]: {:e} is beyond ±{bound:e}", arr[i]),
+                    ));
+                }
             }
         }
         for (s, st) in self.stages.iter().enumerate() {
@@ -230,10 +259,12 @@ impl Animation {
                 ));
             }
             for (i, b) in ks.birds.iter().enumerate() {
-                if !(b.x.is_finite() && b.y.is_finite() && b.xi.is_finite()) {
+                if !(b.x.is_finite() && b.y.is_finite() && b.xi.is_finite())
+                    || b.x.abs().max(b.y.abs()) > MAX_COORDINATE
+                {
                     return Err(Error::format(
                         origin,
-                        format!("key_shapes[{s}].birds[{i}]: not a finite number"),
+                        format!("key_shapes[{s}].birds[{i}]: not a finite number within ±{MAX_COORDINATE:e}"),
                     ));
                 }
             }

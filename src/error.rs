@@ -96,3 +96,70 @@ impl Error {
         }
     }
 }
+
+/// Most characters of an error message as printed: file content quoted in a message (a field, a
+/// header) could otherwise fill the terminal.
+pub const MAX_MESSAGE_CHARS: usize = 400;
+
+/// An error message made fit for one terminal line: control characters from file content
+/// (newlines, ESC, BEL) shown as escapes, numbers of more than 24 digits (1e308 printed in full)
+/// shortened to scientific notation (every 64-bit integer keeps its digits), and the whole cut to [`MAX_MESSAGE_CHARS`].
+pub fn one_line(message: &str) -> String {
+    let mut out = String::with_capacity(message.len().min(MAX_MESSAGE_CHARS + 64));
+    let mut number = String::new();
+    let flush = |number: &mut String, out: &mut String| {
+        let digits = number.bytes().filter(u8::is_ascii_digit).count();
+        match number.parse::<f64>() {
+            Ok(v) if digits > 24 && v.is_finite() => out.push_str(&format!("{v:e}")),
+            _ => out.push_str(number),
+        }
+        number.clear();
+    };
+    for c in message.chars() {
+        if c.is_ascii_digit() || (c == '.' && !number.is_empty()) {
+            number.push(c);
+            continue;
+        }
+        if !number.is_empty() {
+            flush(&mut number, &mut out);
+        }
+        match c {
+            '\n' => out.push_str("\\n"),
+            '\r' => out.push_str("\\r"),
+            '\t' => out.push(' '),
+            c if c.is_control() => out.push_str(&format!("\\u{{{:x}}}", c as u32)),
+            c => out.push(c),
+        }
+    }
+    flush(&mut number, &mut out);
+    let count = out.chars().count();
+    if count > MAX_MESSAGE_CHARS {
+        let cut: String = out.chars().take(MAX_MESSAGE_CHARS).collect();
+        return format!("{cut}… ({} more characters)", count - MAX_MESSAGE_CHARS);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn messages_are_one_short_line() {
+        assert_eq!(one_line("a\nb\u{1b}[31m\u{7}c"), "a\\nb\\u{1b}[31m\\u{7}c");
+        let huge = format!("value {}", 1e308);
+        assert_eq!(one_line(&huge), "value 1e308");
+        assert_eq!(one_line("frame 12, bird 3: 0.75"), "frame 12, bird 3: 0.75");
+        assert_eq!(
+            one_line("got 18446744073709551615"),
+            "got 18446744073709551615"
+        );
+        let long = one_line(&"x".repeat(10_000_000));
+        assert!(
+            long.chars().count() < MAX_MESSAGE_CHARS + 40,
+            "{}",
+            long.len()
+        );
+        assert!(long.ends_with("(9999600 more characters)"), "{long}");
+    }
+}

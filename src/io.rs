@@ -16,37 +16,110 @@ use crate::error::{Error, Result};
 /// [`crate::limits::MAX_BIRD_FRAMES`]).
 pub const MAX_INPUT_BYTES: u64 = 2 * 1024 * 1024 * 1024;
 
-/// Reads a whole file as bytes, with the path in the error and a size limit.
-pub fn read_bytes(path: &Path) -> Result<Vec<u8>> {
+/// Opens an input for reading, refusing directories and regular files over the size limit up
+/// front. Devices, FIFOs and process substitutions (`<(…)`) are read too, through a bounded
+/// reader: their size is only known once read.
+fn open_input(path: &Path) -> Result<(std::io::Take<fs::File>, u64)> {
     let meta = fs::metadata(path).map_err(|e| Error::io(path, e))?;
     if meta.is_dir() {
         return Err(Error::format(path, "is a directory, expected a file"));
     }
-    if meta.len() > MAX_INPUT_BYTES {
-        return Err(Error::format(
-            path,
-            format!(
-                "file is {} bytes, more than the {} byte limit",
-                meta.len(),
-                MAX_INPUT_BYTES
-            ),
-        ));
+    let limit = if meta.is_file() {
+        MAX_INPUT_BYTES
+    } else {
+        MAX_STREAM_BYTES
+    };
+    if meta.len() > limit {
+        return Err(too_big(path, Some(meta.len()), limit));
     }
-    fs::read(path).map_err(|e| Error::io(path, e))
+    let file = fs::File::open(path).map_err(|e| Error::io(path, e))?;
+    Ok((std::io::Read::take(file, limit + 1), limit))
 }
 
-/// Reads a whole file as UTF-8 text.
-pub fn read_text(path: &Path) -> Result<String> {
-    let bytes = read_bytes(path)?;
-    String::from_utf8(bytes).map_err(|e| {
-        Error::format(
+fn too_big(path: &Path, len: Option<u64>, limit: u64) -> Error {
+    match len {
+        Some(n) => Error::format(
+            path,
+            format!("input is {n} bytes, more than the {limit} byte limit"),
+        ),
+        None if limit < MAX_INPUT_BYTES => Error::format(
             path,
             format!(
-                "not UTF-8 text (invalid byte at offset {})",
-                e.utf8_error().valid_up_to()
+                "more than {limit} bytes from a pipe or device (the limit for inputs that are \
+                 not regular files); give the file itself"
             ),
-        )
-    })
+        ),
+        None => Error::format(path, format!("input is more than the {limit} byte limit")),
+    }
+}
+
+/// Size of the chunks inputs are read in, bytes.
+const READ_CHUNK: usize = 1 << 20;
+
+/// Upper bound on what is read from an input that is not a regular file (a pipe, a FIFO, a
+/// device, a process substitution `<(…)`), bytes: 256 MiB. Its size is only known once read, so
+/// the bound is also the memory an endless stream can take before it is refused.
+pub const MAX_STREAM_BYTES: u64 = 256 * 1024 * 1024;
+
+/// Reads a whole file as bytes, with the path in the error and a size limit that also holds for
+/// devices and pipes (`/dev/zero` is refused after 2 GiB, not read until memory runs out).
+pub fn read_bytes(path: &Path) -> Result<Vec<u8>> {
+    let (mut reader, limit) = open_input(path)?;
+    let mut buf = Vec::new();
+    std::io::Read::read_to_end(&mut reader, &mut buf).map_err(|e| Error::io(path, e))?;
+    if buf.len() as u64 > limit {
+        return Err(too_big(path, None, limit));
+    }
+    Ok(buf)
+}
+
+/// Reads a whole file as UTF-8 text. The text is checked while it is read, so binary data (a NUL
+/// byte, bytes that are not UTF-8: `/dev/zero`, `/dev/urandom`, an image given by mistake) is
+/// refused after the first chunk rather than after reading it all.
+pub fn read_text(path: &Path) -> Result<String> {
+    let (mut reader, limit) = open_input(path)?;
+    let mut buf: Vec<u8> = Vec::new();
+    let mut chunk = vec![0u8; READ_CHUNK];
+    // Bytes of `buf` known to be complete, valid UTF-8.
+    let mut valid = 0usize;
+    loop {
+        let n = match std::io::Read::read(&mut reader, &mut chunk) {
+            Ok(0) => break,
+            Ok(n) => n,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+            Err(e) => return Err(Error::io(path, e)),
+        };
+        if (buf.len() + n) as u64 > limit {
+            return Err(too_big(path, None, limit));
+        }
+        if let Some(k) = chunk[..n].iter().position(|&b| b == 0) {
+            return Err(Error::format(
+                path,
+                format!(
+                    "binary data (a NUL byte at offset {}), expected a text file",
+                    buf.len() + k
+                ),
+            ));
+        }
+        buf.extend_from_slice(&chunk[..n]);
+        match std::str::from_utf8(&buf[valid..]) {
+            Ok(_) => valid = buf.len(),
+            // A character cut by the chunk boundary: check it with the next chunk.
+            Err(e) if e.error_len().is_none() => valid += e.valid_up_to(),
+            Err(e) => return Err(not_utf8(path, valid + e.valid_up_to())),
+        }
+    }
+    if valid < buf.len() {
+        return Err(not_utf8(path, valid));
+    }
+    String::from_utf8(buf).map_err(|e| not_utf8(path, e.utf8_error().valid_up_to()))
+}
+
+fn not_utf8(path: &Path, offset: usize) -> Error {
+    Error::format(
+        path,
+        format!("not UTF-8 text (invalid byte at offset {offset})"),
+    )
 }
 
 /// Parses JSON text into `T`, turning serde's message into one line naming the file, line and column.
@@ -115,31 +188,56 @@ pub enum OutputKind {
 }
 
 impl OutputKind {
-    /// Classifies an output path. Unknown extensions are an error naming the path and the choices.
+    /// Classifies an output path given to `-o`. Unknown extensions are an error naming the path
+    /// and the choices.
     pub fn from_path(path: &Path, allowed: &[OutputKind]) -> Result<OutputKind> {
+        Self::for_flag("-o", path, allowed)
+    }
+
+    /// Classifies an output path given to `flag` (e.g. `--report`), naming that flag in errors.
+    /// The format follows the name: a trailing `/` asks for a frames directory, a known extension
+    /// for that format (an existing directory of that name is refused, not filled with frames),
+    /// and an existing directory without an extension is a frames directory.
+    pub fn for_flag(flag: &str, path: &Path, allowed: &[OutputKind]) -> Result<OutputKind> {
         let s = path.to_string_lossy();
-        let kind = if s.ends_with('/') || s.ends_with(std::path::MAIN_SEPARATOR) || path.is_dir() {
+        let by_extension = match path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(|e| e.to_ascii_lowercase())
+            .as_deref()
+        {
+            Some("json") => Some(OutputKind::Json),
+            Some("csv") => Some(OutputKind::Csv),
+            Some("gif") => Some(OutputKind::Gif),
+            Some("png") => Some(OutputKind::Png),
+            Some("svg") => Some(OutputKind::Svg),
+            Some("glb") => Some(OutputKind::Glb),
+            _ => None,
+        };
+        let kind = if s.ends_with('/') || s.ends_with(std::path::MAIN_SEPARATOR) {
+            Some(OutputKind::Directory)
+        } else if let Some(k) = by_extension {
+            if path.is_dir() {
+                return Err(Error::parameter(
+                    flag,
+                    format!(
+                        "{}: is an existing directory, so it cannot be written as a {} file; \
+                         remove it or choose another name",
+                        path.display(),
+                        k.describe()
+                    ),
+                ));
+            }
+            Some(k)
+        } else if path.is_dir() {
             Some(OutputKind::Directory)
         } else {
-            match path
-                .extension()
-                .and_then(|e| e.to_str())
-                .map(|e| e.to_ascii_lowercase())
-                .as_deref()
-            {
-                Some("json") => Some(OutputKind::Json),
-                Some("csv") => Some(OutputKind::Csv),
-                Some("gif") => Some(OutputKind::Gif),
-                Some("png") => Some(OutputKind::Png),
-                Some("svg") => Some(OutputKind::Svg),
-                Some("glb") => Some(OutputKind::Glb),
-                _ => None,
-            }
+            None
         };
         match kind {
             Some(k) if allowed.contains(&k) => Ok(k),
             _ => Err(Error::parameter(
-                "-o",
+                flag,
                 format!(
                     "{}: cannot tell the output format from this name; use one of: {}",
                     path.display(),
@@ -166,31 +264,306 @@ impl OutputKind {
     }
 }
 
+/// Every temporary `formation` creates is named `.formation-PID-RANDOM.tmp` (a file),
+/// `.formation-PID-RANDOM.tmpdir` (a directory of frames) or `.formation-PID-RANDOM.old` (an
+/// output being replaced), in the target's own directory so that the final rename is atomic. The
+/// name does not depend on the target's (a legal 255-byte output name still works), RANDOM is
+/// drawn from the operating system and the temporary is created exclusively (`O_EXCL`, which never
+/// follows a symbolic link), so nothing planted at a predictable path can redirect a write.
+const TEMP_PREFIX: &str = ".formation-";
+
+/// Length of the random part of a temporary's name.
+const TEMP_RANDOM_LEN: usize = 12;
+
+/// The directory a target lives in (`.` for a bare file name).
+fn dir_of(target: &Path) -> PathBuf {
+    match target.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    }
+}
+
+/// Runs `make` with a builder of our temporaries' names: `.formation-PID-RANDOM{suffix}`.
+fn with_temp_builder<T>(
+    suffix: &str,
+    make: impl FnOnce(&tempfile::Builder) -> std::io::Result<T>,
+) -> std::io::Result<T> {
+    let prefix = format!("{TEMP_PREFIX}{}-", std::process::id());
+    let mut b = tempfile::Builder::new();
+    b.prefix(&prefix).suffix(suffix).rand_bytes(TEMP_RANDOM_LEN);
+    make(&b).map_err(without_temp_path)
+}
+
+/// tempfile's errors append "at path …" naming the temporary; the user named the output, and
+/// messages name that, so keep the operating system's own error only.
+fn without_temp_path(e: std::io::Error) -> std::io::Error {
+    let text = e.to_string();
+    match text.find(" at path \"") {
+        Some(cut) if e.get_ref().is_some() => std::io::Error::new(e.kind(), &text[..cut]),
+        _ => e,
+    }
+}
+
+/// Creates a new temporary file in `dir`, exclusively, with an unpredictable name.
+fn create_temp_file(dir: &Path) -> std::io::Result<(fs::File, PathBuf)> {
+    // Outputs get the permissions any new file gets (0666 less the umask), not a temporary's 0600.
+    let named = with_temp_builder(".tmp", |b| {
+        use std::os::unix::fs::PermissionsExt;
+        b.clone()
+            .permissions(fs::Permissions::from_mode(0o666))
+            .tempfile_in(dir)
+    })?;
+    let (file, path) = named.into_parts();
+    let path = path.keep().map_err(|e| e.error)?;
+    Ok((file, path))
+}
+
+/// Creates a new temporary directory in `dir`, exclusively, with an unpredictable name.
+fn create_temp_dir(dir: &Path) -> std::io::Result<PathBuf> {
+    Ok(with_temp_builder(".tmpdir", |b| b.tempdir_in(dir))?.keep())
+}
+
+/// A fresh, unused name for the backup of an output being replaced (nothing is left there).
+fn backup_name(dir: &Path) -> std::io::Result<PathBuf> {
+    // Reserve the name exclusively, then free it: the rename onto it happens under the registry
+    // lock right after; had something appeared there meanwhile, a file rename would replace that
+    // entry itself (rename never follows a link) and a directory rename would fail.
+    let named = with_temp_builder(".old", |b| b.tempfile_in(dir))?;
+    let path = named.path().to_path_buf();
+    named.close()?;
+    Ok(path)
+}
+
+/// The PID in a temporary's name of ours, if `name` is one.
+fn temp_owner_pid(name: &str) -> Option<u32> {
+    let rest = name.strip_prefix(TEMP_PREFIX)?;
+    let (pid, rest) = rest.split_once('-')?;
+    let (random, suffix) = rest.split_once('.')?;
+    let pid: u32 = pid.parse().ok()?;
+    let ours = random.len() == TEMP_RANDOM_LEN
+        && random.bytes().all(|b| b.is_ascii_alphanumeric())
+        && matches!(suffix, "tmp" | "tmpdir" | "old");
+    ours.then_some(pid)
+}
+
+/// Removes the temporaries of earlier `formation` runs that died without cleaning up (SIGKILL, a
+/// power cut) from `dir`: only entries named exactly as ours, whose process no longer runs,
+/// owned by the same user as `witness` (a temporary we just created), and never a symbolic link.
+/// Linux only (process liveness is read from `/proc`); elsewhere nothing is removed.
+fn remove_stale_temporaries(dir: &Path, witness: &Path) {
+    use std::os::unix::fs::MetadataExt;
+    let proc = Path::new("/proc");
+    if !proc.join("self").exists() {
+        return;
+    }
+    let Ok(me) = fs::symlink_metadata(witness) else {
+        return;
+    };
+    let Ok(entries) = fs::read_dir(dir) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let name = entry.file_name();
+        let Some(pid) = name.to_str().and_then(temp_owner_pid) else {
+            continue;
+        };
+        if pid == std::process::id() || proc.join(pid.to_string()).exists() {
+            continue;
+        }
+        let path = entry.path();
+        let Ok(meta) = fs::symlink_metadata(&path) else {
+            continue;
+        };
+        if meta.file_type().is_symlink() || meta.uid() != me.uid() {
+            continue;
+        }
+        // remove_dir_all never follows links inside the directory.
+        let _ = if meta.is_dir() {
+            fs::remove_dir_all(&path)
+        } else {
+            fs::remove_file(&path)
+        };
+    }
+}
+
+/// Registers a new temporary (created by `create` under the registry lock, so that a signal
+/// cannot leave it unregistered) and, the first time a directory is used, removes stale
+/// temporaries of dead runs from it.
+fn new_temporary<T>(
+    dir: &Path,
+    create: impl FnOnce(&Path) -> std::io::Result<(T, PathBuf)>,
+) -> std::io::Result<(T, PathBuf)> {
+    let (value, path, first_use) = with_registry(|r| {
+        let (value, path) = create(dir)?;
+        r.open.push(path.clone());
+        let first_use = r.cleaned_dirs.insert(dir.to_path_buf());
+        Ok((value, path, first_use))
+    })?;
+    if first_use {
+        remove_stale_temporaries(dir, &path);
+    }
+    Ok((value, path))
+}
+
+/// A finished temporary waiting to be moved onto its target.
+#[derive(Debug)]
+struct Pending {
+    tmp: PathBuf,
+    target: PathBuf,
+}
+
+/// Moves `p.tmp` onto `p.target`. An existing target is kept as a backup (returned) when
+/// `keep_backup` is set or when it is a directory (a directory cannot be renamed over); files are
+/// replaced by one atomic rename, so a reader sees either the old or the new file, never neither.
+fn put_in_place(p: &Pending, keep_backup: bool) -> std::io::Result<Option<PathBuf>> {
+    let existing = fs::symlink_metadata(&p.target).ok();
+    let is_dir = existing.as_ref().is_some_and(|m| m.is_dir());
+    if existing.is_none() || !(keep_backup || is_dir) {
+        fs::rename(&p.tmp, &p.target)?;
+        return Ok(None);
+    }
+    let backup = backup_name(&dir_of(&p.target))?;
+    if is_dir {
+        fs::rename(&p.target, &backup)?;
+    } else {
+        // A hard link keeps the old file under the backup name while the rename below replaces
+        // the target atomically (link() never follows a symbolic link on Linux).
+        fs::hard_link(&p.target, &backup)?;
+    }
+    if let Err(e) = fs::rename(&p.tmp, &p.target) {
+        if is_dir {
+            let _ = fs::rename(&backup, &p.target);
+        } else {
+            let _ = fs::remove_file(&backup);
+        }
+        return Err(e);
+    }
+    Ok(Some(backup))
+}
+
+/// Removes a file or directory, whichever it is (never following a link).
+fn remove_any(path: &Path) {
+    match fs::symlink_metadata(path) {
+        Ok(m) if m.is_dir() => {
+            let _ = fs::remove_dir_all(path);
+        }
+        Ok(_) => {
+            let _ = fs::remove_file(path);
+        }
+        Err(_) => {}
+    }
+}
+
+/// Moves every pending temporary onto its target, or none: if one rename fails, the targets
+/// already replaced get their old content back and the remaining temporaries are removed.
+fn commit_all(registry: &mut Registry, pending: Vec<Pending>) -> Result<()> {
+    let keep_backups = pending.len() > 1;
+    let mut done: Vec<(usize, Option<PathBuf>)> = Vec::new();
+    let mut failure = None;
+    for (k, p) in pending.iter().enumerate() {
+        match put_in_place(p, keep_backups) {
+            Ok(backup) => done.push((k, backup)),
+            Err(e) => {
+                failure = Some((k, e));
+                break;
+            }
+        }
+    }
+    if let Some((k, e)) = failure {
+        for (i, backup) in done.into_iter().rev() {
+            let target = &pending[i].target;
+            match backup {
+                Some(b) => {
+                    if fs::symlink_metadata(target).is_ok_and(|m| m.is_dir()) {
+                        let _ = fs::remove_dir_all(target);
+                    }
+                    let _ = fs::rename(&b, target);
+                }
+                None => remove_any(target),
+            }
+        }
+        for p in &pending {
+            remove_any(&p.tmp);
+        }
+        registry.forget(pending.iter().map(|p| &p.tmp));
+        return Err(Error::io(&pending[k].target, e));
+    }
+    for (_, backup) in done {
+        if let Some(b) = backup {
+            remove_any(&b);
+        }
+    }
+    registry.forget(pending.iter().map(|p| &p.tmp));
+    Ok(())
+}
+
+/// Hands a finished temporary to the open [`OutputBatch`], or moves it into place at once when
+/// there is none.
+fn finish(tmp: PathBuf, target: PathBuf) -> Result<()> {
+    lock_registry_then(|r| {
+        let p = Pending { tmp, target };
+        match r.batch.as_mut() {
+            Some(queue) => {
+                let id = output_identity(&p.target);
+                if queue.iter().any(|q| output_identity(&q.target) == id) {
+                    // Two outputs of one run on the same file: the second would silently replace
+                    // the first. Callers check this up front; this is the last line of defence.
+                    remove_any(&p.tmp);
+                    r.forget(std::iter::once(&p.tmp));
+                    return Err(Error::format(
+                        &p.target,
+                        "is given as two outputs of this command; name each output once",
+                    ));
+                }
+                queue.push(p);
+                Ok(())
+            }
+            None => commit_all(r, vec![p]),
+        }
+    })
+}
+
+/// What makes two output names the same file: the canonical directory and the file name
+/// (`a.json`, `./a.json` and `../d/a.json` from inside `d` are one output).
+pub fn output_identity(target: &Path) -> PathBuf {
+    let trimmed = PathBuf::from(target.to_string_lossy().trim_end_matches('/'));
+    match (fs::canonicalize(dir_of(&trimmed)), trimmed.file_name()) {
+        (Ok(dir), Some(name)) => dir.join(name),
+        _ => trimmed,
+    }
+}
+
+/// Checks that the directory an output goes into exists, naming `flag` when it does not, so that
+/// a run fails before any work rather than after the other outputs are written.
+pub fn check_output_dir(flag: &str, target: &Path) -> Result<()> {
+    let trimmed = PathBuf::from(target.to_string_lossy().trim_end_matches('/'));
+    let parent = dir_of(&trimmed);
+    if parent.is_dir() {
+        Ok(())
+    } else {
+        Err(Error::parameter(
+            flag,
+            format!(
+                "{}: directory {} does not exist; create it first",
+                target.display(),
+                parent.display()
+            ),
+        ))
+    }
+}
+
 /// A file being written atomically: data goes to a temporary file in the target's directory and
-/// only [`AtomicFile::commit`] moves it into place. Dropping it uncommitted removes the temporary.
+/// only [`AtomicFile::commit`] moves it into place (or queues it in the open [`OutputBatch`]).
+/// Dropping it uncommitted removes the temporary.
 pub struct AtomicFile {
     target: PathBuf,
     tmp: PathBuf,
     writer: Option<BufWriter<fs::File>>,
 }
 
-/// Temporary path beside `target` (same directory, so the final rename is atomic).
-fn temp_path_for(target: &Path) -> PathBuf {
-    let name = target
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "output".to_string());
-    let dir = target.parent().filter(|p| !p.as_os_str().is_empty());
-    let tmp_name = format!(".{name}.tmp-formation-{}", std::process::id());
-    match dir {
-        Some(d) => d.join(tmp_name),
-        None => PathBuf::from(tmp_name),
-    }
-}
-
 impl AtomicFile {
     /// Creates the temporary file for `target`. Fails (naming `target`) if its directory is missing
-    /// or not writable.
+    /// or not writable, or if `target` is a directory.
     pub fn create(target: &Path) -> Result<AtomicFile> {
         if target.is_dir() {
             return Err(Error::format(
@@ -198,14 +571,8 @@ impl AtomicFile {
                 "is a directory, expected a file name",
             ));
         }
-        let tmp = temp_path_for(target);
-        // Created and registered under the lock, so a signal cannot leave it unregistered.
-        let file = with_temps(|v| {
-            let f = fs::File::create(&tmp)?;
-            v.push(tmp.clone());
-            Ok(f)
-        })
-        .map_err(|e| Error::io(target, e))?;
+        let (file, tmp) =
+            new_temporary(&dir_of(target), create_temp_file).map_err(|e| Error::io(target, e))?;
         Ok(AtomicFile {
             target: target.to_path_buf(),
             tmp,
@@ -218,29 +585,20 @@ impl AtomicFile {
         self.writer.as_mut().expect("writer present until commit")
     }
 
-    /// Flushes, syncs and renames the temporary file onto the target. On any failure the
-    /// temporary is removed and the target left as it was.
+    /// Flushes and syncs the temporary file, then renames it onto the target (at once, or when
+    /// the open [`OutputBatch`] commits). On any failure the temporary is removed and the target
+    /// left as it was.
     pub fn commit(mut self) -> Result<()> {
         let writer = self.writer.take().expect("writer present until commit");
-        let tmp = self.tmp.clone();
-        let result = (|| {
-            let file = writer.into_inner().map_err(|e| e.into_error())?;
-            file.sync_all()?;
-            drop(file);
-            with_temps(|v| {
-                fs::rename(&tmp, &self.target)?;
-                v.retain(|q| q != &tmp);
-                Ok(())
-            })
-        })();
-        result.map_err(|e| {
-            let _ = with_temps(|v| {
-                let _ = fs::remove_file(&tmp);
-                v.retain(|q| q != &tmp);
-                Ok(())
-            });
-            Error::io(&self.target, e)
-        })
+        let synced = writer
+            .into_inner()
+            .map_err(|e| e.into_error())
+            .and_then(|file| file.sync_all());
+        if let Err(e) = synced {
+            discard(&self.tmp);
+            return Err(Error::io(&self.target, e));
+        }
+        finish(self.tmp.clone(), self.target.clone())
     }
 }
 
@@ -255,15 +613,19 @@ impl Write for AtomicFile {
 
 impl Drop for AtomicFile {
     fn drop(&mut self) {
-        if self.writer.is_some() {
-            self.writer = None;
-            let _ = with_temps(|v| {
-                let _ = fs::remove_file(&self.tmp);
-                v.retain(|q| q != &self.tmp);
-                Ok(())
-            });
+        if self.writer.take().is_some() {
+            discard(&self.tmp);
         }
     }
+}
+
+/// Removes an unfinished temporary and forgets it.
+fn discard(tmp: &Path) {
+    let _ = with_registry(|r| {
+        remove_any(tmp);
+        r.forget(std::iter::once(tmp));
+        Ok(())
+    });
 }
 
 /// Writes `bytes` to `target` atomically.
@@ -296,8 +658,8 @@ pub fn write_json_atomic<T: Serialize>(target: &Path, value: &T) -> Result<()> {
 }
 
 /// A directory being filled atomically: files go into a temporary sibling directory that
-/// [`AtomicDir::commit`] renames onto the target (replacing an existing directory of ours only
-/// after the new one is complete).
+/// [`AtomicDir::commit`] renames onto the target (replacing an existing directory only after the
+/// new one is complete), at once or when the open [`OutputBatch`] commits.
 pub struct AtomicDir {
     target: PathBuf,
     tmp: PathBuf,
@@ -308,17 +670,11 @@ impl AtomicDir {
     /// Creates the temporary directory for `target`.
     pub fn create(target: &Path) -> Result<AtomicDir> {
         let trimmed = PathBuf::from(target.to_string_lossy().trim_end_matches('/'));
-        if trimmed.exists() && !trimmed.is_dir() {
+        if fs::symlink_metadata(&trimmed).is_ok_and(|m| !m.is_dir()) {
             return Err(Error::format(&trimmed, "exists and is not a directory"));
         }
-        let tmp = temp_path_for(&trimmed);
-        with_temps(|v| {
-            let _ = fs::remove_dir_all(&tmp);
-            fs::create_dir(&tmp)?;
-            v.push(tmp.clone());
-            Ok(())
-        })
-        .map_err(|e| Error::io(&trimmed, e))?;
+        let ((), tmp) = new_temporary(&dir_of(&trimmed), |d| Ok(((), create_temp_dir(d)?)))
+            .map_err(|e| Error::io(&trimmed, e))?;
         Ok(AtomicDir {
             target: trimmed,
             tmp,
@@ -331,70 +687,126 @@ impl AtomicDir {
         self.tmp.join(name)
     }
 
+    /// The target directory (for messages: errors inside the temporary should name it).
+    pub fn target(&self) -> &Path {
+        &self.target
+    }
+
     /// Moves the finished directory into place. An existing target directory is replaced.
     pub fn commit(mut self) -> Result<()> {
-        // Under the lock: a signal waits until the old directory is replaced (or restored).
-        with_temps(|v| {
-            if self.target.is_dir() {
-                let old = temp_path_for(&self.target).with_extension("old");
-                let _ = fs::remove_dir_all(&old);
-                fs::rename(&self.target, &old)?;
-                if let Err(e) = fs::rename(&self.tmp, &self.target) {
-                    let _ = fs::rename(&old, &self.target);
-                    return Err(e);
-                }
-                let _ = fs::remove_dir_all(&old);
-            } else {
-                fs::rename(&self.tmp, &self.target)?;
-            }
-            v.retain(|q| q != &self.tmp);
-            Ok(())
-        })
-        .map_err(|e| Error::io(&self.target, e))?;
         self.committed = true;
-        Ok(())
+        finish(self.tmp.clone(), self.target.clone())
     }
 }
 
 impl Drop for AtomicDir {
     fn drop(&mut self) {
         if !self.committed {
-            let _ = with_temps(|v| {
-                let _ = fs::remove_dir_all(&self.tmp);
-                v.retain(|q| q != &self.tmp);
+            discard(&self.tmp);
+        }
+    }
+}
+
+/// All outputs of one run, committed together or not at all (SPEC §4: a failed run leaves no
+/// output). While a batch is open, [`AtomicFile::commit`] and [`AtomicDir::commit`] only queue
+/// their temporaries; [`OutputBatch::commit`] moves them all into place, restoring the earlier
+/// targets if one rename fails; dropping the batch uncommitted removes every queued temporary.
+/// The binary opens one batch around each command.
+#[must_use = "an output batch that is dropped discards every output queued in it"]
+pub struct OutputBatch {
+    committed: bool,
+}
+
+impl OutputBatch {
+    /// Opens the batch. Fails if one is already open (batches do not nest).
+    pub fn begin() -> Result<OutputBatch> {
+        with_registry(|r| {
+            if r.batch.is_some() {
+                return Ok(false);
+            }
+            r.batch = Some(Vec::new());
+            Ok(true)
+        })
+        .map_err(|e| Error::Internal(e.to_string()))
+        .and_then(|opened| {
+            if opened {
+                Ok(OutputBatch { committed: false })
+            } else {
+                Err(Error::Internal("an output batch is already open".into()))
+            }
+        })
+    }
+
+    /// Moves every queued output into place, all or none.
+    pub fn commit(mut self) -> Result<()> {
+        self.committed = true;
+        lock_registry_then(|r| {
+            let pending = r.batch.take().unwrap_or_default();
+            commit_all(r, pending)
+        })
+    }
+}
+
+impl Drop for OutputBatch {
+    fn drop(&mut self) {
+        if !self.committed {
+            let _ = with_registry(|r| {
+                let pending = r.batch.take().unwrap_or_default();
+                for p in &pending {
+                    remove_any(&p.tmp);
+                }
+                r.forget(pending.iter().map(|p| &p.tmp));
                 Ok(())
             });
         }
     }
 }
 
-// Temporaries still open, so that a signal handler in the binary can remove them before exiting.
-// Creating, committing and removing a temporary all happen under this lock, so the handler sees
-// every temporary that exists and never runs in the middle of a commit's renames.
-static OPEN_TEMPS: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
-
-fn with_temps<R>(f: impl FnOnce(&mut Vec<PathBuf>) -> std::io::Result<R>) -> std::io::Result<R> {
-    let mut guard = OPEN_TEMPS.lock().unwrap_or_else(|p| p.into_inner());
-    f(&mut guard)
+/// Temporaries still open (so that a signal handler in the binary can remove them before
+/// exiting), the queue of the open [`OutputBatch`], and the directories already cleaned of stale
+/// temporaries. Creating, committing and removing a temporary all happen under this lock, so
+/// the handler sees every temporary that exists and never runs in the middle of a commit.
+#[derive(Default)]
+struct Registry {
+    open: Vec<PathBuf>,
+    batch: Option<Vec<Pending>>,
+    cleaned_dirs: std::collections::BTreeSet<PathBuf>,
 }
 
-/// Removes every temporary file or directory still open (called on Ctrl-C / SIGTERM, right
-/// before the process exits). The list stays locked afterwards: no temporary can be created or
-/// committed any more, so nothing new appears between the cleanup and the exit.
+impl Registry {
+    fn forget<'a, P: AsRef<Path> + ?Sized + 'a>(&mut self, paths: impl Iterator<Item = &'a P>) {
+        for p in paths {
+            self.open.retain(|q| q.as_path() != p.as_ref());
+        }
+    }
+}
+
+static REGISTRY: std::sync::Mutex<Option<Registry>> = std::sync::Mutex::new(None);
+
+fn lock_registry_then<R>(f: impl FnOnce(&mut Registry) -> R) -> R {
+    let mut guard = REGISTRY.lock().unwrap_or_else(|p| p.into_inner());
+    f(guard.get_or_insert_with(Registry::default))
+}
+
+fn with_registry<R>(f: impl FnOnce(&mut Registry) -> std::io::Result<R>) -> std::io::Result<R> {
+    lock_registry_then(f)
+}
+
+/// Removes every temporary file or directory still open (called on a terminating signal, right
+/// before the process exits). The registry stays locked afterwards: no temporary can be created
+/// or committed any more, so nothing new appears between the cleanup and the exit.
 pub fn remove_open_temporaries() {
-    let guard = OPEN_TEMPS.lock().unwrap_or_else(|p| p.into_inner());
-    for p in guard.iter() {
-        // Worker threads may still be adding frames to a temporary directory: retry.
-        for _ in 0..50 {
-            let gone = if p.is_dir() {
-                fs::remove_dir_all(p).is_ok() || !p.exists()
-            } else {
-                fs::remove_file(p).is_ok() || !p.exists()
-            };
-            if gone {
-                break;
+    let mut guard = REGISTRY.lock().unwrap_or_else(|p| p.into_inner());
+    if let Some(r) = guard.as_mut() {
+        for p in r.open.iter() {
+            // Worker threads may still be adding frames to a temporary directory: retry.
+            for _ in 0..50 {
+                remove_any(p);
+                if fs::symlink_metadata(p).is_err() {
+                    break;
+                }
+                std::thread::sleep(std::time::Duration::from_millis(10));
             }
-            std::thread::sleep(std::time::Duration::from_millis(10));
         }
     }
     std::mem::forget(guard);

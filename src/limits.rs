@@ -11,6 +11,12 @@
 /// Most birds in an animation (`--birds` of `steady`/`animate`, `birds` of an animation file).
 pub const MAX_BIRDS: usize = 100_000;
 
+/// Most birds in one formation's steady flight (`steady`/`animate --birds`). Algorithm 1 is
+/// quadratic in a formation's birds (every pair interacts): measured on the shared 2-core machine,
+/// 1000 birds take 1.7 s and 2000 birds 6.3 s for one key shape, so 5000 birds take about 40 s
+/// and the 100 000 that [`MAX_BIRDS`] allows would have taken hours.
+pub const MAX_FORMATION_BIRDS: usize = 5_000;
+
 /// Most frames in an animation (`steady --frames`, `animate --seconds × --fps`): 9¼ hours at
 /// 30 fps.
 pub const MAX_FRAMES: usize = 1_000_000;
@@ -28,6 +34,41 @@ pub const MAX_FRAME_PIXELS: u64 = 7680 * 4320;
 /// height: 2·10¹⁰, i.e. 20 GB of raw 8-bit frames (a GIF compresses it to a few percent). E.g.
 /// 1920 × 1080 at 25 fps allows about 6½ minutes; a request for a 10-GB GIF is far beyond it.
 pub const MAX_PICTURE_PIXELS: u64 = 20_000_000_000;
+
+/// Most birds in a shape or target (`power`, `solve`). `power` is quadratic in birds (10 000
+/// birds: about a second); the solve's cost is measured in `docs/performance.md`.
+pub const MAX_SHAPE_BIRDS: usize = 10_000;
+
+/// Largest coordinate in an animation file or shape, wingspans in magnitude (10⁷ wingspans is
+/// 15 000 km of 1.5 m birds): every exported number then stays well inside f32 (glTF, USD) and
+/// keeps centimetre precision.
+pub const MAX_COORDINATE: f64 = 1e7;
+
+/// Largest `wingspan_m` of an animation file, metres (a flock of 747s is 68 m).
+pub const MAX_WINGSPAN_M: f64 = 1000.0;
+
+/// Largest frame rate of an animation file, frames per second.
+pub const MAX_FPS: f64 = 10_000.0;
+
+/// Largest magnitude of other per-frame numbers of an animation file (headings and wing phases
+/// in radians, speeds in wingspans per second, savings): far beyond any flight, inside f32.
+pub const MAX_FRAME_VALUE: f64 = 1e9;
+
+/// Checks the bird count of a shape or target, naming `what`.
+pub fn check_shape_size(what: &str, birds: usize) -> crate::Result<()> {
+    if birds > MAX_SHAPE_BIRDS {
+        return Err(crate::Error::parameter(
+            what,
+            format!("{birds} birds: at most {MAX_SHAPE_BIRDS}"),
+        ));
+    }
+    Ok(())
+}
+
+/// Most RANSAC samples per model and frame (`extract --max-samples`). Each sample costs a pass
+/// over the frame's birds, so the limit bounds a frame of 1000 birds to about 3·10⁸ distance
+/// evaluations (three families), well under a second; the default is 2000.
+pub const MAX_RANSAC_SAMPLES: usize = 100_000;
 
 /// Most birds marked in one annotated frame (matching ids across frames is cubic in this).
 pub const MAX_ANNOTATED_BIRDS: usize = 1_000;

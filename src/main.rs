@@ -4,6 +4,7 @@
 
 mod cli;
 
+use std::io::Write;
 use std::process::ExitCode;
 
 use clap::Parser;
@@ -36,7 +37,14 @@ fn main() -> ExitCode {
                             first = format!("{first} {next}");
                         }
                     }
-                    eprintln!("{first} (see `formation --help`)");
+                    // Keep what tells the user the way out: the possible values, and clap's
+                    // "a similar argument exists" tip.
+                    for l in lines {
+                        if l.starts_with("[possible values") || l.starts_with("tip:") {
+                            first = format!("{first} {l}");
+                        }
+                    }
+                    let _ = writeln!(std::io::stderr(), "{first} (see `formation --help`)");
                     ExitCode::from(2)
                 }
             };
@@ -46,7 +54,11 @@ fn main() -> ExitCode {
     match cli::run(args) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e}");
+            let _ = writeln!(
+                std::io::stderr(),
+                "error: {}",
+                formation::error::one_line(&e.to_string())
+            );
             ExitCode::from(e.exit_code())
         }
     }

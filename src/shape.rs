@@ -71,6 +71,16 @@ impl Shape {
                 ),
             ));
         }
+        if self.birds.len() > crate::limits::MAX_SHAPE_BIRDS {
+            return Err(Error::format(
+                origin,
+                format!(
+                    "birds: {} birds given, at most {}",
+                    self.birds.len(),
+                    crate::limits::MAX_SHAPE_BIRDS
+                ),
+            ));
+        }
         for (i, b) in self.birds.iter().enumerate() {
             if !b.x.is_finite() {
                 return Err(Error::format(
@@ -82,6 +92,16 @@ impl Shape {
                 return Err(Error::format(
                     origin,
                     format!("birds[{i}].y: not a finite number"),
+                ));
+            }
+            let c = crate::limits::MAX_COORDINATE;
+            if b.x.abs() > c || b.y.abs() > c {
+                return Err(Error::format(
+                    origin,
+                    format!(
+                        "birds[{i}]: ({:e}, {:e}) is more than {c:e} wingspans from the leader",
+                        b.x, b.y
+                    ),
                 ));
             }
         }

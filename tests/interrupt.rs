@@ -1,5 +1,5 @@
 //! No lost files (issue 8, SPEC §4): a render interrupted mid-way by SIGTERM or SIGINT (Ctrl-C)
-//! exits non-zero (130), leaves no temporary (`.NAME.tmp-formation-PID`), never touches an
+//! exits non-zero (128 + the signal: 130, 143), leaves no temporary (`.formation-PID-RANDOM.tmp`, `.tmpdir`), never touches an
 //! existing output (byte-identical afterwards) and creates no later output.
 //!
 //! The render is made slow on purpose (a 70-second animation as a 1280×720 GIF at 50 fps, or as
@@ -61,12 +61,19 @@ fn snapshot(dir: &Path) -> Vec<(String, Vec<u8>)> {
 fn has_temporary(dir: &Path) -> bool {
     snapshot(dir)
         .iter()
-        .any(|(name, _)| name.contains(".tmp-formation-"))
+        .any(|(name, _)| name.contains(".formation-"))
 }
 
 /// Starts `formation render` writing `output` (then `later`), waits until it is writing, sends
 /// `signal`, and checks the aftermath.
 fn interrupt(signal: &str, name: &str, output: &str) {
+    // 128 + the signal's number, as shells report a run ended by a signal.
+    let code = if signal == "INT" { 130 } else { 143 };
+    interrupt_with(signal, name, output, code, "interrupted; no output written");
+}
+
+/// [`interrupt`] for any catchable signal, with its expected exit code and message.
+fn interrupt_with(signal: &str, name: &str, output: &str, code: i32, message: &str) {
     let dir = workdir(name);
     let anim = long_animation(&dir);
     // Existing outputs that must survive: the file itself, or a frames directory of ours.
@@ -116,14 +123,11 @@ fn interrupt(signal: &str, name: &str, output: &str) {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(
         out.status.code(),
-        Some(130),
+        Some(code),
         "{name}: exit {:?}, stderr {stderr}",
         out.status
     );
-    assert!(
-        stderr.contains("interrupted; no output written"),
-        "{name}: {stderr}"
-    );
+    assert!(stderr.contains(message), "{name}: {stderr}");
     let after = snapshot(&dir);
     assert_eq!(
         after.iter().map(|e| &e.0).collect::<Vec<_>>(),
@@ -152,6 +156,64 @@ fn sigterm_during_png_frames_keeps_the_old_frames() {
 #[test]
 fn sigint_during_png_frames_keeps_the_old_frames() {
     interrupt("INT", "int-png", "frames/");
+}
+
+/// Signals the tool does not treat as Ctrl-C still end the run cleanly (issue 17: SIGUSR1,
+/// SIGALRM, SIGXCPU and SIGHUP used to leave the temporary forever): exit 128 + the signal.
+#[test]
+fn other_catchable_signals_clean_up_too() {
+    for (signal, code) in [("HUP", 129), ("USR1", 138), ("ALRM", 142), ("XCPU", 152)] {
+        interrupt_with(
+            signal,
+            &format!("{}-gif", signal.to_lowercase()),
+            "flock.gif",
+            code,
+            &format!("stopped by signal SIG{signal}; no output written"),
+        );
+    }
+}
+
+/// SIGKILL cannot be caught: its temporary stays, and the next run writing into the same
+/// directory recognises it as a dead run's and removes it.
+#[test]
+fn a_killed_runs_temporary_is_removed_by_the_next_run() {
+    let dir = workdir("kill");
+    let anim = long_animation(&dir);
+    let mut child = Command::new(env!("CARGO_BIN_EXE_formation"))
+        .args([
+            "render", "--quiet", "--size", "1280x720", "--fps", "50", "-o",
+        ])
+        .arg(dir.join("flock.gif"))
+        .arg(&anim)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    while !has_temporary(&dir) {
+        assert!(child.try_wait().unwrap().is_none(), "render ended early");
+        assert!(start.elapsed() < Duration::from_secs(120));
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert!(has_temporary(&dir), "SIGKILL should leave the temporary");
+    let small = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/flock_small.json");
+    let ok = Command::new(env!("CARGO_BIN_EXE_formation"))
+        .args(["render", "--quiet", "-o"])
+        .arg(dir.join("small.csv"))
+        .arg(&small)
+        .status()
+        .unwrap();
+    assert!(ok.success());
+    assert!(
+        !has_temporary(&dir),
+        "{:?}",
+        snapshot(&dir).iter().map(|e| &e.0).collect::<Vec<_>>()
+    );
+    assert!(dir.join("small.csv").is_file());
+    assert!(!dir.join("flock.gif").exists());
+    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// A write that fails (a number JSON cannot hold) refuses before creating anything: the existing

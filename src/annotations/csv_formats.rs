@@ -153,6 +153,8 @@ fn parse_long(path: &Path, rdr: &mut csv::Reader<&[u8]>, hdr: &[String]) -> Resu
     };
     let (cb, cw) = (col("bird"), col("wingspan_px"));
     let mut frames: Vec<RawFrame> = Vec::new();
+    // Frame index → position in `frames` (a linear search made reading quadratic in frames).
+    let mut frame_pos: std::collections::HashMap<i64, usize> = std::collections::HashMap::new();
     let mut rec = csv::StringRecord::new();
     let mut row = 0usize;
     loop {
@@ -219,9 +221,10 @@ fn parse_long(path: &Path, rdr: &mut csv::Reader<&[u8]>, hdr: &[String]) -> Resu
             Some(c) if !field(c, "wingspan_px")?.is_empty() => Some(fnum(c, "wingspan_px")?),
             _ => None,
         };
-        let pos = match frames.iter().position(|f| f.index == index) {
-            Some(p) => p,
+        let pos = match frame_pos.get(&index) {
+            Some(&p) => p,
             None => {
+                frame_pos.insert(index, frames.len());
                 frames.push(RawFrame {
                     index,
                     image: None,
@@ -260,13 +263,26 @@ fn parse_dltdv(path: &Path, rdr: &mut csv::Reader<&[u8]>, hdr: &[String]) -> Res
     let cam = cols.iter().map(|c| c.1).min().unwrap_or(1);
     // (point number, x column, y column) of the chosen camera.
     let mut points: Vec<(usize, Option<usize>, Option<usize>)> = Vec::new();
+    // Point number → position in `points` (a linear search made a wide header quadratic).
+    let mut point_pos: std::collections::HashMap<usize, usize> = std::collections::HashMap::new();
     for (ci, &(n, m, is_x)) in cols.iter().enumerate() {
         if m != cam {
             continue;
         }
-        let p = match points.iter().position(|p| p.0 == n) {
-            Some(p) => p,
+        let p = match point_pos.get(&n) {
+            Some(&p) => p,
             None => {
+                if points.len() == crate::limits::MAX_ANNOTATED_BIRDS {
+                    return Err(Error::format(
+                        path,
+                        format!(
+                            "header: more than {} points per camera, at most {} birds per frame",
+                            crate::limits::MAX_ANNOTATED_BIRDS,
+                            crate::limits::MAX_ANNOTATED_BIRDS
+                        ),
+                    ));
+                }
+                point_pos.insert(n, points.len());
                 points.push((n, None, None));
                 points.len() - 1
             }

@@ -183,6 +183,32 @@ pub(crate) fn read_dir(dir: &Path) -> Result<RawAnnotations> {
             "directory has no .json files; expected one Labelme file per frame",
         ));
     }
+    // Refuse before reading: the frame limit, and one budget for the whole directory (each file
+    // alone is also bounded by `io::read_text`).
+    let max_frames = crate::limits::MAX_ANNOTATED_FRAMES;
+    if files.len() > max_frames {
+        return Err(Error::format(
+            dir,
+            format!(
+                "{} .json files, at most {max_frames} annotated frames; annotate a subset (a few dozen frames are plenty)",
+                files.len()
+            ),
+        ));
+    }
+    let total: u64 = files
+        .iter()
+        .filter_map(|p| std::fs::metadata(p).ok())
+        .map(|m| m.len())
+        .sum();
+    if total > crate::io::MAX_INPUT_BYTES {
+        return Err(Error::format(
+            dir,
+            format!(
+                "its .json files hold {total} bytes, more than the {} byte limit of one input",
+                crate::io::MAX_INPUT_BYTES
+            ),
+        ));
+    }
     let names: Vec<String> = files
         .iter()
         .map(|p| {

@@ -250,23 +250,36 @@ fn detect_text(path: &Path, text: &str) -> Result<Format> {
         ));
     }
     if t.starts_with('{') || t.starts_with('[') {
-        let v: serde_json::Value = crate::io::parse_json(path, t)?;
-        let obj = v.as_object().ok_or_else(|| {
-            Error::format(
+        // Only the top-level keys matter here: skip the values instead of building them in
+        // memory (a parsed JSON tree takes about ten times the text).
+        #[derive(Deserialize)]
+        struct TopLevel {
+            #[serde(default)]
+            format: Option<serde_json::Value>,
+            #[serde(default)]
+            shapes: Option<serde::de::IgnoredAny>,
+            #[serde(default)]
+            frames: Option<serde::de::IgnoredAny>,
+        }
+        if t.starts_with('[') {
+            crate::io::parse_json::<serde::de::IgnoredAny>(path, t)?;
+            return Err(Error::format(
                 path,
                 "top level: expected a JSON object with \"frames\" (native) or \"shapes\" (Labelme)",
-            )
-        })?;
-        if obj.get("format").and_then(|f| f.as_str()) == Some(crate::extract::PARAMS_FORMAT) {
+            ));
+        }
+        let top: TopLevel = crate::io::parse_json(path, t)?;
+        if top.format.as_ref().and_then(|f| f.as_str()) == Some(crate::extract::PARAMS_FORMAT) {
             return Err(Error::format(
                 path,
                 "this is a params file written by `formation extract`, not annotations",
             ));
         }
-        if obj.contains_key("shapes") {
+        if top.shapes.is_some() {
             return Ok(Format::Labelme);
         }
-        if obj.contains_key("frames") {
+        if top.frames.is_some() {
+            native::check_counts(path, t)?;
             return Ok(Format::Native);
         }
         return Err(Error::format(

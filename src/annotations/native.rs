@@ -62,6 +62,106 @@ pub(crate) fn heading(path: &Path, at: &str, v: &Value) -> Result<Heading> {
     }
 }
 
+/// Refuses native annotations beyond the size limits before they are parsed into memory: the
+/// frames are counted and each frame's birds are counted while skipped, so a frame of 10⁷ birds
+/// is refused in the memory of its text, not of its parsed tree. A file whose structure is wrong
+/// passes here and gets the exact message from [`parse`].
+pub(crate) fn check_counts(path: &Path, text: &str) -> Result<()> {
+    use crate::limits::{MAX_ANNOTATED_BIRDS, MAX_ANNOTATED_FRAMES};
+    use serde::de::{Deserializer, IgnoredAny, SeqAccess, Visitor};
+    const TOO_MANY: &str = "formation: too many birds in one frame";
+
+    struct Birds;
+    impl<'de> serde::Deserialize<'de> for Birds {
+        fn deserialize<D: Deserializer<'de>>(d: D) -> std::result::Result<Birds, D::Error> {
+            struct Count;
+            impl<'de> Visitor<'de> for Count {
+                type Value = Birds;
+                fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                    f.write_str("an array of birds")
+                }
+                fn visit_seq<A: SeqAccess<'de>>(
+                    self,
+                    mut seq: A,
+                ) -> std::result::Result<Birds, A::Error> {
+                    let mut n = 0usize;
+                    while seq.next_element::<IgnoredAny>()?.is_some() {
+                        n += 1;
+                        if n > MAX_ANNOTATED_BIRDS {
+                            return Err(serde::de::Error::custom(TOO_MANY));
+                        }
+                    }
+                    Ok(Birds)
+                }
+            }
+            d.deserialize_seq(Count)
+        }
+    }
+    #[derive(serde::Deserialize)]
+    struct Frame {
+        #[serde(default)]
+        #[allow(dead_code)]
+        birds: Option<Birds>,
+    }
+    /// The number of frames; fails with `TOO_MANY k` at the first frame `k` over the limit.
+    struct Frames(usize);
+    impl<'de> serde::Deserialize<'de> for Frames {
+        fn deserialize<D: Deserializer<'de>>(d: D) -> std::result::Result<Frames, D::Error> {
+            struct Each;
+            impl<'de> Visitor<'de> for Each {
+                type Value = Frames;
+                fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                    f.write_str("an array of frames")
+                }
+                fn visit_seq<A: SeqAccess<'de>>(
+                    self,
+                    mut seq: A,
+                ) -> std::result::Result<Frames, A::Error> {
+                    let mut k = 0usize;
+                    loop {
+                        match seq.next_element::<Frame>() {
+                            Ok(Some(_)) => k += 1,
+                            Ok(None) => return Ok(Frames(k)),
+                            Err(e) if e.to_string().starts_with(TOO_MANY) => {
+                                return Err(serde::de::Error::custom(format!("{TOO_MANY} {k}")))
+                            }
+                            Err(e) => return Err(e),
+                        }
+                    }
+                }
+            }
+            d.deserialize_seq(Each)
+        }
+    }
+    #[derive(serde::Deserialize)]
+    struct File {
+        frames: Frames,
+    }
+    match serde_json::from_str::<File>(text) {
+        Err(e) if e.to_string().starts_with(TOO_MANY) => {
+            let k = e.to_string()[TOO_MANY.len()..]
+                .split_whitespace()
+                .next()
+                .unwrap_or("?")
+                .to_string();
+            Err(Error::format(
+                path,
+                format!(
+                    "frames[{k}]: more than {MAX_ANNOTATED_BIRDS} birds marked, at most {MAX_ANNOTATED_BIRDS} per frame"
+                ),
+            ))
+        }
+        Ok(f) if f.frames.0 > MAX_ANNOTATED_FRAMES => Err(Error::format(
+            path,
+            format!(
+                "{} annotated frames, at most {MAX_ANNOTATED_FRAMES}; annotate a subset (a few dozen frames are plenty)",
+                f.frames.0
+            ),
+        )),
+        _ => Ok(()),
+    }
+}
+
 pub(crate) fn parse(path: &Path, text: &str) -> Result<RawAnnotations> {
     let v: Value = crate::io::parse_json(path, text)?;
     let obj = v

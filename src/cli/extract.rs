@@ -118,12 +118,14 @@ pub fn run(args: ExtractArgs, g: Global) -> Result<()> {
     }
     if args.json {
         let s = formation::finite::to_json_pretty("params", &params)?;
-        println!("{s}");
+        super::stdout::println(&s)?;
     } else {
-        print!(
-            "{}",
-            summary_table(&ann, &params, &reports, args.output.as_deref())
-        );
+        super::stdout::print(&summary_table(
+            &ann,
+            &params,
+            &reports,
+            args.output.as_deref(),
+        ))?;
     }
     Ok(())
 }

@@ -176,7 +176,7 @@ pub fn run(args: InitiateArgs, g: Global) -> Result<()> {
     super::write_animation(&anim, &args.output, &Default::default(), g)?;
     if args.json {
         let text = formation::finite::to_json_pretty("statistics", &stats)?;
-        println!("{text}");
+        super::stdout::println(&text)?;
     }
     Ok(())
 }

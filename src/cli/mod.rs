@@ -12,6 +12,7 @@ mod power;
 pub mod progress;
 mod render;
 mod solve;
+mod stdout;
 mod steady;
 mod wingbeat;
 
@@ -64,6 +65,8 @@ pub fn run(cli: Cli) -> Result<()> {
         quiet: cli.quiet,
         seed: cli.seed,
     };
+    // Every output of the command is committed together at the end, or none of them.
+    let outputs = formation::io::OutputBatch::begin()?;
     match cli.command {
         Command::Extract(a) => extract::run(a, g),
         Command::Power(a) => power::run(a, g),
@@ -73,18 +76,46 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Animate(a) => animate::run(*a, g),
         Command::Render(a) => render::run(a, g),
         Command::Plot(a) => plot::run(a, g),
-    }
+    }?;
+    outputs.commit()
 }
 
-/// On Ctrl-C or SIGTERM, remove temporary output files before exiting (no partial outputs).
+/// On a terminating signal, remove temporary output files before exiting (no partial outputs).
+///
+/// Ctrl-C, SIGTERM, SIGHUP, SIGQUIT, SIGALRM, SIGUSR1/2, SIGXCPU (a CPU-time limit) and
+/// SIGVTALRM/SIGPROF all end the run the same way: temporaries removed, one line on stderr, exit
+/// 128 + the signal's number. SIGXFSZ (a `ulimit -f` file-size limit) is caught and ignored, so
+/// the write that crossed the limit fails with "File too large" and the run ends as for a full
+/// disk: exit 2 naming the output. Only SIGKILL cannot be caught; the temporaries it leaves are
+/// removed by the next run that writes into the same directory (`formation::io`).
 pub fn install_signal_cleanup() {
-    // Temporaries are tracked in `formation::io`; an existing output is never touched before the
-    // final rename, so removing the temporaries is all a clean interruption needs.
-    let _ = ctrlc::set_handler(|| {
-        formation::io::remove_open_temporaries();
-        eprintln!("error: interrupted; no output written");
-        std::process::exit(130);
-    });
+    use signal_hook::consts::signal::*;
+    // An existing output is never touched before the final rename, so removing the temporaries
+    // is all a clean interruption needs.
+    let terminating = [
+        SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGALRM, SIGUSR1, SIGUSR2, SIGXCPU, SIGVTALRM, SIGPROF,
+    ];
+    if let Ok(mut signals) =
+        signal_hook::iterator::Signals::new(terminating.iter().chain(&[SIGXFSZ]))
+    {
+        std::thread::spawn(move || {
+            for sig in signals.forever() {
+                if sig == SIGXFSZ {
+                    continue;
+                }
+                formation::io::remove_open_temporaries();
+                let what = match sig {
+                    SIGINT | SIGTERM => "interrupted".to_string(),
+                    _ => format!(
+                        "stopped by signal {}",
+                        signal_hook::low_level::signal_name(sig).unwrap_or("?")
+                    ),
+                };
+                eprintln!("error: {what}; no output written");
+                std::process::exit(128 + sig);
+            }
+        });
+    }
 }
 
 /// Writes `anim` to every output (by extension: .json, .csv, .gif, DIR/, .glb), atomically, with

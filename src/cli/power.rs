@@ -1,6 +1,5 @@
 //! `formation power SHAPE [--json]`: e_i, ξ_i and E of a shape (SPEC §4.3).
 
-use std::io::Write;
 use std::path::PathBuf;
 
 use clap::Args;
@@ -105,9 +104,7 @@ pub fn run(args: PowerArgs, _g: Global) -> Result<()> {
              C = induced / total power (0.3-0.5 in cruise); x, y in wingspans, y behind the leader\n",
         );
     }
-    std::io::stdout()
-        .write_all(out.as_bytes())
-        .map_err(|e| Error::io("<stdout>", e))
+    super::stdout::print(&out)
 }
 
 /// Prefixes a model error with the file it came from.

@@ -57,6 +57,7 @@ pub fn run(args: SolveArgs, _g: Global) -> Result<()> {
         return Err(Error::parameter("--tolerance", "must be a positive number"));
     }
     let target: Target = formation::io::read_json(&args.target)?;
+    formation::limits::check_shape_size(&format!("{}: x", args.target.display()), target.x.len())?;
     let opts = SolveOptions {
         tolerance: args.tolerance,
         aero: formation::aero::AeroOptions {

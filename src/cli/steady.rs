@@ -108,9 +108,23 @@ impl SteadyFlags {
 pub fn run(args: SteadyArgs, g: Global) -> Result<()> {
     let opts = args.steady.options(args.birds, args.frames, g.seed)?;
     let wing = args.wingbeat.options()?;
-    formation::export::plan_outputs(&args.output)?;
+    let plan = formation::export::plan_outputs(&args.output)?;
     if let Some(r) = &args.report {
-        OutputKind::from_path(r, &[OutputKind::Json])?;
+        OutputKind::for_flag("--report", r, &[OutputKind::Json])?;
+        formation::io::check_output_dir("--report", r)?;
+        let id = formation::io::output_identity(r);
+        if plan
+            .iter()
+            .any(|o| formation::io::output_identity(&o.path) == id)
+        {
+            return Err(formation::Error::parameter(
+                "--report",
+                format!(
+                    "{}: is also given to -o; the report needs a file of its own",
+                    r.display()
+                ),
+            ));
+        }
     }
     let params = read_params(&args.params)?;
     let mut rng = formation::rng::stream(g.seed, "steady");

@@ -163,26 +163,13 @@ pub fn plan_outputs(outputs: &[PathBuf]) -> Result<Vec<Output>> {
         } else {
             p.clone()
         };
-        if !seen.insert(path.clone()) {
+        if !seen.insert(crate::io::output_identity(&path)) {
             return Err(Error::parameter(
                 "-o",
                 format!("{}: given twice", path.display()),
             ));
         }
-        let parent = match path.parent() {
-            Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-            _ => PathBuf::from("."),
-        };
-        if !parent.is_dir() {
-            return Err(Error::parameter(
-                "-o",
-                format!(
-                    "{}: directory {} does not exist; create it first",
-                    path.display(),
-                    parent.display()
-                ),
-            ));
-        }
+        crate::io::check_output_dir("-o", &path)?;
         if kind == OutputKind::Directory {
             if path.exists() && !path.is_dir() {
                 return Err(Error::format(

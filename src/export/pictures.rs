@@ -342,7 +342,11 @@ pub fn write_png_dir(
                 h as u32,
                 image::ExtendedColorType::Rgb8,
             )
-            .map_err(|e| Error::Internal(format!("{}: PNG encoder: {e}", target.display())))?;
+            .map_err(|e| match e {
+                // A full disk or a file-size limit: the user's problem with the output, exit 2.
+                image::ImageError::IoError(e) => Error::io(path, e),
+                other => Error::Internal(format!("{}: PNG encoder: {other}", path.display())),
+            })?;
             out.flush().map_err(|e| Error::io(path, e))?;
             Ok(())
         },

@@ -136,8 +136,15 @@ impl ExtractOptions {
                 ),
             ));
         }
-        if self.max_samples < 1 {
-            return Err(Error::parameter("--max-samples", "must be at least 1"));
+        if !(1..=crate::limits::MAX_RANSAC_SAMPLES).contains(&self.max_samples) {
+            return Err(Error::parameter(
+                "--max-samples",
+                format!(
+                    "must be between 1 and {} (each sample costs a pass over the frame's birds), got {}",
+                    crate::limits::MAX_RANSAC_SAMPLES,
+                    self.max_samples
+                ),
+            ));
         }
         if !(self.j_offset.is_finite() && (0.0..=1.0).contains(&self.j_offset)) {
             return Err(Error::parameter(

@@ -113,6 +113,16 @@ impl SteadyOptions {
                 format!("{}: at most {} birds", self.birds, crate::limits::MAX_BIRDS),
             ));
         }
+        if self.birds > crate::limits::MAX_FORMATION_BIRDS {
+            return Err(p(
+                "--birds",
+                format!(
+                    "{}: at most {} birds fly as one formation (the steady flight's cost grows with the square of a formation's birds)",
+                    self.birds,
+                    crate::limits::MAX_FORMATION_BIRDS
+                ),
+            ));
+        }
         if self.frames == 0 {
             return Err(p("--frames", "0: at least 1 frame is needed".into()));
         }
