@@ -210,7 +210,8 @@ fn write_fixtures() {
 }
 
 /// Odd movies: an echelon (leader at the left end, a line), a 2-bird movie, two animated birds,
-/// no positions, zero deviations and a mean gap inside the downwash (a wrong scale).
+/// no positions, zero deviations, and mean gaps with overlapping wingtips (0.6, and 0.3: a
+/// negative total saving for two birds).
 #[test]
 fn odd_movies_still_give_valid_flights() {
     use formation::extract::params::ShapeModel;

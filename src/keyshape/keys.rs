@@ -100,7 +100,7 @@ pub struct KeyStats {
     /// Draws redrawn (or damping steps skipped) because their linear prediction already broke
     /// the structure or the jump bound; no solve was spent on them.
     pub rejected_predicted: usize,
-    /// Solves that reported an error (unreachable target, downwash).
+    /// Solves that reported an error (unreachable target, collision).
     pub solve_errors: usize,
     /// Solves above the residual bound.
     pub rejected_residual: usize,

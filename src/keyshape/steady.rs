@@ -11,7 +11,7 @@
 //!
 //! The lateral positions are drawn once and kept for the whole flight: gaps from N(d̄, σ̄_x) with
 //! d̄ uniform in the movie's range of mean gaps [min_f μ_xf, max_f μ_xf] and σ̄_x the mean of σ_xf,
-//! redrawn within π/4 + margin. Munk's theorem then fixes E = Σ_{i≠j} g(|x_i − x_j|, 0) for every
+//! redrawn only at or below a body's width (`min_gap`; overlapping wingtips are kept). Munk's theorem then fixes E = Σ_{i≠j} g(|x_i − x_j|, 0) for every
 //! key shape (`aero::munk_total`), which makes eq. (3) exact instead of an estimate from a
 //! constant-gap flock. The world frame places the leader at (0, speed·t, 0) and every bird at
 //! (x_i, speed·t − y_i(t), 0) (SPEC §2).
