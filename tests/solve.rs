@@ -198,3 +198,27 @@ fn bad_inputs_are_typed_errors() {
     assert!(solve(&[0.0, 1.0], &[-0.5, 0.2], None, &o).is_err());
     assert!(solve(&[0.0, 1.0], &[0.5, 0.5], Some(&[0.0]), &o).is_err());
 }
+
+/// A bird in downwash (negative ξ, deep wingtip overlap behind the flock) is reachable: from a
+/// guess with the original fore-aft order the solve finds the original shape; from its own
+/// starts it finds a shape with the same ξ (possibly in another order of the overlapping pairs,
+/// each of which has its own solution).
+#[test]
+fn negative_savings_round_trip() {
+    let x = [0.0, 0.77, 1.54, -0.77, -1.54, 0.3];
+    let y = [0.0, 1.24, 2.48, 1.24, 2.48, 4.0];
+    let p = power_reduction(&x, &y).unwrap();
+    assert!(p.xi[5] < 0.0, "bird 5 flies in downwash: {:?}", p.xi);
+    let guess: Vec<f64> = y.iter().map(|v| v + 0.1).collect();
+    let rep = solve(&x, &p.xi, Some(&guess), &SolveOptions::default()).unwrap();
+    assert!(rep.converged);
+    for (a, b) in rep.y.iter().zip(&y) {
+        assert!((a - b).abs() < 1e-6, "{a} vs {b}");
+    }
+    let own = solve(&x, &p.xi, None, &SolveOptions::default()).unwrap();
+    assert!(own.converged, "{own:?}");
+    let again = power_reduction(&x, &own.y).unwrap();
+    for (a, b) in again.xi.iter().zip(&p.xi) {
+        assert!((a - b).abs() < 1e-8);
+    }
+}

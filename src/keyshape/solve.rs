@@ -151,12 +151,13 @@ fn validate(
 /// collides, and the fore-aft order of the laterally overlapping pairs has to be chosen (the
 /// solve keeps it; each order has at most one solution):
 ///
-/// 1. a **V** behind the bird with the smallest target (the bird that gains least flies in
-///    front): y_i = |x_i − x_m| (45° arms), the right arm one collision chord further back so
+/// 1. a **V** behind the bird with the smallest non-negative target (the bird that gains least
+///    flies in front; a negative target is a bird in downwash, which is behind): y_i = |x_i − x_m| (45° arms), the right arm one collision chord further back so
 ///    that birds at equal distances on both arms are not abreast: every overlapping pair in
 ///    lateral order away from the leader, as in the V, J, echelon and U of real flocks;
 /// 2. an order **by targets**: in a pair the bird in front gets less than half the pair's
-///    saving, so birds are placed in order of increasing target (ties: lower index first), each
+///    saving, so birds are placed in order of increasing target, negative targets last (ties:
+///    lower index first), each
 ///    two collision chords behind the rearmost already placed bird it overlaps laterally.
 pub fn default_starts(x: &[f64], target: &[f64], aero: &AeroOptions) -> Vec<Vec<f64>> {
     let n = x.len();
@@ -165,9 +166,13 @@ pub fn default_starts(x: &[f64], target: &[f64], aero: &AeroOptions) -> Vec<Vec<
         return vec![zeros];
     }
     let chord = aero.collision_chord.max(1e-3);
-    let m = (0..n)
-        .min_by(|&a, &b| target[a].total_cmp(&target[b]).then(a.cmp(&b)))
-        .unwrap_or(0);
+    // A negative target is a bird in downwash, i.e. behind: it neither leads nor goes in front.
+    let rank = |i: usize| (target[i] < 0.0, target[i]);
+    let by_rank = |a: &usize, b: &usize| {
+        let (ra, rb) = (rank(*a), rank(*b));
+        ra.0.cmp(&rb.0).then(ra.1.total_cmp(&rb.1)).then(a.cmp(b))
+    };
+    let m = (0..n).min_by(by_rank).unwrap_or(0);
     let v: Vec<f64> = x
         .iter()
         .map(|&xi| (xi - x[m]).abs() + if xi > x[m] { chord } else { 0.0 })
@@ -177,7 +182,7 @@ pub fn default_starts(x: &[f64], target: &[f64], aero: &AeroOptions) -> Vec<Vec<
     by_x.sort_by(|&a, &b| x[a].total_cmp(&x[b]).then(a.cmp(&b)));
     let sorted_x: Vec<f64> = by_x.iter().map(|&i| x[i]).collect();
     let mut order: Vec<usize> = (0..n).collect();
-    order.sort_by(|&a, &b| target[a].total_cmp(&target[b]).then(a.cmp(&b)));
+    order.sort_by(by_rank);
     let mut y = vec![f64::NAN; n];
     for &i in &order {
         let lo = sorted_x.partition_point(|&v| v <= x[i] - COLLISION_SPAN);
