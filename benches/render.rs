@@ -7,6 +7,8 @@
 //!   (sampling, camera, 500 frames at 25 fps, file written), i.e. `formation render -o x.gif`
 //!   after reading the file.
 //! - `glb_14_birds_20s`, `csv_14_birds_20s`: the other exports of the same animation.
+//! - `frame_960x540_14_birds`, `frame_960x540_1000_birds`: drawing one 960×540 picture (sky,
+//!   clouds, birds) of the steady synthetic flock of 14 and of 1000 birds, follow camera.
 
 use std::path::PathBuf;
 
@@ -52,6 +54,21 @@ fn render(c: &mut Criterion) {
     g.bench_function("csv_14_birds_20s", |b| {
         b.iter(|| write_outputs(&anim, std::slice::from_ref(&csv), &opts, &Silent).unwrap())
     });
+    for birds in [14usize, 1000] {
+        let p = SyntheticParams {
+            birds,
+            seconds: 6.0,
+            ..SyntheticParams::default()
+        };
+        let a = synthetic_flock(&mut formation::rng::seeded(0), &p);
+        let film = Film::new(&a, 25.0, 960, 540);
+        let k = film.len() - 1;
+        let mut canvas = formation::export::raster::Canvas::new(960, 540);
+        let mut mask = formation::export::raster::Mask::new();
+        g.bench_function(format!("frame_960x540_{birds}_birds"), |b| {
+            b.iter(|| film.draw(k, &mut canvas, &mut mask, true))
+        });
+    }
     g.finish();
     let _ = std::fs::remove_dir_all(gif.parent().unwrap());
 }

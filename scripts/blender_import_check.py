@@ -1,33 +1,65 @@
-# Imports a .glb written by `formation` into Blender (headless) and prints what arrived: objects,
-# meshes, actions, bird nodes, the actions' frame range, and a bird's position at three frames.
-# Usage: blender -b --python scripts/blender_import_check.py -- flock.glb
+# Imports a .glb written by `formation` into Blender (headless) and checks what arrived: one
+# armature per bird with the documented bones, one action per clip and bird, the wing bones turning
+# and the birds moving while the clips play. Prints a summary; exits 1 when a check fails.
+# Usage: blender -b --python scripts/blender_import_check.py -- flock.glb [FPS]
+# FPS (default 30) is set on the scene BEFORE the import, as docs/export.md advises, so that the
+# importer turns the file's seconds into frames at the animation's own rate.
 # (Debian's Blender 3.4 glTF add-on still uses numpy.bool, which numpy 1.24 removed: the first
 # lines put Debian's numpy first and restore the alias.)
 import sys; sys.path.insert(0, "/usr/lib/python3/dist-packages"); [sys.modules.pop(m) for m in list(sys.modules) if m.startswith("numpy")]
 import numpy; numpy.bool = bool
-import bpy, sys
+import bpy
+
+args = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else sys.argv[-1:]
+path = args[0]
+fps = int(args[1]) if len(args) > 1 else 30
 bpy.ops.wm.read_factory_settings(use_empty=True)
-bpy.ops.import_scene.gltf(filepath=sys.argv[-1])
-objs = bpy.data.objects
-print("OBJECTS", len(objs))
-print("MESHES", sum(1 for o in objs if o.type == 'MESH'))
-print("ACTIONS", len(bpy.data.actions))
-birds = [o for o in objs if o.name.startswith("bird_") and o.name.count("_") == 1]
-print("BIRD NODES", len(birds))
 sc = bpy.context.scene
-print("FRAME RANGE", sc.frame_start, sc.frame_end, "fps", sc.render.fps)
-b = birds[0]
-for f in (sc.frame_start, (sc.frame_start + sc.frame_end)//2, sc.frame_end):
-    sc.frame_set(f)
-    print("frame", f, b.name, tuple(round(v, 3) for v in b.matrix_world.translation))
-hand = objs.get("bird_00_hand_left")
-if hand:
-    angles = []
-    for f in range(sc.frame_end - 30, sc.frame_end):
+sc.render.fps = fps
+bpy.ops.import_scene.gltf(filepath=path)
+objs = bpy.data.objects
+arms = sorted((o for o in objs if o.type == 'ARMATURE'), key=lambda o: o.name)
+meshes = [o for o in objs if o.type == 'MESH']
+print("OBJECTS", len(objs), "ARMATURES", len(arms), "MESHES", len(meshes))
+bones = [b.name for b in arms[0].data.bones]
+print("BONES", bones)
+clips = sorted({t.name for a in arms if a.animation_data for t in a.animation_data.nla_tracks})
+print("CLIPS", clips, "ACTIONS", len(bpy.data.actions))
+failed = []
+want = ["body", "neck", "tail", "upper_arm.L", "hand.L", "upper_arm.R", "hand.R"]
+if bones != want:
+    failed.append("bones %s" % bones)
+names = [a.name for a in arms]
+if names != sorted(names) or not all(n.startswith("bird_") for n in names):
+    failed.append("armature names %s" % names[:5])
+for a in arms:
+    if not any(m.parent == a for m in meshes):
+        failed.append("%s has no skinned mesh" % a.name)
+        break
+# Play each clip alone on the first armature (as its active action) and look at the motion.
+a0 = arms[0]
+for clip in clips:
+    act = bpy.data.actions.get("%s_%s" % (clip, a0.name))
+    if act is None:
+        failed.append("no action for clip %s" % clip)
+        continue
+    for t in a0.animation_data.nla_tracks:
+        t.mute = True
+    a0.animation_data.action = act
+    lo, hi = int(act.frame_range[0]), int(act.frame_range[1])
+    wing, pos = [], []
+    for f in range(lo, min(hi, lo + 60) + 1):
         sc.frame_set(f)
-        angles.append(round(hand.matrix_world.to_euler()[1], 3))
-    print("hand rotation varies:", len(set(angles)) > 5)
-a = birds[0].animation_data.action if birds[0].animation_data else None
-print("ACTION RANGE", a.name if a else None, tuple(a.frame_range) if a else None)
-lo = min(x.frame_range[0] for x in bpy.data.actions); hi = max(x.frame_range[1] for x in bpy.data.actions)
-print("ALL ACTIONS RANGE", lo, hi)
+        wing.append(round(a0.pose.bones["upper_arm.L"].matrix.to_euler()[2], 4))
+        pos.append(tuple(round(v, 3) for v in a0.matrix_world.translation))
+    print("CLIP", clip, "frames", lo, hi, "wing angles", len(set(wing)), "positions", len(set(pos)),
+          "start", pos[0], "after 60 frames", pos[-1])
+    if len(set(wing)) < 10:
+        failed.append("%s: upper_arm.L does not flap" % clip)
+    if len(set(pos)) < 10:
+        failed.append("%s: %s does not move" % (clip, a0.name))
+print("SCENE fps", sc.render.fps, "range", sc.frame_start, sc.frame_end)
+if failed:
+    print("FAILED", "; ".join(failed))
+    sys.exit(1)
+print("OK")

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Regenerates the pictures in README.md and docs/usage.md from the bundled example data with the
-# release binary. Usage: bash scripts/readme_images.sh
+# Regenerates the pictures in README.md, docs/usage.md and docs/export.md from the bundled example
+# data with the release binary, and prints the size of the README job's GIF (to keep the numbers
+# in README.md and docs/export.md honest). Usage: bash scripts/readme_images.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cargo build --release --quiet
@@ -12,11 +13,26 @@ I=docs/images
 mkdir -p "$I"
 $B extract $E/barnacle_geese_v.json -o "$T/geese.json" > /dev/null
 $B plot shape "$T/geese.json" --frame 0 -o "$I/usage-fit.png"
+# The README job's animation: take-off and steady frames from the follow camera.
 $B animate "$T/geese.json" --birds 14 -o "$T/flock.json" -o "$T/frames/" --picture-fps 1 --quiet
-ls "$T/frames" | wc -l
-cp "$T/frames/frame_00003.png" "$I/usage-initiation.png"
+n=$(ls "$T/frames" | wc -l)
+echo "$n frames at 1 fps"
+cp "$T/frames/frame_00006.png" "$I/usage-initiation.png"
 last=$(ls "$T/frames" | tail -n 3 | head -n 1)
 cp "$T/frames/$last" "$I/usage-steady.png"
+# The ground observer: the flock passes over at 70 % of the film; show it a second before.
+$B render "$T/flock.json" -o "$T/ground/" --camera ground --fps 1 --sun --quiet
+g=$(( (n - 1) * 7 / 10 - 1 ))
+cp "$T/ground/$(printf 'frame_%05d.png' "$g")" "$I/usage-ground.png"
+# One close frame per species (a small flock, so the follow camera is at its closest).
+for sp in goose crane pelican; do
+  $B animate "$T/geese.json" --birds 4 --seconds 6 --species "$sp" --seed 3 \
+    -o "$T/$sp/" --picture-fps 2 --quiet
+  cp "$T/$sp/frame_00045.png" "$I/species-$sp.png"
+done
+# The README job's GIF, for its size.
+$B animate $E/barnacle_geese_v.json --birds 14 -o "$T/flock.gif" --quiet
+echo "README job GIF: $(stat -c %s "$T/flock.gif") bytes"
 $B plot paths "$T/flock.json" -o "$I/usage-paths.png"
 $B plot xi "$T/flock.json" -o "$I/usage-xi.png"
 $B plot power "$T/flock.json" --key 2 -o "$I/usage-power.png"

@@ -89,6 +89,9 @@ pub struct Frame {
     pub heading: Vec<f64>,
     /// Ground speed, wingspans per second.
     pub speed: Vec<f64>,
+    /// Bank angle, radians, right wing down positive.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bank: Option<Vec<f64>>,
     /// Power reduction e_i of the current shape (absent when undefined, e.g. during initiation).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub e: Option<Vec<f64>>,

@@ -183,8 +183,14 @@ pub enum OutputKind {
     Svg,
     /// `.glb`
     Glb,
+    /// `.usda` (text USD)
+    Usda,
     /// A directory of numbered PNG frames.
     Directory,
+    /// `.mp4` (H.264 video through the system ffmpeg)
+    Mp4,
+    /// `.webm` (VP9 video through the system ffmpeg)
+    Webm,
 }
 
 impl OutputKind {
@@ -212,6 +218,9 @@ impl OutputKind {
             Some("png") => Some(OutputKind::Png),
             Some("svg") => Some(OutputKind::Svg),
             Some("glb") => Some(OutputKind::Glb),
+            Some("mp4") => Some(OutputKind::Mp4),
+            Some("webm") => Some(OutputKind::Webm),
+            Some("usda") => Some(OutputKind::Usda),
             _ => None,
         };
         let kind = if s.ends_with('/') || s.ends_with(std::path::MAIN_SEPARATOR) {
@@ -259,7 +268,10 @@ impl OutputKind {
             OutputKind::Png => ".png",
             OutputKind::Svg => ".svg",
             OutputKind::Glb => ".glb",
+            OutputKind::Usda => ".usda",
             OutputKind::Directory => "a directory (DIR/)",
+            OutputKind::Mp4 => ".mp4",
+            OutputKind::Webm => ".webm",
         }
     }
 }
@@ -578,6 +590,12 @@ impl AtomicFile {
             tmp,
             writer: Some(BufWriter::new(file)),
         })
+    }
+
+    /// Path of the temporary file, for a writer that opens it by name (the system ffmpeg);
+    /// [`AtomicFile::commit`] still renames it into place.
+    pub fn temp_path(&self) -> &Path {
+        &self.tmp
     }
 
     /// The buffered writer of the temporary file.

@@ -170,7 +170,7 @@ fn bad_flags_fail_up_front_with_one_line_and_no_file() {
     let dir = scratch("bad");
     let geese = example("barnacle_geese_v.json");
     let cases: &[(&[&str], &str)] = &[
-        (&["-o", "OUT/x.mp4"], "x.mp4"),
+        (&["-o", "OUT/x.avi"], "x.avi"),
         (&["-o", "OUT/x.gif", "--size", "0x0"], "--size"),
         (&["-o", "OUT/x.gif", "--fps", "0"], "fps"),
         (&["-o", "OUT/x.gif", "--fps", "nan"], "fps"),

@@ -181,6 +181,18 @@ fn bad_options_and_paths_exit_2_with_one_line_and_no_file() {
             vec!["-o".into(), g.into(), "--wingspan-m".into(), "0".into()],
             vec!["--wingspan-m"],
         ),
+        (
+            vec!["-o".into(), s(&d.join("missing/flock.usda")).into()],
+            vec!["flock.usda", "does not exist"],
+        ),
+        (
+            vec!["-o".into(), g.into(), "--keys".into(), "some".into()],
+            vec!["--keys"],
+        ),
+        (
+            vec!["-o".into(), g.into(), "--bird-model".into(), FIXTURE.into()],
+            vec!["--bird-model", "not a binary .glb"],
+        ),
     ];
     for (extra, needles) in cases {
         let mut args = vec!["render", FIXTURE];
@@ -202,8 +214,8 @@ fn a_bad_second_output_writes_nothing_and_keeps_existing_files() {
     let d = tmpdir("keep");
     let csv = d.join("keep.csv");
     std::fs::write(&csv, "old").unwrap();
-    let out = formation(&["render", FIXTURE, "-o", s(&csv), "-o", s(&d.join("x.mp4"))]);
-    assert_usage_error(&out, &["x.mp4"]);
+    let out = formation(&["render", FIXTURE, "-o", s(&csv), "-o", s(&d.join("x.avi"))]);
+    assert_usage_error(&out, &["x.avi"]);
     assert_eq!(std::fs::read_to_string(&csv).unwrap(), "old");
     // A frames directory holding someone else's files is refused, not replaced.
     std::fs::create_dir_all(d.join("mine")).unwrap();

@@ -27,7 +27,8 @@ pub struct AnimateArgs {
     /// Number of birds to animate (N ≥ 2; any number, whatever the movie had).
     #[arg(long)]
     pub birds: usize,
-    /// Outputs by extension: .gif, DIR/ (numbered PNG frames), .glb, .csv, .json; may be repeated.
+    /// Outputs by extension: .gif, DIR/ (numbered PNG frames), .mp4, .webm (through ffmpeg), .glb,
+    /// .usda, .csv, .json; may be repeated.
     #[arg(short = 'o', long = "output", required = true)]
     pub output: Vec<PathBuf>,
     /// Length of the steady flight, seconds (the initiation before it lasts as long as the flock
@@ -40,13 +41,15 @@ pub struct AnimateArgs {
     /// Picture size WIDTHxHEIGHT in pixels (GIF and PNG frames).
     #[arg(long, value_name = "WxH", default_value = "960x540", value_parser = super::render::parse_size)]
     pub size: (u32, u32),
-    /// Frame rate of the pictures [default: 25 for GIF, the animation's --fps for PNG frames].
+    /// Frame rate of the pictures [default: 25 for GIF, the animation's --fps for PNG frames and video].
     #[arg(
         long = "picture-fps",
         value_name = "FPS",
         allow_negative_numbers = true
     )]
     pub picture_fps: Option<f64>,
+    #[command(flatten)]
+    pub shot: super::render::ShotArgs,
     #[command(flatten)]
     pub read: ReadArgs,
     #[command(flatten)]
@@ -55,6 +58,8 @@ pub struct AnimateArgs {
     pub initiate: InitiateFlags,
     #[command(flatten)]
     pub wingbeat: WingbeatFlags,
+    #[command(flatten)]
+    pub scene: super::render::SceneArgs,
 }
 
 /// Runs `formation animate`.
@@ -82,14 +87,20 @@ pub fn run(args: AnimateArgs, g: Global) -> Result<()> {
     let steady_opts = args.steady.options(args.birds, frames, g.seed)?;
     let init_opts = args.initiate.options(g.seed, args.birds)?;
     let wing = args.wingbeat.options()?;
-    let render = RenderOptions {
+    let mut render = RenderOptions {
         width: args.size.0,
         height: args.size.1,
         fps: args.picture_fps,
+        keys: args.scene.keys,
+        bird_model: args.scene.bird_model.clone(),
         ..RenderOptions::default()
     };
+    args.shot.apply(&mut render)?;
     render.validate()?;
     formation::export::plan_outputs(&args.output)?;
+    if let Some(p) = &args.scene.bird_model {
+        formation::export::bird_model::load(p, wing.species)?;
+    }
 
     let progress = TermProgress::new(g.quiet);
     let params = extract::params_from_path(

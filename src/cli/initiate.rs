@@ -36,6 +36,8 @@ pub struct InitiateArgs {
     pub initiate: InitiateFlags,
     #[command(flatten)]
     pub wingbeat: super::wingbeat::WingbeatFlags,
+    #[command(flatten)]
+    pub scene: super::render::SceneArgs,
     /// Print the run's statistics as JSON on stdout.
     #[arg(long)]
     pub json: bool,
@@ -173,7 +175,7 @@ pub fn run(args: InitiateArgs, g: Global) -> Result<()> {
     // Savings (e, ξ) in the take-off frames too.
     formation::aero::fill_frame_savings(&mut anim, &Default::default());
     formation::wingbeat::assign_phases(&mut anim, &wing)?;
-    super::write_animation(&anim, &args.output, &Default::default(), g)?;
+    super::write_animation(&anim, &args.output, &args.scene.options(), g)?;
     if args.json {
         let text = formation::finite::to_json_pretty("statistics", &stats)?;
         super::stdout::println(&text)?;

@@ -15,11 +15,53 @@ use super::Global;
 pub struct RenderArgs {
     /// An animation file (SPEC §4.4).
     pub animation: PathBuf,
-    /// Outputs by extension: .gif, DIR/ (numbered PNG frames), .glb, .csv, .json; may be repeated.
+    /// Outputs by extension: .gif, DIR/ (numbered PNG frames), .mp4, .webm (through ffmpeg),
+    /// .glb, .usda, .csv, .json; may be repeated.
     #[arg(short = 'o', long = "output", required = true)]
     pub output: Vec<PathBuf>,
     #[command(flatten)]
     pub picture: PictureArgs,
+    #[command(flatten)]
+    pub shot: ShotArgs,
+}
+
+/// Camera and look of the pictures, shared by `render` and `animate` (defaults from
+/// [`RenderOptions::default`]).
+#[derive(Debug, Clone, Args)]
+pub struct ShotArgs {
+    /// Camera: follow (top-down, frames the flock), ground (an observer looking up as the flock
+    /// passes over) or fixed (the --view rectangle).
+    #[arg(long, value_name = "NAME", default_value = "follow")]
+    pub camera: String,
+    /// World rectangle of --camera fixed: x0,y0,x1,y1 in wingspans (x east, y north).
+    #[arg(long, value_name = "X0,Y0,X1,Y1", allow_hyphen_values = true, value_parser = formation::export::camera::parse_view)]
+    pub view: Option<[f64; 4]>,
+    /// Smallest on-screen wingspan of the follow camera, pixels; when the whole flock would be
+    /// smaller it zooms in on the leading birds (0 = always show the whole flock).
+    #[arg(long, value_name = "PX", default_value_t = RenderOptions::default().min_bird_px, allow_negative_numbers = true)]
+    pub min_bird_px: f64,
+    /// Background: sky (gradient and clouds), none (transparent PNG frames) or a colour #rrggbb.
+    #[arg(long, value_name = "BG", default_value = "sky")]
+    pub background: String,
+    /// Add a sun glow to the sky.
+    #[arg(long)]
+    pub sun: bool,
+    /// GIF: largest colour error (8-bit levels) a pixel may show before it is redrawn; higher
+    /// is smaller, 0 is exact.
+    #[arg(long, value_name = "LEVELS", default_value_t = RenderOptions::default().gif_tolerance, allow_negative_numbers = true)]
+    pub gif_tolerance: f64,
+}
+
+impl ShotArgs {
+    /// Sets the camera and look in `opts`.
+    pub fn apply(&self, opts: &mut RenderOptions) -> Result<()> {
+        opts.camera = formation::export::CameraKind::parse(&self.camera, self.view)?;
+        opts.background = formation::export::Background::parse(&self.background)?;
+        opts.min_bird_px = self.min_bird_px;
+        opts.sun = self.sun;
+        opts.gif_tolerance = self.gif_tolerance;
+        Ok(())
+    }
 }
 
 /// Picture and export flags shared by `render` and `animate`.
@@ -29,7 +71,7 @@ pub struct PictureArgs {
     #[arg(long, value_name = "WxH", default_value = "960x540", value_parser = parse_size)]
     pub size: (u32, u32),
     /// Frame rate of the pictures, frames per second [default: 25 for GIF (rounded to whole
-    /// 1/100 s per frame, at most 50), the animation's own rate for PNG frames]. JSON, CSV and glTF
+    /// 1/100 s per frame, at most 50), the animation's own rate for PNG frames and video]. JSON, CSV and glTF
     /// keep the animation's frames.
     #[arg(long, value_name = "FPS", allow_negative_numbers = true)]
     pub fps: Option<f64>,
@@ -37,6 +79,32 @@ pub struct PictureArgs {
     /// animation's, 1.5 for a goose].
     #[arg(long, value_name = "M", allow_negative_numbers = true)]
     pub wingspan_m: Option<f64>,
+    #[command(flatten)]
+    pub scene: SceneArgs,
+}
+
+/// Flags of the 3D outputs (.glb, .usda), shared by `render` and `animate`.
+#[derive(Debug, Clone, Args)]
+pub struct SceneArgs {
+    /// Keyframes of .glb and .usda: `all` (every frame) or `reduced` (only the keys needed to
+    /// stay within 1 mm and 0.1° of every frame for the flight, 1° for the wingbeat).
+    #[arg(long, value_name = "all|reduced", default_value_t = RenderOptions::default().keys)]
+    pub keys: formation::export::keys::KeyMode,
+    /// Your own bird (.glb) on every bird of the .glb and .usda: a static mesh flies and banks, a
+    /// skinned one whose joints follow the naming convention (docs/export.md) also flaps.
+    #[arg(long, value_name = "FILE.glb")]
+    pub bird_model: Option<PathBuf>,
+}
+
+impl SceneArgs {
+    /// Default render options with these flags.
+    pub fn options(&self) -> RenderOptions {
+        RenderOptions {
+            keys: self.keys,
+            bird_model: self.bird_model.clone(),
+            ..RenderOptions::default()
+        }
+    }
 }
 
 impl PictureArgs {
@@ -47,7 +115,9 @@ impl PictureArgs {
             height: self.size.1,
             fps: self.fps,
             wingspan_m: self.wingspan_m,
-            threads: 0,
+            keys: self.scene.keys,
+            bird_model: self.scene.bird_model.clone(),
+            ..RenderOptions::default()
         }
     }
 }
@@ -77,7 +147,8 @@ pub fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
 
 /// Runs `formation render`.
 pub fn run(args: RenderArgs, g: Global) -> Result<()> {
-    let opts = args.picture.options();
+    let mut opts = args.picture.options();
+    args.shot.apply(&mut opts)?;
     opts.validate()?;
     // Check the outputs before reading a possibly large animation.
     formation::export::plan_outputs(&args.output)?;

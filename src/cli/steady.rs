@@ -36,6 +36,8 @@ pub struct SteadyArgs {
     pub steady: SteadyFlags,
     #[command(flatten)]
     pub wingbeat: super::wingbeat::WingbeatFlags,
+    #[command(flatten)]
+    pub scene: super::render::SceneArgs,
     /// Also write the run's report (correspondence, ranges, solve statistics) as JSON here.
     #[arg(long)]
     pub report: Option<PathBuf>,
@@ -131,7 +133,7 @@ pub fn run(args: SteadyArgs, g: Global) -> Result<()> {
     let progress = TermProgress::new(g.quiet);
     let (mut anim, report) = steady_flight_report(&params, &opts, &mut rng, &progress)?;
     formation::wingbeat::assign_phases(&mut anim, &wing)?;
-    super::write_animation(&anim, &args.output, &Default::default(), g)?;
+    super::write_animation(&anim, &args.output, &args.scene.options(), g)?;
     if let Some(r) = &args.report {
         write_json_atomic(r, &report)?;
     }

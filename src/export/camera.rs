@@ -1,59 +1,287 @@
-//! The camera of the image outputs: a top-down view, north up and east right, that follows the
-//! flock and keeps every bird inside the picture with a margin.
+//! The cameras of the image outputs (`--camera`):
 //!
-//! The path is computed offline over all output frames. The centre is the flock's bounding-box
-//! centre smoothed by a Gaussian in time (odd reflection at both ends, so steady motion is not
-//! biased). The zoom is then chosen in two steps that guarantee containment while staying smooth:
-//! for each frame the largest scale `s_need(t)` (pixels per wingspan) that still fits every bird
-//! around the smoothed centre, then an erosion (minimum over ±W frames) followed by a Gaussian
-//! average over the same ±W in log scale:
+//! - **follow** (default): a top-down view, north up and east right, that frames the flock and
+//!   moves smoothly. Birds are never drawn smaller than [`CameraParams::min_bird_px`] (pixels
+//!   per wingspan, default 12): when the whole flock would need a smaller scale to fit, the
+//!   camera zooms in on the leading birds (those nearest the front along the flock's heading)
+//!   and lets the trailing ones leave the picture.
+//! - **ground**: a fixed observer standing under the flock's course, looking up at
+//!   [`GroundParams::elevation_deg`] towards the oncoming flock with a perspective lens; the
+//!   flock approaches low over the horizon, grows and passes over the top of the picture.
+//! - **fixed**: a given rectangle of the world (`--view x0,y0,x1,y1`, wingspans), top-down.
+//!
+//! The follow path is computed offline over all output frames. The centre (the flock's bounding
+//! box centre, or the leading birds' when zoomed in) is smoothed by a Gaussian in time (odd
+//! reflection at both ends, so steady motion is not biased). The zoom is then chosen in two steps
+//! that guarantee containment and the minimum size while staying smooth: for each frame the
+//! largest scale `s_fit(t)` that still fits every bird around the smoothed centre, raised to the
+//! minimum, `s_need = max(s_min, min(s_fit, s_max))`; then an erosion (minimum over ±W frames)
+//! followed by a Gaussian average over the same ±W in log scale:
 //! ```math
 //! \log s(t) = \sum_{|k|\le W} w_k \min_{|j|\le W} \log s_\text{need}(t+k+j) \le \log s_\text{need}(t)
 //! ```
-//! (every term of the average is a minimum over a window that contains `t`), so no bird ever
-//! leaves the frame, and the zoom eases in and out instead of jumping.
+//! Every term of the average is a minimum over a window that contains `t`, so a flock that fits
+//! at `s_min` or more never leaves the frame; and every `s_need ≥ s_min`, so the average is too:
+//! the birds are never smaller than the minimum in any frame.
+//!
+//! The ground camera's projection of a world point `p` (eye `o`, unit forward `f`, right
+//! `r = f × ẑ / |f × ẑ|`, up `u = r × f`, focal length `F` pixels):
+//! ```math
+//! c = w/2 + F \frac{(p-o)\cdot r}{(p-o)\cdot f}, \qquad
+//! \text{row} = h/2 - F \frac{(p-o)\cdot u}{(p-o)\cdot f}, \qquad
+//! F = \frac{h/2}{\tan(\text{fov}/2)}
+//! ```
 
-use super::rig::BIRD_RADIUS;
 use super::sample::BirdState;
+use crate::error::{Error, Result};
+
+/// Which camera draws the pictures.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum CameraKind {
+    /// Top-down, following the flock with a minimum bird size.
+    #[default]
+    Follow,
+    /// A fixed observer on the ground looking up (perspective).
+    Ground,
+    /// A fixed top-down view of the world rectangle `[x0, y0, x1, y1]`, wingspans.
+    Fixed([f64; 4]),
+}
+
+impl CameraKind {
+    /// Parses `follow`, `ground` or `fixed` (`fixed` takes its rectangle from `view`).
+    pub fn parse(name: &str, view: Option<[f64; 4]>) -> Result<CameraKind> {
+        match (name, view) {
+            ("follow", None) => Ok(CameraKind::Follow),
+            ("ground", None) => Ok(CameraKind::Ground),
+            ("fixed", Some(v)) => Ok(CameraKind::Fixed(v)),
+            ("fixed", None) => Err(Error::parameter(
+                "--camera",
+                "fixed needs the view rectangle: add --view x0,y0,x1,y1 (world, wingspans)",
+            )),
+            ("follow" | "ground", Some(_)) => Err(Error::parameter(
+                "--view",
+                format!("only applies to --camera fixed, not {name}"),
+            )),
+            _ => Err(Error::parameter(
+                "--camera",
+                format!("unknown camera {name:?}; use follow, ground or fixed"),
+            )),
+        }
+    }
+
+    /// Checks a fixed view's rectangle.
+    pub fn validate(&self) -> Result<()> {
+        if let CameraKind::Fixed([x0, y0, x1, y1]) = *self {
+            if ![x0, y0, x1, y1].iter().all(|v| v.is_finite()) {
+                return Err(Error::parameter(
+                    "--view",
+                    "every corner must be a finite number of wingspans",
+                ));
+            }
+            if x1 - x0 <= 1e-9 || y1 - y0 <= 1e-9 {
+                return Err(Error::parameter(
+                    "--view",
+                    format!("{x0},{y0},{x1},{y1} has zero or negative size; give x0,y0,x1,y1 with x1 > x0 and y1 > y0 (wingspans)"),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Parses `x0,y0,x1,y1` (wingspans).
+pub fn parse_view(s: &str) -> std::result::Result<[f64; 4], String> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|p| p.trim().parse::<f64>())
+        .collect::<std::result::Result<_, _>>()
+        .map_err(|_| format!("expected x0,y0,x1,y1 in wingspans like -20,0,20,40, got {s:?}"))?;
+    if v.len() != 4 {
+        return Err(format!(
+            "expected four numbers x0,y0,x1,y1 in wingspans, got {}",
+            v.len()
+        ));
+    }
+    Ok([v[0], v[1], v[2], v[3]])
+}
+
+/// A perspective eye (the ground camera).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Eye {
+    /// Position, world frame, wingspans.
+    pub at: [f64; 3],
+    /// Unit viewing direction.
+    pub forward: [f64; 3],
+    /// Unit image-right direction.
+    pub right: [f64; 3],
+    /// Unit image-up direction.
+    pub up: [f64; 3],
+    /// Focal length, pixels.
+    pub focal_px: f64,
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn unit(a: [f64; 3]) -> [f64; 3] {
+    let n = dot(a, a).sqrt().max(1e-300);
+    a.map(|v| v / n)
+}
+
+impl Eye {
+    /// An eye at `at` looking along `forward` (not vertical), with image up towards the sky,
+    /// and a vertical field of view `fov_deg` over `height` pixels.
+    pub fn looking(at: [f64; 3], forward: [f64; 3], fov_deg: f64, height: usize) -> Eye {
+        let f = unit(forward);
+        let r = unit(cross(f, [0.0, 0.0, 1.0]));
+        let u = cross(r, f);
+        Eye {
+            at,
+            forward: f,
+            right: r,
+            up: u,
+            focal_px: 0.5 * height as f64 / (0.5 * fov_deg.to_radians()).tan(),
+        }
+    }
+
+    /// Direction of the ray through pixel `(col, row)` (not normalised).
+    pub fn ray(&self, col: f64, row: f64, width: usize, height: usize) -> [f64; 3] {
+        let a = (col - 0.5 * width as f64) / self.focal_px;
+        let b = (0.5 * height as f64 - row) / self.focal_px;
+        [0, 1, 2].map(|k| self.forward[k] + a * self.right[k] + b * self.up[k])
+    }
+}
+
+/// Nearest distance in front of the ground eye that is drawn, wingspans.
+pub const NEAR: f64 = 0.5;
 
 /// Camera placement for one output frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct View {
-    /// World point at the image centre, east, wingspans.
-    pub cx: f64,
-    /// World point at the image centre, north, wingspans.
-    pub cy: f64,
-    /// Pixels per wingspan.
-    pub scale: f64,
+pub enum View {
+    /// Orthographic, north up, east right.
+    Top {
+        /// World point at the image centre, east, wingspans.
+        cx: f64,
+        /// World point at the image centre, north, wingspans.
+        cy: f64,
+        /// Pixels per wingspan.
+        scale: f64,
+    },
+    /// Perspective from the ground.
+    Ground(Eye),
 }
 
 impl View {
-    /// Pixel coordinates `(column, row)` of a world point in a `width × height` image.
+    /// Pixel coordinates `(column, row)` of the world point `(x, y, z)` in a `width × height`
+    /// image, and its size there in pixels per wingspan; `None` behind (or too near) the eye.
+    pub fn project(&self, p: [f64; 3], width: usize, height: usize) -> Option<(f64, f64, f64)> {
+        match self {
+            View::Top { cx, cy, scale } => Some((
+                0.5 * width as f64 + (p[0] - cx) * scale,
+                0.5 * height as f64 - (p[1] - cy) * scale,
+                *scale,
+            )),
+            View::Ground(e) => {
+                let d = [p[0] - e.at[0], p[1] - e.at[1], p[2] - e.at[2]];
+                let depth = dot(d, e.forward);
+                if depth < NEAR {
+                    return None;
+                }
+                let s = e.focal_px / depth;
+                Some((
+                    0.5 * width as f64 + s * dot(d, e.right),
+                    0.5 * height as f64 - s * dot(d, e.up),
+                    s,
+                ))
+            }
+        }
+    }
+
+    /// Pixel coordinates of the ground point `(x, y)` of a top-down view (the ground camera
+    /// projects it at `z = 0`, behind-the-eye points far off-screen).
     pub fn to_pixel(&self, x: f64, y: f64, width: usize, height: usize) -> (f64, f64) {
-        (
-            0.5 * width as f64 + (x - self.cx) * self.scale,
-            0.5 * height as f64 - (y - self.cy) * self.scale,
-        )
+        self.project([x, y, 0.0], width, height)
+            .map(|(c, r, _)| (c, r))
+            .unwrap_or((f64::MAX, f64::MAX))
+    }
+
+    /// Pixels per wingspan of a top-down view; for the ground camera, at 1 wingspan distance
+    /// (its focal length).
+    pub fn scale(&self) -> f64 {
+        match self {
+            View::Top { scale, .. } => *scale,
+            View::Ground(e) => e.focal_px,
+        }
+    }
+}
+
+/// The ground observer.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GroundParams {
+    /// Height of the flock above the observer where it passes over, wingspans (the animation's
+    /// `z` is taken relative to the flock's median height then).
+    pub distance: f64,
+    /// Elevation of the viewing direction above the horizon, degrees.
+    pub elevation_deg: f64,
+    /// Vertical field of view, degrees.
+    pub fov_deg: f64,
+    /// When the flock passes over the observer, as a fraction of the picture's duration.
+    pub pass_at: f64,
+}
+
+impl Default for GroundParams {
+    fn default() -> Self {
+        GroundParams {
+            distance: 25.0,
+            elevation_deg: 60.0,
+            fov_deg: 60.0,
+            pass_at: 0.7,
+        }
     }
 }
 
 /// How the camera frames the flock.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CameraParams {
-    /// Empty border kept around the outermost birds, as a fraction of the shorter image side.
+    /// Which camera.
+    pub kind: CameraKind,
+    /// Empty border kept around the outermost birds (follow camera), as a fraction of the
+    /// shorter image side.
     pub margin: f64,
-    /// Closest zoom: the image shows at least this many wingspans along its shorter side.
+    /// Closest zoom of the follow camera: the image shows at least this many wingspans along its
+    /// shorter side.
     pub min_extent: f64,
-    /// Standard deviation of the Gaussian smoothing of the centre and the zoom, seconds.
+    /// Smallest bird drawn by the follow camera, pixels per wingspan (the wingspan on screen);
+    /// 0 = always fit the whole flock.
+    pub min_bird_px: f64,
+    /// Standard deviation of the Gaussian smoothing of the follow camera's centre and zoom,
+    /// seconds.
     pub smoothing_s: f64,
+    /// The ground camera.
+    pub ground: GroundParams,
+    /// Largest distance from a bird's origin to any part of it, wingspans.
+    pub bird_radius: f64,
 }
 
 impl Default for CameraParams {
     fn default() -> Self {
         CameraParams {
+            kind: CameraKind::Follow,
             margin: 0.07,
             min_extent: 7.0,
-            smoothing_s: 0.6,
+            min_bird_px: 12.0,
+            smoothing_s: 0.8,
+            ground: GroundParams::default(),
+            bird_radius: super::rig::BIRD_RADIUS,
         }
     }
 }
@@ -107,39 +335,98 @@ pub fn track(
     if n == 0 {
         return Vec::new();
     }
+    match p.kind {
+        CameraKind::Fixed([x0, y0, x1, y1]) => {
+            let scale = (width as f64 / (x1 - x0)).min(height as f64 / (y1 - y0));
+            vec![
+                View::Top {
+                    cx: 0.5 * (x0 + x1),
+                    cy: 0.5 * (y0 + y1),
+                    scale,
+                };
+                n
+            ]
+        }
+        CameraKind::Ground => vec![View::Ground(ground_eye(states, height, &p.ground)); n],
+        CameraKind::Follow => follow(states, fps, width, height, p),
+    }
+}
+
+/// The ground observer for these frames: under the flock's centre at the pass time, `distance`
+/// below the flock's median height then, looking up towards where the flock comes from.
+pub fn ground_eye(states: &[Vec<BirdState>], height: usize, g: &GroundParams) -> Eye {
+    let k = ((states.len() - 1) as f64 * g.pass_at.clamp(0.0, 1.0)).round() as usize;
+    let s = &states[k];
+    let m = s.len().max(1) as f64;
+    let (x, y) = s.iter().fold((0.0, 0.0), |(a, b), q| (a + q.x, b + q.y));
+    let mut zs: Vec<f64> = s.iter().map(|q| q.z).collect();
+    zs.sort_by(f64::total_cmp);
+    let z = zs.get(zs.len() / 2).copied().unwrap_or(0.0);
+    // Mean heading (circular) of the flock there.
+    let (hs, hc) = s.iter().fold((0.0, 0.0), |(a, b), q| {
+        (a + q.heading.sin(), b + q.heading.cos())
+    });
+    let (hs, hc) = if hs.hypot(hc) < 1e-9 {
+        (0.0, 1.0)
+    } else {
+        (hs, hc)
+    };
+    let h = hs.atan2(hc);
+    let el = g.elevation_deg.clamp(5.0, 85.0).to_radians();
+    // Face the oncoming flock: opposite its heading, tilted up.
+    let forward = [-h.sin() * el.cos(), -h.cos() * el.cos(), el.sin()];
+    Eye::looking(
+        [x / m, y / m, z - g.distance],
+        forward,
+        g.fov_deg.clamp(10.0, 150.0),
+        height,
+    )
+}
+
+fn follow(
+    states: &[Vec<BirdState>],
+    fps: f64,
+    width: usize,
+    height: usize,
+    p: &CameraParams,
+) -> Vec<View> {
+    let n = states.len();
     let sigma = (p.smoothing_s * fps).max(0.5);
     let half = ((2.0 * sigma).ceil() as usize).min(n.max(1));
     let kernel = gaussian(sigma, half);
-    let bbox: Vec<(f64, f64, f64, f64)> = states
-        .iter()
-        .map(|s| {
-            s.iter().fold(
-                (f64::MAX, f64::MAX, f64::MIN, f64::MIN),
-                |(a, b, c, d), q| (a.min(q.x), b.min(q.y), c.max(q.x), d.max(q.y)),
-            )
-        })
-        .collect();
-    let cx = smooth_odd(
-        &bbox.iter().map(|b| 0.5 * (b.0 + b.2)).collect::<Vec<_>>(),
-        &kernel,
-    );
-    let cy = smooth_odd(
-        &bbox.iter().map(|b| 0.5 * (b.1 + b.3)).collect::<Vec<_>>(),
-        &kernel,
-    );
     let (w, h) = (width as f64, height as f64);
     let m = p.margin * w.min(h);
     let (hw, hh) = ((0.5 * w - m).max(1.0), (0.5 * h - m).max(1.0));
     let s_max = w.min(h) / p.min_extent;
+    let s_min = p.min_bird_px.clamp(0.0, s_max);
+    let r = p.bird_radius;
+    // Raw centre of each frame: the whole flock's box, or the leading birds' when the whole
+    // flock would be drawn smaller than the minimum.
+    let (raw_x, raw_y): (Vec<f64>, Vec<f64>) = states
+        .iter()
+        .map(|s| {
+            let (x0, y0, x1, y1) = s.iter().fold(
+                (f64::MAX, f64::MAX, f64::MIN, f64::MIN),
+                |(a, b, c, d), q| (a.min(q.x), b.min(q.y), c.max(q.x), d.max(q.y)),
+            );
+            let fit = (hw / (0.5 * (x1 - x0) + r)).min(hh / (0.5 * (y1 - y0) + r));
+            if s.is_empty() || fit >= s_min {
+                return (0.5 * (x0 + x1), 0.5 * (y0 + y1));
+            }
+            lead_centre(s, hw / s_min - r, hh / s_min - r)
+        })
+        .unzip();
+    let cx = smooth_odd(&raw_x, &kernel);
+    let cy = smooth_odd(&raw_y, &kernel);
     let log_need: Vec<f64> = (0..n)
         .map(|i| {
             let mut s = s_max;
             for b in &states[i] {
-                let dx = (b.x - cx[i]).abs() + BIRD_RADIUS;
-                let dy = (b.y - cy[i]).abs() + BIRD_RADIUS;
+                let dx = (b.x - cx[i]).abs() + r;
+                let dy = (b.y - cy[i]).abs() + r;
                 s = s.min(hw / dx).min(hh / dy);
             }
-            s.ln()
+            s.max(s_min).max(1e-6).ln()
         })
         .collect();
     let eroded: Vec<f64> = (0..n)
@@ -161,18 +448,51 @@ pub fn track(
                 acc += wk * eroded[j];
                 wsum += wk;
             }
-            View {
+            View::Top {
                 cx: cx[i],
                 cy: cy[i],
-                scale: (acc / wsum).exp(),
+                // Rounding of the average must not take it under the minimum.
+                scale: (acc / wsum).exp().max(s_min),
             }
         })
         .collect()
 }
 
+/// Centre of a view of half-extents `(ax, ay)` wingspans that holds the leading bird (the one
+/// farthest along the flock's mean heading) and as much of the flock behind it as fits: the box
+/// of the birds within reach of the leader, shifted so that the leader stays inside.
+fn lead_centre(s: &[BirdState], ax: f64, ay: f64) -> (f64, f64) {
+    let (hs, hc) = s.iter().fold((0.0, 0.0), |(a, b), q| {
+        (a + q.heading.sin(), b + q.heading.cos())
+    });
+    let lead = s
+        .iter()
+        .max_by(|a, b| (a.x * hs + a.y * hc).total_cmp(&(b.x * hs + b.y * hc)))
+        .expect("non-empty");
+    let (ax, ay) = (ax.max(0.0), ay.max(0.0));
+    let near = s
+        .iter()
+        .filter(|q| (q.x - lead.x).abs() <= 2.0 * ax && (q.y - lead.y).abs() <= 2.0 * ay);
+    let (x0, y0, x1, y1) = near.fold(
+        (f64::MAX, f64::MAX, f64::MIN, f64::MIN),
+        |(a, b, c, d), q| (a.min(q.x), b.min(q.y), c.max(q.x), d.max(q.y)),
+    );
+    let cx = (0.5 * (x0 + x1)).clamp(lead.x - ax, lead.x + ax);
+    let cy = (0.5 * (y0 + y1)).clamp(lead.y - ay, lead.y + ay);
+    (cx, cy)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn fit_all() -> CameraParams {
+        CameraParams {
+            min_bird_px: 0.0,
+            smoothing_s: 0.6,
+            ..CameraParams::default()
+        }
+    }
 
     #[test]
     fn odd_reflection_keeps_linear_motion_unbiased() {
@@ -181,6 +501,54 @@ mod tests {
         for (a, b) in v.iter().zip(&s) {
             assert!((a - b).abs() < 1e-9);
         }
+    }
+
+    #[test]
+    fn ground_projection_matches_a_hand_computed_point() {
+        // Eye at the origin looking due north, 30° up; vertical field of view 90° over 200 px,
+        // so F = 100 px. Forward f = (0, cos 30°, sin 30°), right r = f × ẑ = (cos 30°, 0, 0)
+        // normalised = (1, 0, 0), up u = r × f = (0, −sin 30°, cos 30°).
+        let eye = Eye::looking(
+            [0.0, 0.0, 0.0],
+            [0.0, 0.866_025_403_784_438_6, 0.5],
+            90.0,
+            200,
+        );
+        assert!((eye.focal_px - 100.0).abs() < 1e-9);
+        let v = View::Ground(eye);
+        // The point (2, 10, 8): depth = 10·0.8660 + 8·0.5 = 12.6603, right = 2,
+        // up = −10·0.5 + 8·0.8660 = 1.9282.
+        let (c, r, s) = v.project([2.0, 10.0, 8.0], 300, 200).unwrap();
+        assert!((c - (150.0 + 100.0 * 2.0 / 12.660_254)).abs() < 1e-4, "{c}");
+        assert!(
+            (r - (100.0 - 100.0 * 1.928_203 / 12.660_254)).abs() < 1e-4,
+            "{r}"
+        );
+        assert!((s - 100.0 / 12.660_254).abs() < 1e-6);
+        // Behind the eye: not drawn.
+        assert!(v.project([0.0, -10.0, -1.0], 300, 200).is_none());
+        // The ray through the projected pixel points back at the point.
+        let d = eye.ray(c, r, 300, 200);
+        let t = 2.0 / d[0];
+        assert!((d[1] * t - 10.0).abs() < 1e-6 && (d[2] * t - 8.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn fixed_view_shows_the_given_rectangle() {
+        let states = vec![vec![BirdState::default()]; 3];
+        let p = CameraParams {
+            kind: CameraKind::Fixed([-10.0, 0.0, 30.0, 20.0]),
+            ..CameraParams::default()
+        };
+        let v = track(&states, 25.0, 400, 200, &p);
+        assert_eq!(v.len(), 3);
+        let (c, r) = v[0].to_pixel(-10.0, 20.0, 400, 200);
+        assert!(c.abs() < 1e-9 && r.abs() < 1e-9);
+        let (c, r) = v[0].to_pixel(30.0, 0.0, 400, 200);
+        assert!((c - 400.0).abs() < 1e-9 && (r - 200.0).abs() < 1e-9);
+        assert!(CameraKind::Fixed([0.0, 0.0, 0.0, 5.0]).validate().is_err());
+        assert!(CameraKind::parse("orbit", None).is_err());
+        assert!(parse_view("1,2,3").is_err());
     }
 
     #[test]
@@ -198,15 +566,37 @@ mod tests {
                     .collect::<Vec<_>>(),
             );
         }
-        let views = track(&states, 25.0, 320, 180, &CameraParams::default());
+        let views = track(&states, 25.0, 320, 180, &fit_all());
         let m = 0.07 * 180.0;
         for (s, v) in states.iter().zip(&views) {
             for b in s {
                 let (px, py) = v.to_pixel(b.x, b.y, 320, 180);
-                let r = BIRD_RADIUS * v.scale;
+                let r = super::super::rig::BIRD_RADIUS * v.scale();
                 assert!(px - r >= m - 1e-6 && px + r <= 320.0 - m + 1e-6, "{px}");
                 assert!(py - r >= m - 1e-6 && py + r <= 180.0 - m + 1e-6, "{py}");
             }
+        }
+    }
+
+    #[test]
+    fn a_spread_flock_is_never_drawn_below_the_minimum_and_the_leader_stays_in_view() {
+        // A line of 60 birds 200 wingspans long flying north: fitting it would need ~2 px.
+        let states: Vec<Vec<BirdState>> = (0..100)
+            .map(|k| {
+                (0..60)
+                    .map(|b| BirdState {
+                        x: (b % 2) as f64 * 3.0,
+                        y: k as f64 * 0.5 - b as f64 * 3.4,
+                        ..Default::default()
+                    })
+                    .collect()
+            })
+            .collect();
+        let views = track(&states, 25.0, 960, 540, &CameraParams::default());
+        for (s, v) in states.iter().zip(&views) {
+            assert!(v.scale() >= 12.0 - 1e-9);
+            let (px, py) = v.to_pixel(s[0].x, s[0].y, 960, 540);
+            assert!((0.0..960.0).contains(&px) && (0.0..540.0).contains(&py));
         }
     }
 
@@ -233,12 +623,12 @@ mod tests {
                 }
                 states.push(pos.iter().map(|&(x, y)| BirdState { x, y, ..Default::default() }).collect::<Vec<_>>());
             }
-            let views = track(&states, 25.0, w, h, &CameraParams::default());
+            let views = track(&states, 25.0, w, h, &fit_all());
             let m = 0.07 * w.min(h) as f64;
             for (s, v) in states.iter().zip(&views) {
                 for b in s {
                     let (px, py) = v.to_pixel(b.x, b.y, w, h);
-                    let r = BIRD_RADIUS * v.scale;
+                    let r = super::super::rig::BIRD_RADIUS * v.scale();
                     proptest::prop_assert!(px - r >= m - 1e-6 && px + r <= w as f64 - m + 1e-6);
                     proptest::prop_assert!(py - r >= m - 1e-6 && py + r <= h as f64 - m + 1e-6);
                 }

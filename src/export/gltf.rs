@@ -1,35 +1,199 @@
-//! glTF 2.0 binary (`.glb`) export, written with `gltf-json`.
+//! glTF 2.0 binary (`.glb`) export, written with `gltf-json` (issue 14: skinned birds, one clip
+//! per stage, metadata, key reduction, the user's own bird).
 //!
-//! Scene: a root node `flock`, and per bird `bird_NN` (body mesh) with two children per wing,
-//! `bird_NN_upper_arm_left|right` (shoulder joint, arm mesh) and under it `bird_NN_hand_left|right`
-//! (wrist joint, hand mesh). One animation, `flight`, keyed at every frame of the animation file
-//! (LINEAR): each bird node's translation and rotation, and each wing joint's rotation from
-//! [`Flapper::pose`] through [`rig::wing_joints`]. Geometry is the [`rig`] model scaled to metres.
+//! Scene `flock`: a node `flock` holding one root node per bird, `bird_000`, `bird_001`, … (zero
+//! padded to at least three digits, so they sort), which carries the flight (translation and
+//! heading). Under each root, the bird's skeleton: joints named by the convention of
+//! [`bird::JOINTS`] (`body` → `neck`, `tail`, `upper_arm.L` → `hand.L`, `upper_arm.R` →
+//! `hand.R`); bank turns `body`, the wingbeat turns the wing and tail joints. Every bird shares one
+//! skinned mesh (`JOINTS_0`/`WEIGHTS_0`, one primitive per material) and one inverse-bind-matrix
+//! accessor; each bird's mesh node `bird_000_mesh` sits at the scene root, untransformed, as glTF
+//! asks of skinned meshes (only the joints place it), with its own skin `bird_000_skin`.
+//!
+//! Clips: one animation per stage of the animation file, named after it (`initiation`,
+//! `steady`, …; `flight` when the file has no stages), each starting at time 0 and ending on the
+//! first frame of the next stage, so that played back to back they join without a jump. LINEAR
+//! keys at every frame (`--keys all`) or only those [`keys::keep`] needs (`--keys reduced`).
+//! Metadata in `extras`: the scene holds fps, wingspan_m, seed, species, birds, the stages and the
+//! bird model; each clip its stage, first frame and start time; each bird root its index.
 //!
 //! Axes: glTF is Y-up and right-handed with a model's front on +Z. World east `x` → glTF `+X`,
 //! world up `z` → glTF `+Y`, world north `y` → glTF `−Z`; lengths are wingspans × `wingspan_m`.
-//! A bird's local `+Z` is its forward direction, so heading θ (clockwise from north) is the yaw
-//! ```math
-//! q_\text{bird} = R_Y(\pi - \theta)\,R_Z(\phi), \qquad \phi = \operatorname{atan}(v\,\dot\theta / g)
-//! ```
-//! with a bank φ into turns (v speed, θ̇ turn rate, g gravity in wingspans/s², φ clamped to ±45°).
+//! The yaw and bank formulas are in [`bird`].
 
 use std::collections::BTreeMap;
-use std::f32::consts::PI;
 
-use glam::{Quat, Vec3};
+use glam::Quat;
 use gltf_json as json;
 use json::validation::{Checked::Valid, USize64};
 
-use super::rig::{self, Side};
+use super::bird::{self, BirdAsset, Flight};
+use super::keys::{self, Curve, KeyMode, Tolerance};
+use super::rig::Side;
 use crate::animation::Animation;
 use crate::error::{Error, Result};
-use crate::wingbeat::Flapper;
+use crate::wingbeat::{Flapper, WingbeatOptions};
 
-/// Builds the `.glb` bytes for `anim` with birds `wingspan_m` metres wide.
+/// Options of the glTF (and USD) export.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct SceneOptions {
+    /// Keys at every frame or reduced within `tolerance`.
+    pub keys: KeyMode,
+    /// Tolerances of `KeyMode::Reduced`.
+    pub tolerance: Tolerance,
+    /// The bird placed on every bird; `None` = the built-in bird of the animation's species.
+    pub asset: Option<BirdAsset>,
+}
+
+/// Builds the `.glb` bytes for `anim` with birds `wingspan_m` metres wide, every frame keyed and
+/// the built-in bird.
 pub fn glb_bytes(anim: &Animation, wingspan_m: f64) -> Result<Vec<u8>> {
+    glb_bytes_with(anim, wingspan_m, &SceneOptions::default())
+}
+
+/// Width of zero-padded bird numbers: at least 3 digits, more for larger flocks.
+pub fn bird_digits(birds: usize) -> usize {
+    birds.saturating_sub(1).to_string().len().max(3)
+}
+
+/// A clip: a named, contiguous range of frames `first..=last`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Clip {
+    /// Stage name.
+    pub name: String,
+    /// First frame.
+    pub first: usize,
+    /// Last frame (the first frame of the next stage when there is one).
+    pub last: usize,
+}
+
+/// The clips of `anim`: one per non-empty stage, or `flight` over every frame.
+pub fn clips(anim: &Animation) -> Vec<Clip> {
+    let n = anim.frames.len();
+    let mut out: Vec<Clip> = anim
+        .stages
+        .iter()
+        .filter(|s| s.end > s.start && s.start < n)
+        .map(|s| Clip {
+            name: s.name.clone(),
+            first: s.start,
+            last: s.end.min(n - 1),
+        })
+        .collect();
+    if out.is_empty() {
+        out.push(Clip {
+            name: "flight".into(),
+            first: 0,
+            last: n - 1,
+        });
+    }
+    out
+}
+
+/// Scene metadata shared by glTF `extras` and USD `customLayerData`.
+pub fn metadata(
+    anim: &Animation,
+    wingspan_m: f64,
+    asset: &BirdAsset,
+    keys: KeyMode,
+) -> serde_json::Value {
+    let species = WingbeatOptions::for_animation(anim).species;
+    serde_json::json!({
+        "generator": format!("formation {}", env!("CARGO_PKG_VERSION")),
+        "fps": anim.fps,
+        "wingspan_m": wingspan_m,
+        "seed": anim.seed,
+        "species": anim.species.clone().unwrap_or_else(|| species.name().to_string()),
+        "birds": anim.birds,
+        "frames": anim.frames.len(),
+        "stages": anim.stages.iter().map(|s| serde_json::json!({"name": s.name, "start": s.start, "end": s.end})).collect::<Vec<_>>(),
+        "bird_model": asset.source,
+        "joints": bird::JOINTS,
+        "keys": keys.to_string(),
+    })
+}
+
+fn extras(v: &serde_json::Value) -> json::Extras {
+    serde_json::value::RawValue::from_string(v.to_string()).ok()
+}
+
+/// The bird asset of an export: the user's if given, else the built-in bird of the species.
+pub fn asset_for(anim: &Animation, opts: &SceneOptions) -> BirdAsset {
+    match &opts.asset {
+        Some(a) => a.clone(),
+        None => BirdAsset::builtin(WingbeatOptions::for_animation(anim).species),
+    }
+}
+
+/// Frame times relative to `first`, refused when 32-bit floats cannot keep them increasing.
+fn clip_times(anim: &Animation, c: &Clip) -> Result<Vec<f32>> {
+    let t0 = anim.frames[c.first].t;
+    let times: Vec<f32> = anim.frames[c.first..=c.last]
+        .iter()
+        .map(|f| (f.t - t0) as f32)
+        .collect();
+    if times.windows(2).any(|w| w[1] <= w[0]) {
+        return Err(Error::parameter(
+            "frames",
+            "frame times are too close to store as glTF keyframes (32-bit floats); render at a lower fps",
+        ));
+    }
+    Ok(times)
+}
+
+/// The joints the wingbeat moves.
+const WING_JOINTS: [usize; 5] = [
+    bird::TAIL,
+    bird::arm_joint(Side::Left),
+    bird::hand_joint(Side::Left),
+    bird::arm_joint(Side::Right),
+    bird::hand_joint(Side::Right),
+];
+
+/// Per bird: flight and local joint rotations at every frame, on the asset's skeleton.
+pub struct BirdTrack {
+    /// Root translation (metres) and yaw, and the bank.
+    pub flight: Flight,
+    /// Local rotation of every joint at every frame (bind rotations applied), sign-continuous.
+    pub joints: Vec<[Quat; 7]>,
+}
+
+/// The track of `bird` for `asset`.
+pub fn bird_track(
+    anim: &Animation,
+    flapper: &Flapper,
+    asset: &BirdAsset,
+    bird: usize,
+    wingspan_m: f64,
+) -> BirdTrack {
+    let flight = bird::flight(anim, bird, wingspan_m);
+    let ours = bird::joint_track(flapper, &flight, bird);
+    let skel = &asset.skeleton;
+    let mut joints: Vec<[Quat; 7]> = Vec::with_capacity(ours.len());
+    for q in ours {
+        let mut l: [Quat; 7] = std::array::from_fn(|j| {
+            // The neck never moves; a static model moves only its body.
+            if j == bird::NECK || (!asset.wingbeat && j != bird::BODY) {
+                skel.rest_rotation(j)
+            } else {
+                skel.local_rotation(j, q[j])
+            }
+        });
+        if let Some(p) = joints.last() {
+            for j in 0..7 {
+                l[j] = bird::continuous(p[j], l[j]);
+            }
+        }
+        joints.push(l);
+    }
+    BirdTrack { flight, joints }
+}
+
+/// Builds the `.glb` bytes with `opts`.
+pub fn glb_bytes_with(anim: &Animation, wingspan_m: f64, opts: &SceneOptions) -> Result<Vec<u8>> {
     let mut b = Builder::default();
     let ws = wingspan_m as f32;
+    let asset = asset_for(anim, opts);
     let mut root = json::Root {
         asset: json::Asset {
             version: "2.0".into(),
@@ -41,171 +205,204 @@ pub fn glb_bytes(anim: &Animation, wingspan_m: f64) -> Result<Vec<u8>> {
         },
         ..Default::default()
     };
-    let body_mat = root.push(material("feathers_body", [0.16, 0.15, 0.14, 1.0]));
-    let wing_mat = root.push(material("feathers_wing", [0.30, 0.29, 0.28, 1.0]));
-    let body = b.mesh(&mut root, "body", &body_mesh(ws), body_mat);
-    let mut arm = BTreeMap::new();
-    let mut hand = BTreeMap::new();
-    for side in Side::BOTH {
-        let a = b.mesh(
-            &mut root,
-            &format!("upper_arm_{}", side.name()),
-            &wing_mesh(side, &rig::ARM_OUTLINE, ws),
-            wing_mat,
-        );
-        let h = b.mesh(
-            &mut root,
-            &format!("hand_{}", side.name()),
-            &wing_mesh(side, &rig::HAND_OUTLINE, ws),
-            body_mat,
-        );
-        arm.insert(side.name(), a);
-        hand.insert(side.name(), h);
-    }
-
-    let times: Vec<f32> = anim
-        .frames
-        .iter()
-        .map(|f| (f.t - anim.frames[0].t) as f32)
+    let mesh = b.skinned_mesh(&mut root, &asset, ws);
+    let ibm: Vec<f32> = (0..bird::JOINTS.len())
+        .flat_map(|j| asset.skeleton.inverse_bind(j, ws).to_cols_array())
         .collect();
-    for w in times.windows(2) {
-        if w[1] <= w[0] {
-            return Err(Error::parameter(
-                "frames",
-                "frame times are too close to store as glTF keyframes (32-bit floats); render at a lower fps",
-            ));
-        }
-    }
-    let time_acc = b.accessor(
-        &mut root,
-        &times,
-        1,
-        json::accessor::Type::Scalar,
-        true,
-        None,
-    );
+    let ibm_acc = b.accessor(&mut root, &ibm, 16, json::accessor::Type::Mat4, false, None);
+
+    let clips = clips(anim);
     let flapper = Flapper::from_animation(anim);
-    let g = (9.81 / wingspan_m) as f32;
-    let mut channels = Vec::new();
-    let mut samplers = Vec::new();
-    let mut bird_nodes = Vec::new();
-    let n = anim.frames.len();
+    let digits = bird_digits(anim.birds);
+    let mut bird_nodes = Vec::with_capacity(anim.birds);
+    let mut mesh_nodes = Vec::with_capacity(anim.birds);
+    // Per clip: channels and samplers.
+    let mut anims: Vec<(Vec<json::animation::Channel>, Vec<json::animation::Sampler>)> =
+        clips.iter().map(|_| (Vec::new(), Vec::new())).collect();
+    let clip_t: Vec<Vec<f32>> = clips
+        .iter()
+        .map(|c| clip_times(anim, c))
+        .collect::<Result<_>>()?;
+    // One time accessor per clip for every channel keyed at every frame (made when first needed).
+    let mut shared_t: Vec<Option<json::Index<json::Accessor>>> = vec![None; clips.len()];
     for bird in 0..anim.birds {
-        // Keyframes of the bird node.
-        let mut tr = Vec::with_capacity(3 * n);
-        let mut rot = Vec::with_capacity(4 * n);
-        let mut joints: BTreeMap<(&str, bool), Vec<f32>> = BTreeMap::new();
-        let mut prev: BTreeMap<(&str, bool), Quat> = BTreeMap::new();
-        let mut prev_body = Quat::IDENTITY;
-        for (k, f) in anim.frames.iter().enumerate() {
-            let at = |v: &Vec<f64>| v.get(bird).copied().unwrap_or(0.0) as f32;
-            tr.extend_from_slice(&[at(&f.x) * ws, at(&f.z) * ws, -at(&f.y) * ws]);
-            let theta = at(&f.heading);
-            let (ka, kb) = (k.saturating_sub(2), (k + 2).min(n - 1));
-            let rate = if kb > ka {
-                let (fa, fb) = (&anim.frames[ka], &anim.frames[kb]);
-                let ha = fa.heading.get(bird).copied().unwrap_or(0.0);
-                let hb = fb.heading.get(bird).copied().unwrap_or(0.0);
-                (super::sample::angle_diff(ha, hb) / (fb.t - fa.t)) as f32
-            } else {
-                0.0
+        let track = bird_track(anim, &flapper, &asset, bird, wingspan_m);
+        // Skeleton nodes, children before parents so indices are known.
+        let mut joint_nodes: [Option<json::Index<json::Node>>; 7] = [None; 7];
+        for j in (0..bird::JOINTS.len()).rev() {
+            let children: Vec<_> = (0..bird::JOINTS.len())
+                .filter(|&c| bird::PARENT[c] == Some(j))
+                .filter_map(|c| joint_nodes[c])
+                .collect();
+            let node = root.push(json::Node {
+                name: Some(bird::JOINTS[j].to_string()),
+                translation: Some((asset.skeleton.rest_translation(j) * ws).to_array()),
+                rotation: Some(json::scene::UnitQuaternion(track.joints[0][j].to_array())),
+                children: (!children.is_empty()).then_some(children),
+                ..Default::default()
+            });
+            joint_nodes[j] = Some(node);
+        }
+        let joints: Vec<_> = joint_nodes
+            .iter()
+            .map(|n| n.expect("every joint built"))
+            .collect();
+        let name = format!("bird_{bird:0digits$}");
+        let bird_node = root.push(json::Node {
+            name: Some(name.clone()),
+            translation: Some(track.flight.translation[0].to_array()),
+            rotation: Some(json::scene::UnitQuaternion(track.flight.yaw[0].to_array())),
+            children: Some(vec![joints[bird::BODY]]),
+            extras: extras(&serde_json::json!({"bird": bird})),
+            ..Default::default()
+        });
+        bird_nodes.push(bird_node);
+        let skin = root.push(json::Skin {
+            extensions: None,
+            extras: Default::default(),
+            inverse_bind_matrices: Some(ibm_acc),
+            joints: joints.clone(),
+            name: Some(format!("{name}_skin")),
+            skeleton: Some(joints[bird::BODY]),
+        });
+        mesh_nodes.push(root.push(json::Node {
+            name: Some(format!("{name}_mesh")),
+            mesh: Some(mesh),
+            skin: Some(skin),
+            ..Default::default()
+        }));
+
+        for (ci, c) in clips.iter().enumerate() {
+            let r = c.first..c.last + 1;
+            let times = &clip_t[ci];
+            let tr = &track.flight.translation[r.clone()];
+            let yaw = &track.flight.yaw[r.clone()];
+            let per_joint: Vec<Vec<Quat>> = (0..bird::JOINTS.len())
+                .map(|j| track.joints[r.clone()].iter().map(|q| q[j]).collect())
+                .collect();
+            let tol = opts.tolerance;
+            let reduced = opts.keys == KeyMode::Reduced;
+            let mut ch = ClipWriter {
+                b: &mut b,
+                root: &mut root,
+                times,
+                shared: &mut shared_t[ci],
+                out: &mut anims[ci],
             };
-            let bank = (at(&f.speed) * rate / g).atan().clamp(-PI / 4.0, PI / 4.0);
-            let q = continuous(
-                prev_body,
-                Quat::from_rotation_y(PI - theta) * Quat::from_rotation_z(bank),
+            use json::animation::Property::{Rotation, Translation};
+            // Flight: translation as floats; yaw and bank as normalised shorts when reduced
+            // (error under 0.01°, far inside the tolerance, which the key choice accounts for).
+            let (yaw16, yaw_s): (Vec<[i16; 4]>, Vec<Quat>) =
+                yaw.iter().map(|&q| keys::quantise_i16(q)).unzip();
+            let (bank16, bank_s): (Vec<[i16; 4]>, Vec<Quat>) = per_joint[bird::BODY]
+                .iter()
+                .map(|&q| keys::quantise_i16(q))
+                .unzip();
+            let kept = keys::keep(
+                opts.keys,
+                times,
+                &[
+                    Curve::Vec3(tr, tol.position_m),
+                    Curve::Stored {
+                        exact: yaw,
+                        stored: &yaw_s,
+                        tol: tol.rotation_rad,
+                    },
+                    Curve::Stored {
+                        exact: &per_joint[bird::BODY],
+                        stored: &bank_s,
+                        tol: tol.rotation_rad,
+                    },
+                ],
             );
-            prev_body = q;
-            rot.extend_from_slice(&q.to_array());
-            let pose = flapper.pose(k, bird);
-            for side in Side::BOTH {
-                let j = rig::wing_joints(&pose, side);
-                for (is_hand, q) in [(false, j.shoulder_q), (true, j.wrist_q)] {
-                    let key = (side.name(), is_hand);
-                    let p = prev.get(&key).copied().unwrap_or(Quat::IDENTITY);
-                    let q = continuous(p, q);
-                    prev.insert(key, q);
-                    joints
-                        .entry(key)
-                        .or_default()
-                        .extend_from_slice(&q.to_array());
+            let input = ch.input(&kept);
+            let trs: Vec<f32> = kept.iter().flat_map(|&k| tr[k].to_array()).collect();
+            ch.floats(input, bird_node, Translation, &trs, 3);
+            if reduced {
+                ch.shorts(input, bird_node, &yaw16, &kept);
+                ch.shorts(input, joints[bird::BODY], &bank16, &kept);
+            } else {
+                ch.quats(input, bird_node, yaw, &kept);
+                ch.quats(input, joints[bird::BODY], &per_joint[bird::BODY], &kept);
+            }
+            if asset.wingbeat {
+                if !reduced {
+                    let all: Vec<usize> = (0..times.len()).collect();
+                    let input = ch.input(&all);
+                    for &j in &WING_JOINTS {
+                        ch.quats(input, joints[j], &per_joint[j], &all);
+                    }
+                } else {
+                    // Reduced: the wing rotations are stored as normalised bytes (4 bytes a key
+                    // instead of 16), and the kept keys are chosen against the decoded values.
+                    let q8: Vec<(Vec<[i8; 4]>, Vec<Quat>)> = WING_JOINTS
+                        .iter()
+                        .map(|&j| per_joint[j].iter().map(|&q| keys::quantise_i8(q)).unzip())
+                        .collect();
+                    let curves: Vec<Curve> = WING_JOINTS
+                        .iter()
+                        .zip(&q8)
+                        .map(|(&j, (_, stored))| Curve::Stored {
+                            exact: &per_joint[j],
+                            stored,
+                            tol: tol.wing_rad,
+                        })
+                        .collect();
+                    let mut kept = keys::keep(opts.keys, times, &curves);
+                    // A time accessor of its own costs 4 bytes a key; keeping every frame on the
+                    // clip's shared one costs 4 bytes a joint for each extra key: take the smaller.
+                    let n = times.len();
+                    if kept.len() * (4 + 4 * WING_JOINTS.len()) >= n * 4 * WING_JOINTS.len() {
+                        kept = (0..n).collect();
+                    }
+                    let input = ch.input(&kept);
+                    for (&j, (bytes, _)) in WING_JOINTS.iter().zip(&q8) {
+                        let data: Vec<u8> = kept
+                            .iter()
+                            .flat_map(|&k| bytes[k].map(|v| v as u8))
+                            .collect();
+                        ch.raw(
+                            input,
+                            joints[j],
+                            Rotation,
+                            &data,
+                            kept.len(),
+                            json::accessor::ComponentType::I8,
+                        );
+                    }
                 }
             }
         }
-        let mut children = Vec::new();
-        let mut joint_nodes = Vec::new();
-        for side in Side::BOTH {
-            let j = rig::wing_joints(&flapper.pose(0, bird), side);
-            let hand_node = root.push(node(
-                format!("bird_{bird:02}_hand_{}", side.name()),
-                Some(hand[side.name()]),
-                (j.wrist_t * ws).to_array(),
-                None,
-            ));
-            let arm_node = root.push(node(
-                format!("bird_{bird:02}_upper_arm_{}", side.name()),
-                Some(arm[side.name()]),
-                (j.shoulder_t * ws).to_array(),
-                Some(vec![hand_node]),
-            ));
-            children.push(arm_node);
-            joint_nodes.push(((side.name(), false), arm_node));
-            joint_nodes.push(((side.name(), true), hand_node));
-        }
-        let bird_node = root.push(node(
-            format!("bird_{bird:02}"),
-            Some(body),
-            [tr[0], tr[1], tr[2]],
-            Some(children),
-        ));
-        bird_nodes.push(bird_node);
-        let tr_acc = b.accessor(&mut root, &tr, 3, json::accessor::Type::Vec3, false, None);
-        let rot_acc = b.accessor(&mut root, &rot, 4, json::accessor::Type::Vec4, false, None);
-        let mut add = |target: json::Index<json::Node>,
-                       path: json::animation::Property,
-                       out: json::Index<json::Accessor>| {
-            samplers.push(json::animation::Sampler {
-                extensions: None,
-                extras: Default::default(),
-                input: time_acc,
-                interpolation: Valid(json::animation::Interpolation::Linear),
-                output: out,
-            });
-            channels.push(json::animation::Channel {
-                sampler: json::Index::new(samplers.len() as u32 - 1),
-                target: json::animation::Target {
-                    extensions: None,
-                    extras: Default::default(),
-                    node: target,
-                    path: Valid(path),
-                },
-                extensions: None,
-                extras: Default::default(),
-            });
-        };
-        add(bird_node, json::animation::Property::Translation, tr_acc);
-        add(bird_node, json::animation::Property::Rotation, rot_acc);
-        for (key, nd) in joint_nodes {
-            let data = joints.get(&key).cloned().unwrap_or_default();
-            let acc = b.accessor(&mut root, &data, 4, json::accessor::Type::Vec4, false, None);
-            add(nd, json::animation::Property::Rotation, acc);
-        }
     }
-    let flock = root.push(node("flock".into(), None, [0.0; 3], Some(bird_nodes)));
+    let flock = root.push(json::Node {
+        name: Some("flock".into()),
+        children: Some(bird_nodes),
+        ..Default::default()
+    });
+    let mut scene_nodes = vec![flock];
+    scene_nodes.extend(mesh_nodes);
     let scene = root.push(json::Scene {
         extensions: None,
-        extras: Default::default(),
+        extras: extras(&metadata(anim, wingspan_m, &asset, opts.keys)),
         name: Some("flock".into()),
-        nodes: vec![flock],
+        nodes: scene_nodes,
     });
     root.scene = Some(scene);
-    root.push(json::Animation {
-        extensions: None,
-        extras: Default::default(),
-        channels,
-        name: Some("flight".into()),
-        samplers,
-    });
+    for (c, (channels, samplers)) in clips.iter().zip(anims) {
+        root.push(json::Animation {
+            extensions: None,
+            extras: extras(&serde_json::json!({
+                "stage": c.name,
+                "first_frame": c.first,
+                "last_frame": c.last,
+                "start_s": anim.frames[c.first].t,
+                "fps": anim.fps,
+            })),
+            channels,
+            name: Some(c.name.clone()),
+            samplers,
+        });
+    }
     if let Some(at) = b.non_finite.take() {
         return Err(Error::Internal(format!(
             "glTF: refusing to write a non-finite number in {at}"
@@ -218,144 +415,166 @@ pub fn glb_bytes(anim: &Animation, wingspan_m: f64) -> Result<Vec<u8>> {
     Ok(glb(json_bytes, bin))
 }
 
-/// Chooses the sign of `q` closest to `prev`, so LINEAR (slerp) keys never take the long way.
-fn continuous(prev: Quat, q: Quat) -> Quat {
-    let q = q.normalize();
-    if prev.dot(q) < 0.0 {
-        -q
-    } else {
-        q
+/// Writes the channels of one bird in one clip.
+struct ClipWriter<'a> {
+    b: &'a mut Builder,
+    root: &'a mut json::Root,
+    /// Times of every frame of the clip, seconds from its start.
+    times: &'a [f32],
+    /// The clip's time accessor over every frame, once made.
+    shared: &'a mut Option<json::Index<json::Accessor>>,
+    out: &'a mut (Vec<json::animation::Channel>, Vec<json::animation::Sampler>),
+}
+
+impl ClipWriter<'_> {
+    /// The time accessor of the frames `kept` (the shared one when that is every frame).
+    fn input(&mut self, kept: &[usize]) -> json::Index<json::Accessor> {
+        if kept.len() == self.times.len() {
+            if let Some(i) = *self.shared {
+                return i;
+            }
+            let i = self.b.accessor(
+                self.root,
+                self.times,
+                1,
+                json::accessor::Type::Scalar,
+                true,
+                None,
+            );
+            *self.shared = Some(i);
+            return i;
+        }
+        let t: Vec<f32> = kept.iter().map(|&k| self.times[k]).collect();
+        self.b
+            .accessor(self.root, &t, 1, json::accessor::Type::Scalar, true, None)
+    }
+
+    fn push(
+        &mut self,
+        input: json::Index<json::Accessor>,
+        output: json::Index<json::Accessor>,
+        node: json::Index<json::Node>,
+        path: json::animation::Property,
+    ) {
+        let (channels, samplers) = &mut *self.out;
+        samplers.push(sampler(input, output));
+        channels.push(channel(samplers.len() - 1, node, path));
+    }
+
+    fn floats(
+        &mut self,
+        input: json::Index<json::Accessor>,
+        node: json::Index<json::Node>,
+        path: json::animation::Property,
+        data: &[f32],
+        width: usize,
+    ) {
+        let ty = if width == 3 {
+            json::accessor::Type::Vec3
+        } else {
+            json::accessor::Type::Vec4
+        };
+        let out = self.b.accessor(self.root, data, width, ty, false, None);
+        self.push(input, out, node, path);
+    }
+
+    fn quats(
+        &mut self,
+        input: json::Index<json::Accessor>,
+        node: json::Index<json::Node>,
+        q: &[Quat],
+        kept: &[usize],
+    ) {
+        let data: Vec<f32> = kept.iter().flat_map(|&k| q[k].to_array()).collect();
+        self.floats(input, node, json::animation::Property::Rotation, &data, 4);
+    }
+
+    fn shorts(
+        &mut self,
+        input: json::Index<json::Accessor>,
+        node: json::Index<json::Node>,
+        q: &[[i16; 4]],
+        kept: &[usize],
+    ) {
+        let data: Vec<u8> = kept
+            .iter()
+            .flat_map(|&k| q[k])
+            .flat_map(|v| v.to_le_bytes())
+            .collect();
+        self.raw(
+            input,
+            node,
+            json::animation::Property::Rotation,
+            &data,
+            kept.len(),
+            json::accessor::ComponentType::I16,
+        );
+    }
+
+    fn raw(
+        &mut self,
+        input: json::Index<json::Accessor>,
+        node: json::Index<json::Node>,
+        path: json::animation::Property,
+        data: &[u8],
+        count: usize,
+        ct: json::accessor::ComponentType,
+    ) {
+        let out = self.b.raw_accessor(
+            self.root,
+            data,
+            count,
+            ct,
+            json::accessor::Type::Vec4,
+            true,
+            None,
+        );
+        self.push(input, out, node, path);
     }
 }
 
-fn material(name: &str, rgba: [f32; 4]) -> json::Material {
+fn sampler(
+    input: json::Index<json::Accessor>,
+    output: json::Index<json::Accessor>,
+) -> json::animation::Sampler {
+    json::animation::Sampler {
+        extensions: None,
+        extras: Default::default(),
+        input,
+        interpolation: Valid(json::animation::Interpolation::Linear),
+        output,
+    }
+}
+
+fn channel(
+    sampler: usize,
+    node: json::Index<json::Node>,
+    path: json::animation::Property,
+) -> json::animation::Channel {
+    json::animation::Channel {
+        sampler: json::Index::new(sampler as u32),
+        target: json::animation::Target {
+            extensions: None,
+            extras: Default::default(),
+            node,
+            path: Valid(path),
+        },
+        extensions: None,
+        extras: Default::default(),
+    }
+}
+
+fn material(name: &str, rgb: [f32; 3]) -> json::Material {
     json::Material {
         name: Some(name.into()),
         double_sided: true,
         pbr_metallic_roughness: json::material::PbrMetallicRoughness {
-            base_color_factor: json::material::PbrBaseColorFactor(rgba),
+            base_color_factor: json::material::PbrBaseColorFactor([rgb[0], rgb[1], rgb[2], 1.0]),
             metallic_factor: json::material::StrengthFactor(0.0),
             roughness_factor: json::material::StrengthFactor(0.85),
             ..Default::default()
         },
         ..Default::default()
-    }
-}
-
-fn node(
-    name: String,
-    mesh: Option<json::Index<json::Mesh>>,
-    translation: [f32; 3],
-    children: Option<Vec<json::Index<json::Node>>>,
-) -> json::Node {
-    json::Node {
-        name: Some(name),
-        mesh,
-        translation: Some(translation),
-        children,
-        ..Default::default()
-    }
-}
-
-/// Triangle mesh: positions, normals (unit), indices.
-struct MeshData {
-    positions: Vec<[f32; 3]>,
-    normals: Vec<[f32; 3]>,
-    indices: Vec<u16>,
-}
-
-/// The body as a loft of ellipses along [`rig::BODY_PROFILE`], closed by a point at each end.
-fn body_mesh(ws: f32) -> MeshData {
-    const RING: usize = 12;
-    let mut m = MeshData {
-        positions: Vec::new(),
-        normals: Vec::new(),
-        indices: Vec::new(),
-    };
-    let prof = &rig::BODY_PROFILE;
-    for &(z, w, h) in prof.iter() {
-        for r in 0..RING {
-            let a = r as f32 / RING as f32 * 2.0 * PI;
-            let (s, c) = a.sin_cos();
-            m.positions.push([w * c * ws, h * s * ws, z * ws]);
-            m.normals.push(
-                Vec3::new(c / w.max(1e-4), s / h.max(1e-4), 0.0)
-                    .normalize()
-                    .to_array(),
-            );
-        }
-    }
-    for st in 0..prof.len() - 1 {
-        for r in 0..RING {
-            let a = (st * RING + r) as u16;
-            let b = (st * RING + (r + 1) % RING) as u16;
-            let c = a + RING as u16;
-            let d = b + RING as u16;
-            // Counter-clockwise seen from outside.
-            m.indices.extend_from_slice(&[a, d, b, a, c, d]);
-        }
-    }
-    let tail = m.positions.len() as u16;
-    m.positions.push([0.0, 0.0, (prof[0].0 - 0.004) * ws]);
-    m.normals.push([0.0, 0.0, -1.0]);
-    let bill = m.positions.len() as u16;
-    m.positions
-        .push([0.0, 0.0, (prof[prof.len() - 1].0 + 0.006) * ws]);
-    m.normals.push([0.0, 0.0, 1.0]);
-    let last = ((prof.len() - 1) * RING) as u16;
-    for r in 0..RING as u16 {
-        let r1 = (r + 1) % RING as u16;
-        m.indices.extend_from_slice(&[tail, r, r1]);
-        m.indices.extend_from_slice(&[bill, last + r1, last + r]);
-    }
-    fix_winding(&mut m);
-    m
-}
-
-/// A flat wing segment (double-sided material), a fan around its centroid, normal up.
-fn wing_mesh(side: Side, outline: &[(f32, f32)], ws: f32) -> MeshData {
-    let mut m = MeshData {
-        positions: Vec::new(),
-        normals: Vec::new(),
-        indices: Vec::new(),
-    };
-    let n = outline.len();
-    let (su, sc) = outline
-        .iter()
-        .fold((0.0, 0.0), |(a, b), p| (a + p.0, b + p.1));
-    let centre = rig::segment_point(side, (su / n as f32, sc / n as f32)) * ws;
-    m.positions.push(centre.to_array());
-    m.normals.push([0.0, 1.0, 0.0]);
-    for &p in outline {
-        m.positions
-            .push((rig::segment_point(side, p) * ws).to_array());
-        m.normals.push([0.0, 1.0, 0.0]);
-    }
-    for i in 0..n as u16 {
-        let (a, b) = (1 + i, 1 + (i + 1) % n as u16);
-        let (pa, pb) = (
-            Vec3::from(m.positions[a as usize]),
-            Vec3::from(m.positions[b as usize]),
-        );
-        // Front face up (+Y): counter-clockwise seen from above.
-        if (pa - centre).cross(pb - centre).y >= 0.0 {
-            m.indices.extend_from_slice(&[0, a, b]);
-        } else {
-            m.indices.extend_from_slice(&[0, b, a]);
-        }
-    }
-    m
-}
-
-/// Orients every body triangle so its face normal agrees with its vertex normals.
-fn fix_winding(m: &mut MeshData) {
-    for t in m.indices.chunks_exact_mut(3) {
-        let p = |i: u16| Vec3::from(m.positions[i as usize]);
-        let face = (p(t[1]) - p(t[0])).cross(p(t[2]) - p(t[0]));
-        let avg: Vec3 = t.iter().map(|&i| Vec3::from(m.normals[i as usize])).sum();
-        if face.dot(avg) < 0.0 {
-            t.swap(1, 2);
-        }
     }
 }
 
@@ -444,68 +663,109 @@ impl Builder {
         })
     }
 
-    fn mesh(
+    /// An accessor over raw little-endian `bytes` of `count` elements.
+    #[allow(clippy::too_many_arguments)]
+    fn raw_accessor(
         &mut self,
         root: &mut json::Root,
-        name: &str,
-        m: &MeshData,
-        material: json::Index<json::Material>,
-    ) -> json::Index<json::Mesh> {
-        let flat = |v: &[[f32; 3]]| v.iter().flatten().copied().collect::<Vec<f32>>();
-        let pos = self.accessor(
-            root,
-            &flat(&m.positions),
-            3,
-            json::accessor::Type::Vec3,
-            true,
-            Some(json::buffer::Target::ArrayBuffer),
-        );
-        let nor = self.accessor(
-            root,
-            &flat(&m.normals),
-            3,
-            json::accessor::Type::Vec3,
-            false,
-            Some(json::buffer::Target::ArrayBuffer),
-        );
-        let ibytes: Vec<u8> = m.indices.iter().flat_map(|v| v.to_le_bytes()).collect();
-        let iview = self.view(
-            root,
-            &ibytes,
-            Some(json::buffer::Target::ElementArrayBuffer),
-        );
-        let idx = root.push(json::Accessor {
-            buffer_view: Some(iview),
+        bytes: &[u8],
+        count: usize,
+        component: json::accessor::ComponentType,
+        type_: json::accessor::Type,
+        normalized: bool,
+        target: Option<json::buffer::Target>,
+    ) -> json::Index<json::Accessor> {
+        let view = self.view(root, bytes, target);
+        root.push(json::Accessor {
+            buffer_view: Some(view),
             byte_offset: None,
-            count: USize64::from(m.indices.len()),
-            component_type: Valid(json::accessor::GenericComponentType(
-                json::accessor::ComponentType::U16,
-            )),
+            count: USize64::from(count),
+            component_type: Valid(json::accessor::GenericComponentType(component)),
             extensions: None,
             extras: Default::default(),
-            type_: Valid(json::accessor::Type::Scalar),
+            type_: Valid(type_),
             min: None,
             max: None,
             name: None,
-            normalized: false,
+            normalized,
             sparse: None,
-        });
-        let mut attributes = BTreeMap::new();
-        attributes.insert(Valid(json::mesh::Semantic::Positions), pos);
-        attributes.insert(Valid(json::mesh::Semantic::Normals), nor);
-        root.push(json::Mesh {
-            extensions: None,
-            extras: Default::default(),
-            name: Some(name.into()),
-            primitives: vec![json::mesh::Primitive {
+        })
+    }
+
+    /// The asset's skinned mesh in metres: shared vertex attributes, one primitive (and
+    /// material) per part.
+    fn skinned_mesh(
+        &mut self,
+        root: &mut json::Root,
+        asset: &BirdAsset,
+        ws: f32,
+    ) -> json::Index<json::Mesh> {
+        let m = &asset.mesh;
+        let pos: Vec<f32> = m
+            .positions
+            .iter()
+            .flat_map(|p| (*p * ws).to_array())
+            .collect();
+        let nor: Vec<f32> = m.normals.iter().flat_map(|n| n.to_array()).collect();
+        let target = Some(json::buffer::Target::ArrayBuffer);
+        let pos = self.accessor(root, &pos, 3, json::accessor::Type::Vec3, true, target);
+        let nor = self.accessor(root, &nor, 3, json::accessor::Type::Vec3, false, target);
+        let jb: Vec<u8> = m.joints.iter().flatten().copied().collect();
+        let joints = self.raw_accessor(
+            root,
+            &jb,
+            m.joints.len(),
+            json::accessor::ComponentType::U8,
+            json::accessor::Type::Vec4,
+            false,
+            target,
+        );
+        let wf: Vec<f32> = m.weights.iter().flatten().copied().collect();
+        let weights = self.accessor(root, &wf, 4, json::accessor::Type::Vec4, false, target);
+        let mut primitives = Vec::new();
+        let big = m.positions.len() > u16::MAX as usize;
+        for ((part, idx), rgb) in m.parts.iter().zip(&m.colours) {
+            let mat = root.push(material(part.name(), *rgb));
+            let (bytes, ct): (Vec<u8>, _) = if big {
+                (
+                    idx.iter().flat_map(|v| v.to_le_bytes()).collect(),
+                    json::accessor::ComponentType::U32,
+                )
+            } else {
+                (
+                    idx.iter().flat_map(|&v| (v as u16).to_le_bytes()).collect(),
+                    json::accessor::ComponentType::U16,
+                )
+            };
+            let ia = self.raw_accessor(
+                root,
+                &bytes,
+                idx.len(),
+                ct,
+                json::accessor::Type::Scalar,
+                false,
+                Some(json::buffer::Target::ElementArrayBuffer),
+            );
+            let mut attributes = BTreeMap::new();
+            attributes.insert(Valid(json::mesh::Semantic::Positions), pos);
+            attributes.insert(Valid(json::mesh::Semantic::Normals), nor);
+            attributes.insert(Valid(json::mesh::Semantic::Joints(0)), joints);
+            attributes.insert(Valid(json::mesh::Semantic::Weights(0)), weights);
+            primitives.push(json::mesh::Primitive {
                 attributes,
                 extensions: None,
                 extras: Default::default(),
-                indices: Some(idx),
-                material: Some(material),
+                indices: Some(ia),
+                material: Some(mat),
                 mode: Valid(json::mesh::Mode::Triangles),
                 targets: None,
-            }],
+            });
+        }
+        root.push(json::Mesh {
+            extensions: None,
+            extras: Default::default(),
+            name: Some("bird".into()),
+            primitives,
             weights: None,
         })
     }
@@ -547,28 +807,21 @@ fn glb(mut json_bytes: Vec<u8>, bin: Vec<u8>) -> Vec<u8> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn body_and_wings_have_unit_normals_and_valid_indices() {
-        for m in [
-            body_mesh(1.5),
-            wing_mesh(Side::Left, &rig::HAND_OUTLINE, 1.5),
-            wing_mesh(Side::Right, &rig::ARM_OUTLINE, 1.5),
-        ] {
-            for n in &m.normals {
-                assert!((Vec3::from(*n).length() - 1.0).abs() < 1e-5);
-            }
-            assert!(m.indices.iter().all(|&i| (i as usize) < m.positions.len()));
-            assert_eq!(m.indices.len() % 3, 0);
-        }
-    }
+    use glam::Vec3;
 
     #[test]
     fn heading_east_faces_glb_plus_x() {
-        let q = Quat::from_rotation_y(PI - PI / 2.0);
+        let q = Quat::from_rotation_y(std::f32::consts::PI - std::f32::consts::PI / 2.0);
         let f = q * Vec3::Z;
         assert!((f - Vec3::X).length() < 1e-6, "{f}");
-        let q = Quat::from_rotation_y(PI);
+        let q = Quat::from_rotation_y(std::f32::consts::PI);
         assert!((q * Vec3::Z - Vec3::NEG_Z).length() < 1e-6, "north is −Z");
+    }
+
+    #[test]
+    fn bird_numbers_are_zero_padded() {
+        assert_eq!(bird_digits(14), 3);
+        assert_eq!(bird_digits(1000), 3);
+        assert_eq!(bird_digits(1001), 4);
     }
 }

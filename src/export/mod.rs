@@ -1,27 +1,34 @@
-//! Outputs of an animation (issue 6): the animation file (`.json`), the long CSV (`.csv`), an
-//! animated GIF (`.gif`), a directory of numbered PNG frames (`DIR/`) and a glTF 2.0 binary
-//! (`.glb`). [`write_outputs`] is the one entry point of `formation render` and
+//! Outputs of an animation (issues 6, 14 and 15): the animation file (`.json`), the long CSV
+//! (`.csv`), an animated GIF (`.gif`), a directory of numbered PNG frames (`DIR/`), a video
+//! (`.mp4`, `.webm`, through the system ffmpeg), a glTF 2.0 binary (`.glb`) and text USD with
+//! UsdSkel (`.usda`). [`write_outputs`] is the one entry point of `formation render` and
 //! `formation animate`: it checks every output path and option before doing any work, then writes
 //! each output atomically (no partial file on failure).
 //!
-//! Units: the animation is in wingspans (world frame `x` east, `y` north, `z` up); the `.glb` is in
-//! metres (`wingspan_m`) on glTF's Y-up axes (see [`gltf`]); the pictures are a top-down view,
-//! north up, that follows the flock (see [`camera`], [`scene`]).
+//! Units: the animation is in wingspans (world frame `x` east, `y` north, `z` up); the `.glb` and
+//! `.usda` are in metres (`wingspan_m`) on glTF's Y-up axes (see [`gltf`], [`usd`]); the pictures
+//! are drawn by one of the [`camera`]s (top-down following the flock by default, a ground
+//! observer, or a fixed view) over a procedural sky (see [`scene`], [`silhouette`]).
 //!
 //! Frame rates: `.json`, `.csv` and `.glb` keep the animation's own frames. The GIF is sampled at
-//! [`pictures::GIF_FPS`] = 25 fps by default (GIF delays are whole 1/100 s); PNG frames at the
-//! animation's frame rate. [`RenderOptions::fps`] overrides both picture rates.
+//! [`pictures::GIF_FPS`] = 25 fps by default (GIF delays are whole 1/100 s); PNG frames and video
+//! at the animation's frame rate. [`RenderOptions::fps`] overrides every picture rate.
 
+pub mod bird;
+pub mod bird_model;
 pub mod camera;
 pub mod gltf;
+pub mod keys;
 pub mod palette;
 pub mod pictures;
 pub mod raster;
 pub mod rig;
 pub mod sample;
 pub mod scene;
+pub mod silhouette;
 pub mod synthetic;
 pub mod table;
+pub mod usd;
 
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
@@ -31,13 +38,18 @@ use crate::error::{Error, Result};
 use crate::io::{write_bytes_atomic, write_json_atomic, AtomicFile, OutputKind};
 use crate::progress::Progress;
 
+pub use camera::CameraKind;
 pub use pictures::{Film, GIF_FPS};
+pub use scene::Background;
 
 /// Output kinds `render` and `animate` accept.
-pub const OUTPUT_KINDS: [OutputKind; 5] = [
+pub const OUTPUT_KINDS: [OutputKind; 8] = [
     OutputKind::Gif,
     OutputKind::Directory,
+    OutputKind::Mp4,
+    OutputKind::Webm,
     OutputKind::Glb,
+    OutputKind::Usda,
     OutputKind::Csv,
     OutputKind::Json,
 ];
@@ -54,19 +66,36 @@ pub const MAX_GIF_FPS: f64 = 50.0;
 pub const MAX_FRAMES: usize = 200_000;
 
 /// How to render; every field is checked by [`RenderOptions::validate`].
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct RenderOptions {
     /// Picture width, pixels.
     pub width: u32,
     /// Picture height, pixels.
     pub height: u32,
-    /// Frame rate of the pictures (GIF, PNG frames), frames per second; `None` = 25 for GIF, the
-    /// animation's own rate for PNG frames.
+    /// Frame rate of the pictures (GIF, PNG frames, video), frames per second; `None` = 25 for
+    /// GIF, the animation's own rate for PNG frames and video.
     pub fps: Option<f64>,
     /// Bird wingspan for the `.glb` and the written `.json`, metres; `None` = the animation's.
     pub wingspan_m: Option<f64>,
     /// Worker threads for pictures; 0 = one per core.
     pub threads: usize,
+    /// The camera (`--camera follow|ground|fixed`, `--view` for fixed).
+    pub camera: CameraKind,
+    /// Smallest bird the follow camera draws: its wingspan on screen, pixels (0 = always fit
+    /// the whole flock).
+    pub min_bird_px: f64,
+    /// What is behind the birds (`--background sky|none|#rrggbb`).
+    pub background: Background,
+    /// Draw a sun glow in the sky (`--sun`).
+    pub sun: bool,
+    /// Largest colour error a GIF pixel may show before it is redrawn, 8-bit levels per
+    /// channel (0 = redraw every changed palette index).
+    pub gif_tolerance: f64,
+    /// Keyframes of the `.glb` and `.usda`: every frame, or reduced within the documented
+    /// tolerances ([`keys::Tolerance`]).
+    pub keys: keys::KeyMode,
+    /// The user's bird (`.glb`) for the `.glb` and `.usda`; `None` = the built-in bird.
+    pub bird_model: Option<PathBuf>,
 }
 
 impl Default for RenderOptions {
@@ -77,6 +106,13 @@ impl Default for RenderOptions {
             fps: None,
             wingspan_m: None,
             threads: 0,
+            camera: CameraKind::Follow,
+            min_bird_px: 12.0,
+            background: Background::Sky,
+            sun: false,
+            gif_tolerance: 10.0,
+            keys: keys::KeyMode::All,
+            bird_model: None,
         }
     }
 }
@@ -111,6 +147,19 @@ impl RenderOptions {
                     format!("{f} frames per second is not a usable frame rate; give a number from 1 to {MAX_FPS}"),
                 ));
             }
+        }
+        self.camera.validate()?;
+        if !(self.min_bird_px.is_finite() && (0.0..=1000.0).contains(&self.min_bird_px)) {
+            return Err(Error::parameter(
+                "--min-bird-px",
+                format!("{} is not a bird size; give the smallest on-screen wingspan in pixels, 0 to 1000 (default 12)", self.min_bird_px),
+            ));
+        }
+        if !(self.gif_tolerance.is_finite() && (0.0..=64.0).contains(&self.gif_tolerance)) {
+            return Err(Error::parameter(
+                "--gif-tolerance",
+                format!("{} is outside 0..=64 colour levels", self.gif_tolerance),
+            ));
         }
         if let Some(w) = self.wingspan_m {
             if !(w.is_finite() && w > 0.0 && w <= 100.0) {
@@ -236,6 +285,27 @@ pub fn write_outputs(
     sample::check_times(anim, origin)?;
     let plan = plan_outputs(outputs)?;
     for o in &plan {
+        let video = matches!(o.kind, OutputKind::Mp4 | OutputKind::Webm);
+        if (video || o.kind == OutputKind::Gif) && opts.background == Background::None {
+            return Err(Error::parameter(
+                "--background",
+                format!("none (transparent) is only for PNG frames; {} has no alpha: give -o frames/ or a colour like --background '#87ceeb'", o.path.display()),
+            ));
+        }
+        if video {
+            if opts.width % 2 == 1 || opts.height % 2 == 1 {
+                return Err(Error::parameter(
+                    "--size",
+                    format!(
+                        "{}: {}x{} has an odd side; video (yuv420p) needs even width and height",
+                        o.path.display(),
+                        opts.width,
+                        opts.height
+                    ),
+                ));
+            }
+            pictures::check_ffmpeg(&o.path)?;
+        }
         if o.kind == OutputKind::Gif {
             if let Some(f) = opts.fps {
                 if f > MAX_GIF_FPS {
@@ -246,7 +316,10 @@ pub fn write_outputs(
                 }
             }
         }
-        if matches!(o.kind, OutputKind::Gif | OutputKind::Directory) {
+        if matches!(
+            o.kind,
+            OutputKind::Gif | OutputKind::Directory | OutputKind::Mp4 | OutputKind::Webm
+        ) {
             let fps = picture_fps(anim, o.kind, opts);
             let n = sample::output_count(anim, fps);
             let pixels = n as u64 * opts.width as u64 * opts.height as u64;
@@ -276,8 +349,20 @@ pub fn write_outputs(
         }
     }
     let wingspan_m = opts.wingspan_m.unwrap_or(anim.wingspan_m);
+    // The user's bird is checked before any output is written (exit 2 with the reason).
+    let asset = match &opts.bird_model {
+        Some(p) => Some(bird_model::load(
+            p,
+            crate::wingbeat::WingbeatOptions::for_animation(anim).species,
+        )?),
+        None => None,
+    };
+    let scene = gltf::SceneOptions {
+        keys: opts.keys,
+        tolerance: keys::Tolerance::default(),
+        asset,
+    };
     let threads = pictures::worker_count(opts.threads);
-    let (w, h) = (opts.width as usize, opts.height as usize);
     for o in &plan {
         match o.kind {
             OutputKind::Json => {
@@ -293,18 +378,37 @@ pub fn write_outputs(
             }
             OutputKind::Glb => {
                 progress.start("glb", 1);
-                let bytes = gltf::glb_bytes(anim, wingspan_m)?;
+                let bytes = gltf::glb_bytes_with(anim, wingspan_m, &scene)?;
                 write_bytes_atomic(&o.path, &bytes)?;
                 progress.advance(1);
                 progress.finish();
             }
+            OutputKind::Usda => {
+                progress.start("usda", 1);
+                // Streamed into the temporary file (a 100-bird minute is tens of MB of text).
+                let mut f = AtomicFile::create(&o.path)?;
+                usd::write_usda(anim, wingspan_m, &scene, f.writer())
+                    .map_err(|e| Error::io(&o.path, e))?;
+                f.commit()?;
+                progress.advance(1);
+                progress.finish();
+            }
             OutputKind::Gif => {
-                let film = Film::new(anim, picture_fps(anim, o.kind, opts), w, h);
+                let film = Film::with_options(anim, picture_fps(anim, o.kind, opts), opts);
                 pictures::write_gif(&film, &o.path, threads, progress)?;
             }
             OutputKind::Directory => {
-                let film = Film::new(anim, picture_fps(anim, o.kind, opts), w, h);
+                let film = Film::with_options(anim, picture_fps(anim, o.kind, opts), opts);
                 pictures::write_png_dir(&film, &o.path, threads, progress)?;
+            }
+            OutputKind::Mp4 | OutputKind::Webm => {
+                let film = Film::with_options(anim, picture_fps(anim, o.kind, opts), opts);
+                let codec = if o.kind == OutputKind::Mp4 {
+                    pictures::VideoCodec::H264
+                } else {
+                    pictures::VideoCodec::Vp9
+                };
+                pictures::write_video(&film, &o.path, codec, threads, progress)?;
             }
             OutputKind::Png | OutputKind::Svg => {
                 return Err(Error::Internal(format!(

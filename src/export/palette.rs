@@ -1,18 +1,25 @@
-//! The GIF's fixed 256-colour palette and a fast nearest-colour lookup.
+//! The GIF's global 256-colour palette and a fast nearest-colour lookup.
 //!
-//! The palette is built once per render from the [`Style`]: it knows which colours a picture can
-//! contain (sky gradient, clouds blended over the sky, birds and their anti-aliased edges over sky
-//! and cloud), so it spends its entries there instead of quantising every frame (no NeuQuant).
-//! Cloud gradients are dithered by the renderer (see [`super::scene::Backdrop::paint`]).
+//! The palette is learnt once per GIF with NeuQuant (the `color_quant` crate, the quantiser of
+//! the `image` crate family) from pixels of a few frames spread over the whole film, so it fits
+//! the sky, the clouds and the birds of this film rather than every possible picture. The
+//! species' plumage colours are added exactly (a few hundred bird pixels would otherwise be
+//! outvoted by half a million sky pixels), and the last entry is reserved for "unchanged since
+//! the previous frame" ([`TRANSPARENT`]). No dither is applied: with a palette fitted to the film
+//! the sky gradient steps by about one level, and a dither pattern would change under every
+//! moving cloud edge and defeat the frame differencing.
+//!
 //! Lookups go through a table indexed by the colour's top 6 bits per channel, filled lazily with
-//! the nearest palette entry (perceptually weighted squared RGB distance), which makes mapping a
-//! 960×540 frame a few milliseconds and the result independent of frame order and thread count.
-
-use super::scene::Style;
+//! the nearest palette entry (perceptually weighted squared RGB distance
+//! `3Δr² + 4Δg² + 2Δb²`), which makes mapping a 960×540 frame a few milliseconds and the result
+//! independent of frame order and thread count.
 
 /// Palette index reserved for "unchanged since the previous frame" (GIF transparency); the
 /// colours are entries `0..TRANSPARENT`.
 pub const TRANSPARENT: u8 = 255;
+
+/// NeuQuant's sampling factor: 1 looks at every training pixel, 30 at one in 30.
+const SAMPLE_FACTOR: i32 = 3;
 
 /// A palette of 256 RGB colours, the last one reserved ([`TRANSPARENT`]).
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -21,57 +28,29 @@ pub struct Palette {
     pub colours: Vec<[u8; 3]>,
 }
 
-fn mix(a: [f32; 3], b: [f32; 3], w: f32) -> [u8; 3] {
-    [0, 1, 2].map(|k| (a[k] + (b[k] - a[k]) * w).round().clamp(0.0, 255.0) as u8)
-}
-
-fn f(c: [u8; 3]) -> [f32; 3] {
-    c.map(|v| v as f32)
-}
-
 impl Palette {
-    /// The palette for pictures drawn in `style`.
-    pub fn for_style(style: &Style) -> Palette {
+    /// A palette for pictures whose colours are sampled in `rgba` (straight RGBA bytes, any
+    /// number of pixels, alpha ignored), always holding the colours `exact`.
+    pub fn learn(rgba: &[u8], exact: &[[u8; 3]]) -> Palette {
+        let mut exact: Vec<[u8; 3]> = exact.to_vec();
+        exact.dedup();
+        exact.truncate(64);
+        let learnt = (TRANSPARENT as usize).saturating_sub(exact.len()).max(2);
         let mut c: Vec<[u8; 3]> = Vec::with_capacity(256);
-        let sky = |v: f32| style.sky(v);
-        // 68 steps of the sky gradient (the rest of the table): about 2 levels per channel.
-        const SKY: usize = 68;
-        for k in 0..SKY {
-            let s = sky(k as f32 / (SKY - 1) as f32);
-            c.push(mix(s, s, 0.0));
-        }
-        // Clouds over the sky: 12 heights × 9 opacities.
-        let cloud = f(style.cloud);
-        for k in 0..12 {
-            let s = sky(k as f32 / 11.0);
-            for a in 1..=9 {
-                c.push(mix(s, cloud, style.cloud_opacity * a as f32 / 9.0));
+        let px = rgba.len() / 4;
+        if px > 0 {
+            // NeuQuant wants RGBA; force opaque so alpha does not take part.
+            let mut train: Vec<u8> = rgba[..px * 4].to_vec();
+            for p in train.chunks_exact_mut(4) {
+                p[3] = 255;
+            }
+            let nq = color_quant::NeuQuant::new(SAMPLE_FACTOR, learnt, &train);
+            for p in nq.color_map_rgba().chunks_exact(4) {
+                c.push([p[0], p[1], p[2]]);
             }
         }
-        // Birds: both tones solid and their shading in between.
-        let (bird, wing) = (f(style.bird), f(style.bird_wing));
-        for k in 0..6 {
-            c.push(mix(bird, wing, k as f32 / 5.0));
-        }
-        // Anti-aliased edges: bird over sky at 7 heights × 8 coverages.
-        for k in 0..7 {
-            let s = sky(k as f32 / 6.0);
-            for a in 1..=8 {
-                c.push(mix(s, bird, a as f32 / 9.0));
-            }
-        }
-        // Edges over cloud and the lighter wing tone over sky.
-        let cloudy = mix(sky(0.5), cloud, style.cloud_opacity * 0.8);
-        for a in 1..=8 {
-            c.push(mix(f(cloudy), bird, a as f32 / 9.0));
-        }
-        for k in 0..3 {
-            let s = sky(k as f32 / 2.0);
-            for a in [0.3f32, 0.55, 0.8] {
-                c.push(mix(s, wing, a));
-            }
-        }
-        debug_assert_eq!(c.len(), TRANSPARENT as usize);
+        c.truncate(learnt);
+        c.extend(exact);
         c.truncate(TRANSPARENT as usize);
         while c.len() < 256 {
             c.push([0, 0, 0]);
@@ -135,11 +114,11 @@ impl<'a> Lookup<'a> {
         n
     }
 
-    /// Maps a whole RGB image to palette indices.
-    pub fn map_image(&mut self, rgb: &[u8], out: &mut Vec<u8>) {
+    /// Maps a whole opaque RGBA image to palette indices.
+    pub fn map_image(&mut self, rgba: &[u8], out: &mut Vec<u8>) {
         out.clear();
-        out.reserve(rgb.len() / 3);
-        for p in rgb.chunks_exact(3) {
+        out.reserve(rgba.len() / 4);
+        for p in rgba.chunks_exact(4) {
             out.push(self.index([p[0], p[1], p[2]]));
         }
     }
@@ -148,21 +127,27 @@ impl<'a> Lookup<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::export::scene::Style;
 
     #[test]
-    fn palette_has_256_entries_and_sky_maps_closely() {
+    fn learnt_palette_fits_the_sky_closely_and_keeps_exact_colours() {
         let st = Style::default();
-        let p = Palette::for_style(&st);
+        let mut px = Vec::new();
+        for k in 0..5000 {
+            let s = st.sky(k as f32 / 4999.0).map(|v| v.round() as u8);
+            px.extend([s[0], s[1], s[2], 255]);
+        }
+        let bird = [34, 34, 42];
+        let p = Palette::learn(&px, &[bird]);
         assert_eq!(p.colours.len(), 256);
         let mut l = Lookup::new(&p);
         for k in 0..=100 {
             let s = st.sky(k as f32 / 100.0).map(|v| v.round() as u8);
             let q = p.colours[l.index(s) as usize];
             for c in 0..3 {
-                assert!((q[c] as i32 - s[c] as i32).abs() <= 5, "{s:?} → {q:?}");
+                assert!((q[c] as i32 - s[c] as i32).abs() <= 4, "{s:?} → {q:?}");
             }
         }
-        let b = p.colours[l.index(st.bird) as usize];
-        assert_eq!(b, st.bird);
+        assert_eq!(p.colours[l.index(bird) as usize], bird);
     }
 }

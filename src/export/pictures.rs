@@ -1,19 +1,32 @@
-//! The image outputs: an animated GIF and a directory of numbered PNG frames, both drawn by
-//! [`scene`] along the [`camera`] path.
+//! The image outputs: an animated GIF, a directory of numbered PNG frames and a video (`.mp4`
+//! H.264, `.webm` VP9, encoded by the system `ffmpeg`), all drawn by [`scene`] along the
+//! [`camera`] path.
 //!
 //! Frames are drawn in parallel (one worker per core pulls the next frame number; results are
-//! written in order), and every frame depends only on its own time, so outputs are byte-identical
-//! whatever the thread count. GIF frames are mapped to the fixed [`Palette`] and LZW-compressed in
-//! the workers, and every frame after the first stores only the box of pixels that changed, with
-//! unchanged ones transparent (clear sky is fixed on screen, so most of it costs nothing); the
-//! file is one global palette, a NETSCAPE loop extension (loop forever) and the
-//! frames. GIF frame delays are whole hundredths of a second, so the GIF frame rate is
-//! `100 / round(100 / fps)`: 25 fps by default (4/100 s per frame).
+//! consumed in order), and every frame depends only on its own time, so outputs are
+//! byte-identical whatever the thread count.
+//!
+//! **GIF.** One global palette learnt from the film ([`Palette::learn`], NeuQuant), no dither.
+//! Every frame after the first stores only what changed, as the bounding box of the changed
+//! pixels with unchanged ones transparent (disposal "keep"). "Changed" is judged against what the
+//! viewer currently sees, with a tolerance ([`super::RenderOptions::gif_tolerance`]): a pixel is
+//! redrawn only when its true colour differs from the shown palette colour by more than the
+//! tolerance in some channel, so a soft cloud sliding by a pixel costs little, while every bird
+//! (dark on the sky) is redrawn exactly. The shown picture therefore never strays from the true
+//! one by more than the tolerance (plus the palette's own error). The differencing is
+//! sequential in time but independent per pixel, so it runs in parallel over bands of rows;
+//! LZW compression runs in parallel over frames. GIF frame delays are whole hundredths of a
+//! second, so the GIF frame rate is `100 / round(100 / fps)`: 25 fps by default.
+//!
+//! **Video.** Raw RGBA frames are piped into `ffmpeg` (found on `PATH`, or at the path in the
+//! `FORMATION_FFMPEG` environment variable), which writes the temporary file that is renamed
+//! into place when it succeeds (like every output, atomically).
 
 use std::borrow::Cow;
 use std::collections::BTreeMap;
 use std::io::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::mpsc;
 
@@ -21,12 +34,13 @@ use super::camera::{self, CameraParams, View};
 use super::palette::{Lookup, Palette, TRANSPARENT};
 use super::raster::{Canvas, Mask};
 use super::sample::{self, BirdState};
-use super::scene::{self, Backdrop, Style};
+use super::scene::{self, Backdrop, Background, Style};
+use super::RenderOptions;
 use crate::animation::Animation;
 use crate::error::{Error, Result};
 use crate::io::{AtomicDir, AtomicFile};
 use crate::progress::Progress;
-use crate::wingbeat::Flapper;
+use crate::wingbeat::{Flapper, Species};
 
 /// Default frame rate of GIF output, frames per second (a whole number of 1/100 s per frame).
 pub const GIF_FPS: f64 = 25.0;
@@ -45,20 +59,49 @@ pub struct Film {
     pub states: Vec<Vec<BirdState>>,
     /// Camera at each output frame.
     pub views: Vec<View>,
+    /// The birds' species (silhouette and plumage).
+    pub species: Species,
     backdrop: Backdrop,
+    gif_tolerance: i32,
 }
 
 impl Film {
-    /// Samples `anim` at `fps` and plans the camera for a `width × height` picture.
+    /// Samples `anim` at `fps` and plans the default camera for a `width × height` picture.
     pub fn new(anim: &Animation, fps: f64, width: usize, height: usize) -> Film {
+        let opts = RenderOptions {
+            width: width as u32,
+            height: height as u32,
+            ..RenderOptions::default()
+        };
+        Film::with_options(anim, fps, &opts)
+    }
+
+    /// Samples `anim` at `fps` and plans the camera, background and look of `opts` (its
+    /// `width × height`; its other fields are assumed checked by [`RenderOptions::validate`]).
+    pub fn with_options(anim: &Animation, fps: f64, opts: &RenderOptions) -> Film {
+        let (width, height) = (opts.width as usize, opts.height as usize);
         let flapper = Flapper::from_animation(anim);
         let times = sample::output_times(anim, fps);
         let states: Vec<Vec<BirdState>> = times
             .iter()
             .map(|&t| sample::state_at(anim, &flapper, t))
             .collect();
-        let views = camera::track(&states, fps, width, height, &CameraParams::default());
-        let style = Style::default();
+        let species = anim
+            .species
+            .as_deref()
+            .and_then(|s| s.parse::<Species>().ok())
+            .unwrap_or_default();
+        let params = CameraParams {
+            kind: opts.camera,
+            min_bird_px: opts.min_bird_px,
+            bird_radius: super::silhouette::radius(species),
+            ..CameraParams::default()
+        };
+        let views = camera::track(&states, fps, width, height, &params);
+        let style = Style {
+            sun: opts.sun,
+            ..Style::default()
+        };
         Film {
             width,
             height,
@@ -66,7 +109,9 @@ impl Film {
             times,
             states,
             views,
-            backdrop: Backdrop::new(width, height, &style, anim.seed),
+            species,
+            backdrop: Backdrop::new(width, height, &style, opts.background, anim.seed),
+            gif_tolerance: opts.gif_tolerance.round().clamp(0.0, 255.0) as i32,
         }
     }
 
@@ -80,22 +125,47 @@ impl Film {
         self.times.is_empty()
     }
 
-    /// Draws frame `k` into `canvas` (which must be `width × height`); `dither` prepares it for
-    /// the GIF palette (see [`Backdrop::paint`]).
-    pub fn draw(&self, k: usize, canvas: &mut Canvas, mask: &mut Mask, dither: bool) {
-        self.backdrop.paint(&self.views[k], canvas, dither);
-        scene::draw_birds(
-            canvas,
-            &self.states[k],
-            &self.views[k],
-            self.backdrop.style(),
-            mask,
-        );
+    /// The background behind the birds.
+    pub fn background(&self) -> Background {
+        self.backdrop.background()
     }
 
-    /// The palette for GIF output.
+    /// The backdrop (sky and clouds).
+    pub fn backdrop(&self) -> &Backdrop {
+        &self.backdrop
+    }
+
+    /// Draws frame `k` into `canvas` (which must be `width × height`). `_for_gif` is kept for
+    /// callers of the earlier dithered renderer; pictures are the same for every output now.
+    pub fn draw(&self, k: usize, canvas: &mut Canvas, mask: &mut Mask, _for_gif: bool) {
+        self.backdrop.paint(&self.views[k], canvas);
+        scene::draw_birds(canvas, &self.states[k], &self.views[k], self.species, mask);
+    }
+
+    /// The GIF palette: NeuQuant over pixels of up to 9 frames spread over the film (every
+    /// 7th pixel of each), plus the species' plumage exactly.
     pub fn palette(&self) -> Palette {
-        Palette::for_style(self.backdrop.style())
+        let (w, h) = (self.width, self.height);
+        let n = self.len();
+        let picks: Vec<usize> = if n == 0 {
+            Vec::new()
+        } else {
+            let m = n.min(9);
+            let mut v: Vec<usize> = (0..m).map(|i| i * (n - 1) / (m - 1).max(1)).collect();
+            v.dedup();
+            v
+        };
+        let mut canvas = Canvas::new(w, h);
+        let mut mask = Mask::new();
+        let mut train = Vec::new();
+        for k in picks {
+            self.draw(k, &mut canvas, &mut mask, true);
+            for p in canvas.rgba.chunks_exact(4).step_by(7) {
+                train.extend_from_slice(p);
+            }
+        }
+        let pl = super::silhouette::plumage(self.species);
+        Palette::learn(&train, &[pl.body, pl.arm, pl.hand, pl.head])
     }
 }
 
@@ -169,30 +239,38 @@ where
     })
 }
 
-/// GIF frames are mapped and compressed in batches of this many frames (bounded memory).
-const GIF_BATCH: usize = 32;
+/// GIF frames are drawn, differenced and compressed in batches of this many frames (bounded
+/// memory: a batch holds its RGBA pictures).
+const GIF_BATCH: usize = 16;
 
 /// The part of `cur` that differs from `prev` as a GIF sub-frame: its bounding box, with
 /// unchanged pixels set to [`TRANSPARENT`] (shown through from the previous frame, which the
 /// `Keep` disposal leaves in place). Returns `(left, top, width, height, indices)`.
 pub fn frame_delta(prev: &[u8], cur: &[u8], width: usize) -> (usize, usize, usize, usize, Vec<u8>) {
-    let height = cur.len() / width.max(1);
+    let out: Vec<u8> = prev
+        .iter()
+        .zip(cur)
+        .map(|(&p, &q)| if p == q { TRANSPARENT } else { q })
+        .collect();
+    crop_changed(&out, width)
+}
+
+/// The bounding box of the non-[`TRANSPARENT`] pixels of `delta` (a full `width`-wide frame)
+/// and its contents; a 1×1 transparent frame when nothing changed.
+fn crop_changed(delta: &[u8], width: usize) -> (usize, usize, usize, usize, Vec<u8>) {
+    let height = delta.len() / width.max(1);
     let (mut x0, mut y0, mut x1, mut y1) = (usize::MAX, usize::MAX, 0, 0);
     for y in 0..height {
-        let (a, b) = (
-            &prev[y * width..(y + 1) * width],
-            &cur[y * width..(y + 1) * width],
-        );
-        if a == b {
+        let row = &delta[y * width..(y + 1) * width];
+        let Some(first) = row.iter().position(|&v| v != TRANSPARENT) else {
             continue;
-        }
-        let first = a.iter().zip(b).position(|(p, q)| p != q).unwrap_or(0);
+        };
         let last = width
             - 1
-            - a.iter()
+            - row
+                .iter()
                 .rev()
-                .zip(b.iter().rev())
-                .position(|(p, q)| p != q)
+                .position(|&v| v != TRANSPARENT)
                 .unwrap_or(0);
         x0 = x0.min(first);
         x1 = x1.max(last);
@@ -205,13 +283,61 @@ pub fn frame_delta(prev: &[u8], cur: &[u8], width: usize) -> (usize, usize, usiz
     let (w, h) = (x1 - x0 + 1, y1 - y0 + 1);
     let mut out = Vec::with_capacity(w * h);
     for y in y0..=y1 {
-        let row = y * width;
-        for x in x0..=x1 {
-            let q = cur[row + x];
-            out.push(if prev[row + x] == q { TRANSPARENT } else { q });
-        }
+        out.extend_from_slice(&delta[y * width + x0..y * width + x1 + 1]);
     }
     (x0, y0, w, h, out)
+}
+
+/// One step of the tolerant differencing for a run of pixels: `shown` (palette indices the viewer
+/// sees, updated in place; `first` for the first frame), the frame's true colours `rgba` and the
+/// previous frame's `prev`; writes the sub-frame indices (or [`TRANSPARENT`]) to `out`. Only pixels that must change
+/// are looked up in the palette.
+#[allow(clippy::too_many_arguments)]
+fn delta_step(
+    shown: &mut [u8],
+    first: bool,
+    rgba: &[u8],
+    prev: &[u8],
+    out: &mut [u8],
+    lookup: &mut Lookup,
+    palette: &Palette,
+    tolerance: i32,
+) {
+    for (((s, p), o), q) in shown
+        .iter_mut()
+        .zip(rgba.chunks_exact(4))
+        .zip(out.iter_mut())
+        .zip(prev.chunks_exact(4))
+    {
+        // Same true colour as in the previous frame: what is shown was within the tolerance of
+        // it then (or set to it), so it still is.
+        if !first && p == q {
+            *o = TRANSPARENT;
+            continue;
+        }
+        if first {
+            let q = lookup.index([p[0], p[1], p[2]]);
+            *s = q;
+            *o = q;
+            continue;
+        }
+        let c = palette.colours[*s as usize];
+        let err = (c[0] as i32 - p[0] as i32)
+            .abs()
+            .max((c[1] as i32 - p[1] as i32).abs())
+            .max((c[2] as i32 - p[2] as i32).abs());
+        if err <= tolerance {
+            *o = TRANSPARENT;
+            continue;
+        }
+        let q = lookup.index([p[0], p[1], p[2]]);
+        if q == *s {
+            *o = TRANSPARENT;
+        } else {
+            *o = q;
+            *s = q;
+        }
+    }
 }
 
 /// Writes an animated, looping GIF of `film` to `path` (atomically).
@@ -219,6 +345,7 @@ pub fn write_gif(film: &Film, path: &Path, threads: usize, progress: &dyn Progre
     let (w, h) = (film.width, film.height);
     let delay = (100.0 / film.fps).round().max(1.0) as u16;
     let palette = film.palette();
+    let tolerance = film.gif_tolerance;
     let mut file = AtomicFile::create(path)?;
     let io_err = |e: gif::EncodingError| match e {
         gif::EncodingError::Io(e) => Error::io(path, e),
@@ -229,48 +356,92 @@ pub fn write_gif(film: &Film, path: &Path, threads: usize, progress: &dyn Progre
             .map_err(io_err)?;
         enc.set_repeat(gif::Repeat::Infinite).map_err(io_err)?;
         progress.start("gif", film.len() as u64);
-        // Indices of the frame before the current batch.
-        let mut prev: Option<Vec<u8>> = None;
+        // Palette indices the viewer sees after the frames written so far, in bands of rows
+        // (one per worker), each with its own lookup table.
+        let band = h.div_ceil(threads.max(1)).max(1) * w;
+        let mut shown = vec![0u8; w * h];
+        let mut lookups: Vec<Lookup> = shown.chunks(band).map(|_| Lookup::new(&palette)).collect();
+        // The previous frame's picture, the batch's sub-frames, and spare picture buffers.
+        let mut last = vec![0u8; w * h * 4];
+        let mut deltas: Vec<Vec<u8>> = vec![vec![TRANSPARENT; w * h]; GIF_BATCH];
+        let pool: std::sync::Mutex<Vec<Vec<u8>>> = std::sync::Mutex::new(Vec::new());
         for start in (0..film.len()).step_by(GIF_BATCH) {
             let count = GIF_BATCH.min(film.len() - start);
-            // 1. Draw and map the batch in parallel.
-            let mut indexed: Vec<Vec<u8>> = Vec::with_capacity(count);
+            // 1. Draw the batch in parallel (into buffers reused from earlier batches).
+            let mut drawn: Vec<Vec<u8>> = Vec::with_capacity(count);
             run_frames(
                 count,
                 threads,
-                || (Canvas::new(w, h), Mask::new(), Lookup::new(&palette)),
-                |k, (canvas, mask, lookup): &mut (Canvas, Mask, Lookup)| {
+                || (Canvas::new(w, h), Mask::new()),
+                |k, (canvas, mask): &mut (Canvas, Mask)| {
                     film.draw(start + k, canvas, mask, true);
-                    let mut idx = Vec::new();
-                    lookup.map_image(&canvas.rgb, &mut idx);
-                    Ok(idx)
+                    let mut buf = pool
+                        .lock()
+                        .map(|mut p| p.pop())
+                        .ok()
+                        .flatten()
+                        .unwrap_or_default();
+                    buf.clear();
+                    buf.extend_from_slice(&canvas.rgba);
+                    Ok(buf)
                 },
-                |_, idx| {
-                    indexed.push(idx);
+                |_, d| {
+                    drawn.push(d);
                     Ok(())
                 },
             )?;
-            // 2. Difference against the previous frame and LZW-compress in parallel.
-            let before = |k: usize| {
-                if k == 0 {
-                    prev.as_deref()
-                } else {
-                    Some(indexed[k - 1].as_slice())
-                }
-            };
+            // 2. Tolerant differencing against what is shown, in parallel over bands of rows.
+            {
+                let mut outs: Vec<std::slice::ChunksMut<u8>> =
+                    deltas.iter_mut().map(|d| d.chunks_mut(band)).collect();
+                let drawn = &drawn;
+                let palette = &palette;
+                let last = &last;
+                std::thread::scope(|scope| {
+                    for (b, (s, lookup)) in shown.chunks_mut(band).zip(&mut lookups).enumerate() {
+                        let mine: Vec<&mut [u8]> =
+                            outs.iter_mut().map(|o| o.next().expect("band")).collect();
+                        scope.spawn(move || {
+                            let lo = b * band;
+                            let hi = lo + s.len();
+                            for (k, o) in mine.into_iter().take(count).enumerate() {
+                                let prev = if k == 0 { last } else { &drawn[k - 1] };
+                                delta_step(
+                                    s,
+                                    start + k == 0,
+                                    &drawn[k][lo * 4..hi * 4],
+                                    &prev[lo * 4..hi * 4],
+                                    o,
+                                    lookup,
+                                    palette,
+                                    tolerance,
+                                );
+                            }
+                        });
+                    }
+                });
+            }
+            // Keep the batch's last picture for the next batch; recycle the others.
+            if let Some(l) = drawn.pop() {
+                let old = std::mem::replace(&mut last, l);
+                drawn.push(old);
+            }
+            if let Ok(mut p) = pool.lock() {
+                p.extend(drawn);
+            }
+            // 3. Crop to the changed box and LZW-compress in parallel.
             let mut frames = Vec::with_capacity(count);
+            let deltas = &deltas;
             run_frames(
                 count,
                 threads,
                 || (),
                 |k, _| {
-                    let cur = &indexed[k];
-                    let (left, top, fw, fh, buf, transparent) = match before(k) {
-                        None => (0, 0, w, h, cur.clone(), None),
-                        Some(p) => {
-                            let (l, t, fw, fh, b) = frame_delta(p, cur, w);
-                            (l, t, fw, fh, b, Some(TRANSPARENT))
-                        }
+                    let (left, top, fw, fh, buf, transparent) = if start + k == 0 {
+                        (0, 0, w, h, deltas[0].clone(), None)
+                    } else {
+                        let (l, t, fw, fh, b) = crop_changed(&deltas[k], w);
+                        (l, t, fw, fh, b, Some(TRANSPARENT))
                     };
                     let mut frame = gif::Frame {
                         left: left as u16,
@@ -295,7 +466,6 @@ pub fn write_gif(film: &Film, path: &Path, threads: usize, progress: &dyn Progre
                 enc.write_lzw_pre_encoded_frame(frame).map_err(io_err)?;
                 progress.advance(1);
             }
-            prev = indexed.pop();
         }
         enc.into_inner().map_err(io_err)?;
     }
@@ -311,7 +481,8 @@ pub fn frame_name(k: usize) -> String {
 }
 
 /// Writes numbered PNG frames `frame_00000.png`, … of `film` into the directory `path`
-/// (atomically: a temporary sibling directory renamed into place when complete).
+/// (atomically: a temporary sibling directory renamed into place when complete). Frames are RGB,
+/// or RGBA with `--background none` (transparent sky, for compositing).
 pub fn write_png_dir(
     film: &Film,
     path: &Path,
@@ -319,6 +490,7 @@ pub fn write_png_dir(
     progress: &dyn Progress,
 ) -> Result<()> {
     let (w, h) = (film.width, film.height);
+    let alpha = film.background() == Background::None;
     let dir = AtomicDir::create(path)?;
     progress.start("png frames", film.len() as u64);
     run_frames(
@@ -335,18 +507,23 @@ pub fn write_png_dir(
                 image::codecs::png::CompressionType::Fast,
                 image::codecs::png::FilterType::Adaptive,
             );
-            image::ImageEncoder::write_image(
-                enc,
-                &canvas.rgb,
-                w as u32,
-                h as u32,
-                image::ExtendedColorType::Rgb8,
-            )
-            .map_err(|e| match e {
-                // A full disk or a file-size limit: the user's problem with the output, exit 2.
-                image::ImageError::IoError(e) => Error::io(path, e),
-                other => Error::Internal(format!("{}: PNG encoder: {other}", path.display())),
-            })?;
+            let (bytes, colour) = if alpha {
+                (canvas.straight_rgba(), image::ExtendedColorType::Rgba8)
+            } else {
+                let rgb: Vec<u8> = canvas
+                    .rgba
+                    .chunks_exact(4)
+                    .flat_map(|p| [p[0], p[1], p[2]])
+                    .collect();
+                (rgb, image::ExtendedColorType::Rgb8)
+            };
+            image::ImageEncoder::write_image(enc, &bytes, w as u32, h as u32, colour).map_err(
+                |e| match e {
+                    // A full disk or a file-size limit: the user's problem with the output, exit 2.
+                    image::ImageError::IoError(e) => Error::io(path, e),
+                    other => Error::Internal(format!("{}: PNG encoder: {other}", path.display())),
+                },
+            )?;
             out.flush().map_err(|e| Error::io(path, e))?;
             Ok(())
         },
@@ -356,6 +533,151 @@ pub fn write_png_dir(
         },
     )?;
     dir.commit()?;
+    progress.finish();
+    Ok(())
+}
+
+/// The video codecs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum VideoCodec {
+    /// H.264 in MP4 (`libx264`, yuv420p, CRF 20: plays everywhere).
+    H264,
+    /// VP9 in WebM (`libvpx-vp9`, yuv420p, CRF 32, realtime speed).
+    Vp9,
+}
+
+/// The `ffmpeg` to use: `FORMATION_FFMPEG` if set, else `ffmpeg` on `PATH`.
+pub fn ffmpeg_program() -> PathBuf {
+    std::env::var_os("FORMATION_FFMPEG")
+        .filter(|v| !v.is_empty())
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from("ffmpeg"))
+}
+
+/// Checks that `ffmpeg` runs, before any work; the error names the output and how to install it.
+pub fn check_ffmpeg(output: &Path) -> Result<()> {
+    let prog = ffmpeg_program();
+    let ok = Command::new(&prog)
+        .arg("-version")
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .status()
+        .map(|s| s.success())
+        .unwrap_or(false);
+    if ok {
+        Ok(())
+    } else {
+        Err(Error::parameter(
+            "-o",
+            format!(
+                "{}: video is encoded by ffmpeg, and {} was not found or does not run; install it (apt-get install ffmpeg) or write .gif or PNG frames",
+                output.display(),
+                prog.display()
+            ),
+        ))
+    }
+}
+
+/// Writes `film` as a video to `path` (atomically) by piping raw RGBA frames into `ffmpeg`.
+pub fn write_video(
+    film: &Film,
+    path: &Path,
+    codec: VideoCodec,
+    threads: usize,
+    progress: &dyn Progress,
+) -> Result<()> {
+    let (w, h) = (film.width, film.height);
+    let file = AtomicFile::create(path)?;
+    let mut cmd = Command::new(ffmpeg_program());
+    cmd.args(["-hide_banner", "-nostdin", "-loglevel", "error", "-y"])
+        .args(["-f", "rawvideo", "-pix_fmt", "rgba"])
+        .args(["-s", &format!("{w}x{h}")])
+        .args(["-framerate", &format!("{}", film.fps)])
+        .args(["-i", "pipe:0"])
+        .args(["-map_metadata", "-1", "-fflags", "+bitexact"]);
+    match codec {
+        VideoCodec::H264 => cmd.args([
+            "-c:v",
+            "libx264",
+            "-preset",
+            "veryfast",
+            "-crf",
+            "20",
+            "-threads",
+            &threads.to_string(),
+            "-pix_fmt",
+            "yuv420p",
+            "-movflags",
+            "+faststart",
+            "-f",
+            "mp4",
+        ]),
+        VideoCodec::Vp9 => cmd.args([
+            "-c:v",
+            "libvpx-vp9",
+            "-crf",
+            "32",
+            "-b:v",
+            "0",
+            "-deadline",
+            "realtime",
+            "-cpu-used",
+            "8",
+            "-row-mt",
+            "1",
+            "-threads",
+            &threads.to_string(),
+            "-pix_fmt",
+            "yuv420p",
+            "-f",
+            "webm",
+        ]),
+    };
+    cmd.arg(file.temp_path())
+        .stdin(Stdio::piped())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped());
+    let ff_err = |m: String| Error::Internal(format!("{}: ffmpeg: {m}", path.display()));
+    let mut child = cmd.spawn().map_err(|e| ff_err(e.to_string()))?;
+    let mut stdin = child.stdin.take().expect("piped");
+    // Read ffmpeg's messages on a thread so a chatty encoder cannot block the pipe.
+    let mut stderr = child.stderr.take().expect("piped");
+    let messages = std::thread::spawn(move || {
+        let mut s = String::new();
+        let _ = std::io::Read::read_to_string(&mut stderr, &mut s);
+        s
+    });
+    progress.start("video", film.len() as u64);
+    let piped = run_frames(
+        film.len(),
+        threads,
+        || (Canvas::new(w, h), Mask::new()),
+        |k, (canvas, mask): &mut (Canvas, Mask)| {
+            film.draw(k, canvas, mask, false);
+            Ok(canvas.rgba.clone())
+        },
+        |_, rgba| {
+            stdin
+                .write_all(&rgba)
+                .map_err(|e| ff_err(format!("stopped reading frames ({e})")))?;
+            progress.advance(1);
+            Ok(())
+        },
+    );
+    drop(stdin);
+    let status = child.wait().map_err(|e| ff_err(e.to_string()))?;
+    let said = messages.join().unwrap_or_default();
+    if !status.success() {
+        let last = said
+            .lines()
+            .rev()
+            .find(|l| !l.trim().is_empty())
+            .unwrap_or("");
+        return Err(ff_err(format!("failed ({status}): {last}")));
+    }
+    piped?;
+    file.commit()?;
     progress.finish();
     Ok(())
 }

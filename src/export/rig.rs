@@ -1,6 +1,7 @@
 //! The bird model shared by every renderer: body outline, wing segments and the joint rotations a
-//! [`WingPose`] implies. The GIF silhouettes and the glTF skeleton are built from the same numbers,
-//! so what a user sees in the GIF is what they import into Blender.
+//! [`WingPose`] implies. The GIF silhouettes and the glTF/USD skeletons turn their wings by the
+//! same [`wing_joints`] rotations, so the wingbeat a user sees in the GIF is the one they import
+//! into Blender; the 3D birds' species proportions are in [`super::bird`].
 //!
 //! Lengths are in wingspans (a bird is 1 wide with its wings fully spread). The bird's own frame
 //! uses glTF's conventions: `+Y` up, `+Z` forward (the glTF "front" of an asset), hence `+X` is the

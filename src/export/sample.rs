@@ -20,6 +20,8 @@ pub struct BirdState {
     pub z: f64,
     /// Heading, radians clockwise from north.
     pub heading: f64,
+    /// Bank angle, radians, right wing down positive (0 when the animation has none).
+    pub bank: f64,
     /// Wing joint angles.
     pub pose: WingPose,
 }
@@ -115,6 +117,11 @@ pub fn state_at(anim: &Animation, flapper: &Flapper, t: f64) -> Vec<BirdState> {
                 y: g(&fa.y, &fb.y),
                 z: g(&fa.z, &fb.z),
                 heading: ha + angle_diff(ha, hb) * w,
+                bank: match (&fa.bank, &fb.bank) {
+                    (Some(a), Some(c)) => g(a, c),
+                    (Some(a), None) => a.get(b).copied().unwrap_or(0.0),
+                    _ => 0.0,
+                },
                 pose: lerp_pose(&flapper.pose(i, b), &flapper.pose(j, b), w),
             }
         })

@@ -1,36 +1,117 @@
-//! Drawing one picture of the flock: a sky gradient, soft clouds that drift past with parallax as
-//! the camera follows the flock (the motion cue: the birds hold formation while the world moves),
-//! and every bird as an anti-aliased silhouette of [`rig::top_view`] turned to its heading.
+//! Drawing one picture of the flock: the background (`--background sky|none|#rrggbb`) and every
+//! bird as an anti-aliased species [`silhouette`] projected by the frame's camera [`View`].
 //!
-//! The view is top-down, north up and east right, so images line up with the CSV's `x`/`y`.
-//! Birds higher up (`z`) are drawn slightly larger and later (on top).
+//! **Sky.** A vertical gradient (by image row for the top-down cameras, by the ray's elevation for
+//! the ground camera), an optional sun glow, and two procedural cloud layers. The clouds are
+//! fractal value noise hashed on the layer's own coordinates (no texture, so no tile period at any
+//! zoom): five octaves, each rotated by 0.5 rad against the one before so the lattice never
+//! lines up, with
+//! ```math
+//! n(u) = \frac{\sum_k a^k \big(w_k\, v(2^k R^k u) + (1 - w_k)/2\big)}{\sum_k a^k}, \qquad
+//! \alpha = \operatorname{smoothstep}\Big(\frac{n - n_0}{\Delta}\Big)
+//! ```
+//! where `v` is bilinear-smoothstep value noise on the integer lattice and `w_k` fades out an
+//! octave whose wavelength on screen is under four samples (so zooming out never aliases: fine
+//! octaves melt into their mean instead of flickering). For the top-down cameras a layer with
+//! parallax `p` is seen at `u = (p c + (q − q₀)/s_L) / L` (camera centre `c`, pixel offset
+//! `q − q₀`, feature size `L`), at the layer scale `s_L = s₀ (s/s₀)^ζ` (bird scale `s`, reference
+//! `s₀` = [`Style::cloud_px`], ζ = [`Style::cloud_zoom`]): it slides by `p` times the camera's
+//! motion, so the nearer layer moves faster than the far one and the flock's travel shows,
+//! while the far sky hardly zooms when the camera closes in on the birds. The layers move
+//! slowly on purpose (under a pixel per GIF frame at cruise): soft edges that crawl cost the GIF
+//! few redrawn pixels, fast ones would cost most of the picture every frame. For the ground
+//! camera a layer is a plane at a fixed height above the observer, intersected by each pixel's
+//! ray. The background is evaluated on a grid of one sample per [`GRID`] pixels and bilinearly
+//! interpolated, which makes it a few milliseconds per 960×540 frame.
 
 use super::camera::View;
 use super::raster::{Canvas, Mask};
-use super::rig;
 use super::sample::BirdState;
+use super::silhouette::{self, Part};
+use crate::error::{Error, Result};
+use crate::wingbeat::Species;
+
+/// What is behind the birds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Background {
+    /// Sky gradient and procedural clouds.
+    #[default]
+    Sky,
+    /// Nothing: transparent (PNG frames keep the alpha, for compositing).
+    None,
+    /// One flat colour.
+    Colour([u8; 3]),
+}
+
+impl Background {
+    /// Parses `sky`, `none` or `#rrggbb`.
+    pub fn parse(s: &str) -> Result<Background> {
+        match s {
+            "sky" => Ok(Background::Sky),
+            "none" => Ok(Background::None),
+            _ => {
+                let hex = s.strip_prefix('#').unwrap_or("");
+                if hex.len() == 6 && hex.chars().all(|c| c.is_ascii_hexdigit()) {
+                    let c = |i: usize| u8::from_str_radix(&hex[i..i + 2], 16).unwrap_or(0);
+                    Ok(Background::Colour([c(0), c(2), c(4)]))
+                } else {
+                    Err(Error::parameter(
+                        "--background",
+                        format!("unknown background {s:?}; use sky, none or a colour like #87ceeb"),
+                    ))
+                }
+            }
+        }
+    }
+}
 
 /// Colours and look of the picture.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Style {
-    /// Sky colour at the top of the picture.
+    /// Sky colour at the top of the picture (the zenith for the ground camera).
     pub sky_top: [u8; 3],
     /// Sky colour halfway down.
     pub sky_mid: [u8; 3],
-    /// Sky colour at the bottom of the picture.
+    /// Sky colour at the bottom of the picture (the horizon for the ground camera).
     pub sky_bottom: [u8; 3],
     /// Colour of the clouds.
     pub cloud: [u8; 3],
     /// Greatest opacity of a cloud, 0..1.
     pub cloud_opacity: f32,
-    /// Cloud drift as a fraction of the camera's motion (smaller looks farther away).
-    pub cloud_parallax: f64,
-    /// Size of a cloud texture cell, wingspans.
-    pub cloud_cell: f64,
-    /// Colour of the birds' bodies and hands.
-    pub bird: [u8; 3],
-    /// Colour of the inner wings (slightly lighter coverts).
-    pub bird_wing: [u8; 3],
+    /// Cloud layers, far to near.
+    pub layers: [CloudLayer; 2],
+    /// Draw a sun glow in the upper right.
+    pub sun: bool,
+    /// Scale at which the top-down cameras show the cloud layers, pixels per wingspan, when the
+    /// birds are drawn at this same scale.
+    pub cloud_px: f64,
+    /// How much the cloud layers zoom with the birds: the layers are shown at
+    /// `cloud_px · (s / cloud_px)^cloud_zoom` for a bird scale `s` (0 = not at all, 1 = fully).
+    /// Distant clouds barely zoom, and a small exponent keeps them from filling the picture
+    /// with blur when the camera closes in.
+    pub cloud_zoom: f64,
+    /// Colour of the sun glow.
+    pub sun_colour: [u8; 3],
+}
+
+/// One procedural cloud layer.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CloudLayer {
+    /// Screen motion as a fraction of the camera's (top-down cameras; smaller looks farther).
+    pub parallax: f64,
+    /// Size of the largest cloud features, wingspans (top-down) or wingspans on the layer's
+    /// plane (ground camera).
+    pub size: f64,
+    /// Height of the layer above the ground observer, wingspans.
+    pub height: f64,
+    /// Noise level where clouds start, 0..1 (higher = less cloud).
+    pub threshold: f32,
+    /// Width of the soft cloud edge in noise units.
+    pub softness: f32,
+    /// Opacity of this layer, 0..1 (times [`Style::cloud_opacity`]).
+    pub opacity: f32,
+    /// Stretch of the features along east–west (wisps when > 1).
+    pub stretch: f64,
 }
 
 impl Default for Style {
@@ -40,16 +121,43 @@ impl Default for Style {
             sky_mid: [112, 166, 214],
             sky_bottom: [206, 224, 236],
             cloud: [250, 251, 253],
-            cloud_opacity: 0.6,
-            cloud_parallax: 0.3,
-            cloud_cell: 0.3,
-            bird: [34, 34, 42],
-            bird_wing: [50, 49, 57],
+            cloud_opacity: 0.85,
+            layers: [
+                // High, thin and streaky: the far layer.
+                CloudLayer {
+                    parallax: 0.06,
+                    size: 40.0,
+                    height: 300.0,
+                    threshold: 0.5,
+                    softness: 0.2,
+                    opacity: 0.3,
+                    stretch: 2.5,
+                },
+                // Puffy fair-weather clouds nearer the flock.
+                CloudLayer {
+                    parallax: 0.12,
+                    size: 14.0,
+                    height: 120.0,
+                    threshold: 0.63,
+                    softness: 0.12,
+                    opacity: 0.7,
+                    stretch: 1.0,
+                },
+            ],
+            sun: false,
+            cloud_px: 16.0,
+            cloud_zoom: 0.25,
+            sun_colour: [255, 242, 210],
         }
     }
 }
 
 impl Style {
+    /// Pixels per wingspan of the cloud layers when the birds are drawn at `scale`.
+    pub fn layer_scale(&self, scale: f64) -> f64 {
+        self.cloud_px * (scale.max(1e-6) / self.cloud_px).powf(self.cloud_zoom)
+    }
+
     /// Sky colour at height fraction `v` (0 top, 1 bottom), as floats.
     pub fn sky(&self, v: f32) -> [f32; 3] {
         let v = v.clamp(0.0, 1.0);
@@ -64,27 +172,8 @@ impl Style {
     }
 }
 
-/// 4×4 Bayer matrix, centred: values in −8..8.
-const BAYER: [[i32; 4]; 4] = [
-    [-8, 0, -6, 2],
-    [4, -4, 6, -2],
-    [-5, 3, -7, 1],
-    [7, -1, 5, -3],
-];
-
-/// Side of the square, tileable cloud texture, cells (a power of two).
-const TEX: usize = 256;
-
-/// Everything that does not change from frame to frame: the sky rows and the cloud texture.
-#[derive(Debug, Clone)]
-pub struct Backdrop {
-    width: usize,
-    height: usize,
-    sky_rows: Vec<[f32; 3]>,
-    /// Cloud opacity per texture cell, 0..=255.
-    clouds: Vec<u8>,
-    style: Style,
-}
+/// Background sample spacing, pixels.
+pub const GRID: usize = 8;
 
 /// Deterministic hash of an integer lattice point to [0, 1).
 fn hash(x: i64, y: i64, seed: u64) -> f32 {
@@ -97,61 +186,110 @@ fn hash(x: i64, y: i64, seed: u64) -> f32 {
     (h >> 40) as f32 / (1u64 << 24) as f32
 }
 
-/// Tileable value noise with `period` lattice cells across the texture.
-fn value_noise(u: f32, v: f32, period: i64, seed: u64) -> f32 {
-    let (x0, y0) = (u.floor(), v.floor());
-    let (fx, fy) = (u - x0, v - y0);
+/// `⌊x⌋` as an integer, without a libm call (baseline x86-64 has no rounding instruction).
+#[inline]
+fn floor_i(x: f64) -> i64 {
+    let i = x as i64;
+    if (i as f64) > x {
+        i - 1
+    } else {
+        i
+    }
+}
+
+/// Value noise on the integer lattice (no period), smoothstep-interpolated, in [0, 1).
+#[inline]
+fn value_noise(u: f64, v: f64, seed: u64) -> f32 {
+    let (ix, iy) = (floor_i(u), floor_i(v));
+    let (fx, fy) = ((u - ix as f64) as f32, (v - iy as f64) as f32);
     let (sx, sy) = (fx * fx * (3.0 - 2.0 * fx), fy * fy * (3.0 - 2.0 * fy));
-    let (ix, iy) = (x0 as i64, y0 as i64);
-    let c = |dx: i64, dy: i64| {
-        hash(
-            (ix + dx).rem_euclid(period),
-            (iy + dy).rem_euclid(period),
-            seed,
-        )
-    };
-    let a = c(0, 0) + (c(1, 0) - c(0, 0)) * sx;
-    let b = c(0, 1) + (c(1, 1) - c(0, 1)) * sx;
+    let c00 = hash(ix, iy, seed);
+    let c10 = hash(ix + 1, iy, seed);
+    let c01 = hash(ix, iy + 1, seed);
+    let c11 = hash(ix + 1, iy + 1, seed);
+    let a = c00 + (c10 - c00) * sx;
+    let b = c01 + (c11 - c01) * sx;
     a + (b - a) * sy
+}
+
+/// Octaves of the cloud noise.
+const OCTAVES: usize = 5;
+/// Amplitude ratio between octaves.
+const GAIN: f32 = 0.5;
+/// `sin 0.5`, `cos 0.5`: the rotation between octaves.
+const ROT: (f64, f64) = (0.479_425_538_604_203, 0.877_582_561_890_372_8);
+
+/// Fractal noise at `(u, v)` (layer units); `footprint` = layer units per background sample.
+pub fn cloud_noise(u: f64, v: f64, footprint: f64, seed: u64) -> f32 {
+    cloud_noise_within(u, v, footprint, seed, (f32::MIN, f32::MAX))
+}
+
+/// [`cloud_noise`], stopping early once the result is sure to be below `bounds.0` or above
+/// `bounds.1` (then any value on that side is returned): the finer octaves can move the sum by
+/// at most their total amplitude, so most clear-sky samples need only one or two octaves.
+pub fn cloud_noise_within(u: f64, v: f64, footprint: f64, seed: u64, bounds: (f32, f32)) -> f32 {
+    let (s, c) = ROT;
+    let (mut x, mut y) = (u, v);
+    // Total amplitude of all octaves, to normalise and to bound what is left.
+    let total: f32 = (0..OCTAVES).map(|k| GAIN.powi(k as i32)).sum();
+    let (lo, hi) = (bounds.0 * total, bounds.1 * total);
+    let (mut n, mut amp, mut rest) = (0.0f32, 1.0f32, total);
+    let mut freq = 1.0f64;
+    for k in 0..OCTAVES {
+        rest -= amp;
+        // Wavelength of this octave in samples; fade out below 4.
+        let wl = 1.0 / (freq * footprint.max(1e-12));
+        let w = ((wl - 2.0) / 2.0).clamp(0.0, 1.0) as f32;
+        if w <= 0.0 {
+            // This and every finer octave sit at their mean.
+            n += 0.5 * (amp + rest);
+            break;
+        }
+        let val = value_noise(x * freq, y * freq, seed.wrapping_add(k as u64 * 7919));
+        n += amp * (w * val + (1.0 - w) * 0.5);
+        if n + rest < lo || n > hi {
+            break;
+        }
+        amp *= GAIN;
+        freq *= 2.0;
+        // Rotate the next octave's axes (and shift them) so lattices never line up.
+        let (nx, ny) = (x * c - y * s + 17.3, x * s + y * c - 5.1);
+        x = nx;
+        y = ny;
+    }
+    n / total
+}
+
+fn smoothstep(x: f32) -> f32 {
+    let x = x.clamp(0.0, 1.0);
+    x * x * (3.0 - 2.0 * x)
+}
+
+/// Everything about the background that does not change from frame to frame.
+#[derive(Debug, Clone)]
+pub struct Backdrop {
+    width: usize,
+    height: usize,
+    background: Background,
+    style: Style,
+    seed: u64,
 }
 
 impl Backdrop {
     /// The backdrop for a `width × height` picture; `seed` varies the clouds.
-    pub fn new(width: usize, height: usize, style: &Style, seed: u64) -> Backdrop {
-        let sky_rows = (0..height)
-            .map(|r| style.sky((r as f32 + 0.5) / height.max(1) as f32))
-            .collect();
-        let mut clouds = vec![0u8; TEX * TEX];
-        for y in 0..TEX {
-            for x in 0..TEX {
-                let (u, v) = (x as f32 / TEX as f32, y as f32 / TEX as f32);
-                let mut n = 0.0;
-                let mut amp = 0.5;
-                let mut total = 0.0;
-                for (o, period) in [8i64, 16, 32, 64, 128].iter().enumerate() {
-                    n += amp
-                        * value_noise(
-                            u * *period as f32,
-                            v * *period as f32,
-                            *period,
-                            seed.wrapping_add(o as u64),
-                        );
-                    total += amp;
-                    amp *= 0.5;
-                }
-                let n = n / total;
-                // Puffy clouds over roughly a third of the sky, soft edges.
-                let t = ((n - 0.53) / 0.12).clamp(0.0, 1.0);
-                let a = t * t * (3.0 - 2.0 * t);
-                clouds[y * TEX + x] = (a * 255.0 + 0.5) as u8;
-            }
-        }
+    pub fn new(
+        width: usize,
+        height: usize,
+        style: &Style,
+        background: Background,
+        seed: u64,
+    ) -> Backdrop {
         Backdrop {
             width,
             height,
-            sky_rows,
-            clouds,
+            background,
             style: style.clone(),
+            seed,
         }
     }
 
@@ -160,111 +298,231 @@ impl Backdrop {
         &self.style
     }
 
-    /// Paints sky and clouds for the camera `view` into `canvas`. With `dither`, cloud opacity
-    /// gets a 4×4 ordered (Bayer) dither of about one palette step, so that the GIF's fixed
-    /// palette shows soft clouds instead of contour bands, and the sky a fixed ±3-level dither
-    /// against banding (fixed on screen like the gradient, so it stays identical from frame to
-    /// frame and costs nothing after the first frame).
-    pub fn paint(&self, view: &View, canvas: &mut Canvas, dither: bool) {
+    /// What is behind the birds.
+    pub fn background(&self) -> Background {
+        self.background
+    }
+
+    /// Cloud opacity (0..1) of layer `l` at pixel `(col, row)` for `view`; `None` where the
+    /// layer is not seen (the ground camera's rays below its plane). For tests and the sampler.
+    pub fn cloud_alpha(&self, view: &View, l: usize, col: f64, row: f64) -> Option<f32> {
+        let s = self.style.layer_scale(view.scale());
+        self.cloud_alpha_at(view, s, l, col, row)
+    }
+
+    /// [`Backdrop::cloud_alpha`] with the top-down layer scale `s` computed once per frame.
+    fn cloud_alpha_at(&self, view: &View, s: f64, l: usize, col: f64, row: f64) -> Option<f32> {
+        let layer = &self.style.layers[l];
         let (w, h) = (self.width, self.height);
-        debug_assert_eq!(canvas.width, w);
+        let seed = self.seed.wrapping_mul(31).wrapping_add(l as u64 + 1);
+        let (u, v, fp) = match view {
+            View::Top { cx, cy, .. } => {
+                let u = (layer.parallax * cx + (col - 0.5 * w as f64) / s) / layer.size;
+                let v = (layer.parallax * cy - (row - 0.5 * h as f64) / s) / layer.size;
+                (u, v, GRID as f64 / (s * layer.size))
+            }
+            View::Ground(e) => {
+                let d = e.ray(col, row, w, h);
+                if d[2] <= 0.02 {
+                    return None;
+                }
+                let t = layer.height / d[2];
+                let (x, y) = (e.at[0] + t * d[0], e.at[1] + t * d[1]);
+                // Layer units covered by one sample there: ray length × angle per sample,
+                // stretched by the plane's obliquity 1 / sin(elevation).
+                let norm = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+                let len = t * norm;
+                let fp = len * GRID as f64 / e.focal_px / (d[2] / norm).max(0.05) / layer.size;
+                (x / layer.size, y / layer.size, fp)
+            }
+        };
+        let n = cloud_noise_within(
+            u / layer.stretch,
+            v,
+            fp,
+            seed,
+            (layer.threshold, layer.threshold + layer.softness),
+        );
+        Some(smoothstep((n - layer.threshold) / layer.softness) * layer.opacity)
+    }
+
+    /// Sky colour (without clouds) at pixel `(col, row)` for `view`.
+    fn sky_at(&self, view: &View, col: f64, row: f64) -> [f32; 3] {
         let st = &self.style;
-        // Texture coordinates (cells, fixed point 16.16) of a pixel: the clouds move by
-        // parallax × camera motion, and scale with the zoom.
-        let cell_px = st.cloud_cell * view.scale;
-        let step = (65536.0 / cell_px.max(1e-3)).round() as i64;
-        let ox = view.cx * st.cloud_parallax / st.cloud_cell - 0.5 * w as f64 / cell_px;
-        let oy = -view.cy * st.cloud_parallax / st.cloud_cell - 0.5 * h as f64 / cell_px;
-        let ox = (ox.rem_euclid(TEX as f64) * 65536.0) as i64;
-        let oy = (oy.rem_euclid(TEX as f64) * 65536.0) as i64;
-        let cloud = st.cloud.map(|c| c as i32);
-        let amax = (st.cloud_opacity.clamp(0.0, 1.0) * 256.0) as i32;
-        // Texture coordinates wrap at TEX cells = 2^24 in 16.16 fixed point.
-        const WRAP: u32 = ((TEX as u32) << 16) - 1;
-        let step = step.clamp(0, WRAP as i64) as u32;
+        let (w, h) = (self.width as f64, self.height as f64);
+        let v = match view {
+            View::Top { .. } => (row / h) as f32,
+            View::Ground(e) => {
+                let d = e.ray(col, row, self.width, self.height);
+                let el = (d[2] / (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()).clamp(-1.0, 1.0);
+                1.0 - (el.asin() / std::f64::consts::FRAC_PI_2).max(0.0) as f32
+            }
+        };
+        let mut c = st.sky(v);
+        if st.sun {
+            let (dx, dy) = (col - 0.82 * w, row - 0.12 * h);
+            let r2 = (dx * dx + dy * dy) / (0.45 * w.max(h)).powi(2);
+            let g = (0.6 * (-r2).exp() + 0.4 * (-12.0 * r2).exp()) as f32;
+            for (k, ck) in c.iter_mut().enumerate() {
+                *ck += (st.sun_colour[k] as f32 - *ck) * g * 0.8;
+            }
+        }
+        c
+    }
+
+    /// Paints the background for the camera `view` into `canvas` (replacing every pixel).
+    pub fn paint(&self, view: &View, canvas: &mut Canvas) {
+        let w = self.width;
+        debug_assert_eq!(canvas.width, w);
+        match self.background {
+            Background::None => canvas.rgba.fill(0),
+            Background::Colour(c) => {
+                for p in canvas.rgba.chunks_exact_mut(4) {
+                    p.copy_from_slice(&[c[0], c[1], c[2], 255]);
+                }
+            }
+            Background::Sky => self.paint_sky(view, canvas),
+        }
+    }
+
+    fn paint_sky(&self, view: &View, canvas: &mut Canvas) {
+        let (w, h) = (self.width, self.height);
+        let st = &self.style;
+        let gw = w / GRID + 2;
+        let gh = h / GRID + 2;
+        let cloud = st.cloud.map(|c| c as f32);
+        let s_layer = st.layer_scale(view.scale());
+        // Colour at every grid sample, 8.8 fixed point.
+        let mut grid = vec![[0i32; 3]; gw * gh];
+        for gy in 0..gh {
+            let row = (gy * GRID) as f64 + 0.5;
+            for gx in 0..gw {
+                let col = (gx * GRID) as f64 + 0.5;
+                let mut c = self.sky_at(view, col, row);
+                for l in 0..st.layers.len() {
+                    if let Some(a) = self.cloud_alpha_at(view, s_layer, l, col, row) {
+                        let a = a * st.cloud_opacity;
+                        for k in 0..3 {
+                            c[k] += (cloud[k] - c[k]) * a;
+                        }
+                    }
+                }
+                grid[gy * gw + gx] = c.map(|v| (v * 256.0) as i32);
+            }
+        }
+        // Bilinear interpolation to every pixel (GRID = 2^SH).
+        const SH: i32 = GRID.trailing_zeros() as i32;
+        const OUT: i32 = 8 + 2 * SH;
+        const HALF: i32 = 1 << (OUT - 1);
+        let mut line = vec![[0i32; 3]; gw];
         for r in 0..h {
-            let sky_i = self.sky_rows[r].map(|c| (c * 256.0) as i32);
-            let ty = ((oy + step as i64 * r as i64).rem_euclid(WRAP as i64 + 1)) as u32;
-            let (y0, fy) = ((ty >> 16) as usize, ((ty & 0xFFFF) >> 8) as i32);
-            let y1 = (y0 + 1) & (TEX - 1);
-            let row0 = &self.clouds[y0 * TEX..(y0 + 1) * TEX];
-            let row1 = &self.clouds[y1 * TEX..(y1 + 1) * TEX];
-            let line = &mut canvas.rgb[r * w * 3..(r + 1) * w * 3];
-            let bayer = &BAYER[r & 3];
-            // Clear-sky pixels of this row, one per dither column.
-            let clear: [[u8; 3]; 4] = std::array::from_fn(|c| {
-                let sd = if dither { bayer[c] * 96 } else { 0 };
-                sky_i.map(|s| ((s + sd + 128) >> 8).clamp(0, 255) as u8)
-            });
-            let mut tx = ox as u32;
-            for (col, px) in line.chunks_exact_mut(3).enumerate() {
-                let x0 = ((tx & WRAP) >> 16) as usize;
-                let x1 = (x0 + 1) & (TEX - 1);
-                let (c00, c01, c10, c11) = (row0[x0], row0[x1], row1[x0], row1[x1]);
-                tx = tx.wrapping_add(step);
-                if c00 | c01 | c10 | c11 == 0 {
-                    px.copy_from_slice(&clear[col & 3]);
-                    continue;
-                }
-                let fx = (((tx.wrapping_sub(step)) & 0xFFFF) >> 8) as i32;
-                let a0 = c00 as i32 * (256 - fx) + c01 as i32 * fx;
-                let a1 = c10 as i32 * (256 - fx) + c11 as i32 * fx;
-                // Opacity in 1/256 units.
-                let mut a = (((a0 * (256 - fy) + a1 * fy) >> 16) * amax) >> 8;
-                if dither && a > 0 {
-                    // ±half a palette opacity step (the palette has 9 opacity levels).
-                    a = (a + bayer[col & 3] * amax / (9 * 16)).clamp(0, 256);
-                }
-                // Sky dither: ±3 levels, fixed on screen like the gradient itself.
-                let sd = if dither { bayer[col & 3] * 96 } else { 0 };
+            let (gy, fy) = (r / GRID, (r % GRID) as i32);
+            let (a, b) = (
+                &grid[gy * gw..(gy + 1) * gw],
+                &grid[(gy + 1) * gw..(gy + 2) * gw],
+            );
+            for (x, l) in line.iter_mut().enumerate() {
                 for k in 0..3 {
-                    let s = sky_i[k] + sd;
-                    let v = s + ((((cloud[k] << 8) - s) * a) >> 8);
-                    px[k] = ((v + 128) >> 8).clamp(0, 255) as u8;
+                    l[k] = (a[x][k] << SH) + (b[x][k] - a[x][k]) * fy;
+                }
+            }
+            let out = &mut canvas.rgba[r * w * 4..(r + 1) * w * 4];
+            for (gx, cell) in out.chunks_mut(4 * GRID).enumerate() {
+                let (p, q) = (line[gx], line[gx + 1]);
+                // Value × GRID² in 8.8 fixed point, stepped along the cell.
+                let mut v = [p[0] << SH, p[1] << SH, p[2] << SH];
+                let d = [q[0] - p[0], q[1] - p[1], q[2] - p[2]];
+                for px in cell.chunks_exact_mut(4) {
+                    px[0] = ((v[0] + HALF) >> OUT).clamp(0, 255) as u8;
+                    px[1] = ((v[1] + HALF) >> OUT).clamp(0, 255) as u8;
+                    px[2] = ((v[2] + HALF) >> OUT).clamp(0, 255) as u8;
+                    px[3] = 255;
+                    v[0] += d[0];
+                    v[1] += d[1];
+                    v[2] += d[2];
                 }
             }
         }
     }
 }
 
-/// Draws every bird of `birds` for `view` on `canvas`.
+/// Draws every bird of `birds` (of `species`) for `view` on `canvas`, far ones first.
 pub fn draw_birds(
     canvas: &mut Canvas,
     birds: &[BirdState],
     view: &View,
-    style: &Style,
+    species: Species,
     mask: &mut Mask,
 ) {
     let (w, h) = (canvas.width, canvas.height);
-    let mut order: Vec<usize> = (0..birds.len()).collect();
-    // Lower birds first; ties keep index order so output is deterministic.
-    order.sort_by(|&a, &b| birds[a].z.total_cmp(&birds[b].z).then(a.cmp(&b)));
+    let plumage = silhouette::plumage(species);
+    let radius = silhouette::radius(species);
+    // Painter's order: lower birds first from above, farther birds first from the ground; ties
+    // keep index order so output is deterministic.
+    let depth = |b: &BirdState| -> f64 {
+        match view {
+            View::Top { .. } => b.z,
+            View::Ground(e) => {
+                -((b.x - e.at[0]) * e.forward[0]
+                    + (b.y - e.at[1]) * e.forward[1]
+                    + (b.z - e.at[2]) * e.forward[2])
+            }
+        }
+    };
+    let mut order: Vec<(f64, usize)> = birds.iter().map(depth).zip(0..).collect();
+    order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
     let zmin = birds.iter().map(|b| b.z).fold(f64::MAX, f64::min);
-    for i in order {
+    let mut layers: [Vec<Vec<[f32; 2]>>; 4] = Default::default();
+    for (_, i) in order {
         let b = &birds[i];
-        let (px, py) = view.to_pixel(b.x, b.y, w, h);
-        // A bird 10 wingspans higher looks 5 % larger: a hint of depth without breaking scale.
-        let s = (view.scale * (1.0 + 0.005 * (b.z - zmin).clamp(0.0, 10.0))) as f32;
-        let (sin, cos) = (b.heading.sin() as f32, b.heading.cos() as f32);
-        // Ground-plane (right, forward) → pixels: forward is (sin θ, cos θ) east/north, right is
-        // (cos θ, −sin θ); screen rows grow southward.
-        let place = |p: &[f32; 2]| {
-            let e = p[0] * cos + p[1] * sin;
-            let n = -p[0] * sin + p[1] * cos;
-            [px as f32 + e * s, py as f32 - n * s]
+        let Some((px, py, s)) = view.project([b.x, b.y, b.z], w, h) else {
+            continue;
         };
-        let outlines = rig::top_view(&b.pose);
-        let mut placed: Vec<Vec<[f32; 2]>> = outlines
-            .iter()
-            .map(|o| o.iter().map(place).collect())
-            .collect();
-        // Screen y is flipped, so the winding flips too; every contour flips alike, which keeps
-        // the union. Inner wings (arm) a touch lighter, then body and hands on top.
-        let arms = vec![placed[1].clone(), placed[3].clone()];
-        canvas.fill(&arms, style.bird_wing, 1.0, mask);
-        placed.remove(3);
-        placed.remove(1);
-        canvas.fill(&placed, style.bird, 1.0, mask);
+        // Cull birds wholly off the picture.
+        let r = radius * s;
+        if px + r < 0.0 || py + r < 0.0 || px - r > w as f64 || py - r > h as f64 {
+            continue;
+        }
+        let (sin, cos) = b.heading.sin_cos();
+        // Body frame (right, forward, up) → world: forward (sin θ, cos θ), right (cos θ, −sin θ).
+        let to_world = |q: &[f32; 3]| {
+            let (x, y, z) = (q[0] as f64, q[1] as f64, q[2] as f64);
+            [b.x + x * cos + y * sin, b.y - x * sin + y * cos, b.z + z]
+        };
+        // Top-down: a bird 10 wingspans higher looks 5 % larger, a hint of depth.
+        let lift = 1.0 + 0.005 * (b.z - zmin).clamp(0.0, 10.0);
+        for l in layers.iter_mut() {
+            l.clear();
+        }
+        for piece in silhouette::pieces(species, &b.pose, b.bank) {
+            let mut pts = Vec::with_capacity(piece.points.len());
+            for q in &piece.points {
+                let p = to_world(q);
+                let proj = match view {
+                    View::Top { .. } => {
+                        let (c, r, _) = view.project(p, w, h).expect("top view");
+                        Some((px + (c - px) * lift, py + (r - py) * lift))
+                    }
+                    View::Ground(_) => view.project(p, w, h).map(|(c, r, _)| (c, r)),
+                };
+                match proj {
+                    Some((c, r)) => pts.push([c as f32, r as f32]),
+                    None => break,
+                }
+            }
+            if pts.len() == piece.points.len() {
+                layers[piece.part as usize].push(pts);
+            }
+        }
+        // From below, the far wing's inner part shows through nothing: order is wings, body,
+        // head; each colour's polygons fill as one union.
+        let colours = [plumage.body, plumage.arm, plumage.hand, plumage.head];
+        for part in [Part::Arm, Part::Hand, Part::Body, Part::Head] {
+            let k = part as usize;
+            if !layers[k].is_empty() {
+                canvas.fill(&layers[k], colours[k], 1.0, mask);
+            }
+        }
     }
 }
 
@@ -284,30 +542,54 @@ mod tests {
     }
 
     #[test]
+    fn backgrounds_parse_and_bad_ones_name_the_flag() {
+        assert_eq!(Background::parse("sky").unwrap(), Background::Sky);
+        assert_eq!(Background::parse("none").unwrap(), Background::None);
+        assert_eq!(
+            Background::parse("#87ceeb").unwrap(),
+            Background::Colour([0x87, 0xce, 0xeb])
+        );
+        for bad in ["#12345", "blue", "#gg0000", ""] {
+            let e = Background::parse(bad).unwrap_err().to_string();
+            assert!(e.contains("--background"), "{e}");
+        }
+    }
+
+    #[test]
     fn a_bird_darkens_the_pixels_under_it() {
         let st = Style::default();
-        let bd = Backdrop::new(200, 120, &st, 0);
+        let bd = Backdrop::new(200, 120, &st, Background::Sky, 0);
         let mut c = Canvas::new(200, 120);
-        let view = View {
+        let view = View::Top {
             cx: 0.0,
             cy: 0.0,
             scale: 60.0,
         };
-        bd.paint(&view, &mut c, false);
+        bd.paint(&view, &mut c);
         let before = c.clone();
         let bird = BirdState {
-            pose: crate::wingbeat::WingPose {
-                spread: 1.0,
-                ..Default::default()
-            },
+            pose: crate::wingbeat::WingPose::EXTENDED,
             ..Default::default()
         };
-        draw_birds(&mut c, &[bird], &view, &st, &mut Mask::new());
-        let centre = (60 * 200 + 100) * 3;
-        assert!(c.rgb[centre] < 60 && before.rgb[centre] > 100);
-        // Wing tip region 0.45 wingspans to the right (east) is covered, far corners are not.
-        let tip = (60 * 200 + 100 + 26) * 3;
-        assert!(c.rgb[tip] < before.rgb[tip]);
-        assert_eq!(c.rgb[0..3], before.rgb[0..3]);
+        draw_birds(&mut c, &[bird], &view, Species::Goose, &mut Mask::new());
+        assert!(c.pixel(100, 60)[0] < 90 && before.pixel(100, 60)[0] > 100);
+        // Wing region 0.4 wingspans to the right (east) is covered, far corners are not.
+        assert!(c.pixel(124, 60)[0] < before.pixel(124, 60)[0]);
+        assert_eq!(c.pixel(0, 0), before.pixel(0, 0));
+    }
+
+    #[test]
+    fn cloud_noise_has_no_period() {
+        // Value noise hashed on the lattice: shifting by any whole number of cells changes it.
+        for period in [8.0, 64.0, 256.0, 4096.0] {
+            let diff: f32 = (0..200)
+                .map(|k| {
+                    let (u, v) = (k as f64 * 0.37, k as f64 * 0.11);
+                    (cloud_noise(u, v, 0.01, 3) - cloud_noise(u + period, v, 0.01, 3)).abs()
+                })
+                .sum::<f32>()
+                / 200.0;
+            assert!(diff > 0.03, "period {period}: {diff}");
+        }
     }
 }

@@ -1,0 +1,128 @@
+"""Checks a .usda written by `formation` with Pixar's USD (PyPI `usd-core`), against the animation
+file it came from (issue 14). Usage: python .ci/check_usd.py flock.usda flock.json [--tolerance M] [--static]
+
+- the stage opens; USD's validators (the UsdValidation framework behind `usdchecker`, all
+  registered validators) report no errors;
+- metersPerUnit 1, upAxis Y, timeCodesPerSecond and framesPerSecond = the animation's fps,
+  startTimeCode 0 and endTimeCode = the last frame;
+- one SkelRoot, Skeleton (with the 7 joints of the convention) and SkelAnimation per bird, the
+  animation bound to the skeleton, the skinned mesh bound to it with 4 influences a vertex;
+- every bird's root transform at every frame matches the JSON positions (x, z, -y) * wingspan_m
+  to the tolerance (default 1e-4 m; give the --keys reduced tolerance for reduced files), and the
+  wing joints turn over time (UsdSkel computes the joint transforms).
+  With --static (a static --bird-model), the wing joints must instead stay still.
+Exits 1 on any failure, printing what failed.
+"""
+import json
+import math
+import sys
+
+from pxr import Gf, Sdf, Usd, UsdGeom, UsdSkel, UsdValidation
+
+JOINTS = ["body", "body/neck", "body/tail", "body/upper_arm_L", "body/upper_arm_L/hand_L",
+          "body/upper_arm_R", "body/upper_arm_R/hand_R"]
+
+
+def main():
+    args = sys.argv[1:]
+    tol = 1e-4
+    static = "--static" in args
+    if static:
+        args.remove("--static")
+    if "--tolerance" in args:
+        i = args.index("--tolerance")
+        tol = float(args[i + 1])
+        del args[i:i + 2]
+    usda, anim_path = args
+    anim = json.load(open(anim_path))
+    failed = []
+
+    def check(ok, what):
+        if not ok:
+            failed.append(what)
+
+    stage = Usd.Stage.Open(usda)
+    check(stage is not None, "stage does not open")
+    # USD's validators (what usdchecker runs).
+    reg = UsdValidation.ValidationRegistry()
+    validators = reg.GetOrLoadAllValidators()
+    errors = UsdValidation.ValidationContext(validators).Validate(stage)
+    counts = {}
+    for e in errors:
+        t = str(e.GetType()).split(".")[-1]
+        counts[t] = counts.get(t, 0) + 1
+        if e.GetType() == UsdValidation.ValidationErrorType.Error:
+            failed.append("validator %s: %s" % (e.GetName(), e.GetMessage()))
+        else:
+            print("  %s %s: %s" % (t, e.GetName(), e.GetMessage()))
+    print("validators: %d run, findings %s" % (len(validators), counts or "none"))
+
+    fps = anim["fps"]
+    n = len(anim["frames"])
+    ws = anim["wingspan_m"]
+    check(UsdGeom.GetStageMetersPerUnit(stage) == 1.0, "metersPerUnit")
+    check(UsdGeom.GetStageUpAxis(stage) == UsdGeom.Tokens.y, "upAxis")
+    check(stage.GetTimeCodesPerSecond() == fps, "timeCodesPerSecond %s" % stage.GetTimeCodesPerSecond())
+    check(stage.GetFramesPerSecond() == fps, "framesPerSecond")
+    check(stage.GetStartTimeCode() == 0, "startTimeCode")
+    check(stage.GetEndTimeCode() == n - 1, "endTimeCode %s, expected %d" % (stage.GetEndTimeCode(), n - 1))
+
+    roots = [p for p in stage.Traverse() if p.IsA(UsdSkel.Root)]
+    skels = [p for p in stage.Traverse() if p.IsA(UsdSkel.Skeleton)]
+    anims = [p for p in stage.Traverse() if p.IsA(UsdSkel.Animation)]
+    meshes = [p for p in stage.Traverse() if p.IsA(UsdGeom.Mesh)]
+    birds = anim["birds"]
+    print("prims: %d SkelRoot, %d Skeleton, %d SkelAnimation, %d Mesh (birds %d); %s frames at %s fps"
+          % (len(roots), len(skels), len(anims), len(meshes), birds, n, fps))
+    check(len(roots) == birds and len(skels) == birds and len(anims) == birds and len(meshes) == birds,
+          "prim counts")
+    names = [p.GetName() for p in roots]
+    check(names == sorted(names), "bird names do not sort")
+
+    cache = UsdSkel.Cache()
+    frames = anim["frames"]
+    worst = 0.0
+    for b, root in enumerate(roots):
+        skel = UsdSkel.Skeleton(root.GetChild("rig"))
+        check(list(skel.GetJointsAttr().Get()) == JOINTS, "%s: joints" % root.GetPath())
+        src = UsdSkel.BindingAPI(skel.GetPrim()).GetAnimationSourceRel().GetTargets()
+        check(len(src) == 1 and stage.GetPrimAtPath(src[0]).IsA(UsdSkel.Animation),
+              "%s: no SkelAnimation bound" % root.GetPath())
+        mesh = UsdSkel.BindingAPI(root.GetChild("mesh"))
+        check(mesh.GetSkeletonRel().GetTargets() == [skel.GetPath()], "%s: mesh not bound to its rig" % root.GetPath())
+        check(mesh.GetJointIndicesPrimvar().GetElementSize() == 4, "%s: jointIndices elementSize" % root.GetPath())
+        xf = UsdGeom.Xformable(root)
+        # Every frame for the first and last birds, every 7th frame for the others.
+        step = 1 if b in (0, birds - 1) else 7
+        for k in range(0, n, step):
+            fr = frames[k]
+            t = Usd.TimeCode(round((fr["t"] - frames[0]["t"]) * fps, 6))
+            p = xf.ComputeLocalToWorldTransform(t).ExtractTranslation()
+            want = (fr["x"][b] * ws, fr["z"][b] * ws, -fr["y"][b] * ws)
+            err = math.sqrt(sum((p[i] - want[i]) ** 2 for i in range(3)))
+            worst = max(worst, err)
+            if err > tol:
+                failed.append("%s frame %d: %.3g m from the JSON" % (root.GetPath(), k, err))
+                break
+        if b == 0:
+            q = cache.GetSkelQuery(skel)
+            arm = JOINTS.index("body/upper_arm_L")
+            ys = []
+            for k in range(0, min(n, 60)):
+                local = q.ComputeJointLocalTransforms(Usd.TimeCode(k))[arm]
+                ys.append(round(local.ExtractRotationQuat().GetImaginary()[2], 4))
+            if static:
+                check(len(set(ys)) == 1, "upper_arm_L turns although the model is static")
+            else:
+                check(len(set(ys)) > 10, "upper_arm_L does not turn over the first 60 frames")
+            print("upper_arm_L: %d distinct rotations over 60 frames" % len(set(ys)))
+    print("root vs JSON: worst %.3g m (tolerance %g m)" % (worst, tol))
+    if failed:
+        for f in failed[:20]:
+            print("FAILED", f)
+        sys.exit(1)
+    print("OK", usda)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,349 @@
+//! Text USD (`.usda`) export with UsdSkel (issue 14): the flock as a stage that opens in
+//! usdview, Houdini Solaris, Blender and Omniverse.
+//!
+//! Stage metadata: `metersPerUnit = 1`, `upAxis = "Y"` (the same axes and numbers as the `.glb`:
+//! world east `x` → `+X`, up `z` → `+Y`, north `y` → `−Z`, metres), `timeCodesPerSecond` and
+//! `framesPerSecond` equal to the animation's fps, time code k = frame k (`t·fps`),
+//! `startTimeCode` and `endTimeCode` the first and last frame; the animation's metadata
+//! (fps, wingspan_m, seed, species, birds, stages, bird model) in `customLayerData.formation`.
+//!
+//! Prims: the bird is written once, as the class `/_bird` (a `SkelRoot` holding the `Skeleton`
+//! `rig` with the joints of [`bird::JOINTS`] as paths `body/upper_arm_L/hand_L`, their bind and
+//! rest transforms, and the skinned `Mesh` `mesh` with `primvars:skel:jointIndices` /
+//! `jointWeights`, four influences a vertex, and per-face `displayColor`). Every bird
+//! `/flock/bird_000` … is a `SkelRoot` that references `/_bird`, carries the flight as
+//! time-sampled `xformOp:translate` and `xformOp:orient`, and binds its own `SkelAnimation`
+//! `anim` (time-sampled joint `rotations`, constant `translations` and `scales`) to its `rig`
+//! through `skel:animationSource`.
+//!
+//! `--keys reduced` thins the flight samples within the tolerances of [`keys`] (the joint
+//! rotations, one array per time sample, keep every frame: the wingbeat needs nearly all of them).
+
+use std::fmt::Write as _;
+use std::io::Write;
+
+use glam::{Mat4, Quat, Vec3};
+
+use super::bird::{self, BirdAsset};
+use super::gltf::{asset_for, bird_digits, bird_track, metadata, SceneOptions};
+use super::keys::{self, Curve};
+use crate::animation::Animation;
+use crate::wingbeat::Flapper;
+
+/// Shortest text of an f32 that reads back to the same value.
+fn f(v: f32) -> String {
+    if v == 0.0 {
+        "0".into()
+    } else {
+        format!("{v}")
+    }
+}
+
+fn vec3(v: Vec3) -> String {
+    format!("({}, {}, {})", f(v.x), f(v.y), f(v.z))
+}
+
+/// USD writes quaternions real part first: `(w, x, y, z)`.
+fn quat(q: Quat) -> String {
+    format!("({}, {}, {}, {})", f(q.w), f(q.x), f(q.y), f(q.z))
+}
+
+/// A matrix as USD's rows (row vectors: translation in the last row), i.e. glam's columns.
+fn matrix(m: Mat4) -> String {
+    let c = m.to_cols_array_2d();
+    let row = |r: [f32; 4]| format!("({}, {}, {}, {})", f(r[0]), f(r[1]), f(r[2]), f(r[3]));
+    format!(
+        "({}, {}, {}, {})",
+        row(c[0]),
+        row(c[1]),
+        row(c[2]),
+        row(c[3])
+    )
+}
+
+/// USD string literal of `s` (JSON escaping is a subset of USD's).
+fn string(s: &str) -> String {
+    serde_json::to_string(s).unwrap_or_else(|_| "\"\"".into())
+}
+
+/// Time code of frame `k`.
+fn time_code(anim: &Animation, k: usize) -> String {
+    let tc = (anim.frames[k].t - anim.frames[0].t) * anim.fps;
+    let r = (tc * 1e6).round() / 1e6;
+    if r == r.round() {
+        format!("{}", r as i64)
+    } else {
+        format!("{r}")
+    }
+}
+
+/// `customLayerData` value of a JSON value (dictionaries, numbers, strings, arrays of strings
+/// or numbers).
+fn dict_entries(v: &serde_json::Value, indent: &str, out: &mut String) {
+    if let Some(map) = v.as_object() {
+        for (k, val) in map {
+            match val {
+                serde_json::Value::String(s) => {
+                    let _ = writeln!(out, "{indent}string {k} = {}", string(s));
+                }
+                serde_json::Value::Number(n) if n.is_u64() || n.is_i64() => {
+                    let _ = writeln!(out, "{indent}int64 {k} = {n}");
+                }
+                serde_json::Value::Number(n) => {
+                    let _ = writeln!(out, "{indent}double {k} = {n}");
+                }
+                serde_json::Value::Array(a) if a.iter().all(|x| x.is_string()) => {
+                    let items: Vec<String> =
+                        a.iter().map(|x| string(x.as_str().unwrap_or(""))).collect();
+                    let _ = writeln!(out, "{indent}string[] {k} = [{}]", items.join(", "));
+                }
+                // Anything else (e.g. the stages) as its JSON text.
+                other => {
+                    let _ = writeln!(out, "{indent}string {k} = {}", string(&other.to_string()));
+                }
+            }
+        }
+    }
+}
+
+/// Writes the `.usda` text of `anim` with birds `wingspan_m` metres wide to `out`.
+pub fn write_usda(
+    anim: &Animation,
+    wingspan_m: f64,
+    opts: &SceneOptions,
+    out: &mut impl Write,
+) -> std::io::Result<()> {
+    let ws = wingspan_m as f32;
+    let asset = asset_for(anim, opts);
+    let n = anim.frames.len();
+    let io = |e: std::io::Error| e;
+    let mut head = String::new();
+    let _ = writeln!(head, "#usda 1.0\n(");
+    let _ = writeln!(
+        head,
+        "    customLayerData = {{\n        dictionary formation = {{"
+    );
+    dict_entries(
+        &metadata(anim, wingspan_m, &asset, opts.keys),
+        "            ",
+        &mut head,
+    );
+    let _ = writeln!(head, "        }}\n    }}");
+    let _ = writeln!(head, "    defaultPrim = \"flock\"");
+    let _ = writeln!(
+        head,
+        "    doc = \"Flock animation written by formation {}\"",
+        env!("CARGO_PKG_VERSION")
+    );
+    let _ = writeln!(head, "    endTimeCode = {}", time_code(anim, n - 1));
+    let _ = writeln!(head, "    framesPerSecond = {}", anim.fps);
+    let _ = writeln!(head, "    metersPerUnit = 1");
+    let _ = writeln!(head, "    startTimeCode = 0");
+    let _ = writeln!(head, "    timeCodesPerSecond = {}", anim.fps);
+    let _ = writeln!(head, "    upAxis = \"Y\"\n)\n");
+    out.write_all(head.as_bytes()).map_err(io)?;
+    out.write_all(prototype(&asset, ws).as_bytes())
+        .map_err(io)?;
+
+    let paths = bird::usd_joint_paths();
+    let joints_tokens = paths
+        .iter()
+        .map(|p| string(p))
+        .collect::<Vec<_>>()
+        .join(", ");
+    let flapper = Flapper::from_animation(anim);
+    let digits = bird_digits(anim.birds);
+    let times: Vec<f32> = anim
+        .frames
+        .iter()
+        .map(|fr| (fr.t - anim.frames[0].t) as f32)
+        .collect();
+    out.write_all(b"def Xform \"flock\" (\n    kind = \"assembly\"\n)\n{\n")
+        .map_err(io)?;
+    for b in 0..anim.birds {
+        let track = bird_track(anim, &flapper, &asset, b, wingspan_m);
+        let name = format!("bird_{b:0digits$}");
+        let mut s = String::new();
+        let _ = writeln!(
+            s,
+            "    def SkelRoot \"{name}\" (\n        prepend references = </_bird>\n        customData = {{\n            int bird = {b}\n        }}\n    )\n    {{"
+        );
+        let tol = opts.tolerance;
+        let kt = keys::keep(
+            opts.keys,
+            &times,
+            &[Curve::Vec3(&track.flight.translation, tol.position_m)],
+        );
+        let kq = keys::keep(
+            opts.keys,
+            &times,
+            &[Curve::Quat(&track.flight.yaw, tol.rotation_rad)],
+        );
+        let _ = writeln!(s, "        float3 xformOp:translate.timeSamples = {{");
+        for &k in &kt {
+            let _ = writeln!(
+                s,
+                "            {}: {},",
+                time_code(anim, k),
+                vec3(track.flight.translation[k])
+            );
+        }
+        let _ = writeln!(
+            s,
+            "        }}\n        quatf xformOp:orient.timeSamples = {{"
+        );
+        for &k in &kq {
+            let _ = writeln!(
+                s,
+                "            {}: {},",
+                time_code(anim, k),
+                quat(track.flight.yaw[k])
+            );
+        }
+        let _ = writeln!(s, "        }}\n        uniform token[] xformOpOrder = [\"xformOp:translate\", \"xformOp:orient\"]\n");
+        let _ = writeln!(
+            s,
+            "        over \"rig\"\n        {{\n            rel skel:animationSource = </flock/{name}/anim>\n        }}\n"
+        );
+        let _ = writeln!(s, "        def SkelAnimation \"anim\"\n        {{\n            uniform token[] joints = [{joints_tokens}]");
+        let rest: Vec<String> = (0..bird::JOINTS.len())
+            .map(|j| vec3(asset.skeleton.rest_translation(j) * ws))
+            .collect();
+        let _ = writeln!(
+            s,
+            "            float3[] translations = [{}]",
+            rest.join(", ")
+        );
+        let _ = writeln!(
+            s,
+            "            half3[] scales = [{}]",
+            vec!["(1, 1, 1)"; bird::JOINTS.len()].join(", ")
+        );
+        let _ = writeln!(s, "            quatf[] rotations.timeSamples = {{");
+        out.write_all(s.as_bytes()).map_err(io)?;
+        for k in 0..n {
+            let q: Vec<String> = track.joints[k].iter().map(|&q| quat(q)).collect();
+            writeln!(
+                out,
+                "                {}: [{}],",
+                time_code(anim, k),
+                q.join(", ")
+            )
+            .map_err(io)?;
+        }
+        out.write_all(b"            }\n        }\n    }\n\n")
+            .map_err(io)?;
+    }
+    out.write_all(b"}\n").map_err(io)?;
+    Ok(())
+}
+
+/// The class `/_bird`: skeleton and skinned mesh, shared by reference.
+fn prototype(asset: &BirdAsset, ws: f32) -> String {
+    let skel = &asset.skeleton;
+    let paths = bird::usd_joint_paths();
+    let joints = paths
+        .iter()
+        .map(|p| string(p))
+        .collect::<Vec<_>>()
+        .join(", ");
+    let bind: Vec<String> = (0..bird::JOINTS.len())
+        .map(|j| {
+            matrix(Mat4::from_rotation_translation(
+                skel.bind_rot[j],
+                skel.bind_pos[j] * ws,
+            ))
+        })
+        .collect();
+    let rest: Vec<String> = (0..bird::JOINTS.len())
+        .map(|j| {
+            matrix(Mat4::from_rotation_translation(
+                skel.rest_rotation(j),
+                skel.rest_translation(j) * ws,
+            ))
+        })
+        .collect();
+    let m = &asset.mesh;
+    let mut counts = Vec::new();
+    let mut indices = Vec::new();
+    let mut colours = Vec::new();
+    for ((_, idx), rgb) in m.parts.iter().zip(&m.colours) {
+        for t in idx.chunks_exact(3) {
+            counts.push("3");
+            indices.extend(t.iter().map(|i| i.to_string()));
+            colours.push(format!("({}, {}, {})", f(rgb[0]), f(rgb[1]), f(rgb[2])));
+        }
+    }
+    let points: Vec<String> = m.positions.iter().map(|&p| vec3(p * ws)).collect();
+    let normals: Vec<String> = m.normals.iter().map(|&p| vec3(p)).collect();
+    let (lo, hi) = m.positions.iter().fold(
+        (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
+        |(a, b), &p| (a.min(p * ws), b.max(p * ws)),
+    );
+    let ji: Vec<String> = m.joints.iter().flatten().map(|j| j.to_string()).collect();
+    let jw: Vec<String> = m.weights.iter().flatten().map(|&w| f(w)).collect();
+    let mut s = String::new();
+    let _ = writeln!(s, "class SkelRoot \"_bird\"\n{{");
+    let _ = writeln!(
+        s,
+        "    def Skeleton \"rig\" (\n        prepend apiSchemas = [\"SkelBindingAPI\"]\n    )\n    {{"
+    );
+    let _ = writeln!(
+        s,
+        "        uniform matrix4d[] bindTransforms = [{}]",
+        bind.join(", ")
+    );
+    let _ = writeln!(s, "        uniform token[] joints = [{joints}]");
+    let _ = writeln!(
+        s,
+        "        uniform matrix4d[] restTransforms = [{}]\n    }}\n",
+        rest.join(", ")
+    );
+    let _ = writeln!(
+        s,
+        "    def Mesh \"mesh\" (\n        prepend apiSchemas = [\"SkelBindingAPI\"]\n    )\n    {{"
+    );
+    let _ = writeln!(s, "        uniform bool doubleSided = 1");
+    let _ = writeln!(s, "        float3[] extent = [{}, {}]", vec3(lo), vec3(hi));
+    let _ = writeln!(
+        s,
+        "        int[] faceVertexCounts = [{}]",
+        counts.join(", ")
+    );
+    let _ = writeln!(
+        s,
+        "        int[] faceVertexIndices = [{}]",
+        indices.join(", ")
+    );
+    let _ = writeln!(
+        s,
+        "        normal3f[] normals = [{}] (\n            interpolation = \"vertex\"\n        )",
+        normals.join(", ")
+    );
+    let _ = writeln!(s, "        point3f[] points = [{}]", points.join(", "));
+    let _ = writeln!(
+        s,
+        "        color3f[] primvars:displayColor = [{}] (\n            interpolation = \"uniform\"\n        )",
+        colours.join(", ")
+    );
+    let _ = writeln!(
+        s,
+        "        matrix4d primvars:skel:geomBindTransform = ((1, 0, 0, 0), (0, 1, 0, 0), (0, 0, 1, 0), (0, 0, 0, 1))"
+    );
+    let _ = writeln!(
+        s,
+        "        int[] primvars:skel:jointIndices = [{}] (\n            elementSize = 4\n            interpolation = \"vertex\"\n        )",
+        ji.join(", ")
+    );
+    let _ = writeln!(
+        s,
+        "        float[] primvars:skel:jointWeights = [{}] (\n            elementSize = 4\n            interpolation = \"vertex\"\n        )",
+        jw.join(", ")
+    );
+    let _ = writeln!(s, "        rel skel:skeleton = </_bird/rig>");
+    let _ = writeln!(
+        s,
+        "        uniform token subdivisionScheme = \"none\"\n    }}\n}}\n"
+    );
+    s
+}
