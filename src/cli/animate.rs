@@ -128,6 +128,8 @@ pub fn run(args: AnimateArgs, g: Global) -> Result<()> {
         )?;
         anim
     };
+    // Savings (e, ξ) in the take-off frames too.
+    formation::aero::fill_frame_savings(&mut anim, &steady_opts.aero);
     wingbeat::assign_phases(&mut anim, &wing)?;
     super::write_animation(&anim, &args.output, &render, g)
 }

@@ -348,7 +348,7 @@ pub fn run_plot_xi(args: PlotXiArgs, _g: Global) -> Result<()> {
     if !any {
         return Err(Error::format(
             &args.input,
-            "no frame has a defined ξ (every frame has birds inside each other's downwash)",
+            "no frame has a defined ξ (every frame has two birds wing to wing)",
         ));
     }
     let lateral = anim
