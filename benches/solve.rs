@@ -1,4 +1,4 @@
-//! Benchmarks of the key-shape solve (eq. 4) for N = 10, 40, 200, 1000: targets are the ξ of a
+//! Benchmarks of the key-shape solve (eq. 4) for N = 10, 40, 200, 1000, 10 000: targets are the ξ of a
 //! V, the start is that V with every bird moved by up to ±0.3 wingspans (as when the steady
 //! flight starts each key shape from the previous one). `benches/solve_scipy.py` times scipy's
 //! MINPACK LM on the same problems. Results: docs/performance.md.
@@ -30,7 +30,11 @@ pub fn problem(n: usize) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
 fn bench_solve(c: &mut Criterion) {
     let mut group = c.benchmark_group("solve");
     group.sample_size(10);
-    for n in [10usize, 40, 200, 1000] {
+    let sizes: Vec<usize> = std::env::var("SOLVE_SIZES")
+        .ok()
+        .map(|v| v.split(',').filter_map(|s| s.trim().parse().ok()).collect())
+        .unwrap_or_else(|| vec![10, 40, 200, 1000, 10_000]);
+    for n in sizes {
         let (x, xi, guess) = problem(n);
         let opts = SolveOptions::default();
         let check = solve(&x, &xi, Some(&guess), &opts).unwrap();
@@ -42,7 +46,7 @@ fn bench_solve(c: &mut Criterion) {
         group.bench_with_input(BenchmarkId::new("perturbed_start", n), &n, |b, _| {
             b.iter(|| solve(black_box(&x), black_box(&xi), Some(&guess), &opts).unwrap())
         });
-        if n <= 200 {
+        if n <= 1000 {
             group.bench_with_input(BenchmarkId::new("neutral_start", n), &n, |b, _| {
                 b.iter(|| solve(black_box(&x), black_box(&xi), None, &opts).unwrap())
             });

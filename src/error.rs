@@ -1,7 +1,7 @@
 //! The library's error type: every fallible stage returns [`Error`], whose message is one line that
 //! names the file, frame, bird or field at fault and what to do about it.
 //!
-//! Bad input (malformed files, impossible parameters, birds in each other's downwash) is the common
+//! Bad input (malformed files, impossible parameters, birds whose wings collide) is the common
 //! case and maps to exit code 2 in the binary; [`Error::NotConverged`] and [`Error::Internal`] are
 //! the tool's own failures and map to exit code 1 (see [`Error::exit_code`]).
 
@@ -38,15 +38,20 @@ pub enum Error {
         /// What is wrong and what would be valid.
         message: String,
     },
-    /// Two birds are inside each other's downwash (lateral distance at or below the vortex span π/4).
-    #[error("birds {i} and {j} are {dx:.4} wingspans apart laterally, inside the downwash (must be more than π/4 = 0.7854)")]
-    Downwash {
+    /// Two birds' wings overlap side by side (lateral distance under one wingspan and fore-aft
+    /// distance under the collision chord), or the birds coincide.
+    #[error("birds {i} and {j} collide: {dx:.4} wingspans apart laterally and {dy:.4} fore and aft (wings overlap side by side when under 1 wingspan laterally and under {chord} fore and aft); move one of them back")]
+    Collision {
         /// First bird (index in input order).
         i: usize,
         /// Second bird.
         j: usize,
         /// Their lateral distance, wingspans.
         dx: f64,
+        /// Their fore-aft distance, wingspans.
+        dy: f64,
+        /// The collision chord in force, wingspans.
+        chord: f64,
     },
     /// The requested ξ targets cannot be reached by any longitudinal placement.
     #[error("{0}")]

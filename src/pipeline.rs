@@ -228,6 +228,8 @@ impl Pipeline {
         } else {
             (steady, None)
         };
+        // Savings (e, ξ) in the take-off frames too.
+        crate::aero::fill_frame_savings(&mut anim, &config.steady_options()?.aero);
         wingbeat::assign_phases(&mut anim, &config.wingbeat)?;
         Ok((
             anim,

@@ -3,6 +3,8 @@
 
 mod support;
 
+use std::path::Path;
+
 use support::{example_arg as example, run_full as run, scratch};
 
 #[test]
@@ -10,7 +12,11 @@ fn power_table_and_json() {
     let (code, out, err) = run(&["power", &example("v9_shape.json")]);
     assert_eq!(code, 0, "{err}");
     assert!(out.contains("leader"));
-    assert!(out.contains("total E"));
+    assert!(out.contains("flock saving") && out.contains('%'), "{out}");
+    assert!(
+        out.contains("induced power"),
+        "the table says what the saving is: {out}"
+    );
     let (code, out, _) = run(&["power", &example("v9_shape.json"), "--json"]);
     assert_eq!(code, 0);
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();
@@ -22,6 +28,13 @@ fn power_table_and_json() {
     assert!((sum_e - total).abs() < 1e-12 * total);
     assert!((sum_xi - 1.0).abs() < 1e-12);
     assert_eq!(birds[4]["y"].as_f64().unwrap(), 0.0);
+    // saving = e per bird, flock_saving = their mean.
+    for b in birds {
+        assert_eq!(b["saving"].as_f64().unwrap(), b["e"].as_f64().unwrap());
+    }
+    let flock = v["flock_saving"].as_f64().unwrap();
+    assert!((flock - total / 9.0).abs() < 1e-15);
+    assert!(flock > 0.0 && flock < 1.0);
 }
 
 #[test]
@@ -118,8 +131,13 @@ fn power_bad_inputs() {
     );
     bad(
         "power",
-        "{\"birds\": [{\"x\": 0, \"y\": 0}, {\"x\": 0.5, \"y\": 1}]}",
-        &["input.json", "birds 0 and 1", "downwash"],
+        "{\"birds\": [{\"x\": 0, \"y\": 0}, {\"x\": 0.5, \"y\": 0.05}]}",
+        &["input.json", "birds 0 and 1 collide"],
+    );
+    bad(
+        "power",
+        "{\"birds\": [{\"x\": 0, \"y\": 1}, {\"x\": 2, \"y\": 0}, {\"x\": 0, \"y\": 1}]}",
+        &["input.json", "birds 0 and 2 collide"],
     );
     bad(
         "power",
@@ -143,17 +161,17 @@ fn solve_bad_inputs() {
     bad(
         "solve",
         "{\"x\": [0, 1, 2], \"xi\": [1, -1, 1]}",
-        &["input.json", "xi[1]", "negative"],
+        &["input.json", "asks for"],
     );
     bad(
         "solve",
         "{\"x\": [0, 1, 2], \"xi\": [0, 0, 0]}",
-        &["input.json", "all targets are zero"],
+        &["input.json", "sum to 0"],
     );
     bad(
         "solve",
         "{\"x\": [0, 1, 1.5], \"xi\": [1, 1, 1]}",
-        &["input.json", "birds 1 and 2", "downwash"],
+        &["input.json", "bird 2", "overlap"],
     );
     bad(
         "solve",
@@ -175,6 +193,47 @@ fn solve_bad_inputs() {
         "{\"x\": [0, 1, 2], \"xi\": [1, 1e999, 1]}",
         &["input.json"],
     );
+}
+
+#[test]
+fn core_radius_flag_is_checked() {
+    for flag in ["-0.1", "NaN", "inf"] {
+        for cmd in ["power", "solve"] {
+            let mut args = vec![cmd.to_string()];
+            args.push(if cmd == "power" {
+                example("v9_shape.json")
+            } else {
+                example("equal_savings_target.json")
+            });
+            if cmd == "solve" {
+                args.extend(["-o".into(), "/tmp/formation-core-radius-never.json".into()]);
+            }
+            args.extend(["--core-radius".into(), flag.into()]);
+            let refs: Vec<&str> = args.iter().map(|s| s.as_str()).collect();
+            let (code, _, err) = run(&refs);
+            assert_eq!(code, 2, "{cmd} --core-radius {flag}: {err}");
+            assert!(err.contains("--core-radius"), "{err}");
+            assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+        }
+    }
+    assert!(!Path::new("/tmp/formation-core-radius-never.json").exists());
+    // A valid radius changes the numbers only slightly away from the vortex lines.
+    let (code, a, _) = run(&[
+        "power",
+        &example("v9_shape.json"),
+        "--json",
+        "--core-radius",
+        "0",
+    ]);
+    assert_eq!(code, 0);
+    let (_, b, _) = run(&["power", &example("v9_shape.json"), "--json"]);
+    let ta = serde_json::from_str::<serde_json::Value>(&a).unwrap()["total"]
+        .as_f64()
+        .unwrap();
+    let tb = serde_json::from_str::<serde_json::Value>(&b).unwrap()["total"]
+        .as_f64()
+        .unwrap();
+    assert!((ta - tb).abs() < 1e-3 * ta, "{ta} vs {tb}");
 }
 
 #[test]

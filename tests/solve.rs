@@ -35,11 +35,11 @@ fn v_shape(
 fn v_strategy() -> impl Strategy<Value = (Vec<f64>, Vec<f64>, Vec<f64>)> {
     (1usize..12, 1usize..12).prop_flat_map(|(l, r)| {
         (
-            prop::collection::vec(0.85f64..1.6, l),
-            prop::collection::vec(0.85f64..1.6, r),
-            prop::collection::vec(0.1f64..1.5, l),
-            prop::collection::vec(0.1f64..1.5, r),
-            prop::collection::vec(-0.3f64..0.3, l + r + 1),
+            prop::collection::vec(0.6f64..1.6, l),
+            prop::collection::vec(0.6f64..1.6, r),
+            prop::collection::vec(0.3f64..1.5, l),
+            prop::collection::vec(0.3f64..1.5, r),
+            prop::collection::vec(-0.1f64..0.1, l + r + 1),
         )
             .prop_map(|(gl, gr, dl, dr, noise)| {
                 let (x, y) = v_shape(&gl, &gr, &dl, &dr);
@@ -52,7 +52,8 @@ fn v_strategy() -> impl Strategy<Value = (Vec<f64>, Vec<f64>, Vec<f64>)> {
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(64))]
 
-    /// Random V → ξ → solve from a perturbed guess → the same ξ (and the same shape).
+    /// Random V (lateral gaps 0.6–1.6 wingspans: wingtips often overlapping) → ξ → solve from a
+    /// perturbed guess (same fore-aft order) → the same ξ (and the same shape).
     #[test]
     fn round_trip((x, y, guess) in v_strategy()) {
         let xi = power_reduction(&x, &y).unwrap().xi;
@@ -69,9 +70,38 @@ proptest! {
     }
 }
 
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    /// Real spacing (the stereo-filmed geese: nearest bird ahead 0.62–0.88 wingspans to the
+    /// side, 1.06–1.49 behind): round trip from the solver's own start and from a perturbed one.
+    #[test]
+    fn round_trip_at_real_spacing(
+        (gl, gr) in (1usize..10, 1usize..10).prop_flat_map(|(l, r)| (
+            prop::collection::vec((0.6f64..0.8, 1.06f64..1.49), l),
+            prop::collection::vec((0.6f64..0.8, 1.06f64..1.49), r),
+        )),
+        noise in prop::collection::vec(-0.2f64..0.2, 19),
+    ) {
+        let gaps_l: Vec<f64> = gl.iter().map(|p| p.0).collect();
+        let depth_l: Vec<f64> = gl.iter().map(|p| p.1).collect();
+        let gaps_r: Vec<f64> = gr.iter().map(|p| p.0).collect();
+        let depth_r: Vec<f64> = gr.iter().map(|p| p.1).collect();
+        let (x, y) = v_shape(&gaps_l, &gaps_r, &depth_l, &depth_r);
+        let xi = power_reduction(&x, &y).unwrap().xi;
+        let guess: Vec<f64> = y.iter().zip(&noise).map(|(a, b)| a + b).collect();
+        for start in [Some(&guess[..]), None] {
+            let rep = solve(&x, &xi, start, &SolveOptions::default()).unwrap();
+            prop_assert!(rep.converged, "residual {}", rep.residual);
+            for (a, b) in rep.y.iter().zip(&y) {
+                prop_assert!((a - b).abs() < 1e-5, "{} vs {}", a, b);
+            }
+        }
+    }
+}
+
 #[test]
 fn round_trip_from_the_neutral_start_for_large_flocks() {
-    // 11 and 41 birds go through the LM crate, 301 through the symmetric LM.
     for n_side in [5usize, 20, 150] {
         let gaps = vec![1.05; n_side];
         let depth: Vec<f64> = (0..n_side).map(|k| 0.5 + 0.02 * k as f64).collect();
@@ -150,6 +180,45 @@ fn bad_inputs_are_typed_errors() {
     assert!(solve(&[0.0, 1.0], &[1.0, -0.5], None, &o).is_err());
     assert!(solve(&[0.0, 1.0], &[0.0, 0.0], None, &o).is_err());
     assert!(solve(&[0.0, 1.0], &[f64::NAN, 0.5], None, &o).is_err());
-    assert!(solve(&[0.0, 0.5], &[0.5, 0.5], None, &o).is_err());
+    // Overlapping wingtips asking for equal shares: only abreast, which is a collision.
+    assert!(matches!(
+        solve(&[0.0, 0.5], &[0.5, 0.5], None, &o),
+        Err(Error::Unreachable(_))
+    ));
+    // A guess with colliding birds names them.
+    let err = solve(
+        &[0.0, 0.7, 2.0],
+        &[0.3, 0.4, 0.3],
+        Some(&[0.0, 0.05, 1.0]),
+        &o,
+    )
+    .unwrap_err();
+    assert!(err.to_string().contains("birds 0 and 1 collide"), "{err}");
+    // Negative targets are allowed (a bird in downwash), but not a non-positive total.
+    assert!(solve(&[0.0, 1.0], &[-0.5, 0.2], None, &o).is_err());
     assert!(solve(&[0.0, 1.0], &[0.5, 0.5], Some(&[0.0]), &o).is_err());
+}
+
+/// A bird in downwash (negative ξ, deep wingtip overlap behind the flock) is reachable: from a
+/// guess with the original fore-aft order the solve finds the original shape; from its own
+/// starts it finds a shape with the same ξ (possibly in another order of the overlapping pairs,
+/// each of which has its own solution).
+#[test]
+fn negative_savings_round_trip() {
+    let x = [0.0, 0.77, 1.54, -0.77, -1.54, 0.3];
+    let y = [0.0, 1.24, 2.48, 1.24, 2.48, 4.0];
+    let p = power_reduction(&x, &y).unwrap();
+    assert!(p.xi[5] < 0.0, "bird 5 flies in downwash: {:?}", p.xi);
+    let guess: Vec<f64> = y.iter().map(|v| v + 0.1).collect();
+    let rep = solve(&x, &p.xi, Some(&guess), &SolveOptions::default()).unwrap();
+    assert!(rep.converged);
+    for (a, b) in rep.y.iter().zip(&y) {
+        assert!((a - b).abs() < 1e-6, "{a} vs {b}");
+    }
+    let own = solve(&x, &p.xi, None, &SolveOptions::default()).unwrap();
+    assert!(own.converged, "{own:?}");
+    let again = power_reduction(&x, &own.y).unwrap();
+    for (a, b) in again.xi.iter().zip(&p.xi) {
+        assert!((a - b).abs() < 1e-8);
+    }
 }

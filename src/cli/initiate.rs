@@ -230,6 +230,8 @@ pub fn run(args: InitiateArgs, g: Global) -> Result<()> {
     let mut rng = formation::rng::stream(g.seed, "initiate");
     let progress = TermProgress::new(g.quiet);
     let (mut anim, stats) = initiate::initiate(&steady, &opts, &mut rng, &progress)?;
+    // Savings (e, ξ) in the take-off frames too.
+    formation::aero::fill_frame_savings(&mut anim, &Default::default());
     formation::wingbeat::assign_phases(&mut anim, &wing)?;
     super::write_animation(&anim, &args.output, &args.scene.options(), g)?;
     if args.json {

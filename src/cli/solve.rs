@@ -25,6 +25,9 @@ pub struct SolveArgs {
     /// Write the shape even when the solver does not converge (the exit code is still 1).
     #[arg(long)]
     pub keep_unconverged: bool,
+    /// Vortex core radius of Hummel's model, wingspans (docs/model.md).
+    #[arg(long, allow_negative_numbers = true, default_value_t = formation::aero::AeroOptions::default().core_radius)]
+    pub core_radius: f64,
 }
 
 #[derive(Debug, Deserialize)]
@@ -52,9 +55,17 @@ pub fn run(args: SolveArgs, _g: Global) -> Result<()> {
     OutputKind::from_path(&args.output, &[OutputKind::Json])?;
     let opts = SolveOptions {
         tolerance: args.tolerance,
+        aero: formation::aero::AeroOptions {
+            core_radius: args.core_radius,
+            ..Default::default()
+        },
         ..SolveOptions::default()
     };
     opts.validate()?;
+    opts.aero.validate().map_err(|e| match e {
+        Error::Parameter { message, .. } => Error::parameter("--core-radius", message),
+        other => other,
+    })?;
     let target: Target = formation::io::read_json(&args.target)?;
     formation::limits::check_shape_size(&format!("{}: x", args.target.display()), target.x.len())?;
     let rep = solve(&target.x, &target.xi, target.y.as_deref(), &opts)

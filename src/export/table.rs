@@ -1,6 +1,6 @@
 //! CSV export in SPEC §4.4's long format, one row per frame and bird, exactly the SPEC's columns
 //! `frame,t,bird,x,y,z,heading,speed,e,xi` (world frame, wingspans, radians, wingspans per
-//! second, seconds). `e` and `xi` are empty where the animation has none (during initiation).
+//! second, seconds). `e` (the saving) and `xi` are numbers in every frame of a file written by this tool (the take-off included; empty only for a hand-made animation file without them).
 //! Numbers use the shortest text that reads back to the same `f64`. The wing phases are in the
 //! JSON animation file and drive the glTF wing nodes.
 

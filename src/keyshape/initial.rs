@@ -15,7 +15,6 @@
 use rand::Rng;
 use rand_distr::{Distribution, Normal};
 
-use crate::aero::VORTEX_SPAN;
 use crate::error::{Error, Result};
 use crate::extract::params::{FormationParams, FrameParams, ShapeModel};
 use crate::shape::Shape;
@@ -36,9 +35,13 @@ pub struct Correspondence {
 /// Options of step 1.
 #[derive(Debug, Clone)]
 pub struct InitialOptions {
-    /// Lateral gaps are redrawn until they exceed the vortex span π/4 by this margin, wingspans.
-    pub downwash_margin: f64,
-    /// Redraws of one gap before it is clamped to π/4 + margin (or the mean, if larger).
+    /// The one physical bound on a lateral gap drawn from the footage's N(μ_x, σ_x), wingspans:
+    /// a gap at or below it (about a body's width: birds nearly in line astern, body behind body)
+    /// is redrawn. Overlapping wingtips (gaps under π/4) are kept: real geese fly there, and the
+    /// model covers them; wings side by side are excluded later, fore and aft, by the collision
+    /// rule (`aero::AeroOptions::collision_chord`).
+    pub min_gap: f64,
+    /// Redraws of one gap before it is clamped to `min_gap` (or the mean, if larger).
     pub max_gap_draws: usize,
     /// Every follower stays at least this far behind the leader, wingspans: the leader is the
     /// front-most bird by definition (§4), so a Gaussian deviation that would put a follower
@@ -50,7 +53,7 @@ pub struct InitialOptions {
 impl Default for InitialOptions {
     fn default() -> Self {
         InitialOptions {
-            downwash_margin: 0.05,
+            min_gap: 0.1,
             max_gap_draws: 64,
             lead_margin: 0.05,
         }
@@ -168,8 +171,8 @@ fn nearest_free(slots: &[Option<usize>], target: usize) -> Option<usize> {
     None
 }
 
-/// `count` lateral gaps from N(μ, σ), each redrawn while it is within π/4 + margin (the downwash,
-/// where Hummel's g is undefined, and just above it, where g is huge), wingspans.
+/// `count` lateral gaps from N(μ, σ), each redrawn while it is at or below `opts.min_gap`
+/// (the only bound: see [`InitialOptions::min_gap`]), wingspans.
 pub fn lateral_gaps(
     rng: &mut impl Rng,
     mu: f64,
@@ -177,7 +180,7 @@ pub fn lateral_gaps(
     count: usize,
     opts: &InitialOptions,
 ) -> Vec<f64> {
-    let floor = VORTEX_SPAN + opts.downwash_margin;
+    let floor = opts.min_gap;
     let normal = Normal::new(mu, sigma.max(0.0)).ok();
     (0..count)
         .map(|_| {
@@ -211,20 +214,25 @@ pub fn positions_from_gaps(gaps: &[f64], leader: usize) -> Vec<f64> {
 /// The curve's `y` behind the leader at animated lateral offset `x` (leader on the curve).
 ///
 /// V and line curves are evaluated as they are (their arms keep their angle however many birds
-/// fly); U and J parabolas are evaluated at `x` scaled by the ratio of movie to animated birds on
-/// that side, so a larger flock makes a wider U of the movie's depth instead of a much deeper one.
+/// fly). A U or J parabola is mapped by rank: with s the ratio of movie to animated birds on that
+/// side, the animated bird at x takes the movie curve's slope at x·s, i.e.
+/// y = (curve(x·s) − curve(0))/s. Each bird then sits behind its lateral neighbour by what the
+/// movie bird of the same relative rank does (the footage's spacing, issue 12), and a flock with
+/// more birds per side makes a U of the movie's proportions that is deeper in proportion to its
+/// birds per side (with the movie's depth, the neighbours of a larger flock would crowd
+/// together fore and aft; with the unscaled parabola, its outer birds would string out).
 pub fn curve_y(model: &ShapeModel, x: f64, scale_left: f64, scale_right: f64) -> f64 {
-    let xs = match model {
+    match model {
         ShapeModel::U { .. } | ShapeModel::J { .. } => {
-            if x < 0.0 {
-                x * scale_left
+            let s = if x < 0.0 { scale_left } else { scale_right };
+            if s > 0.0 && s.is_finite() {
+                (model.y_at(x * s) - model.y_at(0.0)) / s
             } else {
-                x * scale_right
+                model.y_at(x) - model.y_at(0.0)
             }
         }
-        _ => x,
-    };
-    model.y_at(xs) - model.y_at(0.0)
+        _ => model.y_at(x) - model.y_at(0.0),
+    }
 }
 
 /// One initial shape per movie frame (§5 step 1): lateral gaps from N(μ_x, σ_x), `y` on the
@@ -422,13 +430,26 @@ mod tests {
     }
 
     #[test]
-    fn gaps_never_in_downwash() {
+    fn gaps_keep_the_footage_distribution_above_the_physical_bound() {
         let mut rng = seeded(1);
         let opts = InitialOptions::default();
-        let g = lateral_gaps(&mut rng, 0.85, 0.2, 5000, &opts);
-        assert!(g.iter().all(|&v| v > VORTEX_SPAN + opts.downwash_margin));
-        let g = lateral_gaps(&mut rng, 0.5, 0.0, 3, &opts);
-        assert!(g.iter().all(|&v| v > VORTEX_SPAN));
+        let g = lateral_gaps(&mut rng, 0.77, 0.2, 5000, &opts);
+        assert!(g.iter().all(|&v| v > opts.min_gap));
+        // Overlapping wingtips are kept: the sample mean and spread are the footage's.
+        let mean = g.iter().sum::<f64>() / g.len() as f64;
+        let sd = (g.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / g.len() as f64).sqrt();
+        assert!(
+            (mean - 0.77).abs() < 0.01 && (sd - 0.2).abs() < 0.01,
+            "{mean} {sd}"
+        );
+        assert!(
+            g.iter()
+                .filter(|&&v| v < std::f64::consts::FRAC_PI_4)
+                .count()
+                > 2000
+        );
+        let g = lateral_gaps(&mut rng, 0.05, 0.0, 3, &opts);
+        assert!(g.iter().all(|&v| v == opts.min_gap));
     }
 
     #[test]

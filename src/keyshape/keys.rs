@@ -100,7 +100,7 @@ pub struct KeyStats {
     /// Draws redrawn (or damping steps skipped) because their linear prediction already broke
     /// the structure or the jump bound; no solve was spent on them.
     pub rejected_predicted: usize,
-    /// Solves that reported an error (unreachable target, downwash).
+    /// Solves that reported an error (unreachable target, collision).
     pub solve_errors: usize,
     /// Solves above the residual bound.
     pub rejected_residual: usize,
@@ -194,8 +194,10 @@ pub fn draw_target(
         .zip(&feasible.min)
         .zip(&feasible.max)
         .map(|((&p, &lo), &hi)| {
-            let a = lo.max(c1 * p);
-            let b = hi.min(c2 * p);
+            // The step ratios of eq. (2); for a negative ξ (a bird in downwash) c₁p > c₂p.
+            let (r1, r2) = (c1 * p, c2 * p);
+            let a = lo.max(r1.min(r2));
+            let b = hi.min(r1.max(r2));
             let u: f64 = rng.random();
             if a <= b {
                 a + u * (b - a)
@@ -244,9 +246,11 @@ fn attempt(
     stats: &mut KeyStats,
 ) -> Result<Attempt> {
     stats.solves += 1;
-    let report = match solve(x, target, Some(start), &opts.solve) {
+    // A predicted start may put two birds wing to wing; the solve starts from them separated.
+    let start = crate::keyshape::steady::separate(x, start, &opts.solve.aero);
+    let report = match solve(x, target, Some(&start), &opts.solve) {
         Ok(r) => r,
-        Err(Error::Unreachable(_)) | Err(Error::Downwash { .. }) | Err(Error::NotConverged(_)) => {
+        Err(Error::Unreachable(_) | Error::Collision { .. } | Error::NotConverged(_)) => {
             stats.solve_errors += 1;
             return Ok(Attempt::Rejected);
         }
@@ -308,12 +312,18 @@ struct Predictor {
 }
 
 impl Predictor {
-    fn new(x: &[f64], prev: &KeyShape, leader: usize, total: f64) -> Option<Predictor> {
+    fn new(
+        x: &[f64],
+        prev: &KeyShape,
+        leader: usize,
+        total: f64,
+        aero: &crate::aero::AeroOptions,
+    ) -> Option<Predictor> {
         let n = x.len();
         if n < 2 || leader >= n {
             return None;
         }
-        let jac = crate::aero::power_jacobian_unchecked(x, &prev.y);
+        let jac = aero.power_jacobian_unchecked(x, &prev.y);
         let keep: Vec<usize> = (0..n).filter(|&i| i != leader).collect();
         let m = nalgebra::DMatrix::from_fn(n - 1, n - 1, |r, c| jac[keep[r] * n + keep[c]]);
         let lu = m.lu();
@@ -365,7 +375,7 @@ pub fn next_key(
         opts,
         total,
     } = *ctx;
-    let predictor = Predictor::new(x, prev, structure.leader, total);
+    let predictor = Predictor::new(x, prev, structure.leader, total, &opts.solve.aero);
     let promising = |y: &[f64]| structure.accepts(y) && max_jump(&prev.y, y) <= opts.max_jump;
     let mut tried: Vec<Vec<f64>> = Vec::new();
     let mut draws = 0;

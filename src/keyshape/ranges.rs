@@ -9,7 +9,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::aero::{power_reduction, PowerReduction};
+use crate::aero::{AeroOptions, PowerReduction};
 use crate::error::{Error, Result};
 use crate::shape::Shape;
 
@@ -23,11 +23,12 @@ pub struct XiRanges {
 }
 
 impl XiRanges {
-    /// The feasible range of eq. (2), [(1 − ε) p_i, (1 + ε) P_i].
+    /// The feasible range of eq. (2), [(1 − ε) p_i, (1 + ε) P_i], widened outward for negative
+    /// values too (a bird in downwash has ξ < 0): [p_i − ε|p_i|, P_i + ε|P_i|].
     pub fn widened(&self, epsilon: f64) -> XiRanges {
         XiRanges {
-            min: self.min.iter().map(|p| (1.0 - epsilon) * p).collect(),
-            max: self.max.iter().map(|p| (1.0 + epsilon) * p).collect(),
+            min: self.min.iter().map(|p| p - epsilon * p.abs()).collect(),
+            max: self.max.iter().map(|p| p + epsilon * p.abs()).collect(),
         }
     }
 
@@ -58,21 +59,40 @@ impl XiRanges {
     }
 }
 
-/// e_i, ξ_i of every initial shape's longitudinal positions at the lateral positions `x_key`.
-pub fn power_at(x_key: &[f64], shapes: &[Shape]) -> Result<Vec<PowerReduction>> {
-    shapes
-        .iter()
-        .map(|s| {
-            if s.len() != x_key.len() {
-                return Err(Error::Internal(format!(
-                    "initial shape of {} birds for {} lateral positions",
-                    s.len(),
-                    x_key.len()
-                )));
-            }
-            power_reduction(x_key, &s.ys())
-        })
-        .collect()
+/// e_i, ξ_i of every initial shape's longitudinal positions at the lateral positions `x_key`,
+/// leaving out the shapes in which two birds' wings would collide there (their ξ is not a
+/// placement the key shapes can take). Fails when every shape collides.
+pub fn power_at(
+    x_key: &[f64],
+    shapes: &[Shape],
+    aero: &AeroOptions,
+) -> Result<Vec<PowerReduction>> {
+    let mut out = Vec::with_capacity(shapes.len());
+    let mut last = None;
+    for s in shapes {
+        if s.len() != x_key.len() {
+            return Err(Error::Internal(format!(
+                "initial shape of {} birds for {} lateral positions",
+                s.len(),
+                x_key.len()
+            )));
+        }
+        match aero.power_reduction(x_key, &s.ys()) {
+            Ok(p) => out.push(p),
+            Err(e @ Error::Collision { .. }) => last = Some(e),
+            Err(e) => return Err(e),
+        }
+    }
+    if out.is_empty() {
+        return Err(Error::parameter(
+            "params",
+            format!(
+                "every frame's shape collides at the drawn lateral gaps ({}); try another seed",
+                last.map(|e| e.to_string()).unwrap_or_default()
+            ),
+        ));
+    }
+    Ok(out)
 }
 
 /// [p_i, P_i] over the ξ vectors of step 2.

@@ -1,34 +1,33 @@
-//! The key-shape solve of eq. (4): given the birds' lateral positions and target relative power
-//! reductions ξ̂, find the longitudinal positions that realise them, with the
-//! `levenberg-marquardt` crate and an analytic Jacobian.
+//! The key-shape solve of eq. (4): given the birds' lateral positions and target relative savings
+//! ξ̂, find the longitudinal positions that realise them, by Newton's method on the symmetric
+//! system (a Levenberg–Marquardt damping when a full step does not lower the residual) with a
+//! Cholesky factorisation per step.
 //!
 //! ```math
 //! e_i(y) = \hat\xi_i\,E, \qquad i = 1..N, \qquad E = \sum_{i<j} 2\,g(|x_i - x_j|, 0)
 //! ```
 //!
 //! (Klotsman & Tal eq. 3–4). By Munk's stagger theorem E depends only on the lateral positions, so
-//! it is computed once ([`crate::aero::munk_total`]) and the targets are renormalised to Σξ̂ = 1.
-//! Unknowns: the N − 1 longitudinal positions of every bird but one (held fixed, since only
-//! differences matter); residuals: r_i = ξ_i(y) − ξ̂_i for all N birds; Jacobian
-//! ∂r_i/∂y_k = (1/E)·∂e_i/∂y_k, computed with e in one pass over the pairs
-//! ([`crate::aero::power_and_jacobian_unchecked`]).
+//! it is computed once ([`crate::aero::AeroOptions::munk_total`]) and the targets are renormalised
+//! to Σξ̂ = 1. Unknowns: the N − 1 longitudinal positions of every bird but one (held fixed, since
+//! only differences matter); residuals r_i = ξ_i(y) − ξ̂_i; Jacobian ∂r_i/∂y_k = (1/E)·∂e_i/∂y_k.
 //!
-//! e(y) is the gradient of the convex potential Σ_{i<j} G(x_ij, y_i − y_j) with ∂G/∂y = g, so
-//! the system has a solution (unique up to a common shift) exactly when ξ̂·E lies in the interior
-//! of the gradient's range: every subset S of birds must ask for a share strictly between what
-//! the pairs inside S give (if everyone else flew infinitely far ahead) and that plus the pairs
-//! crossing S's boundary. [`reachability`] decides this with one minimum cut and names the birds
-//! of a violating subset; [`solve`] runs it first, so an impossible request is an error that says
-//! which birds ask for the impossible, never a wild shape. "Converged" means the residual
-//! ‖ξ − ξ̂‖₂ is below the tolerance, never the LM termination status alone.
+//! e(y) is the gradient of the potential Φ(y) = Σ_{i<j} G(x_ij, y_i − y_j) with ∂G/∂y = g, and
+//! ∂g/∂y > 0, so the Jacobian is a weighted graph Laplacian: symmetric, positive definite once
+//! one bird is fixed. Pairs whose wings overlap laterally (under one wingspan apart) cannot pass
+//! each other without colliding, and for overlapping wingtips (x < π/4) g has a pole at y = 0,
+//! so the solve keeps the **fore-aft order of those pairs** as it is in the start (a step is
+//! shortened so that no such pair changes order). Within one order Φ is strictly convex: the
+//! solution is unique up to a shift when it exists, and it exists exactly when every subset of
+//! birds asks for a share between what its pairs can give it ([`reachability`], one maximum flow,
+//! which names the birds of a violating subset). "Converged" means ‖ξ − ξ̂‖₂ ≤ tolerance.
 //!
 //! Symbols → code: x → `x`, ξ̂ → `xi_target` (renormalised: `target`), y → [`SolveReport::y`],
 //! E → `total`.
 
-use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
-use nalgebra::{DMatrix, DVector, Dyn, Owned};
+use nalgebra::{DMatrix, DVector};
 
-use crate::aero;
+use crate::aero::{AeroOptions, COLLISION_SPAN};
 use crate::error::{Error, Result};
 
 /// Options of [`solve`].
@@ -36,17 +35,24 @@ use crate::error::{Error, Result};
 pub struct SolveOptions {
     /// Converged means ‖ξ − ξ̂‖₂ ≤ this (dimensionless; ξ sums to 1).
     pub tolerance: f64,
-    /// LM's budget: at most `patience·N` model evaluations per attempt.
+    /// Budget: at most this many Jacobians (Newton steps) per attempt.
     pub patience: usize,
-    /// Check that the targets are reachable before solving (one minimum cut). Done up front for
-    /// flocks up to [`SolveOptions::direct_limit`] birds; larger flocks are checked only when the
+    /// Check that the targets are reachable before solving (one maximum flow). Done up front for
+    /// flocks up to [`SolveOptions::check_limit`] birds; larger flocks are checked only when the
     /// solve fails, to explain why.
     pub check_reachable: bool,
-    /// Largest flock solved with the `levenberg-marquardt` crate (MINPACK's pivoted-QR LM, the
-    /// paper's method). Beyond it, each of that method's trial steps costs a dense O(N³) QR and
-    /// O(N³) Givens updates (20 s for N = 1000), so the same Levenberg–Marquardt iteration runs
-    /// in the symmetric form of [`solve_symmetric`] (one Cholesky per trial step).
-    pub direct_limit: usize,
+    /// Largest flock whose reachability is checked before solving (the check is a dense maximum
+    /// flow, O(N³) in the worst case), birds.
+    pub check_limit: usize,
+    /// Largest flock solved with the exact dense Jacobian (one dense Cholesky per step, O(N³)),
+    /// birds. Larger flocks use [`SolveOptions::band_span`].
+    pub dense_limit: usize,
+    /// For flocks above `dense_limit`: the Newton steps use the Jacobian of the pairs less than
+    /// this far apart laterally (∂g/∂y decays like a²/R³), a banded matrix once the birds are
+    /// sorted by x, factorised in O(N·b²); the residual stays exact. Wingspans.
+    pub band_span: f64,
+    /// The aerodynamic model's core radius and collision distance.
+    pub aero: AeroOptions,
 }
 
 impl Default for SolveOptions {
@@ -55,7 +61,10 @@ impl Default for SolveOptions {
             tolerance: 1e-9,
             patience: 100,
             check_reachable: true,
-            direct_limit: 200,
+            check_limit: 200,
+            dense_limit: 300,
+            band_span: 120.0,
+            aero: AeroOptions::default(),
         }
     }
 }
@@ -88,91 +97,20 @@ pub struct SolveReport {
     pub evaluations: usize,
     /// `residual <= tolerance`.
     pub converged: bool,
-    /// Total power reduction E (fixed by the lateral positions).
+    /// Total saving E (fixed by the lateral positions).
     pub total: f64,
     /// Which iteration produced the result and why it stopped, for diagnostics.
     pub termination: String,
 }
 
-/// The least-squares problem handed to the LM crate.
-struct KeyShapeProblem<'a> {
-    x: &'a [f64],
-    target: &'a [f64],
-    total: f64,
-    /// Index of the bird whose y stays fixed.
-    fixed: usize,
-    /// Full y vector (fixed bird included).
-    y: Vec<f64>,
-    /// e_i at `y`.
-    e: Vec<f64>,
-    /// ∂e_i/∂y_k at `y`, row-major N×N (computed with `e`: the pairs share their square roots).
-    jac: Vec<f64>,
-}
-
-impl<'a> KeyShapeProblem<'a> {
-    fn new(x: &'a [f64], target: &'a [f64], total: f64, y0: &[f64], fixed: usize) -> Self {
-        let y = y0.to_vec();
-        let (e, jac) = aero::power_and_jacobian_unchecked(x, &y);
-        KeyShapeProblem {
-            x,
-            target,
-            total,
-            fixed,
-            y,
-            e,
-            jac,
-        }
-    }
-
-    /// Position in the parameter vector → bird index.
-    fn bird(&self, p: usize) -> usize {
-        if p < self.fixed {
-            p
-        } else {
-            p + 1
-        }
-    }
-}
-
-impl LeastSquaresProblem<f64, Dyn, Dyn> for KeyShapeProblem<'_> {
-    type ResidualStorage = Owned<f64, Dyn>;
-    type JacobianStorage = Owned<f64, Dyn, Dyn>;
-    type ParameterStorage = Owned<f64, Dyn>;
-
-    fn set_params(&mut self, p: &DVector<f64>) {
-        for k in 0..p.len() {
-            let b = self.bird(k);
-            self.y[b] = p[k];
-        }
-        (self.e, self.jac) = aero::power_and_jacobian_unchecked(self.x, &self.y);
-    }
-
-    fn params(&self) -> DVector<f64> {
-        let n = self.y.len();
-        DVector::from_iterator(n - 1, (0..n - 1).map(|k| self.y[self.bird(k)]))
-    }
-
-    fn residuals(&self) -> Option<DVector<f64>> {
-        let r = DVector::from_iterator(
-            self.e.len(),
-            self.e
-                .iter()
-                .zip(self.target)
-                .map(|(e, t)| e / self.total - t),
-        );
-        r.iter().all(|v| v.is_finite()).then_some(r)
-    }
-
-    fn jacobian(&self) -> Option<DMatrix<f64>> {
-        let n = self.y.len();
-        let inv = 1.0 / self.total;
-        let jac = DMatrix::from_fn(n, n - 1, |i, k| self.jac[i * n + self.bird(k)] * inv);
-        jac.iter().all(|v| v.is_finite()).then_some(jac)
-    }
-}
-
 /// Validates the inputs of [`solve`] and returns the renormalised targets.
-fn validate(x: &[f64], xi_target: &[f64], y0: Option<&[f64]>) -> Result<Vec<f64>> {
+fn validate(
+    x: &[f64],
+    xi_target: &[f64],
+    y0: Option<&[f64]>,
+    aero: &AeroOptions,
+) -> Result<Vec<f64>> {
+    aero.validate()?;
     let n = x.len();
     if n < 2 {
         return Err(Error::parameter(
@@ -189,23 +127,20 @@ fn validate(x: &[f64], xi_target: &[f64], y0: Option<&[f64]>) -> Result<Vec<f64>
             ),
         ));
     }
+    if let Some(i) = x.iter().position(|v| !v.is_finite()) {
+        return Err(Error::parameter(
+            format!("x[{i}]"),
+            "lateral position is not a finite number",
+        ));
+    }
     if let Some(i) = xi_target.iter().position(|v| !v.is_finite()) {
         return Err(Error::parameter(format!("xi[{i}]"), "not a finite number"));
-    }
-    if let Some(i) = xi_target.iter().position(|&v| v < 0.0) {
-        return Err(Error::parameter(
-            format!("xi[{i}]"),
-            format!(
-                "negative target {}; relative power reductions are positive",
-                xi_target[i]
-            ),
-        ));
     }
     let sum: f64 = xi_target.iter().sum();
     if !(sum > 0.0) {
         return Err(Error::parameter(
             "xi",
-            "all targets are zero; give each bird a positive relative power reduction",
+            format!("the targets sum to {sum}; relative savings sum to 1 (negative values are allowed for birds in downwash, but not a non-positive total)"),
         ));
     }
     if let Some(y0) = y0 {
@@ -218,84 +153,176 @@ fn validate(x: &[f64], xi_target: &[f64], y0: Option<&[f64]>) -> Result<Vec<f64>
         if let Some(i) = y0.iter().position(|v| !v.is_finite()) {
             return Err(Error::parameter(format!("y[{i}]"), "not a finite number"));
         }
+        aero.check_shape(x, y0)?;
     }
-    aero::check_lateral(x)?;
     Ok(xi_target.iter().map(|v| v / sum).collect())
 }
 
+/// The solver's own starts when no guess is given, in the order they are tried. With every pair
+/// at least one wingspan apart laterally it is the **line abreast** y = 0 alone, where every pair
+/// splits its saving evenly (the one start that favours no bird). Otherwise the line abreast
+/// collides, and the fore-aft order of the laterally overlapping pairs has to be chosen (the
+/// solve keeps it; each order has at most one solution):
+///
+/// 1. a **V** behind the bird with the smallest non-negative target (the bird that gains least
+///    flies in front; a negative target is a bird in downwash, which is behind): y_i = |x_i − x_m| (45° arms), the right arm one collision chord further back so
+///    that birds at equal distances on both arms are not abreast: every overlapping pair in
+///    lateral order away from the leader, as in the V, J, echelon and U of real flocks;
+/// 2. an order **by targets**: in a pair the bird in front gets less than half the pair's
+///    saving, so birds are placed in order of increasing target, negative targets last (ties:
+///    lower index first), each
+///    two collision chords behind the rearmost already placed bird it overlaps laterally.
+pub fn default_starts(x: &[f64], target: &[f64], aero: &AeroOptions) -> Vec<Vec<f64>> {
+    let n = x.len();
+    let zeros = vec![0.0; n];
+    if aero.first_collision(x, &zeros).is_none() {
+        return vec![zeros];
+    }
+    let chord = aero.collision_chord.max(1e-3);
+    // A negative target is a bird in downwash, i.e. behind: it neither leads nor goes in front.
+    let rank = |i: usize| (target[i] < 0.0, target[i]);
+    let by_rank = |a: &usize, b: &usize| {
+        let (ra, rb) = (rank(*a), rank(*b));
+        ra.0.cmp(&rb.0).then(ra.1.total_cmp(&rb.1)).then(a.cmp(b))
+    };
+    let m = (0..n).min_by(by_rank).unwrap_or(0);
+    let v: Vec<f64> = x
+        .iter()
+        .map(|&xi| (xi - x[m]).abs() + if xi > x[m] { chord } else { 0.0 })
+        .collect();
+    let step = 2.0 * chord;
+    let mut by_x: Vec<usize> = (0..n).collect();
+    by_x.sort_by(|&a, &b| x[a].total_cmp(&x[b]).then(a.cmp(&b)));
+    let sorted_x: Vec<f64> = by_x.iter().map(|&i| x[i]).collect();
+    let mut order: Vec<usize> = (0..n).collect();
+    order.sort_by(by_rank);
+    let mut y = vec![f64::NAN; n];
+    for &i in &order {
+        let lo = sorted_x.partition_point(|&v| v <= x[i] - COLLISION_SPAN);
+        let mut yi: f64 = 0.0;
+        for &j in by_x[lo..]
+            .iter()
+            .take_while(|&&j| x[j] < x[i] + COLLISION_SPAN)
+        {
+            if j != i && y[j].is_finite() {
+                yi = yi.max(y[j] + step);
+            }
+        }
+        y[i] = yi;
+    }
+    if ordered_pairs(x, &v) == ordered_pairs(x, &y) {
+        vec![v]
+    } else {
+        vec![v, y]
+    }
+}
+
+/// Pairs (front, rear) whose fore-aft order the solve keeps: lateral distance under one
+/// wingspan, ordered as in `y` (ties: lower index in front).
+pub fn ordered_pairs(x: &[f64], y: &[f64]) -> Vec<(usize, usize)> {
+    let mut idx: Vec<usize> = (0..x.len()).collect();
+    idx.sort_by(|&a, &b| x[a].total_cmp(&x[b]).then(a.cmp(&b)));
+    let mut out = Vec::new();
+    for (k, &i) in idx.iter().enumerate() {
+        for &j in &idx[k + 1..] {
+            if !(x[j] - x[i] < COLLISION_SPAN) {
+                break;
+            }
+            let (a, b) = (i.min(j), i.max(j));
+            if y[b] < y[a] {
+                out.push((b, a));
+            } else {
+                out.push((a, b));
+            }
+        }
+    }
+    out
+}
+
 /// Solves eq. (4): longitudinal positions y such that ξ(x, y) = ξ̂ (renormalised to sum to 1),
-/// starting from `y0` if given, else from the line abreast y = 0 (where every pair splits its
-/// savings evenly: the one start that favours no bird). The output is shifted so that the
+/// starting from `y0` if given, else from [`default_starts`]. The output is shifted so that the
 /// front-most bird is at y = 0.
 ///
-/// Errors: fewer than 2 birds, mismatched lengths, non-finite values, negative or all-zero
-/// targets ([`Error::Parameter`]); a pair within π/4 laterally ([`Error::Downwash`]); targets
-/// that no placement reaches ([`Error::Unreachable`], naming the birds). A feasible target on
-/// which LM stalls is returned with `converged == false`.
+/// Errors: fewer than 2 birds, mismatched lengths, non-finite values, targets that do not sum
+/// to a positive number ([`Error::Parameter`]); a start whose birds collide, or a solution that
+/// only exists with two birds' wings side by side ([`Error::Collision`]); targets that no
+/// placement reaches ([`Error::Unreachable`], naming the birds). A feasible target on which the
+/// iteration stalls is returned with `converged == false`.
 pub fn solve(
     x: &[f64],
     xi_target: &[f64],
     y0: Option<&[f64]>,
     opts: &SolveOptions,
 ) -> Result<SolveReport> {
-    let target = validate(x, xi_target, y0)?;
-    let total = aero::munk_total_unchecked(x);
-    let n = x.len();
-    let small = n <= opts.direct_limit;
-    if opts.check_reachable && small {
-        reachability(x, &target, total)?;
+    let aero = &opts.aero;
+    let target = validate(x, xi_target, y0, aero)?;
+    let total = aero.munk_total(x)?;
+    if !(total > 0.0) {
+        return Err(Error::Unreachable(format!(
+            "these lateral positions give the flock a total saving E = {total:.6} ≤ 0 (wingtips overlap so much that the birds fly in one another's downwash); no placement shares out a positive saving; widen the lateral gaps"
+        )));
     }
-    let zeros = vec![0.0; n];
-    let run = |start: &[f64]| {
-        if small {
-            attempt(x, &target, total, start, opts)
+    let n = x.len();
+    let small = n <= opts.check_limit;
+    let starts: Vec<Vec<f64>> = match y0 {
+        Some(y) => vec![y.to_vec()],
+        None => default_starts(x, &target, aero),
+    };
+    // Each start fixes the fore-aft order of the overlapping pairs; the first order in which
+    // the targets are reachable and the solve converges without a collision wins.
+    let mut first_error: Option<Error> = None;
+    let mut best: Option<SolveReport> = None;
+    let mut evaluations = 0;
+    let mut tried_neutral = y0.is_none();
+    let mut queue = starts;
+    let mut k = 0;
+    while k < queue.len() {
+        let start = queue[k].clone();
+        k += 1;
+        if opts.check_reachable && small {
+            if let Err(e) = reachability_ordered(x, &target, total, &start, aero) {
+                first_error.get_or_insert(e);
+                if k == queue.len() && !tried_neutral {
+                    // A poor guess: the neutral starts are the fallback.
+                    tried_neutral = true;
+                    queue.extend(default_starts(x, &target, aero));
+                }
+                continue;
+            }
+        }
+        let rep = if n <= opts.dense_limit {
+            newton(x, &target, total, &start, opts)
         } else {
-            solve_symmetric(x, &target, total, start, opts)
+            newton_banded(x, &target, total, &start, opts)
+        };
+        evaluations += rep.evaluations;
+        if rep.converged {
+            if let Err(e) = aero.check_shape(x, &rep.y) {
+                first_error.get_or_insert(e);
+            } else {
+                best = Some(rep);
+                break;
+            }
+        } else if best.as_ref().map_or(true, |b| rep.residual < b.residual) {
+            best = Some(rep);
         }
-    };
-    let mut best = run(y0.unwrap_or(&zeros));
-    if !best.converged && y0.is_some() {
-        // A poor guess can strand LM on a plateau of g; the neutral start is the fallback.
-        let retry = run(&zeros);
-        let evaluations = best.evaluations + retry.evaluations;
-        if retry.residual < best.residual {
-            best = retry;
+        if k == queue.len() && !tried_neutral {
+            // A poor guess can strand the iteration on a plateau of g; the neutral starts are
+            // the fallback.
+            tried_neutral = true;
+            queue.extend(default_starts(x, &target, aero));
         }
-        best.evaluations = evaluations;
     }
-    if !best.converged && opts.check_reachable && !small {
-        reachability(x, &target, total)?;
+    match best {
+        Some(mut rep) if rep.converged || first_error.is_none() => {
+            rep.evaluations = evaluations;
+            if !rep.converged && opts.check_reachable && !small {
+                reachability_ordered(x, &target, total, &queue[0], aero)?;
+            }
+            Ok(rep)
+        }
+        _ => Err(first_error.unwrap_or_else(|| Error::Internal("no start tried".into()))),
     }
-    Ok(best)
-}
-
-fn attempt(x: &[f64], target: &[f64], total: f64, y0: &[f64], opts: &SolveOptions) -> SolveReport {
-    let n = x.len();
-    // The front-most bird of the start stays fixed; only differences of y matter.
-    let fixed = (0..n)
-        .min_by(|&a, &b| y0[a].total_cmp(&y0[b]).then(a.cmp(&b)))
-        .unwrap_or(0);
-    let problem = KeyShapeProblem::new(x, target, total, y0, fixed);
-    let lm = LevenbergMarquardt::new()
-        .with_ftol(1e-15)
-        .with_xtol(1e-15)
-        .with_gtol(1e-15)
-        .with_patience(opts.patience.max(1));
-    let (problem, lm_report) = lm.minimize(problem);
-    let y = if problem.y.iter().all(|v| v.is_finite()) {
-        problem.y
-    } else {
-        y0.to_vec()
-    };
-    report(
-        x,
-        target,
-        total,
-        y,
-        lm_report.number_of_evaluations,
-        opts.tolerance,
-        format!("levenberg-marquardt crate: {:?}", lm_report.termination),
-    )
 }
 
 /// Builds the report for positions `y` (shifted so that the front-most bird is at 0).
@@ -305,10 +332,10 @@ fn report(
     total: f64,
     mut y: Vec<f64>,
     evaluations: usize,
-    tolerance: f64,
+    opts: &SolveOptions,
     termination: String,
 ) -> SolveReport {
-    let e = aero::power_unchecked(x, &y);
+    let e = opts.aero.power_unchecked(x, &y);
     let xi: Vec<f64> = e.iter().map(|v| v / total).collect();
     let residual = norm_diff(&xi, target);
     let front = y.iter().copied().fold(f64::INFINITY, f64::min);
@@ -321,7 +348,7 @@ fn report(
         target: target.to_vec(),
         residual,
         evaluations,
-        converged: residual.is_finite() && residual <= tolerance,
+        converged: residual.is_finite() && residual <= opts.tolerance,
         total,
         termination,
     }
@@ -335,52 +362,52 @@ fn norm_diff(a: &[f64], b: &[f64]) -> f64 {
         .sqrt()
 }
 
-/// Levenberg–Marquardt for large flocks, in the form the problem's symmetry allows.
+/// Newton's method on the symmetric system, damped in Levenberg–Marquardt's way when needed.
 ///
-/// The Jacobian J = (1/E)·∂e/∂y is a weighted graph Laplacian: symmetric, and positive definite
-/// once the fixed bird's row and column are removed. So the LM step
+/// The Jacobian J = (1/E)·∂e/∂y restricted to the free birds is symmetric positive definite, so
+/// the step
 /// ```math
 /// (J + \lambda\,\bar d\,I)\,\delta = -r
 /// ```
-/// (d̄ the mean diagonal of J; r and J restricted to the free birds) is a descent direction of
-/// ‖r‖² for every λ ≥ 0, is found with one
-/// Cholesky factorisation of an (N−1)×(N−1) matrix, and λ follows Marquardt's rule: divided by
-/// 10 after a step that lowers ‖r‖, multiplied by 10 (and the step retried) after one that does
-/// not. Stops at the tolerance, after `patience` Jacobians, or when λ exceeds 10¹².
-pub fn solve_symmetric(
-    x: &[f64],
-    target: &[f64],
-    total: f64,
-    y0: &[f64],
-    opts: &SolveOptions,
-) -> SolveReport {
+/// (d̄ the mean diagonal of J) is found with one Cholesky factorisation and is a descent
+/// direction of ‖r‖² for every λ ≥ 0. λ starts at 10⁻⁶ (a Newton step, quadratic convergence
+/// near the solution) and follows Marquardt's rule: ÷10 after a step that lowers ‖r‖, ×10 (and
+/// the step retried) after one that does not. A step that would make two laterally overlapping
+/// birds pass each other is shortened to 90 % of the way to abreast. Stops at the tolerance,
+/// after `patience` Jacobians, or when λ exceeds 10¹².
+fn newton(x: &[f64], target: &[f64], total: f64, y0: &[f64], opts: &SolveOptions) -> SolveReport {
     let n = x.len();
+    let aero = &opts.aero;
     let fixed = (0..n)
         .min_by(|&a, &b| y0[a].total_cmp(&y0[b]).then(a.cmp(&b)))
         .unwrap_or(0);
     let free: Vec<usize> = (0..n).filter(|&i| i != fixed).collect();
     let m = free.len();
+    let order = ordered_pairs(x, y0);
     let evaluate = |y: &[f64]| -> (Vec<f64>, Vec<f64>) {
-        let (e, jac) = aero::power_and_jacobian_unchecked(x, y);
+        let (e, jac) = aero.power_and_jacobian_unchecked(x, y);
         let r = e.iter().zip(target).map(|(e, t)| e / total - t).collect();
         (r, jac)
     };
-    // Merit: the free birds' residuals (the fixed bird's is minus their sum, since Σξ = Σξ̂ = 1);
-    // in this norm the damped step is a descent direction for every λ.
+    // Merit: the free birds' residuals (the fixed bird's is minus their sum, since Σξ = Σξ̂ = 1).
     let merit = |r: &[f64]| -> f64 { free.iter().map(|&i| r[i] * r[i]).sum::<f64>().sqrt() };
     let mut y = y0.to_vec();
     let (mut r, mut full) = evaluate(&y);
     let mut norm = merit(&r);
     let mut evaluations = 1;
-    let mut lambda = 1e-3;
+    let mut lambda = 1e-6;
     let mut why = "iteration budget exhausted";
     let stop = opts.tolerance * 1e-3;
+    let inv = 1.0 / total;
     'outer: for _ in 0..opts.patience.max(1) {
         if norm <= stop {
             why = "residual below tolerance";
             break;
         }
-        let inv = 1.0 / total;
+        if !norm.is_finite() {
+            why = "the start has an infinite saving (birds abreast with overlapping wingtips)";
+            break;
+        }
         let jac = DMatrix::from_fn(m, m, |a, b| full[free[a] * n + free[b]] * inv);
         let mean_diag = (0..m).map(|a| jac[(a, a)]).sum::<f64>() / m as f64;
         let rhs = DVector::from_iterator(m, free.iter().map(|&i| -r[i]));
@@ -398,10 +425,24 @@ pub fn solve_symmetric(
                 continue;
             };
             let step = chol.solve(&rhs);
-            let mut trial = y.clone();
+            let mut full_step = vec![0.0; n];
             for (a, &i) in free.iter().enumerate() {
-                trial[i] += step[a];
+                full_step[i] = step[a];
             }
+            // Keep the fore-aft order of laterally overlapping pairs.
+            let mut alpha: f64 = 1.0;
+            for &(f, b) in &order {
+                let gap = y[b] - y[f];
+                let closing = full_step[f] - full_step[b];
+                if closing > 0.0 && closing * alpha >= 0.9 * gap {
+                    alpha = alpha.min(0.9 * gap / closing);
+                }
+            }
+            let trial: Vec<f64> = y
+                .iter()
+                .zip(&full_step)
+                .map(|(v, s)| v + alpha * s)
+                .collect();
             let (tr, tjac) = evaluate(&trial);
             evaluations += 1;
             let tnorm = merit(&tr);
@@ -426,109 +467,363 @@ pub fn solve_symmetric(
         total,
         y,
         evaluations,
-        opts.tolerance,
-        format!("symmetric Levenberg–Marquardt: {why}"),
+        opts,
+        format!("symmetric Newton–Levenberg–Marquardt: {why}"),
     )
 }
 
-/// Decides whether renormalised targets `target` (Σ = 1) are reachable for lateral positions
-/// `x` with total `total` (= [`aero::munk_total`]), and names the birds of a violating subset
-/// when they are not ([`Error::Unreachable`]).
-///
-/// Each pair (i, j) contributes w_ij = 2g(x_ij, 0)/E to ξ, split between its two birds by their
-/// stagger (all to the rear bird as the stagger → ∞). A subset T asks too little when
-/// ξ̂(T) ≤ W(T), the pairs inside T; maximising W(T) − ξ̂(T) over T is a minimum cut
-/// (Goldberg's densest-subgraph construction): b_i = ξ̂_i − deg_i/2, arcs i↔j of capacity
-/// w_ij/2, s→i of capacity −b_i where b_i < 0, i→t of capacity b_i where b_i > 0.
-pub fn reachability(x: &[f64], target: &[f64], total: f64) -> Result<()> {
+/// Cholesky factor of a symmetric positive definite band matrix: `band[i * (b + 1) + k]` holds
+/// A[i][i − k] for k ≤ b (and i − k ≥ 0). Returns the factor in the same layout, or `None` when
+/// the matrix is not positive definite. O(m·b²).
+fn band_cholesky(band: &[f64], m: usize, b: usize) -> Option<Vec<f64>> {
+    let w = b + 1;
+    let mut l = vec![0.0; m * w];
+    for i in 0..m {
+        let j0 = i.saturating_sub(b);
+        for j in j0..=i {
+            // L[i][j] = (A[i][j] − Σ_{k<j} L[i][k] L[j][k]) / L[j][j]
+            let mut s = band[i * w + (i - j)];
+            let k0 = j0.max(j.saturating_sub(b));
+            for k in k0..j {
+                s -= l[i * w + (i - k)] * l[j * w + (j - k)];
+            }
+            if i == j {
+                if !(s > 0.0) {
+                    return None;
+                }
+                l[i * w] = s.sqrt();
+            } else {
+                l[i * w + (i - j)] = s / l[j * w];
+            }
+        }
+    }
+    Some(l)
+}
+
+/// Solves L Lᵀ z = r with the factor of [`band_cholesky`].
+fn band_solve(l: &[f64], m: usize, b: usize, r: &[f64]) -> Vec<f64> {
+    let w = b + 1;
+    let mut z = r.to_vec();
+    for i in 0..m {
+        let mut s = z[i];
+        for k in i.saturating_sub(b)..i {
+            s -= l[i * w + (i - k)] * z[k];
+        }
+        z[i] = s / l[i * w];
+    }
+    for i in (0..m).rev() {
+        let mut s = z[i];
+        for k in (i + 1)..(i + 1 + b).min(m) {
+            s -= l[k * w + (k - i)] * z[k];
+        }
+        z[i] = s / l[i * w];
+    }
+    z
+}
+
+/// [`newton`] for large flocks: the same damped Newton iteration on the exact residual, with
+/// the Jacobian restricted to the pairs less than `band_span` apart laterally. Sorted by x, that
+/// matrix is a weighted graph Laplacian with a narrow band, factorised in O(N·b²) instead of
+/// O(N³); the dropped entries (∂g/∂y ~ a²/R³ for distant pairs) make the step slightly too
+/// long for the flock's slowest modes, which the damping and a few more steps absorb.
+fn newton_banded(
+    x: &[f64],
+    target: &[f64],
+    total: f64,
+    y0: &[f64],
+    opts: &SolveOptions,
+) -> SolveReport {
     let n = x.len();
+    let aero = &opts.aero;
+    let fixed = (0..n)
+        .min_by(|&a, &b| y0[a].total_cmp(&y0[b]).then(a.cmp(&b)))
+        .unwrap_or(0);
+    // Free birds in lateral order: position p ↔ bird free[p].
+    let mut free: Vec<usize> = (0..n).filter(|&i| i != fixed).collect();
+    free.sort_by(|&a, &b| x[a].total_cmp(&x[b]).then(a.cmp(&b)));
+    let m = free.len();
+    // Pairs kept in the Jacobian (free–free within the span) and the fixed bird's pairs (which
+    // only add to the diagonal).
+    let mut near: Vec<(usize, usize)> = Vec::new();
+    let mut b = 0;
+    for p in 0..m {
+        for q in (p + 1)..m {
+            if x[free[q]] - x[free[p]] >= opts.band_span {
+                break;
+            }
+            near.push((p, q));
+            b = b.max(q - p);
+        }
+    }
+    let w = b + 1;
+    let order = ordered_pairs(x, y0);
+    let merit = |r: &[f64]| -> f64 { free.iter().map(|&i| r[i] * r[i]).sum::<f64>().sqrt() };
+    let residual = |y: &[f64]| -> Vec<f64> {
+        aero.power_unchecked(x, y)
+            .iter()
+            .zip(target)
+            .map(|(e, t)| e / total - t)
+            .collect()
+    };
+    let inv = 1.0 / total;
+    let band_at = |y: &[f64]| -> Vec<f64> {
+        let mut band = vec![0.0; m * w];
+        for &(p, q) in &near {
+            let (i, j) = (free[p], free[q]);
+            let s = aero.dg_dy((x[i] - x[j]).abs(), y[i] - y[j]) * inv;
+            band[q * w + (q - p)] -= s;
+            band[p * w] += s;
+            band[q * w] += s;
+        }
+        for (p, &i) in free.iter().enumerate() {
+            if (x[i] - x[fixed]).abs() < opts.band_span {
+                band[p * w] += aero.dg_dy((x[i] - x[fixed]).abs(), y[i] - y[fixed]) * inv;
+            }
+        }
+        band
+    };
+    let mut y = y0.to_vec();
+    let mut r = residual(&y);
+    let mut norm = merit(&r);
+    let mut evaluations = 1;
+    let mut lambda = 1e-6;
+    let mut why = "iteration budget exhausted";
+    let stop = opts.tolerance * 1e-3;
+    'outer: for _ in 0..opts.patience.max(1) {
+        if norm <= stop {
+            why = "residual below tolerance";
+            break;
+        }
+        if !norm.is_finite() {
+            why = "the start has an infinite saving (birds abreast with overlapping wingtips)";
+            break;
+        }
+        let band = band_at(&y);
+        let mean_diag = (0..m).map(|p| band[p * w]).sum::<f64>() / m as f64;
+        let rhs: Vec<f64> = free.iter().map(|&i| -r[i]).collect();
+        loop {
+            let mut damped = band.clone();
+            for p in 0..m {
+                damped[p * w] += lambda * mean_diag;
+            }
+            let Some(l) = band_cholesky(&damped, m, b) else {
+                lambda *= 10.0;
+                if lambda > 1e12 {
+                    why = "damped Jacobian not positive definite";
+                    break 'outer;
+                }
+                continue;
+            };
+            let step = band_solve(&l, m, b, &rhs);
+            let mut full_step = vec![0.0; n];
+            for (p, &i) in free.iter().enumerate() {
+                full_step[i] = step[p];
+            }
+            let mut alpha: f64 = 1.0;
+            for &(f, bk) in &order {
+                let gap = y[bk] - y[f];
+                let closing = full_step[f] - full_step[bk];
+                if closing > 0.0 && closing * alpha >= 0.9 * gap {
+                    alpha = alpha.min(0.9 * gap / closing);
+                }
+            }
+            let trial: Vec<f64> = y
+                .iter()
+                .zip(&full_step)
+                .map(|(v, s)| v + alpha * s)
+                .collect();
+            let tr = residual(&trial);
+            evaluations += 1;
+            let tnorm = merit(&tr);
+            if tnorm.is_finite() && tnorm < norm {
+                y = trial;
+                r = tr;
+                norm = tnorm;
+                lambda = (lambda / 10.0).max(1e-15);
+                break;
+            }
+            lambda *= 10.0;
+            if lambda > 1e12 {
+                why = "no step lowers the residual";
+                break 'outer;
+            }
+        }
+    }
+    report(
+        x,
+        target,
+        total,
+        y,
+        evaluations,
+        opts,
+        format!("banded Newton–Levenberg–Marquardt (bandwidth {b}): {why}"),
+    )
+}
+
+/// Decides whether renormalised targets `target` (Σ = 1) are reachable for lateral positions `x`
+/// with total `total` (= [`crate::aero::munk_total`]), with the default model and the fore-aft order
+/// of overlapping pairs of the solver's own start; see [`reachability_ordered`].
+pub fn reachability(x: &[f64], target: &[f64], total: f64) -> Result<()> {
+    let aero = AeroOptions::default();
+    let starts = default_starts(x, target, &aero);
+    reachability_ordered(x, target, total, &starts[0], &aero)
+}
+
+/// Decides whether renormalised targets `target` (Σ = 1) are reachable for lateral positions `x`
+/// with total `total`, keeping the fore-aft order that `start` gives laterally overlapping pairs,
+/// and names the birds of a violating subset when they are not ([`Error::Unreachable`]).
+///
+/// Each pair (i, j) contributes w_ij = 2g(x_ij, 0)/E to ξ (negative for heavily overlapping
+/// wings), split between its two birds by their stagger. A pair at least one wingspan apart
+/// laterally can give either bird any share in (0, w) (all to the rear bird as the stagger → ∞).
+/// A laterally overlapping pair keeps its order: the front bird f gets a share in (0, D_c) with
+/// D_c = g(x, −chord)/E (the most it gets just outside a collision), the rear bird the rest. So
+/// each pair is a base amount for one bird plus a transfer t ∈ (0, span) to the other, and the
+/// targets are reachable iff the transfers can deliver every bird's target minus its bases: a
+/// feasible flow, decided by one maximum flow (Dinic on a dense matrix). Single birds are
+/// checked first for clearer messages.
+pub fn reachability_ordered(
+    x: &[f64],
+    target: &[f64],
+    total: f64,
+    start: &[f64],
+    aero: &AeroOptions,
+) -> Result<()> {
+    let n = x.len();
+    // Per pair: base to `to_base`, transfer of up to `span` from `to_base` to `gets`.
+    let mut overlapping = vec![false; n * n];
+    for &(f, b) in &ordered_pairs(x, start) {
+        overlapping[f * n + b] = true;
+    }
+    let mut base = vec![0.0; n];
+    let mut lo = vec![0.0; n];
+    let mut hi = vec![0.0; n];
+    // span[v * n + u]: transfer capacity from v to u.
+    let mut span = vec![0.0; n * n];
     let mut w = vec![0.0; n * n];
-    let mut deg = vec![0.0; n];
+    let chord = aero.collision_chord.max(1e-3);
     for i in 0..n {
         for j in (i + 1)..n {
-            let v = 2.0 * aero::g0((x[i] - x[j]).abs()) / total;
-            w[i * n + j] = v;
-            w[j * n + i] = v;
-            deg[i] += v;
-            deg[j] += v;
+            let dx = (x[i] - x[j]).abs();
+            let wij = 2.0 * aero.g0(dx) / total;
+            w[i * n + j] = wij;
+            w[j * n + i] = wij;
+            let (front, rear, cap) = if overlapping[i * n + j] {
+                (i, j, aero.g(dx, -chord) / total)
+            } else if overlapping[j * n + i] {
+                (j, i, aero.g(dx, -chord) / total)
+            } else {
+                (i, j, wij)
+            };
+            // front gets t ∈ (0, cap), rear gets w − t ∈ (w − cap, w).
+            base[rear] += wij;
+            span[rear * n + front] = cap;
+            hi[front] += cap;
+            lo[rear] += wij - cap;
+            hi[rear] += wij;
         }
     }
-    // Singletons first: the common, easily explained cases (and the boundary ξ̂_i = 0, which the
-    // cut cannot distinguish from the empty set).
-    for i in 0..n {
-        if !(target[i] > 0.0) {
-            return Err(Error::Unreachable(format!(
-                "bird {i} asks for ξ = 0, but every bird gains from its flockmates wherever it flies; give it a positive share"
-            )));
-        }
-        if !(target[i] < deg[i]) {
-            return Err(Error::Unreachable(format!(
-                "bird {i} asks for ξ = {:.6}, more than all its pairs can give it (at most {:.6}, with every other bird infinitely far ahead)",
-                target[i], deg[i]
-            )));
-        }
-    }
-    if n <= 2 {
-        return Ok(());
-    }
-    let b: Vec<f64> = (0..n).map(|i| target[i] - deg[i] / 2.0).collect();
-    let s = n;
-    let t = n + 1;
-    let m = n + 2;
-    let mut cap = vec![0.0; m * m];
-    let mut neg = 0.0;
-    for i in 0..n {
-        for j in 0..n {
-            if i != j {
-                cap[i * m + j] = w[i * n + j] / 2.0;
-            }
-        }
-        if b[i] > 0.0 {
-            cap[i * m + t] = b[i];
-        } else {
-            cap[s * m + i] = -b[i];
-            neg += -b[i];
-        }
-    }
-    let flow = max_flow_dense(&mut cap, m, s, t);
-    let objective = flow - neg;
-    let tol = 1e-12;
-    if objective >= -tol {
-        return Ok(());
-    }
-    // Source side of the minimum cut = the subset T that asks too little.
-    let side = reachable_from(&cap, m, s);
-    let tset: Vec<usize> = (0..n).filter(|&i| side[i]).collect();
-    let sset: Vec<usize> = (0..n).filter(|&i| !side[i]).collect();
-    let inside = |set: &[usize]| -> f64 {
-        let mut acc = 0.0;
-        for (k, &i) in set.iter().enumerate() {
-            for &j in &set[k + 1..] {
-                acc += w[i * n + j];
-            }
-        }
-        acc
-    };
-    let ask = |set: &[usize]| -> f64 { set.iter().map(|&i| target[i]).sum() };
     let list = |set: &[usize]| -> String {
         set.iter()
             .map(|i| i.to_string())
             .collect::<Vec<_>>()
             .join(", ")
     };
-    if tset.len() <= sset.len() || sset.is_empty() {
+    let margin = 1e-12;
+    for i in 0..n {
+        if !(target[i] > lo[i] + margin) {
+            return Err(Error::Unreachable(format!(
+                "bird {i} asks for ξ = {:.6}, but its pairs give it at least {:.6} wherever it flies (every other bird as far ahead as it can be, birds whose wings overlap it laterally kept on their side of it); give it a larger share",
+                target[i], lo[i]
+            )));
+        }
+        if !(target[i] < hi[i] - margin) {
+            return Err(Error::Unreachable(format!(
+                "bird {i} asks for ξ = {:.6}, more than all its pairs can give it (at most {:.6}: every other bird as far behind as it can be, birds whose wings overlap it laterally kept on their side of it)",
+                target[i], hi[i]
+            )));
+        }
+    }
+    if n <= 2 {
+        return Ok(());
+    }
+    // Flow network: nodes 0..n birds, s = n, t = n + 1. Bird i needs net inflow target_i − base_i.
+    let s = n;
+    let t = n + 1;
+    let mm = n + 2;
+    let mut cap = vec![0.0; mm * mm];
+    let mut demand = 0.0;
+    for v in 0..n {
+        for u in 0..n {
+            if u != v {
+                cap[v * mm + u] = span[v * n + u];
+            }
+        }
+        let need = target[v] - base[v];
+        if need > 0.0 {
+            cap[v * mm + t] = need;
+            demand += need;
+        } else {
+            cap[s * mm + v] = -need;
+        }
+    }
+    let flow = max_flow_dense(&mut cap, mm, s, t);
+    if flow >= demand - 1e-12 {
+        return Ok(());
+    }
+    // Source side of the minimum cut: birds whose surplus cannot be shipped out, i.e. a set that
+    // asks for less than its pairs give it at least.
+    let side = reachable_from(&cap, mm, s);
+    let tset: Vec<usize> = (0..n).filter(|&i| side[i]).collect();
+    let uset: Vec<usize> = (0..n).filter(|&i| !side[i]).collect();
+    let ask = |set: &[usize]| -> f64 { set.iter().map(|&i| target[i]).sum() };
+    // Least a set gets: its inside pairs, plus the least of each crossing pair; most: plus the most.
+    let bounds = |set: &[usize]| -> (f64, f64) {
+        let mut inside = vec![false; n];
+        for &i in set {
+            inside[i] = true;
+        }
+        let (mut least, mut most) = (0.0, 0.0);
+        for i in 0..n {
+            for j in (i + 1)..n {
+                match (inside[i], inside[j]) {
+                    (true, true) => {
+                        least += w[i * n + j];
+                        most += w[i * n + j];
+                    }
+                    (true, false) | (false, true) => {
+                        let (me, other) = if inside[i] { (i, j) } else { (j, i) };
+                        // me as the receiver of other's transfer, or as the giver.
+                        let to_me = span[other * n + me];
+                        let from_me = span[me * n + other];
+                        if to_me > 0.0 || from_me == 0.0 {
+                            // me is the front bird of this pair (gets 0..cap).
+                            most += to_me;
+                        } else {
+                            least += w[i * n + j] - from_me;
+                            most += w[i * n + j];
+                        }
+                    }
+                    _ => {}
+                }
+            }
+        }
+        (least, most)
+    };
+    if tset.len() <= uset.len() || uset.is_empty() {
+        let (least, _) = bounds(&tset);
         Err(Error::Unreachable(format!(
-            "birds {} ask for ξ = {:.6} together, but the pairs among them alone give them at least {:.6} however far back the others fly; raise their targets or lower the others'",
+            "birds {} ask for ξ = {:.6} together, but their pairs give them at least {:.6} however the others fly; raise their targets or lower the others'",
             list(&tset),
             ask(&tset),
-            inside(&tset)
+            least
         )))
     } else {
-        let most: f64 = 1.0 - inside(&tset);
+        let (_, most) = bounds(&uset);
         Err(Error::Unreachable(format!(
-            "birds {} ask for ξ = {:.6} together, but all the pairs they belong to give them at most {:.6} even with every other bird infinitely far ahead; lower their targets or raise the others'",
-            list(&sset),
-            ask(&sset),
+            "birds {} ask for ξ = {:.6} together, but all the pairs they belong to give them at most {:.6} however the others fly; lower their targets or raise the others'",
+            list(&uset),
+            ask(&uset),
             most
         )))
     }
@@ -622,6 +917,7 @@ fn reachable_from(cap: &[f64], m: usize, s: usize) -> Vec<bool> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::aero;
 
     fn v_shape(n: usize, gap: f64, depth: f64) -> (Vec<f64>, Vec<f64>) {
         // Leader in the middle, arms alternating right/left.
@@ -666,9 +962,9 @@ mod tests {
     fn cut_finds_pair_asking_too_little() {
         // Two close pairs far apart. Birds 0 and 1 together ask for less than their own pair
         // gives them, while every bird alone asks for something it could get.
-        let x = [0.0, 0.9, 5.0, 6.0];
+        let x = [0.0, 1.1, 5.0, 6.1];
         let total = aero::munk_total(&x).unwrap();
-        let w01 = 2.0 * aero::g0(0.9) / total;
+        let w01 = 2.0 * aero::g0(1.1) / total;
         let a = 0.45 * w01;
         let b = (1.0 - 2.0 * a) / 2.0;
         let err = solve(&x, &[a, a, b, b], None, &SolveOptions::default()).unwrap_err();
@@ -679,5 +975,27 @@ mod tests {
         let xi = aero::power_reduction(&x, &[0.0, 1.0, 0.5, 2.0]).unwrap().xi;
         let rep = solve(&x, &xi, None, &SolveOptions::default()).unwrap();
         assert!(rep.converged, "{rep:?}");
+    }
+
+    #[test]
+    fn overlapping_pairs_keep_their_order_and_the_check_knows_it() {
+        // Real spacing: 0.77 wingspans laterally, 1.24 behind, wingtips overlapping.
+        let x = [0.0, 0.77, 1.54, -0.77, -1.54];
+        let y = [0.0, 1.24, 2.5, 1.1, 2.3];
+        let xi = aero::power_reduction(&x, &y).unwrap().xi;
+        let rep = solve(&x, &xi, None, &SolveOptions::default()).unwrap();
+        assert!(rep.converged, "{rep:?}");
+        for (a, b) in rep.y.iter().zip(&y) {
+            assert!((a - b).abs() < 1e-6, "{a} vs {b}");
+        }
+        // Bird 1 asking for 90 % of the flock's saving is more than its pairs can give it.
+        let err = solve(
+            &x,
+            &[0.02, 0.9, 0.02, 0.03, 0.03],
+            None,
+            &SolveOptions::default(),
+        )
+        .unwrap_err();
+        assert!(matches!(err, Error::Unreachable(_)), "{err}");
     }
 }

@@ -11,7 +11,7 @@
 //!
 //! The lateral positions are drawn once and kept for the whole flight: gaps from N(d̄, σ̄_x) with
 //! d̄ uniform in the movie's range of mean gaps [min_f μ_xf, max_f μ_xf] and σ̄_x the mean of σ_xf,
-//! redrawn within π/4 + margin. Munk's theorem then fixes E = Σ_{i≠j} g(|x_i − x_j|, 0) for every
+//! redrawn only at or below a body's width (`min_gap`; overlapping wingtips are kept). Munk's theorem then fixes E = Σ_{i≠j} g(|x_i − x_j|, 0) for every
 //! key shape (`aero::munk_total`), which makes eq. (3) exact instead of an estimate from a
 //! constant-gap flock. The world frame places the leader at (0, speed·t, 0) and every bird at
 //! (x_i, speed·t − y_i(t), 0) (SPEC §2).
@@ -19,7 +19,7 @@
 use rand::Rng;
 use serde::{Deserialize, Serialize};
 
-use crate::aero::{munk_total, power_reduction, VORTEX_SPAN};
+use crate::aero::AeroOptions;
 use crate::animation::{Animation, Frame, KeyBird, KeyShapeRecord, Stage};
 use crate::error::{Error, Result};
 use crate::extract::params::FormationParams;
@@ -65,10 +65,13 @@ pub struct SteadyOptions {
     pub max_damping: usize,
     /// Largest accepted ‖ξ − ξ̂‖₂ of a key shape.
     pub accept_residual: f64,
-    /// Lateral gaps are kept this far above π/4, wingspans.
-    pub downwash_margin: f64,
+    /// Lateral gaps drawn at or below this are redrawn (the one physical bound, see
+    /// [`InitialOptions::min_gap`]), wingspans.
+    pub min_gap: f64,
     /// Depth limit of key shapes: this factor times the deepest initial shape, plus one wingspan.
     pub max_depth_factor: f64,
+    /// The aerodynamic model's vortex core and collision distance.
+    pub aero: AeroOptions,
 }
 
 impl Default for SteadyOptions {
@@ -88,7 +91,8 @@ impl Default for SteadyOptions {
             max_draws: 3,
             max_damping: 12,
             accept_residual: 1e-6,
-            downwash_margin: 0.05,
+            min_gap: 0.1,
+            aero: AeroOptions::default(),
             max_depth_factor: 1.5,
         }
     }
@@ -184,9 +188,13 @@ impl SteadyOptions {
         if !(self.accept_residual.is_finite() && self.accept_residual > 0.0) {
             return Err(p("steady.accept_residual", "must be positive".into()));
         }
-        if !(self.downwash_margin.is_finite() && self.downwash_margin >= 0.0) {
-            return Err(p("steady.downwash_margin", "must not be negative".into()));
+        if !(self.min_gap.is_finite() && self.min_gap >= 0.0 && self.min_gap < 1.0) {
+            return Err(p(
+                "steady.min_gap",
+                "must be a number of wingspans in [0, 1)".into(),
+            ));
         }
+        self.aero.validate()?;
         if !(self.max_depth_factor.is_finite() && self.max_depth_factor >= 1.0) {
             return Err(p("steady.max_depth_factor", "must be at least 1".into()));
         }
@@ -239,6 +247,55 @@ pub struct SteadyReport {
     pub max_frame_excess: f64,
 }
 
+/// Moves birds back until no two collide at lateral positions `x` (wingspans): for every pair
+/// under one wingspan apart laterally and under `aero.collision_chord` fore and aft, the rear bird
+/// (larger y; ties: the one farther from the front-most bird laterally, then the higher index) is
+/// put two chords behind the other (clear of its wing, not just touching it, so that key shapes
+/// near this placement are not all on the collision boundary). Passes repeat until nothing moves
+/// (at most N).
+pub fn separate(x: &[f64], y: &[f64], aero: &AeroOptions) -> Vec<f64> {
+    let n = x.len();
+    let mut y = y.to_vec();
+    let chord = aero.collision_chord;
+    let front = (0..n)
+        .min_by(|&a, &b| y[a].total_cmp(&y[b]).then(a.cmp(&b)))
+        .unwrap_or(0);
+    let mut idx: Vec<usize> = (0..n).collect();
+    idx.sort_by(|&a, &b| x[a].total_cmp(&x[b]).then(a.cmp(&b)));
+    for _ in 0..n.max(1) {
+        let mut moved = false;
+        for (k, &i) in idx.iter().enumerate() {
+            for &j in &idx[k + 1..] {
+                if !(x[j] - x[i] < crate::aero::COLLISION_SPAN) {
+                    break;
+                }
+                if !aero.collides(x[j] - x[i], y[i] - y[j]) {
+                    continue;
+                }
+                let far = |b: usize| ((x[b] - x[front]).abs(), b);
+                let rear = if y[i] != y[j] {
+                    if y[i] > y[j] {
+                        i
+                    } else {
+                        j
+                    }
+                } else if far(i) > far(j) {
+                    i
+                } else {
+                    j
+                };
+                let other = if rear == i { j } else { i };
+                y[rear] = y[other] + 1.05 * chord.max(1e-9);
+                moved = true;
+            }
+        }
+        if !moved {
+            break;
+        }
+    }
+    y
+}
+
 /// The steady flight of Algorithm 1 as an animation (one `steady` stage covering all frames).
 pub fn steady_flight(
     params: &FormationParams,
@@ -263,7 +320,7 @@ pub fn steady_flight_report(
         .ok_or_else(|| Error::parameter("params", "no frames"))?;
     let n = opts.birds;
     let init_opts = InitialOptions {
-        downwash_margin: opts.downwash_margin,
+        min_gap: opts.min_gap,
         ..InitialOptions::default()
     };
 
@@ -278,16 +335,29 @@ pub fn steady_flight_report(
     let sigma_bar =
         params.frames.iter().map(|f| f.sigma_x).sum::<f64>() / params.frames.len() as f64;
     let u: f64 = rng.random();
-    let mean_gap = (lo_mu + u * (hi_mu - lo_mu)).max(VORTEX_SPAN + opts.downwash_margin);
+    let mean_gap = (lo_mu + u * (hi_mu - lo_mu)).max(opts.min_gap);
     let gaps = lateral_gaps(rng, mean_gap, sigma_bar, n - 1, &init_opts);
     let x = positions_from_gaps(&gaps, corr.leader);
     let shapes = initial_shapes(params, &corr, rng, &init_opts);
 
     // Step 2, at the key shapes' lateral positions.
-    let values = power_at(&x, &shapes)?;
+    // At the key shapes' lateral positions a movie frame's placement can put two birds wing to
+    // wing; the bird behind is moved back to the collision distance (what a real bird does).
+    let aero = &opts.aero;
+    let shapes: Vec<crate::shape::Shape> = shapes
+        .iter()
+        .map(|s| crate::shape::Shape::from_xy(&s.xs(), &separate(&x, &s.ys(), aero)))
+        .collect();
+    let values = power_at(&x, &shapes, aero)?;
     let ranges = xi_ranges(&values)?;
     let feasible = ranges.widened(opts.epsilon);
-    let total = munk_total(&x)?;
+    let total = aero.munk_total(&x)?;
+    if !(total > 0.0) {
+        return Err(Error::parameter(
+            "params",
+            format!("the drawn lateral gaps give the flock no saving in total (E = {total:.4}): the footage's mean lateral gap is too small for Hummel's model; check the wingspan scale of the annotations"),
+        ));
+    }
 
     // The first key shape: the first initial shape whose leader is front-most.
     let deepest = shapes
@@ -301,7 +371,9 @@ pub fn steady_flight_report(
         max_depth,
         monotone_tolerance: 0.0,
     };
-    let first_key_from = shapes.iter().position(|s| loose.accepts(&s.ys()));
+    let first_key_from = shapes
+        .iter()
+        .position(|s| loose.accepts(&s.ys()) && aero.first_collision(&x, &s.ys()).is_none());
     let y0: Vec<f64> = match first_key_from {
         Some(i) => shapes[i].ys(),
         None => {
@@ -318,7 +390,13 @@ pub fn steady_flight_report(
                 .collect()
         }
     };
-    let p0 = power_reduction(&x, &y0)?;
+    let p0 = aero.power_reduction(&x, &y0).map_err(|e| match e {
+        Error::Collision { .. } => Error::parameter(
+            "params",
+            format!("no frame's shape fits the drawn lateral gaps without two birds' wings colliding ({e}); try another seed"),
+        ),
+        other => other,
+    })?;
     let key0 = KeyShape {
         y: y0.clone(),
         xi_target: p0.xi.clone(),
@@ -342,6 +420,7 @@ pub fn steady_flight_report(
         max_depth,
         solve: SolveOptions {
             tolerance: (opts.accept_residual * 1e-3).max(1e-12),
+            aero: opts.aero,
             ..SolveOptions::default()
         },
     };
@@ -390,14 +469,17 @@ pub fn steady_flight_report(
             fr.heading.push(vx.atan2(vy));
             fr.speed.push(vx.hypot(vy));
         }
-        let pr = power_reduction(&x, &ys)?;
-        let excess = feasible.excess(&pr.xi);
+        // Between two collision-free keys a pair can pass within a chord: evaluated at the
+        // collision distance there, so every frame has finite savings.
+        let e = aero.power_lenient(&x, &ys);
+        let xi: Vec<f64> = e.iter().map(|v| v / total).collect();
+        let excess = feasible.excess(&xi);
         if excess > 1e-12 {
             frames_outside_range += 1;
         }
         max_frame_excess = max_frame_excess.max(excess);
-        fr.e = Some(pr.e);
-        fr.xi = Some(pr.xi);
+        fr.e = Some(e);
+        fr.xi = Some(xi);
         frames.push(fr);
         progress.advance(1);
     }

@@ -58,7 +58,7 @@ impl XiChart {
         if !any {
             return Err(Error::format(
                 origin,
-                "no frame has a defined ξ (every frame has birds inside each other's downwash)",
+                "no frame has a defined ξ (every frame has two birds wing to wing)",
             ));
         }
         let lateral = anim
