@@ -150,12 +150,17 @@ fn commands() -> Vec<Command> {
         Command {
             name: &["power"],
             base: strings(&["power", &shape]),
-            cases: vec![seed.clone()],
+            cases: vec![("--core-radius", "nan", None), seed.clone()],
         },
         Command {
             name: &["solve"],
             base: strings(&["solve", &target, "-o", "OUT/s.json"]),
-            cases: vec![("--tolerance", "-1", None), o("OUT/s.txt"), seed.clone()],
+            cases: vec![
+                ("--tolerance", "-1", None),
+                ("--core-radius", "nan", None),
+                o("OUT/s.txt"),
+                seed.clone(),
+            ],
         },
         Command {
             name: &["steady"],
