@@ -198,7 +198,7 @@ impl Default for InitiateOptions {
             takeoff: None,
             separation_distance: 10.0,
             lookahead: 4.0,
-            avoid_distance: 0.8,
+            avoid_distance: 0.6,
             avoid_range: 6.0,
             avoid_horizon: 2.0,
             lost_speed_factor: 0.9,
