@@ -138,7 +138,7 @@ fn seeds(release: u64, debug: u64) -> u64 {
 /// no two birds closer than a quarter wingspan and turns within the turn rate. (Measured over
 /// 100 seeds each: 800/800, closest 0.30 wingspans; docs/initiation.md.)
 #[test]
-#[ignore = "fails since real spacing (issue 12) met the time-based take-off (issue 18): one bird of 9 (geese, seed 3) or 28 (snow geese) never settles; open in issue 18"]
+#[ignore = "fails since real spacing (issue 12) met the time-based take-off (issue 18): snow geese, 16 birds, seed 3 does not converge within 9000 steps; open in issue 18"]
 fn example_flocks_converge_from_random_starts() {
     let cases: [(Example, &[usize]); 4] = [
         (GEESE, &[9, 28]),
@@ -229,7 +229,7 @@ fn real_key_shapes_give_followable_slot_trees() {
 /// hand-over) on the J of snow geese with 28 birds, which failed before the slot tree followed
 /// visibility: it converges and hands over to the steady flight without a jump.
 #[test]
-#[ignore = "fails since real spacing (issue 12) met the time-based take-off (issue 18): one bird of 9 (geese, seed 3) or 28 (snow geese) never settles; open in issue 18"]
+#[ignore = "fails since real spacing (issue 12) met the time-based take-off (issue 18): converged with a closest approach under 0.25 wingspans, or not at all; open in issue 18"]
 fn snow_geese_j_initiates_through_the_library() {
     let config = Config {
         seconds: None,
