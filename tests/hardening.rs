@@ -724,3 +724,54 @@ fn a_wide_dltdv_header_is_refused_at_once() {
     assert!(took < Duration::from_secs(10), "took {took:?}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// The flag or file at fault is named (found at the end of the session, on the merged main):
+/// `power` on an animation file says what the file is, a negative `initiate` flag reaches the
+/// library's check, a vanishing `--fps` and an absurd `--wingspan-px` name their flags.
+#[test]
+fn the_flag_or_file_at_fault_is_named() {
+    let dir = scratch("named");
+    let anim = data("tests/data/flock_small.json").display().to_string();
+    let o = run_in(&dir, &["power", &anim]);
+    assert_refused(
+        &o,
+        "flock_small.json: this is a \"formation-animation/1\" file, not a shape",
+        "power on an animation",
+    );
+    let steady = data("tests/data/initiate_steady_v9.json")
+        .display()
+        .to_string();
+    let o = run_in(
+        &dir,
+        &["initiate", &steady, "-o", "i.json", "--max-turn-rate", "-1"],
+    );
+    assert_refused(
+        &o,
+        "--max-turn-rate: must be a positive number",
+        "--max-turn-rate -1",
+    );
+    let params = data("tests/data/steady_v9_params.json")
+        .display()
+        .to_string();
+    let o = run_in(
+        &dir,
+        &[
+            "steady", &params, "--birds", "9", "--frames", "30", "-o", "a.json", "--fps", "5e-324",
+        ],
+    );
+    assert_refused(&o, "--fps: ", "--fps 5e-324");
+    let ex = data("examples_data/barnacle_geese_v.json")
+        .display()
+        .to_string();
+    let o = run_in(
+        &dir,
+        &["extract", &ex, "-o", "p.json", "--wingspan-px", "1e308"],
+    );
+    assert_refused(
+        &o,
+        "--wingspan-px: must be a positive number of pixels, at most",
+        "--wingspan-px 1e308",
+    );
+    assert!(names(&dir).is_empty(), "{:?}", names(&dir));
+    std::fs::remove_dir_all(&dir).unwrap();
+}

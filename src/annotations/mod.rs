@@ -370,11 +370,14 @@ pub fn parse_str(path: &Path, text: &str, opts: &ReadOptions) -> Result<Annotati
     finish(path, raw, opts)
 }
 
+/// Largest wingspan in pixels: wider than any image (a 1e6-px bird in an 8K frame is an error).
+const MAX_WINGSPAN_PX: f64 = 1e6;
+
 fn check_scale(path: &Path, at: &str, v: f64) -> Result<f64> {
-    if !v.is_finite() || v <= 0.0 {
+    if !v.is_finite() || v <= 0.0 || v > MAX_WINGSPAN_PX {
         return Err(Error::format(
             path,
-            format!("{at}: wingspan_px must be a positive number of pixels, got {v}"),
+            format!("{at}: wingspan_px must be a positive number of pixels, at most {MAX_WINGSPAN_PX}, got {v}"),
         ));
     }
     Ok(v)
@@ -410,10 +413,11 @@ fn finish(path: &Path, raw: RawAnnotations, opts: &ReadOptions) -> Result<Annota
         ));
     }
     if let Some(w) = opts.wingspan_px {
-        if !w.is_finite() || w <= 0.0 {
+        // A wingspan wider than any image (1e308 px) made every bird coincide in wingspans.
+        if !w.is_finite() || w <= 0.0 || w > MAX_WINGSPAN_PX {
             return Err(Error::parameter(
                 "read.wingspan_px",
-                format!("must be a positive number of pixels, got {w}"),
+                format!("must be a positive number of pixels, at most {MAX_WINGSPAN_PX}, got {w}"),
             ));
         }
     }

@@ -66,46 +66,46 @@ pub struct InitiateFlags {
     #[arg(long, value_enum, default_value_t = PerceptionArg::Hpr)]
     pub perception: PerceptionArg,
     /// HPR radius exponent γ: R = (distance of the farthest bird) · 10^γ.
-    #[arg(long, default_value_t = HPR_GAMMA_DEFAULT)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = HPR_GAMMA_DEFAULT)]
     pub hpr_gamma: f64,
     /// Visual field per eye, degrees from straight ahead (paper: 90); widened when the key shape
     /// needs it for a bird to see its reference from its slot (docs/initiation.md).
-    #[arg(long, default_value_t = 90.0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 90.0)]
     pub fov: f64,
     /// Cone per eye in which the closest visible bird is the preferred reference, degrees
     /// (paper: 0.35π = 63).
-    #[arg(long, default_value_t = 63.0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 63.0)]
     pub reference_cone: f64,
     /// α of eq. (6) (heading gain).
-    #[arg(long, default_value_t = 0.2)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 0.2)]
     pub alpha: f64,
     /// |K| of eq. (5) (speed gain).
-    #[arg(long, default_value_t = 0.06)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 0.06)]
     pub k: f64,
     /// Maximum turn rate, degrees per second.
-    #[arg(long, default_value_t = 90.0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 90.0)]
     pub max_turn_rate: f64,
     /// Maximum acceleration, wingspans per second squared [default: 4].
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub max_accel: Option<f64>,
     /// Minimum flight speed, fraction of the cruise speed [default: 0.5].
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub min_speed: Option<f64>,
     /// Maximum flight speed, fraction of the cruise speed [default: 1.6].
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub max_speed: Option<f64>,
     /// Separation drive distance, wingspans [default: 10, as in the paper].
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub separation: Option<f64>,
     /// Collision avoidance: predicted closest approach that triggers evasion, wingspans
     /// [default: 0.8].
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub avoid_distance: Option<f64>,
     /// Convergence: every bird within this distance of its slot, wingspans [default: 0.1].
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub tolerance: Option<f64>,
     /// Convergence: for this long, seconds (also the hand-over blend window) [default: 1].
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub hold: Option<f64>,
     /// Start: `ground` (at rest in a take-off area, leaving one after another, climbing to the
     /// cruise altitude), `air` (the paper's: scattered in the air at the cruise altitude), or a

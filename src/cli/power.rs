@@ -40,7 +40,25 @@ struct BirdJson {
 
 /// Runs `formation power`.
 pub fn run(args: PowerArgs, _g: Global) -> Result<()> {
-    let shape: Shape = formation::io::read_json(&args.shape)?;
+    let text = formation::io::read_text(&args.shape)?;
+    match formation::sniff::text_kind(&text) {
+        None | Some(formation::sniff::Kind::Shape | formation::sniff::Kind::Unknown) => {}
+        Some(kind) => {
+            return Err(Error::format(
+                &args.shape,
+                format!(
+                    "this is {}, not a shape; `formation power` reads {{\"birds\": [{{\"x\": .., \"y\": ..}}, ...]}}{}",
+                    kind.describe(),
+                    if kind == formation::sniff::Kind::Animation {
+                        " (an animation's key shapes are charted by `formation plot power`)"
+                    } else {
+                        ""
+                    }
+                ),
+            ))
+        }
+    }
+    let shape: Shape = formation::io::parse_json(&args.shape, &text)?;
     shape.validate(&args.shape, 2)?;
     let (x, y) = (shape.xs(), shape.ys());
     let model = aero::AeroOptions {

@@ -128,10 +128,11 @@ impl SteadyOptions {
             return Err(p("steady.frames", "0: at least 1 frame is needed".into()));
         }
         crate::limits::check_animation_size("steady.frames", self.birds, self.frames)?;
-        if !(self.fps.is_finite() && self.fps > 0.0 && self.fps <= 1000.0) {
+        // At least one frame a second: a vanishing rate (5e-324) made every frame time infinite.
+        if !(self.fps.is_finite() && self.fps >= 1.0 && self.fps <= 1000.0) {
             return Err(p(
                 "steady.fps",
-                format!("{}: must be in (0, 1000] frames per second", self.fps),
+                format!("{}: must be in [1, 1000] frames per second", self.fps),
             ));
         }
         if !(self.key_every_s.is_finite() && self.key_every_s > 0.0) {
