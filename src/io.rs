@@ -287,6 +287,11 @@ const TEMP_PREFIX: &str = ".formation-";
 /// Length of the random part of a temporary's name.
 const TEMP_RANDOM_LEN: usize = 12;
 
+/// `frames/` → `frames`: a frames directory is named with a trailing slash on the command line.
+fn without_trailing_slash(target: &Path) -> PathBuf {
+    PathBuf::from(target.to_string_lossy().trim_end_matches('/'))
+}
+
 /// The directory a target lives in (`.` for a bare file name).
 fn dir_of(target: &Path) -> PathBuf {
     match target.parent() {
@@ -494,10 +499,7 @@ fn commit_all(registry: &mut Registry, pending: Vec<Pending>) -> Result<()> {
                 None => remove_any(target),
             }
         }
-        for p in &pending {
-            remove_any(&p.tmp);
-        }
-        registry.forget(pending.iter().map(|p| &p.tmp));
+        discard_queued(registry, &pending);
         return Err(Error::io(&pending[k].target, e));
     }
     for (_, backup) in done {
@@ -507,6 +509,14 @@ fn commit_all(registry: &mut Registry, pending: Vec<Pending>) -> Result<()> {
     }
     registry.forget(pending.iter().map(|p| &p.tmp));
     Ok(())
+}
+
+/// Removes queued temporaries that will not be committed, and forgets them.
+fn discard_queued(registry: &mut Registry, pending: &[Pending]) {
+    for p in pending {
+        remove_any(&p.tmp);
+    }
+    registry.forget(pending.iter().map(|p| &p.tmp));
 }
 
 /// Hands a finished temporary to the open [`OutputBatch`], or moves it into place at once when
@@ -538,7 +548,7 @@ fn finish(tmp: PathBuf, target: PathBuf) -> Result<()> {
 /// What makes two output names the same file: the canonical directory and the file name
 /// (`a.json`, `./a.json` and `../d/a.json` from inside `d` are one output).
 pub fn output_identity(target: &Path) -> PathBuf {
-    let trimmed = PathBuf::from(target.to_string_lossy().trim_end_matches('/'));
+    let trimmed = without_trailing_slash(target);
     match (fs::canonicalize(dir_of(&trimmed)), trimmed.file_name()) {
         (Ok(dir), Some(name)) => dir.join(name),
         _ => trimmed,
@@ -548,7 +558,7 @@ pub fn output_identity(target: &Path) -> PathBuf {
 /// Checks that the directory an output goes into exists, naming `flag` when it does not, so that
 /// a run fails before any work rather than after the other outputs are written.
 pub fn check_output_dir(flag: &str, target: &Path) -> Result<()> {
-    let trimmed = PathBuf::from(target.to_string_lossy().trim_end_matches('/'));
+    let trimmed = without_trailing_slash(target);
     let parent = dir_of(&trimmed);
     if parent.is_dir() {
         Ok(())
@@ -687,7 +697,7 @@ pub struct AtomicDir {
 impl AtomicDir {
     /// Creates the temporary directory for `target`.
     pub fn create(target: &Path) -> Result<AtomicDir> {
-        let trimmed = PathBuf::from(target.to_string_lossy().trim_end_matches('/'));
+        let trimmed = without_trailing_slash(target);
         if fs::symlink_metadata(&trimmed).is_ok_and(|m| !m.is_dir()) {
             return Err(Error::format(&trimmed, "exists and is not a directory"));
         }
@@ -703,11 +713,6 @@ impl AtomicDir {
     /// Path of a file inside the temporary directory.
     pub fn path(&self, name: &str) -> PathBuf {
         self.tmp.join(name)
-    }
-
-    /// The target directory (for messages: errors inside the temporary should name it).
-    pub fn target(&self) -> &Path {
-        &self.target
     }
 
     /// Moves the finished directory into place. An existing target directory is replaced.
@@ -770,10 +775,7 @@ impl Drop for OutputBatch {
         if !self.committed {
             let _ = with_registry(|r| {
                 let pending = r.batch.take().unwrap_or_default();
-                for p in &pending {
-                    remove_any(&p.tmp);
-                }
-                r.forget(pending.iter().map(|p| &p.tmp));
+                discard_queued(r, &pending);
                 Ok(())
             });
         }
