@@ -40,8 +40,28 @@ pub struct Animation {
     /// when known.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub xi_ranges: Option<Vec<[f64; 2]>>,
+    /// Flocks flying as several formations (skeins): each formation's birds, leader and key
+    /// shapes. Absent when the whole flock is one formation (then `key_shapes` describe it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub formations: Option<Vec<FormationRecord>>,
     /// One entry per frame.
     pub frames: Vec<Frame>,
+}
+
+/// One formation (skein) of a flock of several formations.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FormationRecord {
+    /// The animation's bird indices that fly in this formation, in formation order.
+    pub birds: Vec<usize>,
+    /// The animation's bird index of this formation's leader.
+    pub leader: usize,
+    /// Key shapes of this formation's steady flight (formation frame, birds in the order of
+    /// `birds`).
+    #[serde(default)]
+    pub key_shapes: Vec<KeyShapeRecord>,
+    /// Feasible ξ range of each of this formation's birds (order of `birds`), when known.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub xi_ranges: Option<Vec<[f64; 2]>>,
 }
 
 /// A named range of frames.
@@ -165,6 +185,10 @@ pub struct Frame {
     /// Absent in files that do not carry it (then level).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub bank: Option<Vec<f64>>,
+    /// Pitch angle, radians, nose up positive (climbs and descents; 0 in level flight). Absent in
+    /// files that do not carry it (then level).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pitch: Option<Vec<f64>>,
     /// Power reduction e_i of the current shape (absent when undefined, e.g. during initiation).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub e: Option<Vec<f64>>,
@@ -190,6 +214,7 @@ impl Animation {
             stages: Vec::new(),
             key_shapes: Vec::new(),
             xi_ranges: None,
+            formations: None,
             frames: Vec::new(),
         }
     }
@@ -261,7 +286,7 @@ impl Animation {
                     ),
                 ));
             }
-            let arrays: [(&str, Option<&Vec<f64>>); 9] = [
+            let arrays: [(&str, Option<&Vec<f64>>); 10] = [
                 ("x", Some(&f.x)),
                 ("y", Some(&f.y)),
                 ("z", Some(&f.z)),
@@ -270,6 +295,7 @@ impl Animation {
                 ("e", f.e.as_ref()),
                 ("xi", f.xi.as_ref()),
                 ("bank", f.bank.as_ref()),
+                ("pitch", f.pitch.as_ref()),
                 ("wing_phase", f.wing_phase.as_ref()),
             ];
             for (name, arr) in arrays {
@@ -339,11 +365,111 @@ impl Animation {
                 }
             }
         }
+        if let Some(fs) = &self.formations {
+            let mut seen = vec![false; n];
+            for (k, fm) in fs.iter().enumerate() {
+                if fm.birds.is_empty() {
+                    return Err(Error::format(
+                        origin,
+                        format!("formations[{k}].birds: empty"),
+                    ));
+                }
+                for &b in &fm.birds {
+                    if b >= n || std::mem::replace(&mut seen[b], true) {
+                        return Err(Error::format(
+                            origin,
+                            format!("formations[{k}].birds: bird {b} is not one of the {n} birds or is in two formations"),
+                        ));
+                    }
+                }
+                if !fm.birds.contains(&fm.leader) {
+                    return Err(Error::format(
+                        origin,
+                        format!(
+                            "formations[{k}].leader: bird {} is not in this formation",
+                            fm.leader
+                        ),
+                    ));
+                }
+                for (s, ks) in fm.key_shapes.iter().enumerate() {
+                    if ks.birds.len() != fm.birds.len() {
+                        return Err(Error::format(
+                            origin,
+                            format!(
+                                "formations[{k}].key_shapes[{s}].birds: {} birds, expected {}",
+                                ks.birds.len(),
+                                fm.birds.len()
+                            ),
+                        ));
+                    }
+                }
+                if let Some(r) = &fm.xi_ranges {
+                    if r.len() != fm.birds.len() {
+                        return Err(Error::format(
+                            origin,
+                            format!(
+                                "formations[{k}].xi_ranges: {} ranges, expected {}",
+                                r.len(),
+                                fm.birds.len()
+                            ),
+                        ));
+                    }
+                }
+            }
+            if let Some(b) = seen.iter().position(|s| !s) {
+                return Err(Error::format(
+                    origin,
+                    format!("formations: bird {b} is in no formation"),
+                ));
+            }
+        }
         Ok(())
     }
 
     /// The stage with this name, if present.
     pub fn stage(&self, name: &str) -> Option<&Stage> {
         self.stages.iter().find(|s| s.name == name)
+    }
+
+    /// Each bird's formation index (all 0 for a flock of one formation).
+    pub fn formation_of_birds(&self) -> Vec<usize> {
+        let mut of = vec![0; self.birds];
+        if let Some(fs) = &self.formations {
+            for (k, f) in fs.iter().enumerate() {
+                for &b in &f.birds {
+                    if b < of.len() {
+                        of[b] = k;
+                    }
+                }
+            }
+        }
+        of
+    }
+
+    /// Each formation's leader (one entry for a flock of one formation): the recorded leader, or
+    /// the bird at the front of the first key shape, or else the front-most bird of the last frame
+    /// along its heading.
+    pub fn leaders(&self) -> Vec<usize> {
+        if let Some(fs) = &self.formations {
+            return fs.iter().map(|f| f.leader).collect();
+        }
+        if let Some(ks) = self.key_shapes.first() {
+            let lead = (0..ks.birds.len())
+                .min_by(|&a, &b| ks.birds[a].y.total_cmp(&ks.birds[b].y))
+                .unwrap_or(0);
+            return vec![lead];
+        }
+        let Some(f) = self.frames.last() else {
+            return vec![0];
+        };
+        let n = f.x.len().min(f.y.len()).min(f.heading.len());
+        let ahead = |i: usize| {
+            let h = f.heading[i];
+            f.x[i] * h.sin() + f.y[i] * h.cos()
+        };
+        let lead = (0..n)
+            .max_by(|&a, &b| ahead(a).total_cmp(&ahead(b)))
+            .unwrap_or(0);
+        vec![lead]
     }
 }
