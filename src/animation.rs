@@ -44,8 +44,30 @@ pub struct Animation {
     /// shapes. Absent when the whole flock is one formation (then `key_shapes` describe it).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub formations: Option<Vec<FormationRecord>>,
+    /// The steady flight cycles seamlessly (issue 19, `steady.loop`): the frame after the last
+    /// would be the first again, in the flock's moving frame (in the world too on a closed path).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not", rename = "loop")]
+    pub looped: bool,
+    /// The path the flock follows (world frame), when it was given one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub path: Option<PathRecord>,
     /// One entry per frame.
     pub frames: Vec<Frame>,
+}
+
+/// The path an animation follows (issue 19).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PathRecord {
+    /// The file it was read from.
+    pub source: String,
+    /// Its control points, wingspans, world frame (a closed path without the repeated first point).
+    pub points: Vec<[f64; 3]>,
+    /// The path is a closed loop.
+    pub closed: bool,
+    /// Arc length of the flown course, wingspans.
+    pub length: f64,
+    /// Some turn was too tight for the flock and was widened.
+    pub widened: bool,
 }
 
 /// One formation (skein) of a flock of several formations.
@@ -215,6 +237,8 @@ impl Animation {
             key_shapes: Vec::new(),
             xi_ranges: None,
             formations: None,
+            looped: false,
+            path: None,
             frames: Vec::new(),
         }
     }

@@ -37,6 +37,7 @@
 //! | §5 step 2, Hummel's power-reduction model | [`aero`] |
 //! | §5 steps 1–4, key shapes and steady flight | [`keyshape`] |
 //! | §6 initiation | [`initiate`] |
+//! | the course: paths, turns, climbs | [`course`] |
 //! | wingbeats (Wu & Popović) | [`wingbeat`] |
 //! | GIF, PNG, glTF, CSV, JSON | [`export`] |
 //! | charts | [`plot`] |
@@ -54,6 +55,7 @@
 pub mod aero;
 pub mod animation;
 pub mod annotations;
+pub mod course;
 pub mod error;
 pub mod export;
 pub mod extract;

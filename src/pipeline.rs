@@ -26,6 +26,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::animation::Animation;
 use crate::annotations::{Annotations, ReadOptions};
+use crate::course::{CourseOptions, CourseReport, PathPoints};
 use crate::error::{Error, Result};
 use crate::export::RenderOptions;
 use crate::extract::{self, ExtractOptions, FormationParams, FrameReport};
@@ -61,6 +62,8 @@ pub struct Config {
     pub initiate: InitiateOptions,
     /// Wingbeats.
     pub wingbeat: WingbeatOptions,
+    /// The course: the path the flock follows, turn and bank limits (issue 19).
+    pub course: CourseOptions,
     /// Pictures and exports (used by [`crate::export::write_outputs`], not by [`Pipeline::run`]).
     pub render: RenderOptions,
 }
@@ -76,6 +79,7 @@ impl Default for Config {
             steady: SteadyOptions::default(),
             initiate: InitiateOptions::default(),
             wingbeat: WingbeatOptions::default(),
+            course: CourseOptions::default(),
             render: RenderOptions::default(),
         }
     }
@@ -141,6 +145,13 @@ impl Config {
         // Checked with or without the take-off, so that a config is valid or not as a whole.
         self.initiate_options()?;
         self.wingbeat.validate()?;
+        self.course.validate()?;
+        if self.steady.looped && self.initiation {
+            return Err(Error::parameter(
+                "steady.loop",
+                "a loop is a steady flight alone and cannot begin with a take-off; fly it without the take-off (initiation off)",
+            ));
+        }
         self.render.validate()?;
         self.extract.validate()
     }
@@ -155,6 +166,8 @@ pub struct Report {
     pub steady: SteadyReport,
     /// The initiation's statistics (`None` without initiation).
     pub initiate: Option<InitiateStats>,
+    /// What the course step did (turns widened, laps of a loop, warnings to show).
+    pub course: CourseReport,
 }
 
 /// What a pipeline starts from.
@@ -219,17 +232,20 @@ impl Pipeline {
         progress: &dyn Progress,
     ) -> Result<(Animation, Report)> {
         config.validate()?;
+        let path = config.course.load(config.steady.wingspan_m)?;
         let (params, extract_report) = self.params(config, progress)?;
         let (steady, steady_report) = steady_stage(&params, config, progress)?;
         let (mut anim, initiate_report) = if config.initiation {
             initiate::check_steady(&steady, self.origin())?;
-            let (anim, stats) = initiate_stage(&steady, config, progress)?;
+            let config = takeoff_config(config, path.as_ref())?;
+            let (anim, stats) = initiate_stage(&steady, &config, progress)?;
             (anim, Some(stats))
         } else {
             (steady, None)
         };
         // Savings (e, ξ) in the take-off frames too.
         crate::aero::fill_frame_savings(&mut anim, &config.steady_options()?.aero);
+        let course = course_stage(&mut anim, path.as_ref(), config)?;
         wingbeat::assign_phases(&mut anim, &config.wingbeat)?;
         Ok((
             anim,
@@ -237,6 +253,7 @@ impl Pipeline {
                 extract: extract_report,
                 steady: steady_report,
                 initiate: initiate_report,
+                course,
             },
         ))
     }
@@ -296,6 +313,41 @@ pub fn steady_stage(
         &mut stream(config.seed, Stream::Steady),
         progress,
     )
+}
+
+/// The config of a take-off onto `path`: the take-off climbs to the height of the path's first
+/// point (`initiate.cruise_altitude`), so that the course step joins it to the path.
+pub fn takeoff_config(config: &Config, path: Option<&PathPoints>) -> Result<Config> {
+    let mut c = config.clone();
+    if let Some(p) = path {
+        let origin = config.course.path.clone().unwrap_or_default();
+        c.initiate.cruise_altitude = crate::course::takeoff_altitude(p, &origin)?;
+    }
+    Ok(c)
+}
+
+/// The course step (issue 19): maps `anim`, made in the course frame by the stages before, onto
+/// `path` (loaded with [`CourseOptions::load`]) or, without one, sets the cruise altitude of a
+/// flight without a take-off; fills banks and pitches. A take-off is recognised by the
+/// animation's `initiation` stage.
+pub fn course_stage(
+    anim: &mut Animation,
+    path: Option<&PathPoints>,
+    config: &Config,
+) -> Result<CourseReport> {
+    let takeoff_altitude = anim
+        .stage("initiation")
+        .is_some()
+        .then(|| match path {
+            Some(p) => p.points[0][2],
+            None => config.initiate.cruise_altitude,
+        });
+    let flight = crate::course::Flight {
+        speed: config.steady.speed,
+        takeoff_altitude,
+        looped: anim.looped,
+    };
+    crate::course::apply(anim, path, &config.course, flight)
 }
 
 /// §6 initiation into the first key shape of `steady` with the config's `initiate` section and

@@ -60,6 +60,8 @@ pub struct AnimateArgs {
     #[command(flatten)]
     pub steady: SteadyFlags,
     #[command(flatten)]
+    pub path: super::course::PathFlags,
+    #[command(flatten)]
     pub initiate: InitiateFlags,
     #[command(flatten)]
     pub wingbeat: WingbeatFlags,
@@ -81,6 +83,11 @@ pub fn run(args: AnimateArgs, g: Global) -> Result<()> {
     // In the order the stages run: the steady flight's options are checked first.
     config.steady_options()?;
     config.initiate = args.initiate.options(g.seed, args.birds)?;
+    config.course = args.path.options();
+    if args.no_initiation {
+        // Without a take-off the steady flight itself flies at the cruise altitude.
+        config.course.cruise_altitude = Some(config.initiate.cruise_altitude);
+    }
     config.wingbeat = args.wingbeat.options()?;
     config.render = RenderOptions {
         width: args.size.width,
@@ -98,6 +105,7 @@ pub fn run(args: AnimateArgs, g: Global) -> Result<()> {
         formation::export::bird_model::load(p, config.wingbeat.species)?;
     }
     let progress = TermProgress::new(g.quiet);
-    let (anim, _report) = Pipeline::from_path(&args.input).run_with(&config, &progress)?;
+    let (anim, report) = Pipeline::from_path(&args.input).run_with(&config, &progress)?;
+    super::course::warn(&report.course);
     super::write_animation(&anim, &args.output, &config.render, g)
 }

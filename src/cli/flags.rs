@@ -43,6 +43,7 @@ const STEADY: &[Cmd] = &[Steady, Animate];
 const INITIATE: &[Cmd] = &[Initiate, Animate];
 const WINGBEAT: &[Cmd] = &[Steady, Initiate, Animate];
 const PICTURES: &[Cmd] = &[Render, Animate];
+const SCENE_COURSE: &[Cmd] = &[Steady, Initiate, Animate];
 const SCENE: &[Cmd] = &[Steady, Initiate, Animate, Render];
 const ALL: &[Cmd] = &[
     Extract,
@@ -85,6 +86,10 @@ pub const FLAGS: &[(&str, &str, &[Cmd])] = &[
     ("steady.c2", "--c2", STEADY),
     ("steady.wingspan_m", "--wingspan-m", STEADY),
     ("steady.max_jump", "--max-jump", STEADY),
+    ("steady.loop", "--loop", STEADY),
+    ("course.path", "--path", SCENE_COURSE),
+    ("course.units", "--path-units", SCENE_COURSE),
+    ("course.cruise_altitude", "--cruise-altitude", STEADY),
     ("initiate.max_steps", "--max-steps", INITIATE),
     ("initiate.perception.mode", "--perception", INITIATE),
     (

@@ -36,6 +36,8 @@ pub struct InitiateArgs {
     #[command(flatten)]
     pub initiate: InitiateFlags,
     #[command(flatten)]
+    pub path: super::course::PathFlags,
+    #[command(flatten)]
     pub wingbeat: super::wingbeat::WingbeatFlags,
     #[command(flatten)]
     pub scene: super::render::SceneArgs,
@@ -226,12 +228,17 @@ pub fn run(args: InitiateArgs, g: Global) -> Result<()> {
     formation::export::plan_outputs(&args.output)?;
     let steady = Animation::read(&args.steady)?;
     initiate::check_steady(&steady, &args.steady)?;
-    let opts = args.initiate.options(g.seed, steady.birds)?;
+    let mut opts = args.initiate.options(g.seed, steady.birds)?;
+    // Issue 19: the take-off climbs to the path's first point, then the course step maps the
+    // whole flight onto the path.
+    let course = super::course::course_config(&args.path, &steady, &args.steady, &mut opts)?;
     let mut rng = formation::rng::stream(g.seed, "initiate");
     let progress = TermProgress::new(g.quiet);
     let (mut anim, stats) = initiate::initiate(&steady, &opts, &mut rng, &progress)?;
     // Savings (e, ξ) in the take-off frames too.
     formation::aero::fill_frame_savings(&mut anim, &Default::default());
+    let report = formation::pipeline::course_stage(&mut anim, course.1.as_ref(), &course.0)?;
+    super::course::warn(&report);
     formation::wingbeat::assign_phases(&mut anim, &wing)?;
     super::write_animation(&anim, &args.output, &args.scene.options(), g)?;
     if args.json {

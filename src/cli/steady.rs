@@ -35,6 +35,12 @@ pub struct SteadyArgs {
     #[command(flatten)]
     pub steady: SteadyFlags,
     #[command(flatten)]
+    pub path: super::course::PathFlags,
+    /// Height of the flight above the ground without a path, wingspans (0 keeps the file ready
+    /// for `formation initiate`, which climbs to its own --cruise-altitude and adds this).
+    #[arg(long = "cruise-altitude", allow_negative_numbers = true, default_value_t = 0.0)]
+    pub cruise_altitude: f64,
+    #[command(flatten)]
     pub wingbeat: super::wingbeat::WingbeatFlags,
     #[command(flatten)]
     pub scene: super::render::SceneArgs,
@@ -71,6 +77,11 @@ pub struct SteadyFlags {
     /// Largest move of a bird between consecutive key shapes, wingspans.
     #[arg(long = "max-jump", default_value_t = SteadyOptions::default().max_jump, allow_negative_numbers = true)]
     pub max_jump: f64,
+    /// A seamless cycle: the last key shape is the first and the wingbeats make whole cycles, so
+    /// the GIF, the glTF clip or a game's background flock loops without a jump (in the flock's
+    /// moving frame; in the world on a closed --path). No take-off.
+    #[arg(long = "loop")]
+    pub looped: bool,
 }
 
 impl SteadyFlags {
@@ -87,6 +98,7 @@ impl SteadyFlags {
             c2: self.c2,
             wingspan_m: self.wingspan_m,
             max_jump: self.max_jump,
+            looped: self.looped,
             ..SteadyOptions::default()
         }
     }
@@ -102,10 +114,16 @@ pub fn run(args: SteadyArgs, g: Global) -> Result<()> {
             ..args.steady.options(args.birds)
         },
         wingbeat: args.wingbeat.options()?,
+        initiation: false,
+        course: formation::course::CourseOptions {
+            cruise_altitude: Some(args.cruise_altitude),
+            ..args.path.options()
+        },
         ..Config::default()
     };
     config.steady_options()?;
     config.wingbeat.validate()?;
+    config.course.validate()?;
     let plan = formation::export::plan_outputs(&args.output)?;
     if let Some(r) = &args.report {
         OutputKind::for_flag("--report", r, &[OutputKind::Json])?;
@@ -124,9 +142,12 @@ pub fn run(args: SteadyArgs, g: Global) -> Result<()> {
             ));
         }
     }
+    let path = config.course.load(config.steady.wingspan_m)?;
     let params = read_params(&args.params)?;
     let progress = TermProgress::new(g.quiet);
     let (mut anim, report) = steady_stage(&params, &config, &progress)?;
+    let course = formation::pipeline::course_stage(&mut anim, path.as_ref(), &config)?;
+    super::course::warn(&course);
     formation::wingbeat::assign_phases(&mut anim, &config.wingbeat)?;
     super::write_animation(&anim, &args.output, &args.scene.options(), g)?;
     if let Some(r) = &args.report {

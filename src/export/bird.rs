@@ -23,7 +23,8 @@
 //! with G_j(t) the joint's global transform (linear blend skinning, as glTF and UsdSkel define it).
 //!
 //! Flight: the root node carries the position (world `x, y, z` → glTF/USD `(x, z, −y)`, metres) and
-//! the yaw `R_Y(π − θ)` of the heading θ. Bank φ is the animation's `bank` when present, otherwise
+//! the rotation `R_Y(π − θ) R_X(−ϑ)` of the heading θ and the pitch ϑ (nose up positive, the
+//! animation's `pitch`, 0 when absent). Bank φ is the animation's `bank` when present, otherwise
 //! the coordinated-turn bank `φ = atan(v θ̇ / g)` from the speed v and turn rate θ̇ (clamped to ±45°).
 
 use std::f32::consts::PI;
@@ -822,7 +823,7 @@ impl BirdAsset {
 pub struct Flight {
     /// Root translation per frame, metres.
     pub translation: Vec<Vec3>,
-    /// Root rotation (yaw) per frame, sign-continuous.
+    /// Root rotation (yaw, then pitch) per frame, sign-continuous.
     pub yaw: Vec<Quat>,
     /// Bank per frame, radians, right wing down positive.
     pub bank: Vec<f32>,
@@ -850,7 +851,12 @@ pub fn flight(anim: &Animation, bird: usize, wingspan_m: f64) -> Flight {
             -(at(&f.y) as f32) * ws,
         ));
         let theta = at(&f.heading) as f32;
-        let q = continuous(prev, Quat::from_rotation_y(PI - theta));
+        // Nose up ϑ: about the bird's left axis (+X), which takes its front (+Z) toward up.
+        let pitch = f.pitch.as_ref().map_or(0.0, at) as f32;
+        let q = continuous(
+            prev,
+            Quat::from_rotation_y(PI - theta) * Quat::from_rotation_x(-pitch),
+        );
         prev = q;
         out.yaw.push(q);
         let bank = match &f.bank {

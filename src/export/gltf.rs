@@ -67,6 +67,44 @@ pub struct Clip {
     pub last: usize,
 }
 
+/// A looping animation (`Animation::looped`) with its closing frame appended: the first frame
+/// again, one frame after the last, moved by the flock's travel over the loop (none on a closed
+/// path, which loops in the world), so that a clip played over and over has no jump in the
+/// flock's moving frame (a game moving the flock itself gets a seamless cycle). Any other
+/// animation as it is.
+pub fn closed_loop(anim: &Animation) -> std::borrow::Cow<'_, Animation> {
+    use std::borrow::Cow;
+    let (Some(first), Some(last)) = (anim.frames.first(), anim.frames.last()) else {
+        return Cow::Borrowed(anim);
+    };
+    if !anim.looped || anim.frames.len() < 2 {
+        return Cow::Borrowed(anim);
+    }
+    let lead = anim.leaders().first().copied().unwrap_or(0);
+    let dt = 1.0 / anim.fps;
+    let (dx, dy) = if anim.path.as_ref().is_some_and(|p| p.closed) {
+        (0.0, 0.0)
+    } else {
+        let v = last.speed[lead] * dt;
+        (
+            last.x[lead] + v * last.heading[lead].sin() - first.x[lead],
+            last.y[lead] + v * last.heading[lead].cos() - first.y[lead],
+        )
+    };
+    let mut close = first.clone();
+    close.t = last.t + dt;
+    close.x.iter_mut().for_each(|x| *x += dx);
+    close.y.iter_mut().for_each(|y| *y += dy);
+    let mut out = anim.clone();
+    out.frames.push(close);
+    for st in &mut out.stages {
+        if st.end == anim.frames.len() {
+            st.end += 1;
+        }
+    }
+    Cow::Owned(out)
+}
+
 /// The clips of `anim`: one per non-empty stage, or `flight` over every frame.
 pub fn clips(anim: &Animation) -> Vec<Clip> {
     let n = anim.frames.len();

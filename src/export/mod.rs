@@ -379,7 +379,7 @@ pub fn write_outputs(
             }
             OutputKind::Glb => {
                 progress.start("glb", 1);
-                let bytes = gltf::glb_bytes_with(anim, wingspan_m, &scene)?;
+                let bytes = gltf::glb_bytes_with(&gltf::closed_loop(anim), wingspan_m, &scene)?;
                 write_bytes_atomic(&o.path, &bytes)?;
                 progress.advance(1);
                 progress.finish();
@@ -388,7 +388,7 @@ pub fn write_outputs(
                 progress.start("usda", 1);
                 // Streamed into the temporary file (a 100-bird minute is tens of MB of text).
                 let mut f = AtomicFile::create(&o.path)?;
-                usd::write_usda(anim, wingspan_m, &scene, f.writer())
+                usd::write_usda(&gltf::closed_loop(anim), wingspan_m, &scene, f.writer())
                     .map_err(|e| Error::io(&o.path, e))?;
                 f.commit()?;
                 progress.advance(1);

@@ -22,6 +22,8 @@ pub struct BirdState {
     pub heading: f64,
     /// Bank angle, radians, right wing down positive (0 when the animation has none).
     pub bank: f64,
+    /// Pitch angle, radians, nose up positive (0 when the animation has none).
+    pub pitch: f64,
     /// Wing joint angles.
     pub pose: WingPose,
 }
@@ -118,6 +120,11 @@ pub fn state_at(anim: &Animation, flapper: &Flapper, t: f64) -> Vec<BirdState> {
                 z: g(&fa.z, &fb.z),
                 heading: ha + angle_diff(ha, hb) * w,
                 bank: match (&fa.bank, &fb.bank) {
+                    (Some(a), Some(c)) => g(a, c),
+                    (Some(a), None) => a.get(b).copied().unwrap_or(0.0),
+                    _ => 0.0,
+                },
+                pitch: match (&fa.pitch, &fb.pitch) {
                     (Some(a), Some(c)) => g(a, c),
                     (Some(a), None) => a.get(b).copied().unwrap_or(0.0),
                     _ => 0.0,

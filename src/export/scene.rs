@@ -485,9 +485,12 @@ pub fn draw_birds(
             continue;
         }
         let (sin, cos) = b.heading.sin_cos();
-        // Body frame (right, forward, up) → world: forward (sin θ, cos θ), right (cos θ, −sin θ).
+        let (sp, cp) = b.pitch.sin_cos();
+        // Body frame (right, forward, up) → world: pitched nose up by ϑ about the right axis,
+        // then forward (sin θ, cos θ), right (cos θ, −sin θ).
         let to_world = |q: &[f32; 3]| {
-            let (x, y, z) = (q[0] as f64, q[1] as f64, q[2] as f64);
+            let (x, y0, z0) = (q[0] as f64, q[1] as f64, q[2] as f64);
+            let (y, z) = (y0 * cp - z0 * sp, y0 * sp + z0 * cp);
             [b.x + x * cos + y * sin, b.y - x * sin + y * cos, b.z + z]
         };
         // Top-down: a bird 10 wingspans higher looks 5 % larger, a hint of depth.

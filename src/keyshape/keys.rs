@@ -65,9 +65,11 @@ impl Default for KeyOptions {
     }
 }
 
-/// One key shape, formation frame (lateral positions are shared by all keys).
+/// One key shape, formation frame.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct KeyShape {
+    /// Lateral position of each bird, wingspans (the key's own: they drift slowly between keys).
+    pub x: Vec<f64>,
     /// Distance of each bird behind the leader, wingspans (leader at 0).
     pub y: Vec<f64>,
     /// The target ξ̂ the shape was solved for (after damping).
@@ -309,6 +311,8 @@ struct Predictor {
     lu: nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>,
     leader: usize,
     total: f64,
+    /// ξ of the previous shape's y at this key's lateral positions (they drift between keys).
+    base: Vec<f64>,
 }
 
 impl Predictor {
@@ -330,7 +334,18 @@ impl Predictor {
         if !lu.is_invertible() {
             return None;
         }
-        Some(Predictor { lu, leader, total })
+        let e = aero.power_lenient(x, &prev.y);
+        let base = if prev.x.as_slice() == x {
+            prev.xi.clone()
+        } else {
+            e.iter().map(|v| v / total).collect()
+        };
+        Some(Predictor {
+            lu,
+            leader,
+            total,
+            base,
+        })
     }
 
     fn predict(&self, prev: &KeyShape, target: &[f64]) -> Option<Vec<f64>> {
@@ -339,7 +354,7 @@ impl Predictor {
             n - 1,
             (0..n)
                 .filter(|&i| i != self.leader)
-                .map(|i| self.total * (target[i] - prev.xi[i])),
+                .map(|i| self.total * (target[i] - self.base[i])),
         );
         let dy = self.lu.solve(&rhs)?;
         let mut y = prev.y.clone();
@@ -365,6 +380,7 @@ impl Predictor {
 pub fn next_key(
     ctx: &KeyContext,
     prev: &KeyShape,
+    home: Option<(&[f64], f64)>,
     rng: &mut impl Rng,
     stats: &mut KeyStats,
 ) -> Result<KeyShape> {
@@ -375,12 +391,39 @@ pub fn next_key(
         opts,
         total,
     } = *ctx;
+    // The lateral positions drifted since the previous key: its fore-aft placement at the new
+    // positions is the reference of eq. (2) (and the fallback at λ = 0, reachable by design).
+    let moved;
+    let prev = if prev.x.as_slice() == x {
+        prev
+    } else {
+        let xi: Vec<f64> = opts
+            .solve
+            .aero
+            .power_lenient(x, &prev.y)
+            .iter()
+            .map(|e| e / total)
+            .collect();
+        moved = KeyShape {
+            x: x.to_vec(),
+            xi_target: xi.clone(),
+            xi,
+            ..prev.clone()
+        };
+        &moved
+    };
     let predictor = Predictor::new(x, prev, structure.leader, total, &opts.solve.aero);
     let promising = |y: &[f64]| structure.accepts(y) && max_jump(&prev.y, y) <= opts.max_jump;
     let mut tried: Vec<Vec<f64>> = Vec::new();
     let mut draws = 0;
     for _ in 0..opts.max_draws.max(1) {
-        let target = draw_target(&prev.xi_target, feasible, opts.c1, opts.c2, rng);
+        let mut target = draw_target(&prev.xi_target, feasible, opts.c1, opts.c2, rng);
+        if let Some((xi0, w)) = home {
+            // A loop returns to its first key: the draw is pulled toward it (Σ stays 1).
+            for (t, h) in target.iter_mut().zip(xi0) {
+                *t += w * (h - *t);
+            }
+        }
         draws += 1;
         stats.draws += 1;
         if draws > 1 {
@@ -400,6 +443,7 @@ pub fn next_key(
             attempt(x, prev, &start, &target, structure, opts, stats)?
         {
             return Ok(KeyShape {
+                x: x.to_vec(),
                 y,
                 xi_target: target,
                 xi,
@@ -432,6 +476,7 @@ pub fn next_key(
             {
                 stats.damped += 1;
                 return Ok(KeyShape {
+                    x: x.to_vec(),
                     y,
                     xi_target: target,
                     xi,
@@ -450,9 +495,21 @@ pub fn next_key(
     })
 }
 
-/// `count` key shapes starting from `first` (already solved), each from the one before.
+/// The lateral positions of every key and E there (Munk), and whether the keys return to the
+/// first one (a loop: each draw is pulled toward the first key's ξ̂, more so near the end).
+#[derive(Debug, Clone, Default)]
+pub struct KeyPlan {
+    /// Per key after the first: lateral positions (wingspans) and E there; empty: `ctx.x`.
+    pub lateral: Vec<(Vec<f64>, f64)>,
+    /// Pull the draws back toward the first key (a loop).
+    pub home: bool,
+}
+
+/// `count` key shapes starting from `first` (already solved), each from the one before, key k
+/// at the lateral positions `plan.lateral[k]`.
 pub fn key_shapes(
     ctx: &KeyContext,
+    plan: &KeyPlan,
     first: KeyShape,
     count: usize,
     rng: &mut impl Rng,
@@ -470,7 +527,18 @@ pub fn key_shapes(
         let prev = keys
             .last()
             .ok_or_else(|| Error::Internal("no key".into()))?;
-        let k = next_key(ctx, prev, rng, &mut stats)?;
+        let at = keys.len();
+        let ctx_k = match plan.lateral.get(at) {
+            Some((x, total)) => KeyContext {
+                x,
+                total: *total,
+                ..*ctx
+            },
+            None => *ctx,
+        };
+        let w = (at as f64 / count.max(2) as f64).powi(2);
+        let home = plan.home.then(|| (keys[0].xi_target.as_slice(), w));
+        let k = next_key(&ctx_k, prev, home, rng, &mut stats)?;
         stats.min_damping = stats.min_damping.min(k.damping);
         stats.max_residual = stats.max_residual.max(k.residual);
         stats.max_jump = stats.max_jump.max(max_jump(&prev.y, &k.y));

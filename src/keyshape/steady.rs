@@ -28,7 +28,9 @@ use crate::keyshape::initial::{
     Correspondence, InitialOptions,
 };
 use crate::keyshape::interpolate::Track;
-use crate::keyshape::keys::{key_shapes, KeyContext, KeyOptions, KeyShape, KeyStats, Structure};
+use crate::keyshape::keys::{
+    key_shapes, KeyContext, KeyOptions, KeyPlan, KeyShape, KeyStats, Structure,
+};
 use crate::keyshape::ranges::{power_at, xi_ranges, XiRanges};
 use crate::keyshape::solve::SolveOptions;
 use crate::progress::Progress;
@@ -72,6 +74,19 @@ pub struct SteadyOptions {
     pub max_depth_factor: f64,
     /// The aerodynamic model's vortex core and collision distance.
     pub aero: AeroOptions,
+    /// Standard deviation of each lateral gap's slow drift around its drawn value, from key
+    /// shape to key shape, wingspans (0: lateral positions fixed for the whole flight).
+    pub lateral_drift: f64,
+    /// Standard deviation of the birds' heights about the leader's, wingspans (a stereo-filmed
+    /// V of white-fronted geese: 0.14).
+    pub height_spread: f64,
+    /// Root-mean-square height difference of lateral neighbours, wingspans (the same V: 0.06);
+    /// at most `height_spread` · √2.
+    pub height_neighbour: f64,
+    /// A seamless cycle: the last key shape is the first, placed one frame after the last
+    /// frame, so the frame after the last is the first again (in the flock's moving frame).
+    #[serde(rename = "loop")]
+    pub looped: bool,
 }
 
 impl Default for SteadyOptions {
@@ -94,6 +109,10 @@ impl Default for SteadyOptions {
             min_gap: 0.1,
             aero: AeroOptions::default(),
             max_depth_factor: 1.5,
+            lateral_drift: 0.06,
+            height_spread: 0.14,
+            height_neighbour: 0.06,
+            looped: false,
         }
     }
 }
@@ -199,12 +218,47 @@ impl SteadyOptions {
         if !(self.max_depth_factor.is_finite() && self.max_depth_factor >= 1.0) {
             return Err(p("steady.max_depth_factor", "must be at least 1".into()));
         }
+        if !(self.lateral_drift >= 0.0 && self.lateral_drift <= 1.0) {
+            return Err(p(
+                "steady.lateral_drift",
+                format!("{}: must be in [0, 1] wingspans", self.lateral_drift),
+            ));
+        }
+        if !(self.height_spread >= 0.0 && self.height_spread <= 10.0) {
+            return Err(p(
+                "steady.height_spread",
+                format!("{}: must be in [0, 10] wingspans", self.height_spread),
+            ));
+        }
+        if !(self.height_neighbour >= 0.0
+            && self.height_neighbour <= self.height_spread * std::f64::consts::SQRT_2 + 1e-12)
+        {
+            return Err(p(
+                "steady.height_neighbour",
+                format!(
+                    "{}: must be in [0, √2 · steady.height_spread = {:.3}] wingspans",
+                    self.height_neighbour,
+                    self.height_spread * std::f64::consts::SQRT_2
+                ),
+            ));
+        }
+        let seconds = self.frames as f64 / self.fps;
+        if self.looped && seconds < self.key_every_s {
+            return Err(p(
+                "steady.loop",
+                format!(
+                    "a loop of {seconds:.2} s is shorter than one key interval (steady.key_every_s = {} s); make the flight longer or the key interval shorter",
+                    self.key_every_s
+                ),
+            ));
+        }
         Ok(())
     }
 
-    /// Number of key shapes and the frame of each (evenly spread, first at 0, last at F − 1).
+    /// Number of key shapes and the frame of each (evenly spread, first at 0, last at F − 1; for
+    /// a loop the last at F, one frame after the last, where the first key comes round again).
     pub fn key_frames(&self) -> Vec<usize> {
-        let f = self.frames;
+        let f = self.frames + usize::from(self.looped);
         if f <= 1 {
             return vec![0];
         }
@@ -295,6 +349,101 @@ pub fn separate(x: &[f64], y: &[f64], aero: &AeroOptions) -> Vec<f64> {
         }
     }
     y
+}
+
+/// Correlation of a lateral gap's drift, and of the height field, from one key shape to the next.
+const KEY_CORRELATION: f64 = 0.7;
+
+/// Lateral positions of every key shape (the first the drawn `x` from `gaps`): each gap drifts
+/// around its drawn value as an AR(1) process from key to key (standard deviation
+/// `lateral_drift`, correlation [`KEY_CORRELATION`]), never at or below `min_gap`, no bird moving
+/// more than `max_jump` between keys; a loop's drift tapers to 0 at its last key (= the first).
+fn lateral_plan(
+    gaps: &[f64],
+    leader: usize,
+    keys: usize,
+    opts: &SteadyOptions,
+    rng: &mut impl Rng,
+) -> Vec<Vec<f64>> {
+    use rand_distr::{Distribution, StandardNormal};
+    let rho = KEY_CORRELATION;
+    let mut dev = vec![0.0; gaps.len()];
+    let mut prev = positions_from_gaps(gaps, leader);
+    let mut out = vec![prev.clone()];
+    for k in 1..keys {
+        for d in dev.iter_mut() {
+            let z: f64 = StandardNormal.sample(rng);
+            *d = rho * *d + (1.0 - rho * rho).sqrt() * opts.lateral_drift * z;
+        }
+        let taper = if opts.looped {
+            1.0 - (k as f64 / (keys - 1).max(1) as f64).powi(2)
+        } else {
+            1.0
+        };
+        let g: Vec<f64> = gaps
+            .iter()
+            .zip(&dev)
+            .map(|(&g, &d)| (g + taper * d).max((opts.min_gap + 0.02).min(g)))
+            .collect();
+        let mut xk = positions_from_gaps(&g, leader);
+        let jump = crate::keyshape::keys::max_jump(&prev, &xk);
+        if jump > opts.max_jump {
+            let f = opts.max_jump / jump;
+            for (a, b) in xk.iter_mut().zip(&prev) {
+                *a = b + f * (*a - b);
+            }
+        }
+        prev = xk.clone();
+        out.push(xk);
+    }
+    out
+}
+
+/// Heights of every bird at every key shape, wingspans, the leader at 0: a random walk along
+/// the lateral order (step `height_neighbour`) plus a tilt across the flock that brings the
+/// expected spread to `height_spread` (one arm a little higher than the other, as in the
+/// footage), both evolving from key to key as AR(1) processes (correlation [`KEY_CORRELATION`]).
+/// A loop's last key repeats the first. Drawn from the seed's `steady.height` stream.
+fn heights(n: usize, x: &[f64], leader: usize, keys: usize, opts: &SteadyOptions) -> Vec<Vec<f64>> {
+    use rand_distr::{Distribution, StandardNormal};
+    let mut rng = crate::rng::stream(opts.seed, "steady.height");
+    let rho = KEY_CORRELATION;
+    let nf = n as f64;
+    let walk_var = opts.height_neighbour.powi(2) * (nf * nf - 1.0) / (6.0 * nf);
+    let mean_x = x.iter().sum::<f64>() / nf;
+    let var_x = x.iter().map(|v| (v - mean_x).powi(2)).sum::<f64>() / nf;
+    let tilt_sd = if var_x > 1e-12 {
+        ((opts.height_spread.powi(2) - walk_var).max(0.0) / var_x).sqrt()
+    } else {
+        0.0
+    };
+    let draw = |rng: &mut crate::rng::FlockRng| -> Vec<f64> {
+        let tilt: f64 = StandardNormal.sample(rng);
+        let mut h = Vec::with_capacity(n);
+        let mut walk = 0.0;
+        for &xi in x {
+            let z: f64 = StandardNormal.sample(rng);
+            walk += opts.height_neighbour * z;
+            h.push(walk + tilt_sd * tilt * (xi - mean_x));
+        }
+        h
+    };
+    let mut field = draw(&mut rng);
+    let mut out = Vec::with_capacity(keys);
+    for k in 0..keys {
+        if k > 0 {
+            let fresh = draw(&mut rng);
+            for (f, g) in field.iter_mut().zip(fresh) {
+                *f = rho * *f + (1.0 - rho * rho).sqrt() * g;
+            }
+        }
+        let lead = field[leader];
+        out.push(field.iter().map(|h| h - lead).collect::<Vec<f64>>());
+    }
+    if opts.looped && keys > 1 {
+        out[keys - 1] = out[0].clone();
+    }
+    out
 }
 
 /// The steady flight of Algorithm 1 as an animation (one `steady` stage covering all frames).
@@ -399,6 +548,7 @@ pub fn steady_flight_report(
         other => other,
     })?;
     let key0 = KeyShape {
+        x: x.clone(),
         y: y0.clone(),
         xi_target: p0.xi.clone(),
         xi: p0.xi,
@@ -425,7 +575,8 @@ pub fn steady_flight_report(
             ..SolveOptions::default()
         },
     };
-    progress.start("steady: key shapes", key_frames.len() as u64);
+    let nk = key_frames.len();
+    progress.start("steady: key shapes", nk as u64);
     let ctx = KeyContext {
         x: &x,
         feasible: &feasible,
@@ -433,16 +584,43 @@ pub fn steady_flight_report(
         opts: &key_opts,
         total,
     };
-    let (keys, key_stats) = key_shapes(&ctx, key0, key_frames.len(), rng, || progress.advance(1))?;
+    let mut lateral = Vec::with_capacity(nk);
+    let mut lat_rng = crate::rng::stream(opts.seed, "steady.lateral");
+    for xk in lateral_plan(&gaps, corr.leader, nk, opts, &mut lat_rng) {
+        // A drift that leaves the flock no saving in total keeps the drawn positions.
+        match aero.munk_total(&xk) {
+            Ok(t) if t > 0.0 => lateral.push((xk, t)),
+            _ => lateral.push((x.clone(), total)),
+        }
+    }
+    let plan = KeyPlan {
+        lateral,
+        home: opts.looped,
+    };
+    let solved = if opts.looped { nk - 1 } else { nk };
+    let (mut keys, key_stats) =
+        key_shapes(&ctx, &plan, key0, solved, rng, || progress.advance(1))?;
+    if opts.looped {
+        keys.push(keys[0].clone());
+        progress.advance(1);
+    }
     progress.finish();
+    let heights = heights(n, &x, corr.leader, nk, opts);
 
     // Step 4.
     progress.start("steady: frames", opts.frames as u64);
     let times: Vec<f64> = key_frames.iter().map(|&f| f as f64 / opts.fps).collect();
-    let tracks: Vec<Track> = (0..n)
+    let track = |v: &dyn Fn(usize) -> f64| {
+        let v: Vec<f64> = (0..nk).map(v).collect();
+        Track::pchip(&times, &v)
+    };
+    let tracks: Vec<[Track; 3]> = (0..n)
         .map(|i| {
-            let v: Vec<f64> = keys.iter().map(|k| k.y[i]).collect();
-            Track::pchip(&times, &v)
+            [
+                track(&|k| keys[k].y[i]),
+                track(&|k| keys[k].x[i]),
+                track(&|k| heights[k][i]),
+            ]
         })
         .collect();
     let mut frames = Vec::with_capacity(opts.frames);
@@ -453,27 +631,34 @@ pub fn steady_flight_report(
         let lead_y = opts.speed * t;
         let mut fr = Frame {
             t,
-            x: x.clone(),
+            x: Vec::with_capacity(n),
             y: Vec::with_capacity(n),
-            z: vec![0.0; n],
+            z: Vec::with_capacity(n),
             heading: Vec::with_capacity(n),
             speed: Vec::with_capacity(n),
             ..Frame::default()
         };
         let mut ys = Vec::with_capacity(n);
-        for tr in &tracks {
-            let (y, dy) = tr.eval(t);
+        for [ty, tx, tz] in &tracks {
+            let (y, dy) = ty.eval(t);
+            let (xl, dx) = tx.eval(t);
             ys.push(y);
+            fr.x.push(xl);
             fr.y.push(lead_y - y);
-            // World velocity (0, speed − dy/dt): the flock frame moves at `speed` along +y.
-            let (vx, vy) = (0.0f64, opts.speed - dy);
+            fr.z.push(tz.eval(t).0);
+            // World velocity (dx/dt, speed − dy/dt): the flock frame moves at `speed` along +y.
+            let (vx, vy) = (dx, opts.speed - dy);
             fr.heading.push(vx.atan2(vy));
             fr.speed.push(vx.hypot(vy));
         }
         // Between two collision-free keys a pair can pass within a chord: evaluated at the
         // collision distance there, so every frame has finite savings.
-        let e = aero.power_lenient(&x, &ys);
-        let xi: Vec<f64> = e.iter().map(|v| v / total).collect();
+        let e = aero.power_lenient(&fr.x, &ys);
+        let total_t = match aero.munk_total(&fr.x) {
+            Ok(t) if t > 0.0 => t,
+            _ => total,
+        };
+        let xi: Vec<f64> = e.iter().map(|v| v / total_t).collect();
         let excess = feasible.excess(&xi);
         if excess > 1e-12 {
             frames_outside_range += 1;
@@ -492,12 +677,15 @@ pub fn steady_flight_report(
         start: 0,
         end: opts.frames,
     });
+    anim.looped = opts.looped;
     anim.key_shapes = keys
         .iter()
         .zip(&key_frames)
+        .filter(|(_, &frame)| frame < opts.frames)
         .map(|(k, &frame)| KeyShapeRecord {
             frame,
-            birds: x
+            birds: k
+                .x
                 .iter()
                 .zip(&k.y)
                 .zip(&k.xi)

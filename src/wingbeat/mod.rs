@@ -158,6 +158,8 @@ struct BirdBeats {
     /// Index of `beats[0]`.
     first: i64,
     beats: Vec<Beat>,
+    /// A looping animation: the wingbeats repeat after this many (whole cycles over the loop).
+    period: Option<i64>,
 }
 
 impl BirdBeats {
@@ -169,7 +171,10 @@ impl BirdBeats {
 
     fn beat(&self, n: i64) -> Beat {
         let last = self.beats.len().saturating_sub(1) as i64;
-        let k = (n - self.first).clamp(0, last) as usize;
+        let k = match self.period {
+            Some(p) => (n - self.first).rem_euclid(p.max(1)).min(last),
+            None => (n - self.first).clamp(0, last),
+        } as usize;
         self.beats.get(k).copied().unwrap_or(Beat {
             amp: 1.0,
             offset: 0.0,
@@ -236,6 +241,10 @@ impl BirdBeats {
         // At most 2π of phase passes per frame, so only a few wingbeats can be new; the cap guards
         // against absurd stored phases.
         let stop = hi.min(start + 4);
+        let stop = match self.period {
+            Some(p) => stop.min(self.first + p - 1),
+            None => stop,
+        };
         for n in start..=stop {
             let beat = self.decide(n, effort, rng, glide, variation);
             self.beats.push(beat);
@@ -319,6 +328,7 @@ fn draw_birds(seed: u64, birds: usize, opts: &WingbeatOptions) -> (Vec<BirdBeats
             glide_beats: i64::from(preset.glide_beats),
             first: 0,
             beats: Vec::new(),
+            period: None,
         });
         rngs.push(r);
     }
@@ -518,6 +528,24 @@ fn simulate(anim: &Animation, opts: &WingbeatOptions) -> Run {
             last_rate[i] = rate[i];
         }
     }
+    if anim.looped && nf > 1 {
+        // A whole number of cycles over the loop: every bird's phase advance, including the
+        // step from the last frame back to the first, is scaled to the nearest multiple of 2π,
+        // and the wingbeats are replayed so that they repeat with the loop.
+        let dt = 1.0 / anim.fps;
+        for i in 0..n {
+            let s0 = unwrapped[i];
+            let advance = unwrapped[(nf - 1) * n + i] - s0 + (TAU * own[i] * dt).clamp(0.0, PI);
+            let m = (advance / TAU).round().max(1.0);
+            let f = if advance > 0.0 { TAU * m / advance } else { 1.0 };
+            for k in 0..nf {
+                let s = s0 + (unwrapped[k * n + i] - s0) * f;
+                unwrapped[k * n + i] = s;
+                phase[k * n + i] = s.rem_euclid(TAU).min(TAU - f64::EPSILON * TAU);
+            }
+        }
+        return replay_phases(anim, opts, |k, i| phase[k * n + i]);
+    }
     Run {
         birds,
         phase,
@@ -553,24 +581,46 @@ fn locked_rate(
 
 /// Rebuilds the wingbeat decisions from phases stored in the animation (what the renderers see).
 fn replay(anim: &Animation, opts: &WingbeatOptions) -> Run {
+    replay_phases(anim, opts, |k, i| {
+        anim.frames[k]
+            .wing_phase
+            .as_deref()
+            .and_then(|p| p.get(i))
+            .copied()
+            .unwrap_or(0.0)
+    })
+}
+
+/// [`replay`] of the phases `stored(frame, bird)`; a looping animation's wingbeats repeat with
+/// its whole cycles (counted from the phases, the wrap step included).
+fn replay_phases(anim: &Animation, opts: &WingbeatOptions, stored: impl Fn(usize, usize) -> f64) -> Run {
     let n = anim.birds;
     let nf = anim.frames.len();
     let preset = opts.species.preset();
     let eff = efforts(anim, &preset);
     let (mut birds, mut rngs) = draw_birds(anim.seed, n, opts);
+    let wrapped = |k: usize, i: usize| {
+        let raw = stored(k, i);
+        if raw.is_finite() {
+            raw.rem_euclid(TAU)
+        } else {
+            0.0
+        }
+    };
+    if anim.looped && nf > 1 {
+        for (i, b) in birds.iter_mut().enumerate() {
+            let wraps = (1..nf).filter(|&k| wrapped(k, i) < wrapped(k - 1, i)).count() as i64;
+            let closing = i64::from(wrapped(0, i) <= wrapped(nf - 1, i));
+            b.period = Some((wraps + closing).max(1));
+        }
+    }
     let mut cycles = vec![0u64; n];
     let mut prev = vec![0.0; n];
     let mut phase = vec![0.0; n * nf];
     let mut unwrapped = vec![0.0; n * nf];
-    for (k, frame) in anim.frames.iter().enumerate() {
-        let stored = frame.wing_phase.as_deref().unwrap_or(&[]);
+    for k in 0..nf {
         for i in 0..n {
-            let raw = stored.get(i).copied().unwrap_or(0.0);
-            let p = if raw.is_finite() {
-                raw.rem_euclid(TAU)
-            } else {
-                0.0
-            };
+            let p = wrapped(k, i);
             if k > 0 && p < prev[i] {
                 cycles[i] += 1;
             }
@@ -762,6 +812,7 @@ pub mod probe {
                     glide: false,
                 })
                 .collect(),
+            period: None,
         };
         (b.pose_at(s, s.rem_euclid(TAU)), b.freq_at(s))
     }

@@ -1,0 +1,80 @@
+//! Course flags (issue 19) shared by `steady`, `initiate` and `animate`: the path the flock
+//! follows and its units (the `course` section of the library's `Config`), and the warnings the
+//! course step reports.
+
+use std::path::PathBuf;
+
+use clap::Args;
+use formation::course::{CourseOptions, CourseReport, PathUnits};
+
+/// `--path` and `--path-units`.
+#[derive(Debug, Clone, Args)]
+pub struct PathFlags {
+    /// The leader's path, world frame (x east, y north, z up): JSON {"units": "wingspans" | "m",
+    /// "points": [[x, y, z], ...]} or CSV x,y,z; the formation turns, banks and climbs along it
+    /// (docs/paths.md). A last point equal to the first closes the path.
+    #[arg(long)]
+    pub path: Option<PathBuf>,
+    /// Units of the path's coordinates: wingspans or m [default: the file's "units", else
+    /// wingspans].
+    #[arg(long = "path-units", value_name = "UNITS", value_parser = parse_units)]
+    pub path_units: Option<PathUnits>,
+}
+
+fn parse_units(s: &str) -> Result<PathUnits, String> {
+    PathUnits::parse(s).ok_or_else(|| format!("unknown units \"{s}\"; use wingspans or m"))
+}
+
+impl PathFlags {
+    /// The course options with this path (other fields default).
+    pub fn options(&self) -> CourseOptions {
+        CourseOptions {
+            path: self.path.clone(),
+            units: self.path_units,
+            ..CourseOptions::default()
+        }
+    }
+}
+
+/// Prints the course step's warnings on stderr, one line each.
+pub fn warn(report: &CourseReport) {
+    for w in &report.warnings {
+        eprintln!("warning: {w}");
+    }
+}
+
+/// For `initiate --path`: the config the course step needs (the steady file's cruise speed and
+/// wingspan, the take-off's altitude) and the loaded path; sets the take-off's cruise altitude
+/// to the path's first point. A steady file already on a path is refused.
+pub fn course_config(
+    flags: &PathFlags,
+    steady: &formation::Animation,
+    origin: &std::path::Path,
+    opts: &mut formation::initiate::InitiateOptions,
+) -> formation::Result<(
+    formation::pipeline::Config,
+    Option<formation::course::PathPoints>,
+)> {
+    let mut config = formation::pipeline::Config {
+        course: flags.options(),
+        ..formation::pipeline::Config::default()
+    };
+    config.steady.wingspan_m = steady.wingspan_m;
+    let leader = steady.leaders().first().copied().unwrap_or(0);
+    if let Some(f) = steady.frames.first() {
+        config.steady.speed = f.speed.get(leader).copied().unwrap_or(config.steady.speed);
+    }
+    if steady.path.is_some() && flags.path.is_some() {
+        return Err(formation::Error::format(
+            origin,
+            "path: this steady flight already follows a path; give initiate the steady flight written without --path, and the path here",
+        ));
+    }
+    let path = config.course.load(steady.wingspan_m)?;
+    if let Some(p) = &path {
+        let file = flags.path.clone().unwrap_or_default();
+        opts.cruise_altitude = formation::course::takeoff_altitude(p, &file)?;
+    }
+    config.initiate.cruise_altitude = opts.cruise_altitude;
+    Ok((config, path))
+}

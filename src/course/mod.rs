@@ -1,0 +1,492 @@
+//! The course (issue 19): where in the world the flock flies. Every earlier stage works in the
+//! *course frame*, a straight flight along +y at constant altitude (SPEC §2's world frame before
+//! this step); this stage maps it onto the user's path. A point at along-track distance `s`,
+//! lateral offset `d` (right of the track) and height `h` goes to
+//! ```math
+//! P(s) + d\,N(s) + h\,\hat z, \qquad N(s) = (\cos\theta(s), -\sin\theta(s), 0),
+//! ```
+//! with P the path at arc length s and θ its heading. Birds therefore keep their slots in the
+//! formation frame that turns with the track, and in a turn of radius R a bird d wingspans
+//! outward of the leader's track flies at v = V (R + d)/R. Velocities follow from the chain rule
+//! (`∂/∂s = (cos γ − d θ′) T_h + sin γ ẑ`, `∂/∂d = N`, `∂/∂h = ẑ`, γ the climb angle), so a
+//! bird at rest stays at rest and headings are exact, not finite differences. Each bird banks for
+//! its own turn, tan φ = v ω / g (coordinated turn, g in wingspans/s² from `wingspan_m`), reached
+//! with a limited roll rate; it pitches with its climb, tan ϑ = ż / v.
+//!
+//! A turn tighter than the flock can fly (an inner bird below `min_speed`, an outer one above
+//! `max_speed`, or a bank beyond `max_bank`) is widened by local smoothing of the path
+//! ([`spline::widen`]) and reported once, with the place on the path ([`CourseReport::widened`]).
+//!
+//! Without a path the course frame is the world frame; only the cruise altitude of a flight
+//! without a take-off is added, and pitch is filled in.
+
+pub mod file;
+pub mod spline;
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use crate::animation::{Animation, PathRecord};
+use crate::error::{Error, Result};
+
+pub use file::{PathPoints, PathUnits};
+pub use spline::{Course, CourseAt};
+
+/// Gravity, metres per second squared.
+const GRAVITY_M_S2: f64 = 9.81;
+
+/// Options of the course (the `course` section of [`crate::pipeline::Config`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct CourseOptions {
+    /// The leader's path, a JSON or CSV file of control points (world frame); `None`: straight
+    /// north.
+    pub path: Option<PathBuf>,
+    /// Units of the path's coordinates (`None`: the file's `units`, or wingspans).
+    pub units: Option<PathUnits>,
+    /// Height of a flight without a take-off and without a path, wingspans (`None`: 0, the
+    /// course frame's own; a take-off climbs to `initiate.cruise_altitude` instead).
+    pub cruise_altitude: Option<f64>,
+    /// Largest bank of any bird in a turn, radians.
+    pub max_bank: f64,
+    /// Largest roll rate, radians per second.
+    pub max_roll_rate: f64,
+    /// Time constant of the bank following the coordinated-turn bank, seconds.
+    pub roll_lag: f64,
+    /// Slowest a bird may fly on the inside of a turn, as a fraction of the cruise speed.
+    pub min_speed: f64,
+    /// Fastest a bird may fly on the outside of a turn, as a fraction of the cruise speed.
+    pub max_speed: f64,
+}
+
+impl Default for CourseOptions {
+    fn default() -> Self {
+        CourseOptions {
+            path: None,
+            units: None,
+            cruise_altitude: None,
+            max_bank: 40f64.to_radians(),
+            max_roll_rate: 90f64.to_radians(),
+            roll_lag: 0.25,
+            min_speed: 0.6,
+            max_speed: 1.4,
+        }
+    }
+}
+
+impl CourseOptions {
+    /// Checks every option; errors name `course.*`.
+    pub fn validate(&self) -> Result<()> {
+        let p = |name: &str, msg: String| Err(Error::parameter(name, msg));
+        if let Some(a) = self.cruise_altitude {
+            if !(a.is_finite() && a.abs() <= 1e5) {
+                return p(
+                    "course.cruise_altitude",
+                    format!("{a}: must be a number of wingspans within ±1e5"),
+                );
+            }
+        }
+        if !(self.max_bank > 0.0 && self.max_bank <= 80f64.to_radians()) {
+            return p(
+                "course.max_bank",
+                format!("{}: must be in (0, 80°] (radians)", self.max_bank),
+            );
+        }
+        if !(self.max_roll_rate > 0.0 && self.max_roll_rate.is_finite()) {
+            return p("course.max_roll_rate", "must be a positive number of radians per second".into());
+        }
+        if !(self.roll_lag >= 0.0 && self.roll_lag <= 10.0) {
+            return p("course.roll_lag", "must be in [0, 10] seconds".into());
+        }
+        if !(self.min_speed > 0.0 && self.min_speed < 1.0) {
+            return p("course.min_speed", format!("{}: must be in (0, 1)", self.min_speed));
+        }
+        if !(self.max_speed > 1.0 && self.max_speed <= 10.0) {
+            return p("course.max_speed", format!("{}: must be in (1, 10]", self.max_speed));
+        }
+        Ok(())
+    }
+
+    /// Reads and checks the path file, if any (points in wingspans for birds `wingspan_m` wide).
+    pub fn load(&self, wingspan_m: f64) -> Result<Option<PathPoints>> {
+        match &self.path {
+            None => Ok(None),
+            Some(p) => file::read(p, self.units, wingspan_m).map(Some),
+        }
+    }
+}
+
+/// A turn the flock could not fly as drawn.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Widened {
+    /// The control point nearest to the tightest place.
+    pub point: usize,
+    /// Arc length of the tightest place from the first point, wingspans.
+    pub s: f64,
+    /// Radius there as drawn, wingspans.
+    pub radius: f64,
+    /// The smallest radius the flock can fly, wingspans.
+    pub needed: f64,
+}
+
+/// What the course step did.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct CourseReport {
+    /// Length of the flown course, wingspans (0 without a path).
+    pub length: f64,
+    /// Turns widened (empty when every turn could be flown as drawn).
+    pub widened: Vec<Widened>,
+    /// Laps of a closed path flown by a loop (0 otherwise).
+    pub laps: usize,
+    /// Factor applied to the cruise speed so a loop closes on a closed path (1 otherwise).
+    pub speed_factor: f64,
+    /// One-line warnings for the user (turns widened, the flight running past the path's end).
+    pub warnings: Vec<String>,
+}
+
+/// Smallest radius at which birds from `d_lo` to `d_hi` wingspans right of the track (d_lo ≤ 0 ≤
+/// d_hi) fly a turn within the speed and bank limits at cruise speed `v` (g in wingspans/s²);
+/// returns the radius and the binding limit.
+pub fn min_radius(d_lo: f64, d_hi: f64, v: f64, g: f64, opts: &CourseOptions) -> (f64, &'static str) {
+    let inner = d_hi.max(-d_lo).max(0.0);
+    let outer = inner;
+    let c = g * opts.max_bank.tan() / (v * v);
+    // Outer bird: V²(1 + κd)κ/g ≤ tan φ_max.
+    let k_bank = if outer > 1e-9 {
+        (-1.0 + (1.0 + 4.0 * outer * c).sqrt()) / (2.0 * outer)
+    } else {
+        c
+    };
+    let k_slow = if inner > 1e-9 { (1.0 - opts.min_speed) / inner } else { f64::INFINITY };
+    let k_fast = if outer > 1e-9 { (opts.max_speed - 1.0) / outer } else { f64::INFINITY };
+    let mut best = (k_bank, "an outer bird would bank beyond the bank limit");
+    if k_slow < best.0 {
+        best = (k_slow, "the inner birds would fly below their minimum speed");
+    }
+    if k_fast < best.0 {
+        best = (k_fast, "the outer birds would fly above their maximum speed");
+    }
+    (1.0 / best.0, best.1)
+}
+
+/// What the course step needs of the flight before it: the cruise speed (wingspans per second),
+/// the take-off's cruise altitude when a take-off was flown, and whether the flight loops.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Flight {
+    /// Cruise speed of the course frame, wingspans per second.
+    pub speed: f64,
+    /// `Some(altitude)` when the animation begins with a take-off from the ground climbing to
+    /// this altitude (wingspans), `None` for a steady flight alone.
+    pub takeoff_altitude: Option<f64>,
+    /// The steady flight cycles (`steady.loop`).
+    pub looped: bool,
+}
+
+/// The height of the path's first point, which a take-off climbs to (wingspans); an error when
+/// a take-off from the ground could not reach it.
+pub fn takeoff_altitude(points: &PathPoints, origin: &Path) -> Result<f64> {
+    let z = points.points[0][2];
+    if !(z >= 1.0) {
+        return Err(Error::format(
+            origin,
+            format!(
+                "point 0: at height {z:.2} wingspans; a take-off from the ground needs the path to start at least 1 wingspan up (raise the path, or fly without the take-off)"
+            ),
+        ));
+    }
+    Ok(z)
+}
+
+/// Maps `anim` (course frame) onto its course: positions, headings, speeds, banks and pitches.
+/// `points` is the loaded path (or `None`), `flight` what the earlier stages did.
+pub fn apply(
+    anim: &mut Animation,
+    points: Option<&PathPoints>,
+    opts: &CourseOptions,
+    flight: Flight,
+) -> Result<CourseReport> {
+    opts.validate()?;
+    let mut report = CourseReport {
+        speed_factor: 1.0,
+        ..CourseReport::default()
+    };
+    if anim.frames.is_empty() {
+        return Ok(report);
+    }
+    let g = GRAVITY_M_S2 / anim.wingspan_m;
+    let Some(points) = points else {
+        if flight.takeoff_altitude.is_none() {
+            let alt = opts.cruise_altitude.unwrap_or(0.0);
+            for f in &mut anim.frames {
+                for z in &mut f.z {
+                    *z += alt;
+                }
+            }
+        }
+        fill_pitch(anim, flight.looped);
+        if anim.frames.iter().any(|f| f.bank.is_none()) {
+            let bank = banks(anim, g, opts, flight.looped);
+            for (f, b) in anim.frames.iter_mut().zip(bank) {
+                f.bank = Some(b);
+            }
+        }
+        return Ok(report);
+    };
+    let origin = opts.path.clone().unwrap_or_else(|| PathBuf::from("path"));
+    let n = anim.birds;
+    let leader = anim.leaders().first().copied().unwrap_or(0);
+    let steady = anim
+        .stage("steady")
+        .map(|s| s.start..s.end)
+        .unwrap_or(0..anim.frames.len());
+    let f_ref = &anim.frames[steady.start.min(anim.frames.len() - 1)];
+    let x_ref = f_ref.x[leader];
+    let f0 = &anim.frames[0];
+    let s0 = if flight.takeoff_altitude.is_some() {
+        f0.y.iter().sum::<f64>() / n as f64
+    } else {
+        f0.y[leader]
+    };
+    // The flock's lateral extent and the formation's length (course frame).
+    let (mut d_lo, mut d_hi, mut depth) = (0.0f64, 0.0f64, 1.0f64);
+    for f in &anim.frames[steady.clone()] {
+        let (mut lo, mut hi) = (f64::MAX, f64::MIN);
+        for i in 0..n {
+            d_lo = d_lo.min(f.x[i] - x_ref);
+            d_hi = d_hi.max(f.x[i] - x_ref);
+            lo = lo.min(f.y[i]);
+            hi = hi.max(f.y[i]);
+        }
+        depth = depth.max(hi - lo);
+    }
+    check_backwards(points, depth, &origin)?;
+    let (r_min, why) = min_radius(d_lo, d_hi, flight.speed, g, opts);
+    let dense = spline::spline_points(&points.points, points.closed);
+    let (pts, ds) = spline::resample(&dense, spline::SAMPLE_SPACING);
+    let before = pts.clone();
+    let (pts, ds, tight) = spline::widen(pts, ds, points.closed, 1.0 / r_min, spline::SAMPLE_SPACING);
+    let course = Course::from_samples(pts, ds, points.closed);
+    report.length = course.length();
+    for t in &tight {
+        let p = before[t.sample.min(before.len() - 1)];
+        let point = (0..points.points.len())
+            .min_by(|&a, &b| {
+                file::dist(points.points[a], p).total_cmp(&file::dist(points.points[b], p))
+            })
+            .unwrap_or(0);
+        report.widened.push(Widened {
+            point,
+            s: t.s,
+            radius: t.radius,
+            needed: r_min,
+        });
+    }
+    if let Some(w) = report
+        .widened
+        .iter()
+        .min_by(|a, b| a.radius.total_cmp(&b.radius))
+    {
+        report.warnings.push(format!(
+            "{}: {} turn(s) too tight for the flock, widened to a radius of {:.0} wingspans; the tightest near point {} ({}), {:.0} wingspans along the path, has a radius of {:.1} wingspans ({}); draw wider turns or slow the flock to fly them as drawn",
+            origin.display(),
+            report.widened.len(),
+            w.needed,
+            w.point,
+            file::show(points.points[w.point]),
+            w.s,
+            w.radius,
+            why
+        ));
+    }
+    // A loop on a closed path: a whole number of laps over the loop's duration.
+    let period = anim.frames.len() as f64 / anim.fps;
+    let mut drift = 0.0;
+    if flight.looped && points.closed {
+        let flown = flight.speed * period;
+        let laps = (flown / course.length()).round().max(1.0);
+        drift = (laps * course.length() - flown) / period;
+        report.laps = laps as usize;
+        report.speed_factor = 1.0 + drift / flight.speed;
+        if !(opts.min_speed..=opts.max_speed).contains(&report.speed_factor) {
+            return Err(Error::format(
+                &origin,
+                format!(
+                    "a loop of {period:.1} s cannot close on this closed path ({:.0} wingspans, {:.1} s a lap at cruise speed) without flying at {:.0} % of the cruise speed; give a duration near a whole number of laps",
+                    course.length(),
+                    course.length() / flight.speed,
+                    100.0 * report.speed_factor
+                ),
+            ));
+        }
+        if (report.speed_factor - 1.0).abs() > 0.1 {
+            report.warnings.push(format!(
+                "{}: a loop of {period:.1} s flies {laps:.0} lap(s) of the closed path ({:.0} wingspans) at {:.0} % of the cruise speed; give a duration near a whole number of laps ({:.1} s a lap) to keep the speed",
+                origin.display(),
+                course.length(),
+                100.0 * report.speed_factor,
+                course.length() / flight.speed
+            ));
+        }
+    }
+    let z0 = points.points[0][2];
+    let alt = flight.takeoff_altitude;
+    let mut s_max = f64::MIN;
+    for f in anim.frames.iter_mut() {
+        for i in 0..n {
+            let s = f.y[i] - s0 + drift * f.t;
+            s_max = s_max.max(s);
+            let d = f.x[i] - x_ref;
+            let c = course.at(s);
+            let (sh, ch) = c.heading.sin_cos();
+            let zc = f.z[i];
+            let z = match alt {
+                Some(a) => {
+                    let u = (zc / a).clamp(0.0, 1.0);
+                    zc + u * u * (3.0 - 2.0 * u) * (c.p[2] - z0)
+                }
+                None => c.p[2] + zc,
+            };
+            // Course-frame velocity (right, along, up).
+            let (uh, uv) = (f.heading[i], f.speed[i]);
+            let (ux, uy) = (uv * uh.sin(), uv * uh.cos() + drift);
+            let along = uy * (c.climb.cos() - d * c.turn);
+            let vx = along * sh + ux * ch;
+            let vy = along * ch - ux * sh;
+            f.x[i] = c.p[0] + d * ch;
+            f.y[i] = c.p[1] - d * sh;
+            f.z[i] = z;
+            f.heading[i] = spline::wrap(vx.atan2(vy));
+            f.speed[i] = vx.hypot(vy);
+        }
+    }
+    let len = course.length();
+    if !points.closed && s_max > len + 1.0 {
+        report.warnings.push(format!(
+            "{}: the flight runs {:.0} wingspans past the path's last point ({:.1} s at cruise speed); it flies straight on there — make the path longer or the flight shorter",
+            origin.display(),
+            s_max - len,
+            (s_max - len) / flight.speed
+        ));
+    }
+    fill_pitch(anim, flight.looped && points.closed);
+    let bank = banks(anim, g, opts, flight.looped && points.closed);
+    for (f, b) in anim.frames.iter_mut().zip(bank) {
+        f.bank = Some(b);
+    }
+    anim.path = Some(PathRecord {
+        source: origin.display().to_string(),
+        points: points.points.clone(),
+        closed: points.closed,
+        length: len,
+        widened: !report.widened.is_empty(),
+    });
+    Ok(report)
+}
+
+/// Refuses a path that turns back on itself (more than 90° at a control point) with a segment
+/// shorter than the formation's length `depth` (wingspans): the formation would fly into itself.
+fn check_backwards(points: &PathPoints, depth: f64, origin: &Path) -> Result<()> {
+    let p = &points.points;
+    let n = p.len();
+    let inner: Vec<usize> = if points.closed { (0..n).collect() } else { (1..n.saturating_sub(1)).collect() };
+    for i in inner {
+        let a = p[(i + n - 1) % n];
+        let b = p[i];
+        let c = p[(i + 1) % n];
+        let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+        let v = [c[0] - b[0], c[1] - b[1], c[2] - b[2]];
+        let (lu, lv) = (file::dist(a, b), file::dist(b, c));
+        let cos = (u[0] * v[0] + u[1] * v[1] + u[2] * v[2]) / (lu * lv);
+        if cos < 0.0 && lu.min(lv) < depth {
+            return Err(Error::format(
+                origin,
+                format!(
+                    "point {i} ({}): the path turns back on itself by {:.0}° within one formation length ({depth:.1} wingspans); move the point, or make the legs at least that long",
+                    file::show(b),
+                    cos.clamp(-1.0, 1.0).acos().to_degrees()
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Fills `pitch`: tan ϑ = ż / v from the height change over neighbouring frames (`cyclic`: the
+/// last frame's neighbour is the first).
+fn fill_pitch(anim: &mut Animation, cyclic: bool) {
+    let nf = anim.frames.len();
+    let n = anim.birds;
+    let period = nf as f64 / anim.fps;
+    let mut out = vec![vec![0.0; n]; nf];
+    for (k, row) in out.iter_mut().enumerate() {
+        let (a, b, dt) = neighbours(anim, k, cyclic, period);
+        if !(dt > 0.0) {
+            continue;
+        }
+        for (i, v) in row.iter_mut().enumerate() {
+            let vz = (anim.frames[b].z[i] - anim.frames[a].z[i]) / dt;
+            *v = vz.atan2(anim.frames[k].speed[i].max(1e-9));
+            if anim.frames[k].speed[i] < 1e-6 && vz.abs() < 1e-6 {
+                *v = 0.0;
+            }
+        }
+    }
+    for (f, p) in anim.frames.iter_mut().zip(out) {
+        f.pitch = Some(p);
+    }
+}
+
+/// The frames before and after `k` and the time between them.
+fn neighbours(anim: &Animation, k: usize, cyclic: bool, period: f64) -> (usize, usize, f64) {
+    let nf = anim.frames.len();
+    if cyclic && nf > 2 {
+        let (a, b) = ((k + nf - 1) % nf, (k + 1) % nf);
+        return (a, b, 2.0 * period / nf as f64);
+    }
+    let (a, b) = (k.saturating_sub(1), (k + 1).min(nf - 1));
+    (a, b, anim.frames[b].t - anim.frames[a].t)
+}
+
+/// Coordinated-turn banks tan φ* = v ω / g (ω from neighbouring headings), followed with the
+/// roll lag and the roll-rate limit, within ±`max_bank` (`cyclic`: run twice round the loop so
+/// the last frame leads into the first).
+fn banks(anim: &Animation, g: f64, opts: &CourseOptions, cyclic: bool) -> Vec<Vec<f64>> {
+    let nf = anim.frames.len();
+    let n = anim.birds;
+    let period = nf as f64 / anim.fps;
+    let target: Vec<Vec<f64>> = (0..nf)
+        .map(|k| {
+            let (a, b, dt) = neighbours(anim, k, cyclic, period);
+            (0..n)
+                .map(|i| {
+                    if !(dt > 0.0) {
+                        return 0.0;
+                    }
+                    let w = spline::wrap(anim.frames[b].heading[i] - anim.frames[a].heading[i]) / dt;
+                    (anim.frames[k].speed[i] * w / g)
+                        .atan()
+                        .clamp(-opts.max_bank, opts.max_bank)
+                })
+                .collect()
+        })
+        .collect();
+    let h = 1.0 / anim.fps;
+    let mut phi = target[0].clone();
+    let mut out = vec![Vec::new(); nf];
+    let passes = if cyclic { 2 } else { 1 };
+    for pass in 0..passes {
+        for k in 0..nf {
+            if k > 0 || pass > 0 {
+                for (p, &t) in phi.iter_mut().zip(&target[k]) {
+                    let rate = if opts.roll_lag > 0.0 { (t - *p) / opts.roll_lag } else { (t - *p) / h };
+                    let rate = rate.clamp(-opts.max_roll_rate, opts.max_roll_rate);
+                    let next = *p + rate * h;
+                    *p = if (next - t) * (*p - t) < 0.0 { t } else { next };
+                }
+            }
+            out[k] = phi.clone();
+        }
+    }
+    out
+}

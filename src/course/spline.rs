@@ -1,0 +1,462 @@
+//! The course curve: a centripetal Catmull–Rom spline through the control points (C¹, no cusps
+//! or self-intersections within a segment), resampled at even arc length, widened where a turn is
+//! tighter than the flock can fly, and evaluated at any arc length with its heading, turn rate
+//! and climb angle. World frame, wingspans; headings radians clockwise from +y.
+//!
+//! Centripetal Catmull–Rom (α = ½): knots t_{i+1} = t_i + |p_{i+1} − p_i|^½ and, between p_1 and
+//! p_2 of four consecutive points, the Barry–Goldman pyramid
+//! ```math
+//! A_k = \frac{t_{k+1} - t}{t_{k+1} - t_k} p_k + \frac{t - t_k}{t_{k+1} - t_k} p_{k+1},\quad
+//! B_k = \frac{t_{k+2} - t}{t_{k+2} - t_k} A_k + \frac{t - t_k}{t_{k+2} - t_k} A_{k+1},\quad
+//! C = \frac{t_2 - t}{t_2 - t_1} B_0 + \frac{t - t_1}{t_2 - t_1} B_1 .
+//! ```
+//! An open path gets mirrored end points (2p₀ − p₁); a closed one wraps around.
+//!
+//! Evaluation between two samples is a cubic Hermite of position (tangents the unit directions,
+//! so C¹), with heading, turn rate and climb angle interpolated linearly (so heading and bank
+//! are continuous). Beyond an open path's ends the course runs straight on along the end
+//! tangents; a closed path repeats.
+
+use std::f64::consts::PI;
+
+/// Sample spacing of the evaluated course, wingspans (at most [`MAX_SAMPLES`] samples).
+pub const SAMPLE_SPACING: f64 = 0.25;
+
+/// Largest number of samples of a course.
+pub const MAX_SAMPLES: usize = 400_000;
+
+/// The course at one place.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CourseAt {
+    /// Position, wingspans.
+    pub p: [f64; 3],
+    /// Heading of the horizontal tangent, radians clockwise from +y (unwrapped along the path).
+    pub heading: f64,
+    /// Turn rate dθ/ds of the heading per unit of arc length, radians per wingspan (right turn
+    /// positive).
+    pub turn: f64,
+    /// Climb angle γ of the tangent above the horizontal, radians.
+    pub climb: f64,
+}
+
+/// An evaluated course: samples at even arc length.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Course {
+    /// Samples (positions), wingspans.
+    pts: Vec<[f64; 3]>,
+    /// Unit tangents.
+    tan: Vec<[f64; 3]>,
+    /// Unwrapped heading of each sample, radians.
+    heading: Vec<f64>,
+    /// dθ/ds per sample, radians per wingspan.
+    turn: Vec<f64>,
+    /// Climb angle per sample, radians.
+    climb: Vec<f64>,
+    /// Arc length between samples, wingspans.
+    ds: f64,
+    /// Whether the course is a closed loop (the last sample joins the first).
+    pub closed: bool,
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn lerp3(a: [f64; 3], b: [f64; 3], u: f64) -> [f64; 3] {
+    [
+        a[0] + u * (b[0] - a[0]),
+        a[1] + u * (b[1] - a[1]),
+        a[2] + u * (b[2] - a[2]),
+    ]
+}
+
+fn norm(a: [f64; 3]) -> f64 {
+    (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
+}
+
+/// Wraps an angle into (−π, π].
+pub fn wrap(a: f64) -> f64 {
+    let r = (a + PI).rem_euclid(2.0 * PI) - PI;
+    if r <= -PI {
+        r + 2.0 * PI
+    } else {
+        r
+    }
+}
+
+/// One centripetal Catmull–Rom segment from `p[1]` to `p[2]` at parameter `u` ∈ [0, 1].
+fn segment(p: [[f64; 3]; 4], u: f64) -> [f64; 3] {
+    let mut t = [0.0; 4];
+    for k in 1..4 {
+        t[k] = t[k - 1] + norm(sub(p[k], p[k - 1])).sqrt().max(1e-9);
+    }
+    let tt = t[1] + u * (t[2] - t[1]);
+    let a = |k: usize| lerp3(p[k], p[k + 1], (tt - t[k]) / (t[k + 1] - t[k]));
+    let (a0, a1, a2) = (a(0), a(1), a(2));
+    let b0 = lerp3(a0, a1, (tt - t[0]) / (t[2] - t[0]));
+    let b1 = lerp3(a1, a2, (tt - t[1]) / (t[3] - t[1]));
+    lerp3(b0, b1, u)
+}
+
+/// Dense points of the spline through `points` (open or closed).
+pub fn spline_points(points: &[[f64; 3]], closed: bool) -> Vec<[f64; 3]> {
+    let n = points.len();
+    let get = |i: isize| -> [f64; 3] {
+        if closed {
+            points[i.rem_euclid(n as isize) as usize]
+        } else if i < 0 {
+            let (a, b) = (points[0], points[1.min(n - 1)]);
+            [2.0 * a[0] - b[0], 2.0 * a[1] - b[1], 2.0 * a[2] - b[2]]
+        } else if i as usize >= n {
+            let (a, b) = (points[n - 1], points[n.saturating_sub(2)]);
+            [2.0 * a[0] - b[0], 2.0 * a[1] - b[1], 2.0 * a[2] - b[2]]
+        } else {
+            points[i as usize]
+        }
+    };
+    let segs = if closed { n } else { n - 1 };
+    let total: f64 = (0..segs)
+        .map(|i| norm(sub(get(i as isize + 1), get(i as isize))))
+        .sum();
+    let budget = (MAX_SAMPLES / 2) as f64;
+    let mut out = Vec::new();
+    for i in 0..segs as isize {
+        let q = [get(i - 1), get(i), get(i + 1), get(i + 2)];
+        let len = norm(sub(q[2], q[1]));
+        let steps = ((len / (0.5 * SAMPLE_SPACING)).ceil() as usize)
+            .clamp(8, (budget * len / total.max(1e-9)).max(8.0) as usize);
+        for k in 0..steps {
+            out.push(segment(q, k as f64 / steps as f64));
+        }
+    }
+    if closed {
+        out.push(points[0]);
+    } else {
+        out.push(points[n - 1]);
+    }
+    out
+}
+
+/// Resamples a polyline at even arc length (about `spacing` apart; the ends kept).
+pub fn resample(poly: &[[f64; 3]], spacing: f64) -> (Vec<[f64; 3]>, f64) {
+    let mut acc = vec![0.0; poly.len()];
+    for i in 1..poly.len() {
+        acc[i] = acc[i - 1] + norm(sub(poly[i], poly[i - 1]));
+    }
+    let total = *acc.last().unwrap_or(&0.0);
+    let count = ((total / spacing).ceil() as usize).clamp(2, MAX_SAMPLES);
+    let ds = total / count as f64;
+    let mut out = Vec::with_capacity(count + 1);
+    let mut j = 0;
+    for k in 0..=count {
+        let s = k as f64 * ds;
+        while j + 2 < poly.len() && acc[j + 1] < s {
+            j += 1;
+        }
+        let h = acc[j + 1] - acc[j];
+        let u = if h > 0.0 { ((s - acc[j]) / h).clamp(0.0, 1.0) } else { 0.0 };
+        out.push(lerp3(poly[j], poly[j + 1], u));
+    }
+    (out, ds)
+}
+
+/// Signed horizontal curvature (dθ/ds of the horizontal heading, right turn positive) at every
+/// sample of an evenly spaced polyline, radians per wingspan.
+pub fn curvature(pts: &[[f64; 3]], ds: f64, closed: bool) -> Vec<f64> {
+    let n = pts.len();
+    let dir = |a: [f64; 3], b: [f64; 3]| (b[0] - a[0]).atan2(b[1] - a[1]);
+    (0..n)
+        .map(|i| {
+            let (a, b, c) = if closed {
+                // The last sample repeats the first.
+                let m = n - 1;
+                (pts[(i + m - 1) % m], pts[i % m], pts[(i + 1) % m])
+            } else if i == 0 || i + 1 == n {
+                return 0.0;
+            } else {
+                (pts[i - 1], pts[i], pts[i + 1])
+            };
+            wrap(dir(b, c) - dir(a, b)) / ds
+        })
+        .collect()
+}
+
+/// One too-tight place: the sample index and the radius there before widening, wingspans.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Tight {
+    /// Sample of the tightest point of the place.
+    pub sample: usize,
+    /// Arc length there, wingspans.
+    pub s: f64,
+    /// Radius of the turn there, wingspans.
+    pub radius: f64,
+}
+
+/// Widens every turn tighter than `max_turn` (radians per wingspan) by local smoothing of the
+/// horizontal course (Laplacian steps on the offending stretch and its surroundings, end points
+/// of an open path fixed), on a polyline of a spacing fitting the needed radius; returns the
+/// widened polyline (even spacing `spacing`), and the too-tight places found before.
+pub fn widen(
+    pts: Vec<[f64; 3]>,
+    ds: f64,
+    closed: bool,
+    max_turn: f64,
+    spacing: f64,
+) -> (Vec<[f64; 3]>, f64, Vec<Tight>) {
+    let k = curvature(&pts, ds, closed);
+    let mut tight: Vec<Tight> = Vec::new();
+    let mut inside = false;
+    for (i, &c) in k.iter().enumerate() {
+        if c.abs() > max_turn {
+            let r = 1.0 / c.abs();
+            match (inside, tight.last_mut()) {
+                (true, Some(t)) if r < t.radius => {
+                    *t = Tight { sample: i, s: i as f64 * ds, radius: r }
+                }
+                (true, _) => {}
+                (false, _) => tight.push(Tight { sample: i, s: i as f64 * ds, radius: r }),
+            }
+            inside = true;
+        } else {
+            inside = false;
+        }
+    }
+    if tight.is_empty() {
+        return (pts, ds, tight);
+    }
+    // Coarse spacing: a tenth of the needed radius (finer detail is too tight anyway).
+    let coarse = (0.1 / max_turn).max(spacing);
+    let (mut q, mut dq) = resample(&pts, coarse);
+    let target = 0.97 * max_turn;
+    for _round in 0..400 {
+        let k = curvature(&q, dq, closed);
+        let n = q.len();
+        let bad: Vec<usize> = (0..n).filter(|&i| k[i].abs() > target).collect();
+        if bad.is_empty() {
+            break;
+        }
+        // Smooth around every offending sample, over a stretch of the needed quarter turn.
+        let reach = ((0.5 * PI / max_turn) / dq).ceil() as isize + 2;
+        let mut mark = vec![false; n];
+        for &b in &bad {
+            for o in -reach..=reach {
+                let j = b as isize + o;
+                let j = if closed {
+                    j.rem_euclid(n as isize - 1) as usize
+                } else if j <= 0 || j as usize >= n - 1 {
+                    continue;
+                } else {
+                    j as usize
+                };
+                mark[j] = true;
+            }
+        }
+        for _ in 0..20 {
+            let prev = q.clone();
+            for j in 0..n {
+                if !mark[j] {
+                    continue;
+                }
+                let (a, c) = if closed {
+                    let m = n - 1;
+                    (prev[(j + m - 1) % m], prev[(j + 1) % m])
+                } else {
+                    (prev[j - 1], prev[j + 1])
+                };
+                for d in 0..3 {
+                    q[j][d] = prev[j][d] + 0.5 * (0.5 * (a[d] + c[d]) - prev[j][d]);
+                }
+            }
+            if closed {
+                q[n - 1] = q[0];
+            }
+        }
+        let (r, d) = resample(&q, coarse);
+        q = r;
+        dq = d;
+    }
+    let dense = spline_points(&q[..if closed { q.len() - 1 } else { q.len() }], closed);
+    let (out, d) = resample(&dense, spacing);
+    (out, d, tight)
+}
+
+impl Course {
+    /// The course through evenly spaced samples `pts` (`ds` apart; for a closed course the last
+    /// sample equals the first).
+    pub fn from_samples(pts: Vec<[f64; 3]>, ds: f64, closed: bool) -> Course {
+        let n = pts.len();
+        let mut tan = Vec::with_capacity(n);
+        for i in 0..n {
+            let (a, b) = if closed {
+                let m = n - 1;
+                (pts[(i + m - 1) % m], pts[(i + 1) % m])
+            } else {
+                (pts[i.saturating_sub(1)], pts[(i + 1).min(n - 1)])
+            };
+            let d = sub(b, a);
+            let l = norm(d).max(1e-12);
+            tan.push([d[0] / l, d[1] / l, d[2] / l]);
+        }
+        let mut heading = Vec::with_capacity(n);
+        let mut climb = Vec::with_capacity(n);
+        for t in &tan {
+            let h = t[0].atan2(t[1]);
+            let h = match heading.last() {
+                Some(&p) => p + wrap(h - p),
+                None => h,
+            };
+            heading.push(h);
+            climb.push(t[2].atan2(t[0].hypot(t[1])));
+        }
+        let turn: Vec<f64> = (0..n)
+            .map(|i| {
+                let (a, b, steps) = if closed && n > 2 {
+                    let m = n - 1;
+                    ((i + m - 1) % m, (i + 1) % m, 2.0)
+                } else {
+                    let (a, b) = (i.saturating_sub(1), (i + 1).min(n - 1));
+                    (a, b, (b - a) as f64)
+                };
+                if steps > 0.0 {
+                    wrap(heading[b] - heading[a]) / (steps * ds)
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        Course {
+            pts,
+            tan,
+            heading,
+            turn,
+            climb,
+            ds,
+            closed,
+        }
+    }
+
+    /// Arc length of the course, wingspans.
+    pub fn length(&self) -> f64 {
+        (self.pts.len() - 1) as f64 * self.ds
+    }
+
+    /// Largest |turn rate| along the course, radians per wingspan.
+    pub fn max_turn(&self) -> f64 {
+        self.turn.iter().fold(0.0, |m, t| m.max(t.abs()))
+    }
+
+    /// The course at arc length `s` (wingspans from the first point; straight on beyond the
+    /// ends of an open course, repeating for a closed one).
+    pub fn at(&self, s: f64) -> CourseAt {
+        let len = self.length();
+        let n = self.pts.len();
+        let (s, laps) = if self.closed && len > 0.0 {
+            let laps = (s / len).floor();
+            (s - laps * len, laps)
+        } else {
+            (s, 0.0)
+        };
+        let turns = laps * (self.heading[n - 1] - self.heading[0]);
+        if !self.closed && (s < 0.0 || s > len) {
+            let (i, over) = if s < 0.0 { (0, s) } else { (n - 1, s - len) };
+            let t = self.tan[i];
+            let p = self.pts[i];
+            return CourseAt {
+                p: [p[0] + over * t[0], p[1] + over * t[1], p[2] + over * t[2]],
+                heading: self.heading[i],
+                turn: 0.0,
+                climb: self.climb[i],
+            };
+        }
+        let x = (s / self.ds).clamp(0.0, (n - 1) as f64);
+        let j = (x.floor() as usize).min(n - 2);
+        let u = x - j as f64;
+        let (p0, p1, t0, t1) = (self.pts[j], self.pts[j + 1], self.tan[j], self.tan[j + 1]);
+        let (u2, u3) = (u * u, u * u * u);
+        let (h00, h10, h01, h11) = (
+            2.0 * u3 - 3.0 * u2 + 1.0,
+            u3 - 2.0 * u2 + u,
+            -2.0 * u3 + 3.0 * u2,
+            u3 - u2,
+        );
+        let l = self.ds;
+        let p = [0, 1, 2].map(|d| h00 * p0[d] + h10 * l * t0[d] + h01 * p1[d] + h11 * l * t1[d]);
+        let li = |v: &[f64]| v[j] + u * (v[j + 1] - v[j]);
+        CourseAt {
+            p,
+            heading: li(&self.heading) + turns,
+            turn: li(&self.turn),
+            climb: li(&self.climb),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn course(points: &[[f64; 3]], closed: bool) -> Course {
+        let dense = spline_points(points, closed);
+        let (pts, ds) = resample(&dense, SAMPLE_SPACING);
+        Course::from_samples(pts, ds, closed)
+    }
+
+    #[test]
+    fn passes_through_control_points_and_is_c1() {
+        let pts = [[0.0, 0.0, 0.0], [0.0, 100.0, 0.0], [100.0, 200.0, 10.0], [300.0, 200.0, 10.0]];
+        let c = course(&pts, false);
+        for p in &pts {
+            let best = (0..=4000)
+                .map(|k| {
+                    let q = c.at(k as f64 * c.length() / 4000.0).p;
+                    norm(sub(q, *p))
+                })
+                .fold(f64::MAX, f64::min);
+            assert!(best < 0.2, "{best}");
+        }
+        // Heading continuous: no jump between neighbouring evaluations.
+        let mut prev = c.at(0.0).heading;
+        for k in 1..20000 {
+            let h = c.at(k as f64 * c.length() / 20000.0).heading;
+            assert!((h - prev).abs() < 0.01, "{k}: {h} {prev}");
+            prev = h;
+        }
+        // Arc length: the position moves at unit speed.
+        let (a, b) = (c.at(150.0).p, c.at(151.0).p);
+        assert!((norm(sub(b, a)) - 1.0).abs() < 0.01);
+    }
+
+    #[test]
+    fn a_circle_has_its_curvature_and_closes() {
+        let r = 50.0;
+        let pts: Vec<[f64; 3]> = (0..24)
+            .map(|k| {
+                let a = k as f64 * 2.0 * PI / 24.0;
+                // Clockwise seen from above: a right turn.
+                [r * a.cos(), -r * a.sin(), 0.0]
+            })
+            .collect();
+        let c = course(&pts, true);
+        assert!((c.length() - 2.0 * PI * r).abs() < 0.5, "{}", c.length());
+        for k in 0..100 {
+            let at = c.at(k as f64 * 3.7);
+            assert!((at.turn - 1.0 / r).abs() < 0.002, "{k}: {}", at.turn);
+        }
+        // One lap later: same place, heading one turn on.
+        let (a, b) = (c.at(10.0), c.at(10.0 + c.length()));
+        assert!(norm(sub(a.p, b.p)) < 1e-6);
+        assert!((b.heading - a.heading - 2.0 * PI).abs() < 1e-6);
+    }
+
+    #[test]
+    fn widening_removes_a_corner_tighter_than_allowed() {
+        let pts = [[0.0, 0.0, 0.0], [0.0, 100.0, 0.0], [100.0, 100.0, 0.0]];
+        let dense = spline_points(&pts, false);
+        let (p, ds) = resample(&dense, SAMPLE_SPACING);
+        let (w, ds, tight) = widen(p, ds, false, 1.0 / 40.0, SAMPLE_SPACING);
+        assert_eq!(tight.len(), 1);
+        assert!(tight[0].radius < 40.0);
+        let c = Course::from_samples(w, ds, false);
+        assert!(c.max_turn() <= 1.0 / 40.0 * 1.05, "{}", 1.0 / c.max_turn());
+    }
+}
