@@ -12,11 +12,32 @@ use formation::progress::Silent;
 use formation::Animation;
 
 fn simulate() -> Animation {
+    simulate_on(None)
+}
+
+fn simulate_on(path: Option<PathBuf>) -> Animation {
     let input = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples_data/barnacle_geese_v.json");
     let mut config = Config::default();
     config.steady.birds = 14;
     config.seconds = Some(20.0);
+    config.course.path = path;
     Pipeline::from_path(input).run(&config).unwrap().0
+}
+
+/// Issue 19's test path: 200 wingspans north, a 90° right turn of radius 150, 300 east
+/// climbing 20 wingspans (the take-off joins it at its first point, 20 wingspans up).
+fn turn_path(dir: &Path) -> PathBuf {
+    let mut pts: Vec<[f64; 3]> = (0..5).map(|k| [0.0, 50.0 * k as f64, 20.0]).collect();
+    for k in 1..=12 {
+        let a = std::f64::consts::PI * (1.0 - k as f64 / 24.0);
+        pts.push([150.0 + 150.0 * a.cos(), 200.0 + 150.0 * a.sin(), 20.0]);
+    }
+    for k in 1..=6 {
+        pts.push([150.0 + 50.0 * k as f64, 350.0, 20.0 + 20.0 * k as f64 / 6.0]);
+    }
+    let p = dir.join("turn.json");
+    std::fs::write(&p, format!("{{\"points\": {pts:?}}}")).unwrap();
+    p
 }
 
 fn bench(c: &mut Criterion) {
@@ -25,6 +46,10 @@ fn bench(c: &mut Criterion) {
     g.bench_function("geese_14_birds_20s_simulation", |b| b.iter(simulate));
     let dir = std::env::temp_dir().join(format!("formation-bench-animate-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
+    let path = turn_path(&dir);
+    g.bench_function("geese_14_birds_20s_simulation_on_a_path", |b| {
+        b.iter(|| simulate_on(Some(path.clone())))
+    });
     let gif: PathBuf = dir.join("flock.gif");
     let anim = simulate();
     eprintln!(

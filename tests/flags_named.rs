@@ -18,6 +18,7 @@ const SWITCHES: &[&str] = &[
     "--keep-unconverged",
     "--no-initiation",
     "--sun",
+    "--loop",
 ];
 
 /// The flags `formation ARGS --help` lists.
@@ -89,6 +90,10 @@ fn commands() -> Vec<Command> {
         ("--c2", "3", None),
         ("--wingspan-m", "0", None),
         ("--max-jump", "0", None),
+    ];
+    let course: Vec<(&str, &str, Option<String>)> = vec![
+        ("--path", "OUT/no-path.json", Some("no-path.json".into())),
+        ("--path-units", "feet", None),
     ];
     let wingbeat: Vec<(&str, &str, Option<String>)> = vec![
         ("--species", "dodo", None),
@@ -176,9 +181,11 @@ fn commands() -> Vec<Command> {
             ]),
             cases: cat(vec![
                 steady_flags.clone(),
+                course.clone(),
                 wingbeat.clone(),
                 scene.clone(),
                 vec![
+                    ("--cruise-altitude", "1e9", None),
                     ("--frames", "0", None),
                     ("--report", "OUT/r.txt", None),
                     o("OUT/s.txt"),
@@ -191,6 +198,7 @@ fn commands() -> Vec<Command> {
             base: strings(&["initiate", &steady, "-o", "OUT/i.json"]),
             cases: cat(vec![
                 initiate.clone(),
+                course.clone(),
                 wingbeat.clone(),
                 scene.clone(),
                 vec![o("OUT/i.txt"), seed.clone()],
@@ -211,6 +219,7 @@ fn commands() -> Vec<Command> {
             cases: cat(vec![
                 read.clone(),
                 steady_flags.clone(),
+                course,
                 initiate.clone(),
                 wingbeat.clone(),
                 shot.clone(),

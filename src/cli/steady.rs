@@ -156,8 +156,8 @@ pub fn run(args: SteadyArgs, g: Global) -> Result<()> {
     if !g.quiet {
         let k = &report.keys;
         eprintln!(
-            "steady: {} key shapes ({} draws, {} redraws, {} damped, {} held, min λ {:.3}), max key residual {:.1e}, max jump {:.2} wingspans",
-            k.keys, k.draws, k.redraws, k.damped, k.held, k.min_damping, k.max_residual, k.max_jump
+            "steady: {} key shapes ({} draws, {} redraws, {} damped, {} held, {} kept the previous lateral positions, min λ {:.3}), max key residual {:.1e}, max jump {:.2} wingspans",
+            k.keys, k.draws, k.redraws, k.damped, k.held, k.lateral_held, k.min_damping, k.max_residual, k.max_jump
         );
     }
     Ok(())

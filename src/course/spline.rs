@@ -205,20 +205,26 @@ pub fn widen(
 ) -> (Vec<[f64; 3]>, f64, Vec<Tight>) {
     let k = curvature(&pts, ds, closed);
     let mut tight: Vec<Tight> = Vec::new();
-    let mut inside = false;
+    // Offending samples closer than a quarter turn of the needed radius are one place.
+    let join = ((0.5 * PI / max_turn) / ds).ceil() as usize;
+    let mut last_bad: Option<usize> = None;
     for (i, &c) in k.iter().enumerate() {
         if c.abs() > max_turn {
             let r = 1.0 / c.abs();
-            match (inside, tight.last_mut()) {
-                (true, Some(t)) if r < t.radius => {
-                    *t = Tight { sample: i, s: i as f64 * ds, radius: r }
+            let here = Tight {
+                sample: i,
+                s: i as f64 * ds,
+                radius: r,
+            };
+            match (last_bad, tight.last_mut()) {
+                (Some(b), Some(t)) if i - b <= join => {
+                    if r < t.radius {
+                        *t = here;
+                    }
                 }
-                (true, _) => {}
-                (false, _) => tight.push(Tight { sample: i, s: i as f64 * ds, radius: r }),
+                _ => tight.push(here),
             }
-            inside = true;
-        } else {
-            inside = false;
+            last_bad = Some(i);
         }
     }
     if tight.is_empty() {
@@ -227,7 +233,7 @@ pub fn widen(
     // Coarse spacing: a tenth of the needed radius (finer detail is too tight anyway).
     let coarse = (0.1 / max_turn).max(spacing);
     let (mut q, mut dq) = resample(&pts, coarse);
-    let target = 0.97 * max_turn;
+    let target = 0.92 * max_turn;
     for _round in 0..400 {
         let k = curvature(&q, dq, closed);
         let n = q.len();
@@ -450,13 +456,19 @@ mod tests {
 
     #[test]
     fn widening_removes_a_corner_tighter_than_allowed() {
-        let pts = [[0.0, 0.0, 0.0], [0.0, 100.0, 0.0], [100.0, 100.0, 0.0]];
+        let pts = [
+            [0.0, 0.0, 0.0],
+            [0.0, 95.0, 0.0],
+            [0.0, 100.0, 0.0],
+            [5.0, 100.0, 0.0],
+            [100.0, 100.0, 0.0],
+        ];
         let dense = spline_points(&pts, false);
         let (p, ds) = resample(&dense, SAMPLE_SPACING);
         let (w, ds, tight) = widen(p, ds, false, 1.0 / 40.0, SAMPLE_SPACING);
         assert_eq!(tight.len(), 1);
         assert!(tight[0].radius < 40.0);
         let c = Course::from_samples(w, ds, false);
-        assert!(c.max_turn() <= 1.0 / 40.0 * 1.05, "{}", 1.0 / c.max_turn());
+        assert!(c.max_turn() <= 1.0 / 40.0 * 1.02, "{}", 1.0 / c.max_turn());
     }
 }

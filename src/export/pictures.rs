@@ -82,10 +82,11 @@ impl Film {
         let (width, height) = (opts.width as usize, opts.height as usize);
         let flapper = Flapper::from_animation(anim);
         let times = sample::output_times(anim, fps);
-        let states: Vec<Vec<BirdState>> = times
+        let mut states: Vec<Vec<BirdState>> = times
             .iter()
             .map(|&t| sample::state_at(anim, &flapper, t))
             .collect();
+        loop_frame(anim, &times, &mut states);
         let species = anim
             .species
             .as_deref()
@@ -166,6 +167,33 @@ impl Film {
         }
         let pl = super::silhouette::plumage(self.species);
         Palette::learn(&train, &[pl.body, pl.arm, pl.hand, pl.head])
+    }
+}
+
+/// A loop in the flock's moving frame (`Animation::looped`, not on a closed path) is drawn in
+/// that frame: the flock's travel over the loop, spread evenly over its duration, is taken off
+/// every bird, so the camera, the sky and the birds of the last picture lead into the first
+/// without a jump (the flock holds its place in a still sky). On a closed path the loop is in
+/// the world and is drawn as it is.
+fn loop_frame(anim: &Animation, times: &[f64], states: &mut [Vec<BirdState>]) {
+    if !anim.looped || anim.path.as_ref().is_some_and(|p| p.closed) {
+        return;
+    }
+    let closed = super::gltf::closed_loop(anim);
+    let (Some(first), Some(close)) = (anim.frames.first(), closed.frames.last()) else {
+        return;
+    };
+    let period = close.t - first.t;
+    if !(period > 0.0) || closed.frames.len() == anim.frames.len() {
+        return;
+    }
+    let (dx, dy) = (close.x[0] - first.x[0], close.y[0] - first.y[0]);
+    for (t, st) in times.iter().zip(states.iter_mut()) {
+        let u = (t - first.t) / period;
+        for b in st.iter_mut() {
+            b.x -= u * dx;
+            b.y -= u * dy;
+        }
     }
 }
 

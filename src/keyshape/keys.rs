@@ -118,6 +118,9 @@ pub struct KeyStats {
     pub max_residual: f64,
     /// Largest move of a bird between consecutive keys, wingspans.
     pub max_jump: f64,
+    /// Keys where no shape fitted the drifted lateral positions, which then kept the previous
+    /// key's lateral positions.
+    pub lateral_held: usize,
 }
 
 /// The structure every key shape must keep: leader, arm steps and depth.
@@ -404,9 +407,19 @@ pub fn next_key(
             .iter()
             .map(|e| e / total)
             .collect();
+        // The reference of eq. (2) inside the feasible ranges (renormalised, as a draw is), so
+        // that every target, damped or not, stays in them.
+        let mut reference = xi.clone();
+        for _ in 0..100 {
+            if feasible.excess(&reference) <= 1e-13 {
+                break;
+            }
+            feasible.clip(&mut reference);
+            renormalise(&mut reference);
+        }
         moved = KeyShape {
             x: x.to_vec(),
-            xi_target: xi.clone(),
+            xi_target: reference,
             xi,
             ..prev.clone()
         };
@@ -538,7 +551,25 @@ pub fn key_shapes(
         };
         let w = (at as f64 / count.max(2) as f64).powi(2);
         let home = plan.home.then(|| (keys[0].xi_target.as_slice(), w));
-        let k = next_key(&ctx_k, prev, home, rng, &mut stats)?;
+        let mut k = next_key(&ctx_k, prev, home, rng, &mut stats)?;
+        if k.damping == 0.0 && k.x != prev.x {
+            // No shape at the drifted lateral positions: this key keeps the previous ones.
+            stats.held -= 1;
+            stats.lateral_held += 1;
+            let ctx_prev = KeyContext {
+                x: &prev.x,
+                total: if prev.x.as_slice() == ctx.x {
+                    ctx.total
+                } else {
+                    plan.lateral
+                        .iter()
+                        .find(|(x, _)| *x == prev.x)
+                        .map_or(ctx.total, |(_, t)| *t)
+                },
+                ..*ctx
+            };
+            k = next_key(&ctx_prev, prev, home, rng, &mut stats)?;
+        }
         stats.min_damping = stats.min_damping.min(k.damping);
         stats.max_residual = stats.max_residual.max(k.residual);
         stats.max_jump = stats.max_jump.max(max_jump(&prev.y, &k.y));

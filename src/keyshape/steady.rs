@@ -9,12 +9,15 @@
 //! 4. [`interpolate`](crate::keyshape::interpolate): C¹ monotone cubic of each bird's `y` between
 //!    keys, the flock cruising along +y.
 //!
-//! The lateral positions are drawn once and kept for the whole flight: gaps from N(d̄, σ̄_x) with
+//! The lateral positions are drawn once: gaps from N(d̄, σ̄_x) with
 //! d̄ uniform in the movie's range of mean gaps [min_f μ_xf, max_f μ_xf] and σ̄_x the mean of σ_xf,
-//! redrawn only at or below a body's width (`min_gap`; overlapping wingtips are kept). Munk's theorem then fixes E = Σ_{i≠j} g(|x_i − x_j|, 0) for every
+//! redrawn only at or below a body's width (`min_gap`; overlapping wingtips are kept); each gap
+//! then drifts slowly around its drawn value from key to key (`lateral_drift`, issue 19), so
+//! every key shape has its own x. Munk's theorem fixes E = Σ_{i≠j} g(|x_i − x_j|, 0) of each
 //! key shape (`aero::munk_total`), which makes eq. (3) exact instead of an estimate from a
-//! constant-gap flock. The world frame places the leader at (0, speed·t, 0) and every bird at
-//! (x_i, speed·t − y_i(t), 0) (SPEC §2).
+//! constant-gap flock. Heights differ slightly between birds (`height_spread`,
+//! `height_neighbour`). This is the course frame: the leader at (0, speed·t, 0) and every bird
+//! at (x_i(t), speed·t − y_i(t), z_i(t)); the course step (`crate::course`) maps it onto a path.
 
 use rand::Rng;
 use serde::{Deserialize, Serialize};
