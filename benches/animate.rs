@@ -25,15 +25,16 @@ fn simulate_on(path: Option<PathBuf>) -> Animation {
 }
 
 /// Issue 19's test path: 200 wingspans north, a 90° right turn of radius 150, 300 east
-/// climbing 20 wingspans (the take-off joins it at its first point, 20 wingspans up).
+/// climbing 20 wingspans (the take-off joins it at its first point, at the default cruise
+/// altitude of 10 wingspans, so both runs fly the same take-off).
 fn turn_path(dir: &Path) -> PathBuf {
-    let mut pts: Vec<[f64; 3]> = (0..5).map(|k| [0.0, 50.0 * k as f64, 20.0]).collect();
+    let mut pts: Vec<[f64; 3]> = (0..5).map(|k| [0.0, 50.0 * k as f64, 10.0]).collect();
     for k in 1..=12 {
         let a = std::f64::consts::PI * (1.0 - k as f64 / 24.0);
-        pts.push([150.0 + 150.0 * a.cos(), 200.0 + 150.0 * a.sin(), 20.0]);
+        pts.push([150.0 + 150.0 * a.cos(), 200.0 + 150.0 * a.sin(), 10.0]);
     }
     for k in 1..=6 {
-        pts.push([150.0 + 50.0 * k as f64, 350.0, 20.0 + 20.0 * k as f64 / 6.0]);
+        pts.push([150.0 + 50.0 * k as f64, 350.0, 10.0 + 20.0 * k as f64 / 6.0]);
     }
     let p = dir.join("turn.json");
     std::fs::write(&p, format!("{{\"points\": {pts:?}}}")).unwrap();
@@ -50,6 +51,22 @@ fn bench(c: &mut Criterion) {
     g.bench_function("geese_14_birds_20s_simulation_on_a_path", |b| {
         b.iter(|| simulate_on(Some(path.clone())))
     });
+    // The course step alone (reading the path, the spline, the mapping, banks and pitches) on
+    // the course-frame flight of the first benchmark.
+    {
+        let mut config = Config::default();
+        config.steady.birds = 14;
+        config.course.path = Some(path.clone());
+        let straight = simulate();
+        g.bench_function("geese_14_birds_20s_course_step", |b| {
+            b.iter(|| {
+                let points = config.course.load(config.steady.wingspan_m).unwrap();
+                let mut a = straight.clone();
+                formation::pipeline::course_stage(&mut a, points.as_ref(), &config).unwrap();
+                a
+            })
+        });
+    }
     let gif: PathBuf = dir.join("flock.gif");
     let anim = simulate();
     eprintln!(

@@ -335,13 +335,10 @@ pub fn course_stage(
     path: Option<&PathPoints>,
     config: &Config,
 ) -> Result<CourseReport> {
-    let takeoff_altitude = anim
-        .stage("initiation")
-        .is_some()
-        .then(|| match path {
-            Some(p) => p.points[0][2],
-            None => config.initiate.cruise_altitude,
-        });
+    let takeoff_altitude = anim.stage("initiation").is_some().then(|| match path {
+        Some(p) => p.points[0][2],
+        None => config.initiate.cruise_altitude,
+    });
     let flight = crate::course::Flight {
         speed: config.steady.speed,
         takeoff_altitude,

@@ -109,12 +109,21 @@ fn check(anim: &Animation, rep: &SteadyReport, opts: &SteadyOptions) {
         prev_step = Some(step);
         // Lateral positions drift only between keys (issue 19), between the two keys' values
         // (monotone interpolation), never by more than the jump bound per key.
-        let k = rep.key_frames.partition_point(|&kf| kf <= f).clamp(1, rep.key_frames.len() - 1);
+        let k = rep
+            .key_frames
+            .partition_point(|&kf| kf <= f)
+            .clamp(1, rep.key_frames.len() - 1);
         let (ka, kb) = (&anim.key_shapes[k - 1], &anim.key_shapes[k]);
         for i in 0..n {
-            let (lo, hi) = (ka.birds[i].x.min(kb.birds[i].x), ka.birds[i].x.max(kb.birds[i].x));
+            let (lo, hi) = (
+                ka.birds[i].x.min(kb.birds[i].x),
+                ka.birds[i].x.max(kb.birds[i].x),
+            );
             let xf = anim.frames[f].x[i];
-            assert!(xf >= lo - 1e-9 && xf <= hi + 1e-9, "frame {f} bird {i}: x {xf} outside [{lo}, {hi}]");
+            assert!(
+                xf >= lo - 1e-9 && xf <= hi + 1e-9,
+                "frame {f} bird {i}: x {xf} outside [{lo}, {hi}]"
+            );
             assert!(hi - lo <= opts.max_jump + 1e-9);
         }
     }

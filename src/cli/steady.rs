@@ -38,7 +38,11 @@ pub struct SteadyArgs {
     pub path: super::course::PathFlags,
     /// Height of the flight above the ground without a path, wingspans (0 keeps the file ready
     /// for `formation initiate`, which climbs to its own --cruise-altitude and adds this).
-    #[arg(long = "cruise-altitude", allow_negative_numbers = true, default_value_t = 0.0)]
+    #[arg(
+        long = "cruise-altitude",
+        allow_negative_numbers = true,
+        default_value_t = 0.0
+    )]
     pub cruise_altitude: f64,
     #[command(flatten)]
     pub wingbeat: super::wingbeat::WingbeatFlags,

@@ -82,10 +82,7 @@ pub fn read(path: &Path, units: Option<PathUnits>, wingspan_m: f64) -> Result<Pa
             if p.len() != 3 {
                 return Err(Error::format(
                     path,
-                    format!(
-                        "points[{i}]: {} numbers, expected [x, y, z]",
-                        p.len()
-                    ),
+                    format!("points[{i}]: {} numbers, expected [x, y, z]", p.len()),
                 ));
             }
             pts.push([p[0], p[1], p[2]]);
@@ -194,10 +191,7 @@ fn check(path: &Path, raw: Vec<[f64; 3]>, scale: f64) -> Result<PathPoints> {
     if points.len() < 2 {
         return Err(Error::format(
             path,
-            format!(
-                "points: {} point(s); a path needs at least 2",
-                points.len()
-            ),
+            format!("points: {} point(s); a path needs at least 2", points.len()),
         ));
     }
     for i in 1..points.len() {
@@ -259,7 +253,9 @@ mod tests {
         assert_eq!(a, b);
         assert_eq!(a.points[2], [100.0, 200.0, 20.0]);
         assert!(!a.closed);
-        let e = read(&j, Some(PathUnits::Wingspans), 1.5).unwrap_err().to_string();
+        let e = read(&j, Some(PathUnits::Wingspans), 1.5)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("units"), "{e}");
     }
 
@@ -267,11 +263,19 @@ mod tests {
     fn bad_paths_name_the_point() {
         for (text, want) in [
             (r#"{"points": [[0, 0, 0]]}"#, "at least 2"),
-            (r#"{"points": [[0, 0, 0], [0, 0, 0]]}"#, "point 1: repeats point 0"),
-            (r#"{"units": "feet", "points": [[0, 0, 0], [1, 0, 0]]}"#, "unknown units"),
+            (
+                r#"{"points": [[0, 0, 0], [0, 0, 0]]}"#,
+                "point 1: repeats point 0",
+            ),
+            (
+                r#"{"units": "feet", "points": [[0, 0, 0], [1, 0, 0]]}"#,
+                "unknown units",
+            ),
             (r#"{"points": [[0, 0, 0], [1, 0]]}"#, "points[1]"),
         ] {
-            let e = read(&write("b.json", text), None, 1.5).unwrap_err().to_string();
+            let e = read(&write("b.json", text), None, 1.5)
+                .unwrap_err()
+                .to_string();
             assert!(e.contains(want), "{e}");
             assert_eq!(e.lines().count(), 1);
         }

@@ -94,16 +94,25 @@ impl CourseOptions {
             );
         }
         if !(self.max_roll_rate > 0.0 && self.max_roll_rate.is_finite()) {
-            return p("course.max_roll_rate", "must be a positive number of radians per second".into());
+            return p(
+                "course.max_roll_rate",
+                "must be a positive number of radians per second".into(),
+            );
         }
         if !(self.roll_lag >= 0.0 && self.roll_lag <= 10.0) {
             return p("course.roll_lag", "must be in [0, 10] seconds".into());
         }
         if !(self.min_speed > 0.0 && self.min_speed < 1.0) {
-            return p("course.min_speed", format!("{}: must be in (0, 1)", self.min_speed));
+            return p(
+                "course.min_speed",
+                format!("{}: must be in (0, 1)", self.min_speed),
+            );
         }
         if !(self.max_speed > 1.0 && self.max_speed <= 10.0) {
-            return p("course.max_speed", format!("{}: must be in (1, 10]", self.max_speed));
+            return p(
+                "course.max_speed",
+                format!("{}: must be in (1, 10]", self.max_speed),
+            );
         }
         Ok(())
     }
@@ -148,7 +157,13 @@ pub struct CourseReport {
 /// Smallest radius at which birds from `d_lo` to `d_hi` wingspans right of the track (d_lo ≤ 0 ≤
 /// d_hi) fly a turn within the speed and bank limits at cruise speed `v` (g in wingspans/s²);
 /// returns the radius and the binding limit.
-pub fn min_radius(d_lo: f64, d_hi: f64, v: f64, g: f64, opts: &CourseOptions) -> (f64, &'static str) {
+pub fn min_radius(
+    d_lo: f64,
+    d_hi: f64,
+    v: f64,
+    g: f64,
+    opts: &CourseOptions,
+) -> (f64, &'static str) {
     let inner = d_hi.max(-d_lo).max(0.0);
     let outer = inner;
     let c = g * opts.max_bank.tan() / (v * v);
@@ -158,14 +173,28 @@ pub fn min_radius(d_lo: f64, d_hi: f64, v: f64, g: f64, opts: &CourseOptions) ->
     } else {
         c
     };
-    let k_slow = if inner > 1e-9 { (1.0 - opts.min_speed) / inner } else { f64::INFINITY };
-    let k_fast = if outer > 1e-9 { (opts.max_speed - 1.0) / outer } else { f64::INFINITY };
+    let k_slow = if inner > 1e-9 {
+        (1.0 - opts.min_speed) / inner
+    } else {
+        f64::INFINITY
+    };
+    let k_fast = if outer > 1e-9 {
+        (opts.max_speed - 1.0) / outer
+    } else {
+        f64::INFINITY
+    };
     let mut best = (k_bank, "an outer bird would bank beyond the bank limit");
     if k_slow < best.0 {
-        best = (k_slow, "the inner birds would fly below their minimum speed");
+        best = (
+            k_slow,
+            "the inner birds would fly below their minimum speed",
+        );
     }
     if k_fast < best.0 {
-        best = (k_fast, "the outer birds would fly above their maximum speed");
+        best = (
+            k_fast,
+            "the outer birds would fly above their maximum speed",
+        );
     }
     (1.0 / best.0, best.1)
 }
@@ -265,7 +294,8 @@ pub fn apply(
     let dense = spline::spline_points(&points.points, points.closed);
     let (pts, ds) = spline::resample(&dense, spline::SAMPLE_SPACING);
     let before = pts.clone();
-    let (pts, ds, tight) = spline::widen(pts, ds, points.closed, 1.0 / r_min, spline::SAMPLE_SPACING);
+    let (pts, ds, tight) =
+        spline::widen(pts, ds, points.closed, 1.0 / r_min, spline::SAMPLE_SPACING);
     let course = Course::from_samples(pts, ds, points.closed);
     report.length = course.length();
     for t in &tight {
@@ -389,7 +419,11 @@ pub fn apply(
 fn check_backwards(points: &PathPoints, depth: f64, origin: &Path) -> Result<()> {
     let p = &points.points;
     let n = p.len();
-    let inner: Vec<usize> = if points.closed { (0..n).collect() } else { (1..n.saturating_sub(1)).collect() };
+    let inner: Vec<usize> = if points.closed {
+        (0..n).collect()
+    } else {
+        (1..n.saturating_sub(1)).collect()
+    };
     for i in inner {
         let a = p[(i + n - 1) % n];
         let b = p[i];
@@ -463,7 +497,8 @@ fn banks(anim: &Animation, g: f64, opts: &CourseOptions, cyclic: bool) -> Vec<Ve
                     if !(dt > 0.0) {
                         return 0.0;
                     }
-                    let w = spline::wrap(anim.frames[b].heading[i] - anim.frames[a].heading[i]) / dt;
+                    let w =
+                        spline::wrap(anim.frames[b].heading[i] - anim.frames[a].heading[i]) / dt;
                     (anim.frames[k].speed[i] * w / g)
                         .atan()
                         .clamp(-opts.max_bank, opts.max_bank)
@@ -479,7 +514,11 @@ fn banks(anim: &Animation, g: f64, opts: &CourseOptions, cyclic: bool) -> Vec<Ve
         for k in 0..nf {
             if k > 0 || pass > 0 {
                 for (p, &t) in phi.iter_mut().zip(&target[k]) {
-                    let rate = if opts.roll_lag > 0.0 { (t - *p) / opts.roll_lag } else { (t - *p) / h };
+                    let rate = if opts.roll_lag > 0.0 {
+                        (t - *p) / opts.roll_lag
+                    } else {
+                        (t - *p) / h
+                    };
                     let rate = rate.clamp(-opts.max_roll_rate, opts.max_roll_rate);
                     let next = *p + rate * h;
                     *p = if (next - t) * (*p - t) < 0.0 { t } else { next };

@@ -154,7 +154,11 @@ pub fn resample(poly: &[[f64; 3]], spacing: f64) -> (Vec<[f64; 3]>, f64) {
             j += 1;
         }
         let h = acc[j + 1] - acc[j];
-        let u = if h > 0.0 { ((s - acc[j]) / h).clamp(0.0, 1.0) } else { 0.0 };
+        let u = if h > 0.0 {
+            ((s - acc[j]) / h).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
         out.push(lerp3(poly[j], poly[j + 1], u));
     }
     (out, ds)
@@ -409,7 +413,12 @@ mod tests {
 
     #[test]
     fn passes_through_control_points_and_is_c1() {
-        let pts = [[0.0, 0.0, 0.0], [0.0, 100.0, 0.0], [100.0, 200.0, 10.0], [300.0, 200.0, 10.0]];
+        let pts = [
+            [0.0, 0.0, 0.0],
+            [0.0, 100.0, 0.0],
+            [100.0, 200.0, 10.0],
+            [300.0, 200.0, 10.0],
+        ];
         let c = course(&pts, false);
         for p in &pts {
             let best = (0..=4000)

@@ -601,8 +601,7 @@ pub fn steady_flight_report(
         home: opts.looped,
     };
     let solved = if opts.looped { nk - 1 } else { nk };
-    let (mut keys, key_stats) =
-        key_shapes(&ctx, &plan, key0, solved, rng, || progress.advance(1))?;
+    let (mut keys, key_stats) = key_shapes(&ctx, &plan, key0, solved, rng, || progress.advance(1))?;
     if opts.looped {
         keys.push(keys[0].clone());
         progress.advance(1);

@@ -537,7 +537,11 @@ fn simulate(anim: &Animation, opts: &WingbeatOptions) -> Run {
             let s0 = unwrapped[i];
             let advance = unwrapped[(nf - 1) * n + i] - s0 + (TAU * own[i] * dt).clamp(0.0, PI);
             let m = (advance / TAU).round().max(1.0);
-            let f = if advance > 0.0 { TAU * m / advance } else { 1.0 };
+            let f = if advance > 0.0 {
+                TAU * m / advance
+            } else {
+                1.0
+            };
             for k in 0..nf {
                 let s = s0 + (unwrapped[k * n + i] - s0) * f;
                 unwrapped[k * n + i] = s;
@@ -593,7 +597,11 @@ fn replay(anim: &Animation, opts: &WingbeatOptions) -> Run {
 
 /// [`replay`] of the phases `stored(frame, bird)`; a looping animation's wingbeats repeat with
 /// its whole cycles (counted from the phases, the wrap step included).
-fn replay_phases(anim: &Animation, opts: &WingbeatOptions, stored: impl Fn(usize, usize) -> f64) -> Run {
+fn replay_phases(
+    anim: &Animation,
+    opts: &WingbeatOptions,
+    stored: impl Fn(usize, usize) -> f64,
+) -> Run {
     let n = anim.birds;
     let nf = anim.frames.len();
     let preset = opts.species.preset();
@@ -609,7 +617,9 @@ fn replay_phases(anim: &Animation, opts: &WingbeatOptions, stored: impl Fn(usize
     };
     if anim.looped && nf > 1 {
         for (i, b) in birds.iter_mut().enumerate() {
-            let wraps = (1..nf).filter(|&k| wrapped(k, i) < wrapped(k - 1, i)).count() as i64;
+            let wraps = (1..nf)
+                .filter(|&k| wrapped(k, i) < wrapped(k - 1, i))
+                .count() as i64;
             let closing = i64::from(wrapped(0, i) <= wrapped(nf - 1, i));
             b.period = Some((wraps + closing).max(1));
         }
