@@ -533,3 +533,33 @@ fn the_pictures_and_the_gltf_of_a_loop_close_the_cycle() {
         assert!((fc.y[i] - f0.y[i] - travel).abs() < 1e-9 && (fc.x[i] - f0.x[i]).abs() < 1e-9);
     }
 }
+
+#[test]
+fn the_camera_follows_a_flock_turning_at_any_heading() {
+    let dir = scratch("paths-camera");
+    let (ctrl, _) = turn_path(230f64.to_radians(), [-500.0, 800.0, 0.0]);
+    let path = write_path(&dir, "turn.json", &ctrl);
+    let c = config(14, 60.0, Some(path));
+    let (a, _) = Pipeline::from_path(data("steady_v9_params.json"))
+        .run(&c)
+        .unwrap();
+    let (w, h) = (480, 270);
+    let film = formation::export::pictures::Film::new(&a, 5.0, w, h);
+    let lead = a.leaders()[0];
+    for (k, (st, view)) in film.states.iter().zip(&film.views).enumerate() {
+        let b = &st[lead];
+        let (px, py, _) = view.project([b.x, b.y, b.z], w, h).unwrap();
+        assert!(
+            px > 0.0 && px < w as f64 && py > 0.0 && py < h as f64,
+            "picture {k}: the leader at ({px:.0}, {py:.0}) is out of the picture"
+        );
+        let inside = st
+            .iter()
+            .filter(|b| {
+                let (x, y, _) = view.project([b.x, b.y, b.z], w, h).unwrap();
+                x > 0.0 && x < w as f64 && y > 0.0 && y < h as f64
+            })
+            .count();
+        assert!(inside >= 7, "picture {k}: {inside} birds in the picture");
+    }
+}

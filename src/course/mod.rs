@@ -368,7 +368,7 @@ pub fn apply(
             s_max = s_max.max(s);
             let d = f.x[i] - x_ref;
             let c = course.at(s);
-            let (sh, ch) = c.heading.sin_cos();
+            let (sh, ch) = c.sin_cos;
             let zc = f.z[i];
             let z = match alt {
                 Some(a) => {
@@ -380,14 +380,15 @@ pub fn apply(
             // Course-frame velocity (right, along, up).
             let (uh, uv) = (f.heading[i], f.speed[i]);
             let (ux, uy) = (uv * uh.sin(), uv * uh.cos() + drift);
-            let along = uy * (c.climb.cos() - d * c.turn);
+            let along = uy * (c.cos_climb - d * c.turn);
             let vx = along * sh + ux * ch;
             let vy = along * ch - ux * sh;
             f.x[i] = c.p[0] + d * ch;
             f.y[i] = c.p[1] - d * sh;
             f.z[i] = z;
-            f.heading[i] = spline::wrap(vx.atan2(vy));
-            f.speed[i] = vx.hypot(vy);
+            // atan2 is already in [−π, π].
+            f.heading[i] = vx.atan2(vy);
+            f.speed[i] = (vx * vx + vy * vy).sqrt();
         }
     }
     let len = course.length();
@@ -489,31 +490,29 @@ fn banks(anim: &Animation, g: f64, opts: &CourseOptions, cyclic: bool) -> Vec<Ve
     let nf = anim.frames.len();
     let n = anim.birds;
     let period = nf as f64 / anim.fps;
-    let target: Vec<Vec<f64>> = (0..nf)
-        .map(|k| {
-            let (a, b, dt) = neighbours(anim, k, cyclic, period);
-            (0..n)
-                .map(|i| {
-                    if !(dt > 0.0) {
-                        return 0.0;
-                    }
-                    let w =
-                        spline::wrap(anim.frames[b].heading[i] - anim.frames[a].heading[i]) / dt;
-                    (anim.frames[k].speed[i] * w / g)
-                        .atan()
-                        .clamp(-opts.max_bank, opts.max_bank)
-                })
-                .collect()
-        })
-        .collect();
+    // Targets of every frame and bird (frame-major, one allocation).
+    let mut target = vec![0.0; nf * n];
+    for k in 0..nf {
+        let (a, b, dt) = neighbours(anim, k, cyclic, period);
+        if !(dt > 0.0) {
+            continue;
+        }
+        let (fa, fb, fk) = (&anim.frames[a], &anim.frames[b], &anim.frames[k]);
+        for i in 0..n {
+            let w = spline::wrap(fb.heading[i] - fa.heading[i]) / dt;
+            target[k * n + i] = (fk.speed[i] * w / g)
+                .atan()
+                .clamp(-opts.max_bank, opts.max_bank);
+        }
+    }
     let h = 1.0 / anim.fps;
-    let mut phi = target[0].clone();
+    let mut phi = target[..n].to_vec();
     let mut out = vec![Vec::new(); nf];
     let passes = if cyclic { 2 } else { 1 };
     for pass in 0..passes {
         for k in 0..nf {
             if k > 0 || pass > 0 {
-                for (p, &t) in phi.iter_mut().zip(&target[k]) {
+                for (p, &t) in phi.iter_mut().zip(&target[k * n..(k + 1) * n]) {
                     let rate = if opts.roll_lag > 0.0 {
                         (t - *p) / opts.roll_lag
                     } else {

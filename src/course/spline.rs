@@ -37,6 +37,10 @@ pub struct CourseAt {
     pub turn: f64,
     /// Climb angle γ of the tangent above the horizontal, radians.
     pub climb: f64,
+    /// sin θ and cos θ of the heading.
+    pub sin_cos: (f64, f64),
+    /// cos γ of the climb angle.
+    pub cos_climb: f64,
 }
 
 /// An evaluated course: samples at even arc length.
@@ -123,7 +127,7 @@ pub fn spline_points(points: &[[f64; 3]], closed: bool) -> Vec<[f64; 3]> {
     for i in 0..segs as isize {
         let q = [get(i - 1), get(i), get(i + 1), get(i + 2)];
         let len = norm(sub(q[2], q[1]));
-        let steps = ((len / (0.5 * SAMPLE_SPACING)).ceil() as usize)
+        let steps = ((len / SAMPLE_SPACING).ceil() as usize)
             .clamp(8, (budget * len / total.max(1e-9)).max(8.0) as usize);
         for k in 0..steps {
             out.push(segment(q, k as f64 / steps as f64));
@@ -376,6 +380,8 @@ impl Course {
                 heading: self.heading[i],
                 turn: 0.0,
                 climb: self.climb[i],
+                sin_cos: self.heading[i].sin_cos(),
+                cos_climb: self.climb[i].cos(),
             };
         }
         let x = (s / self.ds).clamp(0.0, (n - 1) as f64);
@@ -392,11 +398,24 @@ impl Course {
         let l = self.ds;
         let p = [0, 1, 2].map(|d| h00 * p0[d] + h10 * l * t0[d] + h01 * p1[d] + h11 * l * t1[d]);
         let li = |v: &[f64]| v[j] + u * (v[j + 1] - v[j]);
+        // The unit horizontal tangent, interpolated and renormalised (no trigonometry per call).
+        let (ta, tb) = (self.tan[j], self.tan[j + 1]);
+        let (hx, hy) = (ta[0] + u * (tb[0] - ta[0]), ta[1] + u * (tb[1] - ta[1]));
+        let hl = (hx * hx + hy * hy).sqrt();
+        let hz = ta[2] + u * (tb[2] - ta[2]);
+        let heading = li(&self.heading) + turns;
+        let sin_cos = if hl > 1e-12 {
+            (hx / hl, hy / hl)
+        } else {
+            heading.sin_cos()
+        };
         CourseAt {
             p,
-            heading: li(&self.heading) + turns,
+            heading,
             turn: li(&self.turn),
             climb: li(&self.climb),
+            sin_cos,
+            cos_climb: hl / (hl * hl + hz * hz).sqrt().max(1e-12),
         }
     }
 }
