@@ -112,7 +112,7 @@ impl Default for SteadyOptions {
             min_gap: 0.1,
             aero: AeroOptions::default(),
             max_depth_factor: 1.5,
-            lateral_drift: 0.06,
+            lateral_drift: 0.03,
             height_spread: 0.14,
             height_neighbour: 0.06,
             looped: false,
