@@ -23,7 +23,15 @@ fn env_u(name: &str) -> Option<u64> {
 }
 
 fn run_stats(n: usize, seed: u64, opts: &InitiateOptions) -> InitiateStats {
-    let t = target(n);
+    run_stats_shape(n, 1.0, 0.6, seed, opts)
+}
+
+fn run_stats_shape(n: usize, gap: f64, back: f64, seed: u64, opts: &InitiateOptions) -> InitiateStats {
+    let pts: Vec<DVec2> = v_shape(n, gap, back)
+        .iter()
+        .map(|&(x, y)| DVec2::new(x, y))
+        .collect();
+    let t = TargetShape::new(&pts).unwrap();
     let mut r = rng::seeded(seed);
     initiate::simulate(&t, 30.0, &Cruise::new(0.0, 10.0), opts, &mut r, &Silent)
         .unwrap()
@@ -81,12 +89,26 @@ fn table() {
     if std::env::var("AIR").is_ok() {
         opts.start = Start::Random(Default::default());
     }
+    for (name, field) in [
+        ("APPROACH", &mut opts.approach_distance),
+        ("APPTIME", &mut opts.approach_time),
+        ("BRAKE", &mut opts.approach_brake),
+        ("AVOID", &mut opts.avoid_distance),
+        ("AVOIDRANGE", &mut opts.avoid_range),
+        ("HORIZON", &mut opts.avoid_horizon),
+    ] {
+        if let Some(k) = std::env::var(name).ok().and_then(|v| v.parse().ok()) {
+            *field = k;
+        }
+    }
+    let gap: f64 = std::env::var("GAP").ok().and_then(|v| v.parse().ok()).unwrap_or(1.0);
+    let back: f64 = std::env::var("BACK").ok().and_then(|v| v.parse().ok()).unwrap_or(0.6);
     for n in sizes {
         let mut secs = Vec::new();
         let (mut ok, mut mind, mut stray, mut lift) = (0, f64::INFINITY, 0.0f64, 0.0f64);
         let mut planned = 0.0;
         for seed in 0..seeds {
-            let s = run_stats(n, seed, &opts);
+            let s = run_stats_shape(n, gap, back, seed, &opts);
             planned = s.planned_seconds;
             if s.converged {
                 ok += 1;

@@ -148,6 +148,21 @@ pub struct InitiateOptions {
     /// Speed of the leader while flockmates are still on the ground or running, as a fraction
     /// of the cruise speed (at least the minimum speed).
     pub gather_speed: f64,
+    /// Slots assigned once at the start, in the order of the birds' positions across the cruise
+    /// heading (no sideways crossings; the departures follow the slots' depth), instead of the
+    /// paper's §6.2.1 correspondence through reference birds, re-evaluated at every decision
+    /// (docs/initiation.md).
+    pub assign_slots: bool,
+    /// Final approach: within this distance of its slot a bird steers by the formation-frame
+    /// controller (slot error and the leader's velocity) instead of eqs. (5)–(6); blended out to
+    /// twice it, wingspans.
+    pub approach_distance: f64,
+    /// Final approach: time constant of the sideways slot error, seconds (along the heading
+    /// 0.7 of it).
+    pub approach_time: f64,
+    /// Final approach: deceleration that brakes the closing speed on the slot, wingspans per
+    /// second squared.
+    pub approach_brake: f64,
     /// Convergence: distance of every bird from its slot and from the cruise altitude, wingspans.
     pub tolerance: f64,
     /// Convergence: heading difference from the cruise heading, radians.
@@ -210,6 +225,10 @@ impl Default for InitiateOptions {
             catchup_distance: 1.5,
             gap_speed: true,
             gather_speed: 0.6,
+            assign_slots: true,
+            approach_distance: 5.0,
+            approach_time: 1.2,
+            approach_brake: 2.0,
             tolerance: 0.1,
             heading_tolerance: 2f64.to_radians(),
             speed_tolerance: 0.02,
@@ -666,6 +685,9 @@ impl InitiateOptions {
         pos("initiate.linear_zone", self.linear_zone)?;
         pos("initiate.catchup_distance", self.catchup_distance)?;
         pos("initiate.gather_speed", self.gather_speed)?;
+        pos("initiate.approach_distance", self.approach_distance)?;
+        pos("initiate.approach_time", self.approach_time)?;
+        pos("initiate.approach_brake", self.approach_brake)?;
         let memory = self.reference_memory();
         if !(memory.is_finite() && (0.0..=60.0).contains(&memory)) {
             return Err(Error::parameter(
@@ -839,6 +861,10 @@ impl InitiateOptions {
             catchup_distance: catchup,
             gap_speed: self.gap_speed,
             gather_speed: self.gather_speed * vc,
+            assign_slots: self.assign_slots,
+            approach_distance: self.approach_distance,
+            approach_time: self.approach_time,
+            approach_brake: self.approach_brake,
         }
     }
 
