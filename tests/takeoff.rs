@@ -141,7 +141,13 @@ fn trace() {
     if let Some(k) = std::env::var("K").ok().and_then(|v| v.parse().ok()) {
         opts.k = k;
     }
-    let t = target(n);
+    let gap: f64 = std::env::var("GAP").ok().and_then(|v| v.parse().ok()).unwrap_or(1.0);
+    let back: f64 = std::env::var("BACK").ok().and_then(|v| v.parse().ok()).unwrap_or(0.6);
+    let pts: Vec<DVec2> = v_shape(n, gap, back)
+        .iter()
+        .map(|&(x, y)| DVec2::new(x, y))
+        .collect();
+    let t = TargetShape::new(&pts).unwrap();
     let mut r = rng::seeded(seed);
     let (mut sim, plan) =
         initiate::start_simulation(&t, &Cruise::new(0.0, 10.0), &opts, &mut r).unwrap();
@@ -165,8 +171,8 @@ fn trace() {
             .iter()
             .map(|(e, i)| {
                 format!(
-                    "b{i} e{e:.2} v{:.1} z{:.1} ref{:?} slot{:?}",
-                    f.speed[*i], f.z[*i], f.reference[*i], f.slot[*i]
+                    "b{i} e{e:.2} v{:.2} z{:.2} h{:.1} w{:.1} ref{:?} slot{:?}",
+                    f.speed[*i], f.z[*i], f.heading[*i].to_degrees(), f.turn_rate[*i].to_degrees(), f.reference[*i], f.slot[*i]
                 )
             })
             .collect();

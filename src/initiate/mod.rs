@@ -207,8 +207,8 @@ impl Default for InitiateOptions {
             roll_lag: 0.2,
             max_roll_accel: 400f64.to_radians(),
             cruise_altitude: 10.0,
-            climb_rate: 2.0,
-            vertical_accel: 1.5,
+            climb_rate: 2.5,
+            vertical_accel: 2.0,
             run_accel: 3.0,
             takeoff: None,
             separation_distance: 10.0,
@@ -300,14 +300,26 @@ pub struct TakeoffPlan {
     pub k: f64,
     /// Catch-up distance of eq. (5) used, wingspans.
     pub catchup_distance: f64,
+    /// How hard the birds drive: the natural duration over the wanted one, within
+    /// [[`TakeoffPlan::MIN_DRIVE`], [`TakeoffPlan::MAX_DRIVE`]]. The run and vertical
+    /// accelerations and the climb rate are multiplied by it, the approach time divided by it;
+    /// the departure stagger is 1 s over it; below 1 the take-off area also grows by 1/drive.
+    pub drive: f64,
 }
 
 impl TakeoffPlan {
-    /// The shortest take-off the rules give `n` birds from the ground, about, seconds: measured
-    /// medians 17 s for 9 birds, 22 s for 14, 53 s for 41 (docs/initiation.md; arms fill one bird
-    /// at a time, so it grows with the flock size).
+    /// The weakest drive: a take-off at most about twice the natural one.
+    pub const MIN_DRIVE: f64 = 0.45;
+    /// The strongest drive: a take-off down to about 0.7 of the natural one (the climb to the
+    /// cruise altitude bounds it).
+    pub const MAX_DRIVE: f64 = 1.6;
+
+    /// The natural take-off of `n` birds from the ground at the default options, seconds:
+    /// measured medians (docs/initiation.md) about 10.5 s for 9–14 birds, 12.5 s for 41, 18.5 s
+    /// for 100, 37 s for 300 (the lift-off and climb to 10 wingspans take about 8 s; the rest
+    /// grows with the width of the V).
     pub fn natural_seconds(n: usize) -> f64 {
-        7.0 + 1.1 * n.max(1) as f64
+        9.5 + 0.09 * n.max(1) as f64
     }
 
     /// The automatic take-off duration of `n` birds, seconds: the natural one.
@@ -315,24 +327,25 @@ impl TakeoffPlan {
         Self::natural_seconds(n)
     }
 
-    /// The plan for `n` birds under `opts` (its `takeoff`, or the automatic duration). A longer
-    /// take-off than the natural one stretches the departures (each second of stagger beyond
-    /// the first adds about 1.3 s, measured); a shorter one cannot be had from these rules and
-    /// gets the natural plan (the CLI warns).
+    /// The plan for `n` birds under `opts` (its `takeoff`, or the automatic duration): the
+    /// drive is the natural duration over the wanted one (bounded), which scales the departure
+    /// stagger, the accelerations, the climb rate, the approach and (for a longer take-off) the
+    /// take-off area, so that every part of the take-off takes about `seconds / natural` times
+    /// as long. The simulation itself is never cut.
     pub fn new(n: usize, opts: &InitiateOptions) -> TakeoffPlan {
         let natural = Self::natural_seconds(n);
         let seconds = opts.takeoff.unwrap_or(natural);
+        let drive = (natural / seconds).clamp(Self::MIN_DRIVE, Self::MAX_DRIVE);
         let root = (n.max(1) as f64).sqrt();
         let (width, depth, stagger) = match &opts.start {
             Start::Ground(g) => {
                 // About 10 square wingspans per bird (1.6 times what random packing of birds
-                // `min_spacing` = 2 apart needs).
-                let base = (1.6 * g.min_spacing * root).max(4.0 * g.min_spacing);
+                // `min_spacing` = 2 apart needs), more for a slow take-off.
+                let base = (1.6 * g.min_spacing * root).max(4.0 * g.min_spacing) / drive.min(1.0);
                 (
                     g.width.unwrap_or(1.4 * base),
                     g.depth.unwrap_or(0.7 * base),
-                    g.stagger
-                        .unwrap_or(1.0 + (seconds - natural).max(0.0) / 1.3),
+                    g.stagger.unwrap_or(1.0 / drive),
                 )
             }
             Start::Random(r) => {
@@ -342,12 +355,13 @@ impl TakeoffPlan {
             Start::Given(_) => (0.0, 0.0, 0.0),
         };
         TakeoffPlan {
-            seconds: seconds.max(natural),
+            seconds,
             width,
             depth,
             stagger,
             k: opts.k,
             catchup_distance: opts.catchup_distance,
+            drive,
         }
     }
 }
@@ -868,6 +882,19 @@ impl InitiateOptions {
         }
     }
 
+    /// The simulation's parameters for a cruise under a take-off plan: [`Self::step_params`]
+    /// with the plan's gain and drive (accelerations of the run and the climb, the climb rate
+    /// and the approach scaled by it).
+    pub fn plan_params(&self, cruise: &Cruise, plan: &TakeoffPlan) -> StepParams {
+        let mut p = self.step_params(cruise, plan.k, plan.catchup_distance);
+        p.run_accel *= plan.drive;
+        p.climb_rate *= plan.drive;
+        p.vertical_accel *= plan.drive;
+        p.approach_time /= plan.drive;
+        p.approach_brake *= plan.drive;
+        p
+    }
+
     /// The convergence tolerances: the options' distance, heading and speed, and steady flight
     /// (turn rate ≤ 2°/s, acceleration ≤ 0.2 wingspans/s², climb rate ≤ 0.1 wingspans/s).
     pub fn tolerances(&self) -> Tolerances {
@@ -1116,7 +1143,7 @@ pub fn start_simulation(
     }
     let n = target.len();
     let plan = TakeoffPlan::new(n, opts);
-    let mut params = opts.step_params(cruise, plan.k, plan.catchup_distance);
+    let mut params = opts.plan_params(cruise, &plan);
     if opts.widen_field {
         let field = &mut params.perception.fov_per_eye;
         *field = field.max(target.required_field(FIELD_MARGIN));

@@ -156,6 +156,17 @@ pub const SLOT_CLAIM_MARGIN: f64 = 1.0;
 /// neither is in the slot yet).
 pub const SETTLED_DISTANCE: f64 = 1.0;
 
+/// Collision avoidance yields to the shape's geometry between two birds both closer than this
+/// to their own slots, wingspans: their threshold is [`YIELD_FRACTION`] of their slots' distance
+/// (at least [`YIELD_FLOOR`]) when that is below the avoidance distance.
+pub const YIELD_DISTANCE: f64 = 3.0;
+
+/// Fraction of two slots' distance that two birds settling into them keep apart.
+pub const YIELD_FRACTION: f64 = 0.5;
+
+/// Least avoidance threshold between two birds settling into their slots, wingspans.
+pub const YIELD_FLOOR: f64 = 0.35;
+
 /// Width of a take-off run's lane: a bird on the ground leaves only after every bird ahead of it
 /// closer than this across the heading, wingspans.
 pub const RUN_LANE: f64 = 1.5;
@@ -1348,11 +1359,13 @@ impl Simulation {
             // threshold yields to the shape's geometry (slots may overlap wingtips).
             let limit = match (f.slot[i], f.slot[k]) {
                 (Some(a), Some(b))
-                    if self.slot_err.get(i).is_some_and(|&e| e < SETTLED_DISTANCE)
-                        && self.slot_err.get(k).is_some_and(|&e| e < SETTLED_DISTANCE) =>
+                    if self.slot_err.get(i).is_some_and(|&e| e < YIELD_DISTANCE)
+                        && self.slot_err.get(k).is_some_and(|&e| e < YIELD_DISTANCE) =>
                 {
-                    p.avoid_distance
-                        .min(0.6 * (self.target.slots[a] - self.target.slots[b]).length())
+                    p.avoid_distance.min(
+                        (YIELD_FRACTION * (self.target.slots[a] - self.target.slots[b]).length())
+                            .max(YIELD_FLOOR),
+                    )
                 }
                 _ => p.avoid_distance,
             };
