@@ -327,6 +327,22 @@ impl TakeoffPlan {
         Self::natural_seconds(n)
     }
 
+    /// A warning when the take-off duration of `opts` is outside what the drive can reach for
+    /// `n` birds (about 0.75 to 2 times the natural duration), naming `initiate.takeoff`.
+    pub fn warning(n: usize, opts: &InitiateOptions) -> Option<String> {
+        let t = opts.takeoff?;
+        let natural = Self::natural_seconds(n);
+        let (lo, hi) = (0.75 * natural, 2.0 * natural);
+        if t < lo || t > hi {
+            let near = t.clamp(lo, hi);
+            Some(format!(
+                "initiate.takeoff {t} s: {n} birds form in about {lo:.0} to {hi:.0} s with these rules (docs/initiation.md); the take-off will last about {near:.0} s"
+            ))
+        } else {
+            None
+        }
+    }
+
     /// The plan for `n` birds under `opts` (its `takeoff`, or the automatic duration): the
     /// drive is the natural duration over the wanted one (bounded), which scales the departure
     /// stagger, the accelerations, the climb rate, the approach and (for a longer take-off) the
@@ -363,6 +379,18 @@ impl TakeoffPlan {
             catchup_distance: opts.catchup_distance,
             drive,
         }
+    }
+}
+
+/// An angle in radians as degrees for a message or a flag's default, rounded to 10⁻⁹° so that
+/// a value given in degrees and converted to radians reads back as given.
+pub fn display_degrees(rad: f64) -> f64 {
+    let d = rad.to_degrees();
+    let r = (d * 1e9).round() / 1e9;
+    if r.is_finite() {
+        r
+    } else {
+        d
     }
 }
 
@@ -571,8 +599,8 @@ impl InitiateOptions {
             return Err(Error::parameter(
                 "initiate.perception.fov_per_eye",
                 format!(
-                    "visual field per eye must be in (0, 180] degrees, got {:.3}",
-                    fov.to_degrees()
+                    "visual field per eye must be in (0, 180] degrees, got {}",
+                    display_degrees(fov)
                 ),
             ));
         }
@@ -580,7 +608,10 @@ impl InitiateOptions {
         if !(cone.is_finite() && cone > 0.0 && cone <= PI) {
             return Err(Error::parameter(
                 "initiate.perception.reference_cone",
-                format!("must be in (0, 180] degrees, got {:.3}", cone.to_degrees()),
+                format!(
+                    "must be in (0, 180] degrees, got {}",
+                    display_degrees(cone)
+                ),
             ));
         }
         if let PerceptionMode::Hpr { gamma } = self.perception.mode {
@@ -602,13 +633,46 @@ impl InitiateOptions {
             ));
         }
         pos("initiate.k", self.k)?;
-        pos("initiate.max_turn_rate", self.max_turn_rate)?;
+        let pos_deg = |name: &str, v: f64, unit: &str| -> Result<()> {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                Err(Error::parameter(
+                    name,
+                    format!(
+                        "must be a positive number of {unit}, got {}",
+                        display_degrees(v)
+                    ),
+                ))
+            }
+        };
+        pos_deg(
+            "initiate.max_turn_rate",
+            self.max_turn_rate,
+            "degrees per second",
+        )?;
         pos("initiate.max_accel", self.max_accel)?;
-        pos("initiate.max_turn_accel", self.max_turn_accel)?;
+        pos_deg(
+            "initiate.max_turn_accel",
+            self.max_turn_accel,
+            "degrees per second squared",
+        )?;
         pos("initiate.max_jerk", self.max_jerk)?;
-        pos("initiate.max_turn_jerk", self.max_turn_jerk)?;
-        pos("initiate.max_roll_rate", self.max_roll_rate)?;
-        pos("initiate.max_roll_accel", self.max_roll_accel)?;
+        pos_deg(
+            "initiate.max_turn_jerk",
+            self.max_turn_jerk,
+            "degrees per second cubed",
+        )?;
+        pos_deg(
+            "initiate.max_roll_rate",
+            self.max_roll_rate,
+            "degrees per second",
+        )?;
+        pos_deg(
+            "initiate.max_roll_accel",
+            self.max_roll_accel,
+            "degrees per second squared",
+        )?;
         pos("initiate.climb_rate", self.climb_rate)?;
         pos("initiate.vertical_accel", self.vertical_accel)?;
         pos("initiate.run_accel", self.run_accel)?;
@@ -769,7 +833,7 @@ impl InitiateOptions {
             if let Some(w) = g.stagger {
                 if !(w.is_finite() && w >= 0.0 && w <= self.max_time) {
                     return Err(Error::parameter(
-                        "initiate.stagger",
+                        "initiate.start.ground.stagger",
                         format!(
                             "must be a number of seconds between 0 and the time limit, got {w}"
                         ),
@@ -779,7 +843,10 @@ impl InitiateOptions {
             if !(g.heading_spread.is_finite() && (0.0..=PI).contains(&g.heading_spread)) {
                 return Err(Error::parameter(
                     "initiate.start.ground.heading_spread",
-                    "must be in [0, 180] degrees",
+                    format!(
+                        "must be in [0, 180] degrees, got {}",
+                        display_degrees(g.heading_spread)
+                    ),
                 ));
             }
             if !(g.min_spacing.is_finite() && g.min_spacing > 0.0) {
@@ -809,7 +876,7 @@ impl InitiateOptions {
                     "initiate.start.random.heading_spread",
                     format!(
                         "must be in [0, 180] degrees, got {}",
-                        r.heading_spread.to_degrees()
+                        display_degrees(r.heading_spread)
                     ),
                 ));
             }
