@@ -599,8 +599,8 @@ impl InitiateOptions {
             return Err(Error::parameter(
                 "initiate.perception.fov_per_eye",
                 format!(
-                    "visual field per eye must be in (0, 180] degrees, got {}",
-                    display_degrees(fov)
+                    "visual field per eye must be in (0, 180] degrees, got {:.3}",
+                    fov.to_degrees()
                 ),
             ));
         }
@@ -608,10 +608,7 @@ impl InitiateOptions {
         if !(cone.is_finite() && cone > 0.0 && cone <= PI) {
             return Err(Error::parameter(
                 "initiate.perception.reference_cone",
-                format!(
-                    "must be in (0, 180] degrees, got {}",
-                    display_degrees(cone)
-                ),
+                format!("must be in (0, 180] degrees, got {:.3}", cone.to_degrees()),
             ));
         }
         if let PerceptionMode::Hpr { gamma } = self.perception.mode {
