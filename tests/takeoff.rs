@@ -512,7 +512,13 @@ fn closest() {
     let n = env_u("N").unwrap_or(41) as usize;
     for seed in 0..env_u("SEEDS").unwrap_or(10) {
         let opts = InitiateOptions::default();
-        let t = target(n);
+        let gap: f64 = std::env::var("GAP").ok().and_then(|v| v.parse().ok()).unwrap_or(1.0);
+        let back: f64 = std::env::var("BACK").ok().and_then(|v| v.parse().ok()).unwrap_or(0.6);
+        let pts: Vec<DVec2> = v_shape(n, gap, back)
+            .iter()
+            .map(|&(x, y)| DVec2::new(x, y))
+            .collect();
+        let t = TargetShape::new(&pts).unwrap();
         let (mut sim, _) =
             initiate::start_simulation(&t, &Cruise::new(0.0, 10.0), &opts, &mut rng::seeded(seed))
                 .unwrap();
@@ -525,10 +531,12 @@ fn closest() {
                     let d =
                         ((f.pos[a] - f.pos[b]).length_squared() + (f.z[a] - f.z[b]).powi(2)).sqrt();
                     if d < best.0 {
+                        let sp = sim.slot_positions();
+                        let e = |i: usize| f.slot[i].map_or(f64::NAN, |s| (f.pos[i] - sp[s]).length());
                         best = (d, sim.time, format!(
-                            "{a}:{:?} z{:.2} v{:.1} h{:.0} ref{:?} | {b}:{:?} z{:.2} v{:.1} h{:.0} ref{:?}",
-                            f.phase[a], f.z[a], f.speed[a], f.heading[a].to_degrees(), f.reference[a],
-                            f.phase[b], f.z[b], f.speed[b], f.heading[b].to_degrees(), f.reference[b]));
+                            "{a}:{:?} z{:.2} v{:.1} h{:.0} slot{:?} e{:.2} | {b}:{:?} z{:.2} v{:.1} h{:.0} slot{:?} e{:.2}",
+                            f.phase[a], f.z[a], f.speed[a], f.heading[a].to_degrees(), f.slot[a], e(a),
+                            f.phase[b], f.z[b], f.speed[b], f.heading[b].to_degrees(), f.slot[b], e(b)));
                     }
                 }
             }

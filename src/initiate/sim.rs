@@ -167,6 +167,13 @@ pub const YIELD_FRACTION: f64 = 0.5;
 /// Least avoidance threshold between two birds settling into their slots, wingspans.
 pub const YIELD_FLOOR: f64 = 0.35;
 
+/// Height between the two layers of birds away from their slots, wingspans.
+pub const LAYER_HEIGHT: f64 = 0.6;
+
+/// Birds closer to their slots than this fly at the cruise altitude; from twice it on in their
+/// layer (smoothstep in between), wingspans.
+pub const LAYER_MERGE: f64 = 1.0;
+
 /// Width of a take-off run's lane: a bird on the ground leaves only after every bird ahead of it
 /// closer than this across the heading, wingspans.
 pub const RUN_LANE: f64 = 1.5;
@@ -374,6 +381,9 @@ pub struct Simulation {
     slot_err: Vec<f64>,
     /// With assigned slots, the bird of every slot.
     bird_of_slot: Vec<usize>,
+    /// With assigned slots, each bird's layer while away from its slot: +½ or −½, alternating
+    /// across the formation.
+    layer: Vec<f64>,
     next_reference: Vec<Option<usize>>,
     next_side: Vec<Option<Side>>,
     next_branch: Vec<Option<usize>>,
@@ -552,6 +562,7 @@ impl Simulation {
             lead_vel: DVec2::ZERO,
             slot_err: Vec::new(),
             bird_of_slot: Vec::new(),
+            layer: Vec::new(),
             next_reference: vec![None; n],
             next_side: vec![None; n],
             next_branch: vec![None; n],
@@ -613,6 +624,13 @@ impl Simulation {
             sim.bird_of_slot = vec![0; n];
             for (i, &s) in slot.iter().enumerate() {
                 sim.bird_of_slot[s] = i;
+            }
+            let mut across: Vec<usize> = (0..n).collect();
+            let ts = &sim.target.slots;
+            across.sort_by(|&a, &b| ts[slot[a]].x.total_cmp(&ts[slot[b]].x).then(a.cmp(&b)));
+            sim.layer = vec![0.0; n];
+            for (k, &i) in across.iter().enumerate() {
+                sim.layer[i] = if k % 2 == 0 { 0.5 } else { -0.5 };
             }
             sim.flock.slot = slot.iter().map(|&s| Some(s)).collect();
             sim.update_departed();
@@ -1123,7 +1141,16 @@ impl Simulation {
         };
         let (mut w, mut v) = (turn.clamp(-p.max_turn, p.max_turn), want_speed);
         self.grid.within(&f.pos, f.pos[i], p.avoid_range, near);
-        let mut alt_offset = 0.0;
+        // With assigned slots, neighbours across the formation fly in two layers while they are
+        // away from their slots (half a wingspan apart in height), merging as they settle, so
+        // that two birds passing each other on the way are apart in 3-D.
+        let mut alt_offset = match (self.layer.get(i), self.slot_err.get(i)) {
+            (Some(&l), Some(&e)) if e.is_finite() => {
+                let u = ((e - LAYER_MERGE) / LAYER_MERGE).clamp(0.0, 1.0);
+                l * LAYER_HEIGHT * u * u * (3.0 - 2.0 * u)
+            }
+            _ => 0.0,
+        };
         if let Some((turn, slow, dz)) = self.avoidance(i, w, near) {
             w = turn;
             alt_offset = dz;
