@@ -10,6 +10,27 @@ use formation::rng;
 use glam::DVec2;
 use initiate_support::v_shape;
 
+/// The V of `n` birds `gap` wingspans across and `back` behind per rank, as a target shape.
+fn shape_target(n: usize, gap: f64, back: f64) -> TargetShape {
+    let pts: Vec<DVec2> = v_shape(n, gap, back)
+        .iter()
+        .map(|&(x, y)| DVec2::new(x, y))
+        .collect();
+    TargetShape::new(&pts).unwrap()
+}
+
+/// The V's spacing of the diagnostic runs: `GAP` across and `BACK` behind per rank (default 1
+/// and 0.6 wingspans).
+fn env_shape() -> (f64, f64) {
+    let f = |name: &str, default: f64| {
+        std::env::var(name)
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(default)
+    };
+    (f("GAP", 1.0), f("BACK", 0.6))
+}
+
 fn env_u(name: &str) -> Option<u64> {
     std::env::var(name).ok().and_then(|v| v.parse().ok())
 }
@@ -18,12 +39,14 @@ fn run_stats(n: usize, seed: u64, opts: &InitiateOptions) -> InitiateStats {
     run_stats_shape(n, 1.0, 0.6, seed, opts)
 }
 
-fn run_stats_shape(n: usize, gap: f64, back: f64, seed: u64, opts: &InitiateOptions) -> InitiateStats {
-    let pts: Vec<DVec2> = v_shape(n, gap, back)
-        .iter()
-        .map(|&(x, y)| DVec2::new(x, y))
-        .collect();
-    let t = TargetShape::new(&pts).unwrap();
+fn run_stats_shape(
+    n: usize,
+    gap: f64,
+    back: f64,
+    seed: u64,
+    opts: &InitiateOptions,
+) -> InitiateStats {
+    let t = shape_target(n, gap, back);
     let mut r = rng::seeded(seed);
     initiate::simulate(&t, 30.0, &Cruise::new(0.0, 10.0), opts, &mut r, &Silent)
         .unwrap()
@@ -93,8 +116,7 @@ fn table() {
             *field = k;
         }
     }
-    let gap: f64 = std::env::var("GAP").ok().and_then(|v| v.parse().ok()).unwrap_or(1.0);
-    let back: f64 = std::env::var("BACK").ok().and_then(|v| v.parse().ok()).unwrap_or(0.6);
+    let (gap, back) = env_shape();
     for n in sizes {
         let mut secs = Vec::new();
         let (mut ok, mut mind, mut stray, mut lift) = (0, f64::INFINITY, 0.0f64, 0.0f64);
@@ -133,13 +155,8 @@ fn trace() {
     if let Some(k) = std::env::var("K").ok().and_then(|v| v.parse().ok()) {
         opts.k = k;
     }
-    let gap: f64 = std::env::var("GAP").ok().and_then(|v| v.parse().ok()).unwrap_or(1.0);
-    let back: f64 = std::env::var("BACK").ok().and_then(|v| v.parse().ok()).unwrap_or(0.6);
-    let pts: Vec<DVec2> = v_shape(n, gap, back)
-        .iter()
-        .map(|&(x, y)| DVec2::new(x, y))
-        .collect();
-    let t = TargetShape::new(&pts).unwrap();
+    let (gap, back) = env_shape();
+    let t = shape_target(n, gap, back);
     let mut r = rng::seeded(seed);
     let (mut sim, plan) =
         initiate::start_simulation(&t, &Cruise::new(0.0, 10.0), &opts, &mut r).unwrap();
@@ -164,7 +181,12 @@ fn trace() {
             .map(|(e, i)| {
                 format!(
                     "b{i} e{e:.2} v{:.2} z{:.2} h{:.1} w{:.1} ref{:?} slot{:?}",
-                    f.speed[*i], f.z[*i], f.heading[*i].to_degrees(), f.turn_rate[*i].to_degrees(), f.reference[*i], f.slot[*i]
+                    f.speed[*i],
+                    f.z[*i],
+                    f.heading[*i].to_degrees(),
+                    f.turn_rate[*i].to_degrees(),
+                    f.reference[*i],
+                    f.slot[*i]
                 )
             })
             .collect();
@@ -482,7 +504,11 @@ fn takeoff_8_and_20_seconds_are_met_and_the_default_is_short() {
 #[test]
 fn convergence_over_seeds_and_flock_sizes() {
     let opts = InitiateOptions::default();
-    let (many, few) = if cfg!(debug_assertions) { (2, 1) } else { (100, 10) };
+    let (many, few) = if cfg!(debug_assertions) {
+        (2, 1)
+    } else {
+        (100, 10)
+    };
     for (n, seeds, median_max) in [
         (9usize, many, 12.0),
         (14, many, 12.0),
@@ -501,10 +527,7 @@ fn convergence_over_seeds_and_flock_sizes() {
             closest = closest.min(s.min_distance);
             stray = stray.max(s.max_stray);
         }
-        assert!(
-            ok * 100 >= 99 * seeds,
-            "{n} birds: {ok}/{seeds} converged"
-        );
+        assert!(ok * 100 >= 99 * seeds, "{n} birds: {ok}/{seeds} converged");
         secs.sort_by(f64::total_cmp);
         let median = secs[secs.len() / 2];
         assert!(median <= median_max, "{n} birds: median {median:.1} s");
@@ -517,7 +540,10 @@ fn convergence_over_seeds_and_flock_sizes() {
         assert!(closest >= floor, "{n} birds: closest approach {closest:.3}");
         // Strays: at most 30 wingspans up to 100 birds; 300 birds reach 49 (open).
         let stray_max = if n <= 100 { 31.0 } else { 55.0 };
-        assert!(stray <= stray_max, "{n} birds: a bird strayed {stray:.1} wingspans");
+        assert!(
+            stray <= stray_max,
+            "{n} birds: a bird strayed {stray:.1} wingspans"
+        );
     }
 }
 
@@ -552,13 +578,8 @@ fn closest() {
     let n = env_u("N").unwrap_or(41) as usize;
     for seed in 0..env_u("SEEDS").unwrap_or(10) {
         let opts = InitiateOptions::default();
-        let gap: f64 = std::env::var("GAP").ok().and_then(|v| v.parse().ok()).unwrap_or(1.0);
-        let back: f64 = std::env::var("BACK").ok().and_then(|v| v.parse().ok()).unwrap_or(0.6);
-        let pts: Vec<DVec2> = v_shape(n, gap, back)
-            .iter()
-            .map(|&(x, y)| DVec2::new(x, y))
-            .collect();
-        let t = TargetShape::new(&pts).unwrap();
+        let (gap, back) = env_shape();
+        let t = shape_target(n, gap, back);
         let (mut sim, _) =
             initiate::start_simulation(&t, &Cruise::new(0.0, 10.0), &opts, &mut rng::seeded(seed))
                 .unwrap();
@@ -572,7 +593,8 @@ fn closest() {
                         ((f.pos[a] - f.pos[b]).length_squared() + (f.z[a] - f.z[b]).powi(2)).sqrt();
                     if d < best.0 {
                         let sp = sim.slot_positions();
-                        let e = |i: usize| f.slot[i].map_or(f64::NAN, |s| (f.pos[i] - sp[s]).length());
+                        let e =
+                            |i: usize| f.slot[i].map_or(f64::NAN, |s| (f.pos[i] - sp[s]).length());
                         best = (d, sim.time, format!(
                             "{a}:{:?} z{:.2} v{:.1} h{:.0} slot{:?} e{:.2} | {b}:{:?} z{:.2} v{:.1} h{:.0} slot{:?} e{:.2}",
                             f.phase[a], f.z[a], f.speed[a], f.heading[a].to_degrees(), f.slot[a], e(a),

@@ -596,7 +596,12 @@ impl Simulation {
             let dc = direction(sim.params.cruise_heading);
             let rc = right_of(sim.params.cruise_heading);
             let f = &sim.flock;
-            front.sort_by(|&a, &b| f.pos[b].dot(dc).total_cmp(&f.pos[a].dot(dc)).then(a.cmp(&b)));
+            front.sort_by(|&a, &b| {
+                f.pos[b]
+                    .dot(dc)
+                    .total_cmp(&f.pos[a].dot(dc))
+                    .then(a.cmp(&b))
+            });
             for (k, &i) in front.iter().enumerate() {
                 if sim.flock.phase[i] == Phase::Airborne {
                     continue;
@@ -605,7 +610,8 @@ impl Simulation {
                 let after = front[..k]
                     .iter()
                     .filter(|&&a| {
-                        f.phase[a] != Phase::Airborne && (f.pos[a] - f.pos[i]).dot(rc).abs() < RUN_LANE
+                        f.phase[a] != Phase::Airborne
+                            && (f.pos[a] - f.pos[i]).dot(rc).abs() < RUN_LANE
                     })
                     .map(|&a| f.depart[a] + RUN_GAP)
                     .fold(f.depart[i], f64::max);
@@ -1227,7 +1233,10 @@ impl Simulation {
         let u = (2.0 * near - r) / near;
         let w = u * u * (3.0 - 2.0 * u);
         let far = self.pursue(i, j, c);
-        (far.0 + w * (settle.0 - far.0), far.1 + w * (settle.1 - far.1))
+        (
+            far.0 + w * (settle.0 - far.0),
+            far.1 + w * (settle.1 - far.1),
+        )
     }
 
     /// Final approach in the formation frame: the bird wants the formation's velocity (the
@@ -1572,7 +1581,9 @@ pub fn assign_slots(target: &TargetShape, pos: &[DVec2], heading: f64) -> (Vec<u
     let mut slots: Vec<usize> = (0..target.len()).filter(|&s| s != target.leader).collect();
     slots.sort_by(|&a, &b| {
         let (pa, pb) = (target.slots[a], target.slots[b]);
-        pa.x.total_cmp(&pb.x).then(pa.y.total_cmp(&pb.y)).then(a.cmp(&b))
+        pa.x.total_cmp(&pb.x)
+            .then(pa.y.total_cmp(&pb.y))
+            .then(a.cmp(&b))
     });
     let mut slot = vec![target.leader; pos.len()];
     let others = by_x.iter().copied().filter(|&i| i != leader);
