@@ -111,8 +111,9 @@ pub struct InitiateOptions {
     /// Acceleration of the take-off run on the ground, wingspans per second squared.
     pub run_accel: f64,
     /// Wanted take-off duration, seconds (`None`: the natural one of the flock size, see
-    /// [`TakeoffPlan::natural_seconds`]). A longer one stretches the departures; the simulation
-    /// is never cut.
+    /// [`TakeoffPlan::natural_seconds`]). The take-off plan scales the start area, the departure
+    /// stagger and how hard the birds drive (accelerations, climb, approach) to it
+    /// ([`TakeoffPlan::drive`]); the simulation is never cut.
     pub takeoff: Option<f64>,
     /// Separation drive threshold, wingspans (paper: 10).
     pub separation_distance: f64,
@@ -1126,8 +1127,9 @@ pub fn random_start(
 /// A take-off area: positions uniform in the plan's rectangle at least `min_spacing` apart, at
 /// rest (speed 0, z = 0), facing within the spread of the cruise heading, with departure times
 /// front to back over the stagger window (the front-most bird leaves at 0 and leads; a small
-/// random jitter of a tenth of the window mixes neighbours). An area too small for the flock is
-/// an error naming the flags.
+/// random jitter of a tenth of the window mixes neighbours). With assigned slots the simulation
+/// hands these times out again by slot depth ([`Simulation::new`]). An area too small for the
+/// flock is an error naming the option paths.
 pub fn ground_start(
     n: usize,
     g: &GroundStart,

@@ -4,6 +4,10 @@
 //! Output frames are samples of this one simulation, so the same seed gives the same take-off at
 //! any output frame rate.
 //!
+//! With assigned slots (the default, [`StepParams::assign_slots`]) every bird has its slot from
+//! the start ([`assign_slots`]) and flies the final approach in the formation frame
+//! (`Simulation::settle`); the paper's correspondence below applies otherwise.
+//!
 //! Each decision: every departed bird perceives the departed flock as it was (Jacobi update), in
 //! the horizontal plane; it chooses its reference bird and side, derives its target position
 //! from the correspondence with the target shape and asks for a turn rate (eq. 6 as a rate,
