@@ -21,7 +21,7 @@ cp "$T/frames/frame_00006.png" "$I/usage-initiation.png"
 last=$(ls "$T/frames" | tail -n 3 | head -n 1)
 cp "$T/frames/$last" "$I/usage-steady.png"
 # The ground observer: the flock passes over at 70 % of the film; show it a second before.
-$B render "$T/flock.json" -o "$T/ground/" --camera ground --fps 1 --sun --quiet
+$B render "$T/flock.json" -o "$T/ground/" --camera ground --picture-fps 1 --sun --quiet
 g=$(( (n - 1) * 7 / 10 - 1 ))
 cp "$T/ground/$(printf 'frame_%05d.png' "$g")" "$I/usage-ground.png"
 # One close frame per species (a small flock, so the follow camera is at its closest).

@@ -65,6 +65,7 @@ pub mod limits;
 pub mod pipeline;
 pub mod plot;
 pub mod progress;
+pub mod report;
 pub mod rng;
 pub mod shape;
 pub mod sniff;

@@ -232,7 +232,7 @@ fn commands() -> Vec<Command> {
                 scene,
                 vec![
                     ("--size", "0x0", None),
-                    ("--fps", "0", None),
+                    ("--picture-fps", "0", None),
                     ("--wingspan-m", "0", None),
                     o("OUT/r.txt"),
                     seed.clone(),

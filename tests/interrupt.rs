@@ -87,7 +87,7 @@ fn interrupt_with(signal: &str, name: &str, output: &str, code: i32, message: &s
     let before = snapshot(&dir);
     let mut child = Command::new(env!("CARGO_BIN_EXE_formation"))
         .args([
-            "render", "--quiet", "--size", "1280x720", "--fps", "50", "-o",
+            "render", "--quiet", "--size", "1280x720", "--picture-fps", "50", "-o",
         ])
         .arg(dir.join(output))
         .arg("-o")
@@ -181,7 +181,7 @@ fn a_killed_runs_temporary_is_removed_by_the_next_run() {
     let anim = long_animation(&dir);
     let mut child = Command::new(env!("CARGO_BIN_EXE_formation"))
         .args([
-            "render", "--quiet", "--size", "1280x720", "--fps", "50", "-o",
+            "render", "--quiet", "--size", "1280x720", "--picture-fps", "50", "-o",
         ])
         .arg(dir.join("flock.gif"))
         .arg(&anim)

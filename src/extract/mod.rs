@@ -30,18 +30,26 @@
 //! |r| ≤ T are inliers; μ_y, σ_y are the mean and sample standard deviation of the inliers'
 //! vertical deviations dy = y − curve(x) (the paper's y-deviations).
 
+pub mod checks;
+pub mod geometry;
 pub mod params;
 pub mod ransac;
 
 use rand::Rng;
 use serde::{Deserialize, Serialize};
 
-pub use params::{BirdPosition, FormationParams, FrameParams, LineCoef, ShapeModel, PARAMS_FORMAT};
+pub use checks::{Warning, WarningKind};
+pub use params::{
+    BirdPosition, FormationParams, FrameParams, LineCoef, ParamsSummary, ShapeModel, PARAMS_FORMAT,
+};
 
 use crate::annotations::{AnnotatedFrame, Annotations};
 use crate::error::{Error, Result};
 use crate::progress::Progress;
-use ransac::{Line, Model, Parabola, RansacOptions};
+use ransac::{Line, Model, Parabola, RansacOptions, Vee};
+
+/// Relative gap under which two criterion values count as equal (exact fits of a few birds).
+const TIE: f64 = 1e-6;
 
 pub use crate::shape::ShapeKind;
 
@@ -74,6 +82,8 @@ pub struct ExtractOptions {
     pub j_offset: f64,
     /// Fit only this family (U and J both mean "parabola", labelled as given).
     pub kind: Option<ShapeKind>,
+    /// Wingspan of one bird, metres, when known: the wingtip spacings are also given in metres.
+    pub wingspan_m: Option<f64>,
 }
 
 impl Default for ExtractOptions {
@@ -84,6 +94,7 @@ impl Default for ExtractOptions {
             refine_rounds: 5,
             j_offset: 0.5,
             kind: None,
+            wingspan_m: None,
         }
     }
 }
@@ -115,6 +126,17 @@ impl ExtractOptions {
                 "extract.j_offset",
                 format!("must be between 0 and 1, got {}", self.j_offset),
             ));
+        }
+        if let Some(m) = self.wingspan_m {
+            if !(m.is_finite() && m > 0.0 && m <= crate::limits::MAX_WINGSPAN_M) {
+                return Err(Error::parameter(
+                    "extract.wingspan_m",
+                    format!(
+                        "must be a positive number of metres, at most {}, got {m}",
+                        crate::limits::MAX_WINGSPAN_M
+                    ),
+                ));
+            }
         }
         Ok(())
     }
@@ -201,15 +223,24 @@ pub fn extract_with_report(
         progress.advance(1);
     }
     progress.finish();
-    Ok((
-        FormationParams {
-            format: PARAMS_FORMAT.to_string(),
-            source: ann.source.clone(),
-            birds: ann.bird_count(),
-            frames,
-        },
-        reports,
-    ))
+    for f in &mut frames {
+        f.geometry = Some(geometry::frame_geometry(f, opts.wingspan_m));
+    }
+    let geometry = geometry::summarise(&frames.iter().filter_map(|f| f.geometry).collect::<Vec<_>>());
+    let mut params = FormationParams {
+        format: PARAMS_FORMAT.to_string(),
+        source: ann.source.clone(),
+        birds: ann.bird_count(),
+        frames,
+        summary: None,
+    };
+    let warnings = checks::check(ann, &params, &reports, opts, rng);
+    params.summary = Some(ParamsSummary {
+        wingspan_m: opts.wingspan_m,
+        geometry,
+        warnings,
+    });
+    Ok((params, reports))
 }
 
 /// Slope dy/dx of a fitted curve at x (a V uses the arm of x's side).
@@ -316,6 +347,7 @@ pub fn extract_frame(
             inliers,
             outliers,
             positions,
+            geometry: None,
         },
         FrameReport {
             index: f.index,
@@ -399,30 +431,33 @@ fn choose_model(
         }
     }
     if want(ShapeKind::V) {
-        // A line per side; the leader (at x = 0) belongs to both.
-        let left: Vec<(f64, f64)> = pts.iter().copied().filter(|p| p.0 <= 0.0).collect();
-        let right: Vec<(f64, f64)> = pts.iter().copied().filter(|p| p.0 >= 0.0).collect();
-        if left.len() >= 2 && right.len() >= 2 {
-            let l = ransac::ransac::<Line>(&left, &ro, rng);
-            let r = ransac::ransac::<Line>(&right, &ro, rng);
-            if let (Some((l, _)), Some((r, _))) = (l, r) {
-                let m = ShapeModel::V {
-                    left: LineCoef {
-                        intercept: l.c,
-                        slope: l.s,
-                    },
-                    right: LineCoef {
-                        intercept: r.c,
-                        slope: r.s,
-                    },
-                };
-                cands.push((m, cost_of(&m) / sigma2 + 4.0 * ln_n));
-            }
+        // Two arms meeting at the leader's lateral position (needs a bird on each side).
+        if let Some((v, _)) = ransac::ransac::<Vee>(pts, &ro, rng) {
+            let m = ShapeModel::V {
+                left: LineCoef {
+                    intercept: v.c,
+                    slope: v.sl,
+                },
+                right: LineCoef {
+                    intercept: v.c,
+                    slope: v.sr,
+                },
+            };
+            cands.push((m, cost_of(&m) / sigma2 + 3.0 * ln_n));
         }
     }
+    // Lowest S; among scores equal to rounding (three birds fit a V and a parabola exactly) the
+    // V, then the line, then the parabola.
+    let lowest = cands.iter().map(|c| c.1).fold(f64::INFINITY, f64::min);
+    let preference = |m: &ShapeModel| match m {
+        ShapeModel::V { .. } => 0,
+        ShapeModel::Line { .. } => 1,
+        _ => 2,
+    };
     let best = cands
         .iter()
-        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .filter(|c| c.1 <= lowest + TIE * (1.0 + lowest.abs()))
+        .min_by_key(|c| preference(&c.0))
         .map(|c| c.0)?;
     let scores = cands.iter().map(|(m, s)| (ShapeKind::of(m), *s)).collect();
     Some((best, scores))

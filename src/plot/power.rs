@@ -49,7 +49,7 @@ pub enum PowerOf {
 }
 
 /// The file name of `origin`, for titles.
-fn file_name(origin: &Path) -> String {
+pub(crate) fn file_name(origin: &Path) -> String {
     origin
         .file_name()
         .map(|s| s.to_string_lossy().into_owned())
