@@ -18,6 +18,7 @@ const SWITCHES: &[&str] = &[
     "--keep-unconverged",
     "--no-initiation",
     "--sun",
+    "--strict",
 ];
 
 /// The flags `formation ARGS --help` lists.
@@ -144,7 +145,24 @@ fn commands() -> Vec<Command> {
             cases: cat(vec![
                 read.clone(),
                 fit.clone(),
-                vec![o("OUT/p.txt"), seed.clone()],
+                vec![
+                    ("--wingspan-m", "0", None),
+                    o("OUT/p.txt"),
+                    seed.clone(),
+                ],
+            ]),
+        },
+        Command {
+            name: &["report"],
+            base: strings(&["report", &geese, "-o", "OUT/r.html"]),
+            cases: cat(vec![
+                read.clone(),
+                fit.clone(),
+                vec![
+                    ("--wingspan-m", "-1", None),
+                    o("OUT/r.txt"),
+                    seed.clone(),
+                ],
             ]),
         },
         Command {
@@ -180,6 +198,7 @@ fn commands() -> Vec<Command> {
                 scene.clone(),
                 vec![
                     ("--frames", "0", None),
+                    ("--seconds", "-1", None),
                     ("--report", "OUT/r.txt", None),
                     o("OUT/s.txt"),
                     seed.clone(),
@@ -263,6 +282,11 @@ fn commands() -> Vec<Command> {
                 fit,
                 vec![("--frame", "999", None), o("OUT/s.txt"), seed.clone()],
             ]),
+        },
+        Command {
+            name: &["plot", "savings"],
+            base: strings(&["plot", "savings", &flock, "-o", "OUT/s.png"]),
+            cases: vec![o("OUT/s.txt"), seed.clone()],
         },
         Command {
             name: &["plot", "paths"],

@@ -106,14 +106,6 @@ pub fn run(args: AnimateArgs, g: Global) -> Result<()> {
         .unwrap_or_default();
     super::warn(super::flags::Cmd::Animate, g, &warnings)?;
     super::write_animation(&anim, &args.output, &config.render, g)?;
-    if !g.quiet {
-        let mut text = super::summary::animation_text("animate", &anim, Some(&report.params));
-        if let Some(st) = &report.initiate {
-            if !st.converged {
-                text.push_str(" (the take-off did not converge)");
-            }
-        }
-        super::summary::defer(text, &args.output);
-    }
+    super::summary::animate(g, &anim, &report, &args.output);
     Ok(())
 }

@@ -231,15 +231,8 @@ pub fn summary_table(
                 .unwrap_or_else(|| "-".into()),
         );
     }
-    let mut counts: Vec<(&str, usize)> = Vec::new();
-    for f in &p.frames {
-        let k = f.shape.kind();
-        match counts.iter_mut().find(|c| c.0 == k) {
-            Some(c) => c.1 += 1,
-            None => counts.push((k, 1)),
-        }
-    }
-    let kinds: Vec<String> = counts
+    let kinds: Vec<String> = p
+        .kind_counts()
         .iter()
         .map(|(k, c)| format!("{k} in {c}/{}", p.frames.len()))
         .collect();

@@ -112,20 +112,27 @@ pub fn warn_params(g: Global, params: &formation::extract::FormationParams) -> R
 }
 
 /// Prints `warnings` on stderr (`warning: …`, option paths shown as `cmd`'s flags, even with
-/// `--quiet`); with `--strict` any warning is an error (exit 2, nothing written).
+/// `--quiet`). With `--strict` the first warning is the error instead (exit 2, one line,
+/// nothing written).
 pub fn warn(cmd: flags::Cmd, g: Global, warnings: &[formation::extract::Warning]) -> Result<()> {
+    if g.strict {
+        if let Some(first) = warnings.first() {
+            let more = match warnings.len() - 1 {
+                0 => String::new(),
+                1 => " (and 1 more warning)".into(),
+                n => format!(" (and {n} more warnings)"),
+            };
+            return Err(formation::Error::parameter(
+                "--strict",
+                format!(
+                    "{}{more}; no output written",
+                    flags::rewrite(cmd, &first.message)
+                ),
+            ));
+        }
+    }
     for w in warnings {
         eprintln!("warning: {}", flags::rewrite(cmd, &w.message));
-    }
-    if g.strict && !warnings.is_empty() {
-        let n = warnings.len();
-        return Err(formation::Error::parameter(
-            "--strict",
-            format!(
-                "{n} warning{} above; fix the input (or leave out --strict); no output written",
-                if n == 1 { "" } else { "s" }
-            ),
-        ));
     }
     Ok(())
 }

@@ -67,16 +67,8 @@ pub fn human_size(bytes: &u64) -> String {
 
 /// The kinds fitted over the frames of `p`: `V in 20/20 frames`.
 pub fn kinds_text(p: &FormationParams) -> String {
-    let mut counts: Vec<(&str, usize)> = Vec::new();
-    for f in &p.frames {
-        let k = f.shape.kind();
-        match counts.iter_mut().find(|c| c.0 == k) {
-            Some(c) => c.1 += 1,
-            None => counts.push((k, 1)),
-        }
-    }
-    counts.sort_by(|a, b| b.1.cmp(&a.1));
-    let parts: Vec<String> = counts
+    let parts: Vec<String> = p
+        .kind_counts()
         .iter()
         .map(|(k, c)| format!("{} in {c}/{}", k.to_uppercase(), p.frames.len()))
         .collect();
@@ -112,13 +104,36 @@ pub fn animation_text(what: &str, anim: &Animation, params: Option<&FormationPar
 
 /// The most frequent kind of `p`, upper case.
 pub fn dominant(p: &FormationParams) -> String {
-    let mut best = ("?", 0usize);
-    for f in &p.frames {
-        let k = f.shape.kind();
-        let c = p.frames.iter().filter(|g| g.shape.kind() == k).count();
-        if c > best.1 {
-            best = (k, c);
-        }
+    p.kind_counts()
+        .first()
+        .map_or("?".into(), |(k, _)| k.to_uppercase())
+}
+
+/// `initiate`'s summary (one call from its command, so that its file stays its own).
+pub fn initiate(g: super::Global, anim: &Animation, converged: bool, outputs: &[PathBuf]) {
+    if g.quiet {
+        return;
     }
-    best.0.to_uppercase()
+    let mut text = animation_text("initiate", anim, None);
+    if !converged {
+        text.push_str(" (the take-off did not converge)");
+    }
+    defer(text, outputs);
+}
+
+/// `animate`'s summary.
+pub fn animate(
+    g: super::Global,
+    anim: &Animation,
+    report: &formation::pipeline::Report,
+    outputs: &[PathBuf],
+) {
+    if g.quiet {
+        return;
+    }
+    let mut text = animation_text("animate", anim, Some(&report.params));
+    if report.initiate.as_ref().is_some_and(|s| !s.converged) {
+        text.push_str(" (the take-off did not converge)");
+    }
+    defer(text, outputs);
 }

@@ -167,6 +167,21 @@ impl ShapeModel {
 }
 
 impl FormationParams {
+    /// How many frames were fitted by each kind (`"v"`, `"line"`, …), most frequent first
+    /// (ties in order of first appearance).
+    pub fn kind_counts(&self) -> Vec<(&'static str, usize)> {
+        let mut counts: Vec<(&'static str, usize)> = Vec::new();
+        for f in &self.frames {
+            let k = f.shape.kind();
+            match counts.iter_mut().find(|c| c.0 == k) {
+                Some(c) => c.1 += 1,
+                None => counts.push((k, 1)),
+            }
+        }
+        counts.sort_by(|a, b| b.1.cmp(&a.1));
+        counts
+    }
+
     /// Reads and validates a params file.
     pub fn read(path: &Path) -> Result<FormationParams> {
         let p: FormationParams = crate::io::read_json(path)?;

@@ -406,15 +406,7 @@ fn field_section(page: &mut Page, p: Option<&FormationParams>, a: Option<&Animat
 }
 
 fn kinds(p: &FormationParams) -> String {
-    let mut counts: Vec<(&str, usize)> = Vec::new();
-    for f in &p.frames {
-        let k = f.shape.kind();
-        match counts.iter_mut().find(|c| c.0 == k) {
-            Some(c) => c.1 += 1,
-            None => counts.push((k, 1)),
-        }
-    }
-    counts
+    p.kind_counts()
         .iter()
         .map(|(k, c)| format!("{} in {c} of {}", k.to_uppercase(), p.frames.len()))
         .collect::<Vec<_>>()
