@@ -269,7 +269,7 @@ pub fn overall_text(g: &formation::extract::geometry::GeometrySummary, metres: b
     use formation::extract::geometry::Stat;
     let st = |s: &Option<Stat>, unit: &str, prec: usize| match s {
         Some(s) => format!(
-            "{:.prec$}{unit} (median of {} frames, {:.prec$}–{:.prec$})",
+            "{:.prec$}{unit} (median of {} frames, {:.prec$} to {:.prec$})",
             s.median, s.frames, s.min, s.max
         ),
         None => "-".into(),

@@ -33,7 +33,7 @@ fn pct(v: f64) -> String {
 fn stat(s: &Option<Stat>, unit: &str, prec: usize) -> String {
     match s {
         Some(s) => format!(
-            "{:.prec$}{unit} (median; {:.prec$}–{:.prec$} over {} frames)",
+            "{:.prec$}{unit} (median; {:.prec$} to {:.prec$} over {} frames)",
             s.median, s.min, s.max, s.frames
         ),
         None => "–".into(),
