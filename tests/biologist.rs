@@ -45,7 +45,9 @@ fn geese_with(dir: &Path, name: &str, key: &str, value: serde_json::Value) -> Pa
 
 /// A small deterministic noise in [−a, a].
 fn noise(k: &mut u64, a: f64) -> f64 {
-    *k = k.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+    *k = k
+        .wrapping_mul(6364136223846793005)
+        .wrapping_add(1442695040888963407);
     ((*k >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0) * a
 }
 
@@ -68,8 +70,8 @@ fn pixels(pts: &[(f64, f64)], frames: usize, seed: u64) -> Vec<Vec<[f64; 2]>> {
 }
 
 fn kinds_of(pts: &[(f64, f64)]) -> Vec<String> {
-    let ann = Annotations::from_points("model choice", Heading::Up, 40.0, &pixels(pts, 6, 7))
-        .unwrap();
+    let ann =
+        Annotations::from_points("model choice", Heading::Up, 40.0, &pixels(pts, 6, 7)).unwrap();
     let p = extract(&ann, &ExtractOptions::default(), &mut seeded(0)).unwrap();
     p.frames
         .iter()
@@ -150,7 +152,11 @@ fn each_warning_has_its_first_line_and_strict_makes_it_exit_2() {
     // With the suggested fix the V comes back and the warning goes.
     let out = run(&["extract", f, "--heading", "down", "-o", &d("b.json"), "-q"]);
     assert!(!stderr(&out).contains("warning"), "{}", stderr(&out));
-    assert!(stdout(&out).contains("kinds: v in 20/20"), "{}", stdout(&out));
+    assert!(
+        stdout(&out).contains("kinds: v in 20/20"),
+        "{}",
+        stdout(&out)
+    );
 
     // A long CSV with y up: the fix is --y-origin.
     let mut csv = String::from("frame,bird,x,y\n");
@@ -169,12 +175,30 @@ fn each_warning_has_its_first_line_and_strict_makes_it_exit_2() {
     let csv_path = dir.join("up.csv");
     std::fs::write(&csv_path, csv).unwrap();
     let c = s(&csv_path);
-    let (_, w) = first_warning(&["extract", c, "--wingspan-px", "38", "-o", &d("c.json"), "-q"]);
+    let (_, w) = first_warning(&[
+        "extract",
+        c,
+        "--wingspan-px",
+        "38",
+        "-o",
+        &d("c.json"),
+        "-q",
+    ]);
     assert_eq!(
         w,
         format!("warning: {c}: the formation opens forward in 20 of 20 frames (birds ahead of the leader's arms): pixel y probably grows upward; give --y-origin bottom (or --heading down if the flock flies the other way)")
     );
-    let out = run(&["extract", c, "--wingspan-px", "38", "--y-origin", "bottom", "-o", &d("c.json"), "-q"]);
+    let out = run(&[
+        "extract",
+        c,
+        "--wingspan-px",
+        "38",
+        "--y-origin",
+        "bottom",
+        "-o",
+        &d("c.json"),
+        "-q",
+    ]);
     assert!(!stderr(&out).contains("warning"), "{}", stderr(&out));
 
     // The heading turned by 90°.
@@ -233,7 +257,10 @@ fn each_warning_has_its_first_line_and_strict_makes_it_exit_2() {
         ("barnacle_geese_v.json", vec![]),
         ("snow_geese_j.csv", vec![]),
         ("pelicans_u_labelme", vec![]),
-        ("cranes_v_dltdv.csv", vec!["--wingspan-px", "22", "--heading", "300"]),
+        (
+            "cranes_v_dltdv.csv",
+            vec!["--wingspan-px", "22", "--heading", "300"],
+        ),
     ] {
         let e = example_arg(ex);
         let mut args = vec!["extract", e.as_str(), "-o", "OUT"];
@@ -249,7 +276,10 @@ fn each_warning_has_its_first_line_and_strict_makes_it_exit_2() {
     // --strict: exit 2, one line (the warning itself), nothing written.
     for (cmd, target) in [
         (vec!["extract", f, "-o"], d("strict.json")),
-        (vec!["animate", f, "--birds", "5", "--seconds", "1", "-o"], d("strict-a.json")),
+        (
+            vec!["animate", f, "--birds", "5", "--seconds", "1", "-o"],
+            d("strict-a.json"),
+        ),
         (vec!["report", f, "-o"], d("strict.html")),
     ] {
         let mut args = cmd.clone();
@@ -257,14 +287,28 @@ fn each_warning_has_its_first_line_and_strict_makes_it_exit_2() {
         args.push("--strict");
         args.push("-q");
         let out = run(&args);
-        assert_usage_error(&out, &["--strict: ", "opens forward", "--heading down", "no output written"]);
+        assert_usage_error(
+            &out,
+            &[
+                "--strict: ",
+                "opens forward",
+                "--heading down",
+                "no output written",
+            ],
+        );
         assert!(!Path::new(&target).exists(), "{target} written");
     }
     // steady repeats a params file's recorded warnings, and --strict refuses it.
-    let out = run(&["steady", &d("a.json"), "--birds", "5", "--frames", "3", "-o", &d("s.json"), "-q"]);
+    let steady = |out: &str, flag: &str| {
+        let (a, o) = (d("a.json"), d(out));
+        run(&[
+            "steady", &a, "--birds", "5", "--frames", "3", "-o", &o, flag,
+        ])
+    };
+    let out = steady("s.json", "-q");
     assert_eq!(code(&out), 0);
     assert!(stderr(&out).starts_with(&format!("warning: {f}: the formation opens forward")));
-    let out = run(&["steady", &d("a.json"), "--birds", "5", "--frames", "3", "-o", &d("s2.json"), "--strict"]);
+    let out = steady("s2.json", "--strict");
     assert_usage_error(&out, &["--strict", "opens forward"]);
     assert!(!dir.join("s2.json").exists());
     let _ = std::fs::remove_dir_all(&dir);
@@ -285,7 +329,10 @@ fn extract_reports_the_apex_depth_and_wingtip_spacing() {
     ]);
     assert_eq!(code(&out), 0, "{}", stderr(&out));
     let table = stdout(&out);
-    assert!(table.contains("apex° (left+right)  depth    WTS"), "{table}");
+    assert!(
+        table.contains("apex° (left+right)  depth    WTS"),
+        "{table}"
+    );
     let overall = table
         .lines()
         .find(|l| l.starts_with("overall: apex angle "))
@@ -302,7 +349,10 @@ fn extract_reports_the_apex_depth_and_wingtip_spacing() {
         );
         assert!((l + r - a).abs() < 1e-9);
         // The example's arms have slopes 0.5–0.7: about 55–63° from the flight axis.
-        assert!((50.0..70.0).contains(&l) && (50.0..70.0).contains(&r), "{l} {r}");
+        assert!(
+            (50.0..70.0).contains(&l) && (50.0..70.0).contains(&r),
+            "{l} {r}"
+        );
         let wts = g["wingtip_spacing"].as_f64().unwrap();
         assert!((wts - (f["mu_x"].as_f64().unwrap() - 1.0)).abs() < 1e-12);
         assert!((g["wingtip_spacing_m"].as_f64().unwrap() - 1.4 * wts).abs() < 1e-12);
@@ -345,11 +395,18 @@ fn csv_columns_match_the_json_in_every_frame() {
     // The summary: one paragraph after the outputs exist.
     let first = err.lines().next().unwrap_or("");
     assert!(
-        first.starts_with("animate: 9 birds, shape V (learnt from V in 20/20 frames), 1 formation, take-off "),
+        first.starts_with(
+            "animate: 9 birds, shape V (learnt from V in 20/20 frames), 1 formation, take-off "
+        ),
         "{err}"
     );
-    assert!(first.contains("flock saving ") && first.contains(" % of induced power in steady flight"));
-    assert!(err.contains("flock.json (") && err.contains("flock.csv ("), "{err}");
+    assert!(
+        first.contains("flock saving ") && first.contains(" % of induced power in steady flight")
+    );
+    assert!(
+        err.contains("flock.json (") && err.contains("flock.csv ("),
+        "{err}"
+    );
     let a = formation::Animation::read(&json).unwrap();
     let text = std::fs::read_to_string(&csv).unwrap();
     let mut lines = text.lines();
@@ -415,7 +472,10 @@ fn charts_draw_the_leader_the_ranges_and_the_stages_they_claim() {
     for chart in ["savings", "xi", "paths"] {
         let text = svg(&["plot", chart, j, "-o", &out(&format!("{chart}.svg"))]);
         assert!(text.contains("#C81E1E"), "{chart}: no leader colour");
-        assert!(text.contains(&format!("leader (bird {leader})")), "{chart}: no leader label");
+        assert!(
+            text.contains(&format!("leader (bird {leader})")),
+            "{chart}: no leader label"
+        );
         // The colour map stops before viridis' pale yellow end (invisible on white).
         assert!(!text.contains("#FDE725"), "{chart}");
     }
@@ -424,7 +484,8 @@ fn charts_draw_the_leader_the_ranges_and_the_stages_they_claim() {
     assert!(sav.contains("take-off ("));
     assert!(sav.contains("(take-off and steady flight)"));
     // Feasible ranges are recorded in animate's output and drawn.
-    let a: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let a: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     assert_eq!(a["xi_ranges"].as_array().unwrap().len(), 14);
     let pow = svg(&["plot", "power", j, "--key", "1", "-o", &out("p.svg")]);
     assert!(pow.contains("feasible range"), "no ranges drawn");
@@ -444,12 +505,16 @@ fn charts_draw_the_leader_the_ranges_and_the_stages_they_claim() {
     ]);
     assert_eq!(code(&o), 0);
     let paths = svg(&["plot", "paths", s(&steady), "-o", &out("sp.svg")]);
-    assert!(paths.contains("No take-off in this file (steady flight only)"), "title");
+    assert!(
+        paths.contains("No take-off in this file (steady flight only)"),
+        "title"
+    );
     assert!(!paths.contains("Take-off of"));
     let xi = svg(&["plot", "xi", s(&steady), "-o", &out("sx.svg")]);
     assert!(xi.contains("(steady flight only)") && !xi.contains("take-off ("));
     // plot xi draws only the ξ the file records: without it, it says so.
-    let mut v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&steady).unwrap()).unwrap();
+    let mut v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&steady).unwrap()).unwrap();
     for f in v["frames"].as_array_mut().unwrap() {
         f.as_object_mut().unwrap().remove("xi");
         f.as_object_mut().unwrap().remove("e");
@@ -458,7 +523,13 @@ fn charts_draw_the_leader_the_ranges_and_the_stages_they_claim() {
     std::fs::write(&bare, v.to_string()).unwrap();
     for chart in ["xi", "savings"] {
         let o = run(&["plot", chart, s(&bare), "-o", &out("bare.svg")]);
-        assert_usage_error(&o, &["bare.json", "write the file with `formation steady` or `formation animate`"]);
+        assert_usage_error(
+            &o,
+            &[
+                "bare.json",
+                "write the file with `formation steady` or `formation animate`",
+            ],
+        );
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -468,25 +539,91 @@ fn one_vocabulary_for_rates_and_lengths() {
     let dir = scratch("bio-vocab");
     let out = |n: &str| dir.join(n).to_string_lossy().into_owned();
     let params = out("geese.json");
-    assert_eq!(code(&run(&["extract", &example_arg("barnacle_geese_v.json"), "-o", &params, "-q"])), 0);
+    assert_eq!(
+        code(&run(&[
+            "extract",
+            &example_arg("barnacle_geese_v.json"),
+            "-o",
+            &params,
+            "-q"
+        ])),
+        0
+    );
     // steady takes --seconds as well as --frames: 1.5 s at 20 fps is 30 frames.
-    let o = run(&["steady", &params, "--birds", "5", "--seconds", "1.5", "--fps", "20", "-o", &out("s.json")]);
+    let o = run(&[
+        "steady",
+        &params,
+        "--birds",
+        "5",
+        "--seconds",
+        "1.5",
+        "--fps",
+        "20",
+        "-o",
+        &out("s.json"),
+    ]);
     assert_eq!(code(&o), 0, "{}", stderr(&o));
-    assert!(stderr(&o).starts_with("steady: 5 birds, shape V"), "{}", stderr(&o));
+    assert!(
+        stderr(&o).starts_with("steady: 5 birds, shape V"),
+        "{}",
+        stderr(&o)
+    );
     let a = formation::Animation::read(Path::new(&out("s.json"))).unwrap();
     assert_eq!(a.frames.len(), 30);
     // --quiet hides the summary.
-    let o = run(&["steady", &params, "--birds", "5", "--frames", "3", "-o", &out("q.json"), "-q"]);
+    let o = run(&[
+        "steady",
+        &params,
+        "--birds",
+        "5",
+        "--frames",
+        "3",
+        "-o",
+        &out("q.json"),
+        "-q",
+    ]);
     assert_eq!((code(&o), stderr(&o)), (0, String::new()));
     // render: --picture-fps is the picture rate; --fps (the animation's rate) is refused.
-    let o = run(&["render", &out("s.json"), "--picture-fps", "10", "-o", &out("r.gif"), "-q"]);
+    let o = run(&[
+        "render",
+        &out("s.json"),
+        "--picture-fps",
+        "10",
+        "-o",
+        &out("r.gif"),
+        "-q",
+    ]);
     assert_eq!(code(&o), 0, "{}", stderr(&o));
-    let o = run(&["render", &out("s.json"), "--fps", "10", "-o", &out("r2.gif")]);
-    assert_usage_error(&o, &["--fps", "the animation's own frame rate", "--picture-fps"]);
+    let o = run(&[
+        "render",
+        &out("s.json"),
+        "--fps",
+        "10",
+        "-o",
+        &out("r2.gif"),
+    ]);
+    assert_usage_error(
+        &o,
+        &["--fps", "the animation's own frame rate", "--picture-fps"],
+    );
     // animate on a shape or a target says which command reads it.
-    let o = run(&["animate", &example_arg("v9_shape.json"), "--birds", "5", "-o", &out("x.json")]);
+    let o = run(&[
+        "animate",
+        &example_arg("v9_shape.json"),
+        "--birds",
+        "5",
+        "-o",
+        &out("x.json"),
+    ]);
     assert_usage_error(&o, &["v9_shape.json", "shape file", "`formation power`"]);
-    let o = run(&["animate", &example_arg("equal_savings_target.json"), "--birds", "5", "-o", &out("x.json")]);
+    let o = run(&[
+        "animate",
+        &example_arg("equal_savings_target.json"),
+        "--birds",
+        "5",
+        "-o",
+        &out("x.json"),
+    ]);
     assert_usage_error(&o, &["target file", "`formation solve`"]);
     let o = run(&["extract", &out("s.json"), "-o", &out("x.json")]);
     assert_usage_error(&o, &["animation file", "`formation render`"]);
@@ -495,7 +632,10 @@ fn one_vocabulary_for_rates_and_lengths() {
     for e in std::fs::read_dir(support::examples_dir()).unwrap() {
         let name = e.unwrap().file_name().to_string_lossy().into_owned();
         if name != "README.md" {
-            assert!(readme.contains(&format!("`{name}")), "{name} missing from examples_data/README.md");
+            assert!(
+                readme.contains(&format!("`{name}")),
+                "{name} missing from examples_data/README.md"
+            );
         }
     }
     let _ = std::fs::remove_dir_all(&dir);
@@ -508,21 +648,64 @@ fn bad_values_of_the_new_flags_are_one_line() {
     let geese = example_arg("barnacle_geese_v.json");
     let params = out("p.json");
     assert_eq!(code(&run(&["extract", &geese, "-o", &params, "-q"])), 0);
-    let cases: Vec<(Vec<String>, Vec<&str>)> = vec![
-        (vec!["extract".into(), geese.clone(), "-o".into(), out("a.json"), "--wingspan-m".into(), "0".into()], vec!["--wingspan-m", "metres"]),
-        (vec!["extract".into(), geese.clone(), "-o".into(), out("a.json"), "--wingspan-m".into(), "nan".into()], vec!["--wingspan-m"]),
-        (vec!["report".into(), geese.clone(), "-o".into(), out("a.html"), "--wingspan-m".into(), "-1".into()], vec!["--wingspan-m"]),
-        (vec!["report".into(), geese.clone(), "-o".into(), out("a.txt")], vec!["-o", "a.txt"]),
-        (vec!["report".into(), out("missing.json"), "-o".into(), out("a.html")], vec!["missing.json"]),
-        (vec!["report".into(), geese.clone(), "-o".into(), out("nodir/a.html")], vec!["nodir"]),
-        (vec!["steady".into(), params.clone(), "--birds".into(), "5".into(), "--seconds".into(), "-1".into(), "-o".into(), out("s.json")], vec!["--seconds"]),
-        (vec!["steady".into(), params.clone(), "--birds".into(), "5".into(), "-o".into(), out("s.json")], vec!["--frames", "--seconds"]),
-        (vec!["steady".into(), params.clone(), "--birds".into(), "5".into(), "--frames".into(), "3".into(), "--seconds".into(), "1".into(), "-o".into(), out("s.json")], vec!["--frames", "--seconds"]),
-        (vec!["render".into(), "tests/data/flock_small.json".into(), "-o".into(), out("r.gif"), "--picture-fps".into(), "0".into()], vec!["--picture-fps"]),
-        (vec!["plot".into(), "savings".into(), params.clone(), "-o".into(), out("p.svg")], vec!["p.json", "not an animation file"]),
-        (vec!["plot".into(), "savings".into(), "tests/data/flock_small.json".into(), "-o".into(), out("p.gif")], vec!["-o", "p.gif"]),
-        (vec!["extract".into(), geese.clone(), "-o".into(), out("a.json"), "--strict=yes".into()], vec!["--strict"]),
+    // GEESE, PARAMS and OUT/ stand for the example, a params file and the scratch directory.
+    let cases: &[(&str, &[&str])] = &[
+        (
+            "extract GEESE -o OUT/a.json --wingspan-m 0",
+            &["--wingspan-m", "metres"],
+        ),
+        (
+            "extract GEESE -o OUT/a.json --wingspan-m nan",
+            &["--wingspan-m"],
+        ),
+        (
+            "report GEESE -o OUT/a.html --wingspan-m -1",
+            &["--wingspan-m"],
+        ),
+        ("report GEESE -o OUT/a.txt", &["-o", "a.txt"]),
+        ("report OUT/missing.json -o OUT/a.html", &["missing.json"]),
+        ("report GEESE -o OUT/nodir/a.html", &["nodir"]),
+        (
+            "steady PARAMS --birds 5 --seconds -1 -o OUT/s.json",
+            &["--seconds"],
+        ),
+        (
+            "steady PARAMS --birds 5 -o OUT/s.json",
+            &["--frames", "--seconds"],
+        ),
+        (
+            "steady PARAMS --birds 5 --frames 3 --seconds 1 -o OUT/s.json",
+            &["--frames", "--seconds"],
+        ),
+        (
+            "render tests/data/flock_small.json -o OUT/r.gif --picture-fps 0",
+            &["--picture-fps"],
+        ),
+        (
+            "plot savings PARAMS -o OUT/p.svg",
+            &["p.json", "not an animation file"],
+        ),
+        (
+            "plot savings tests/data/flock_small.json -o OUT/p.gif",
+            &["-o", "p.gif"],
+        ),
+        ("extract GEESE -o OUT/a.json --strict=yes", &["--strict"]),
     ];
+    let scratch_dir = format!("{}/", s(&dir));
+    let cases: Vec<(Vec<String>, Vec<&str>)> = cases
+        .iter()
+        .map(|(line, needles)| {
+            let args = line
+                .split_whitespace()
+                .map(|a| {
+                    a.replace("GEESE", &geese)
+                        .replace("PARAMS", &params)
+                        .replace("OUT/", &scratch_dir)
+                })
+                .collect();
+            (args, needles.to_vec())
+        })
+        .collect();
     for (args, needles) in cases {
         let refs: Vec<&str> = args.iter().map(String::as_str).collect();
         let o = support::bin()

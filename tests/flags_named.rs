@@ -145,11 +145,7 @@ fn commands() -> Vec<Command> {
             cases: cat(vec![
                 read.clone(),
                 fit.clone(),
-                vec![
-                    ("--wingspan-m", "0", None),
-                    o("OUT/p.txt"),
-                    seed.clone(),
-                ],
+                vec![("--wingspan-m", "0", None), o("OUT/p.txt"), seed.clone()],
             ]),
         },
         Command {
@@ -158,11 +154,7 @@ fn commands() -> Vec<Command> {
             cases: cat(vec![
                 read.clone(),
                 fit.clone(),
-                vec![
-                    ("--wingspan-m", "-1", None),
-                    o("OUT/r.txt"),
-                    seed.clone(),
-                ],
+                vec![("--wingspan-m", "-1", None), o("OUT/r.txt"), seed.clone()],
             ]),
         },
         Command {

@@ -24,7 +24,15 @@ fn charts(page: &str) -> Vec<String> {
 fn self_contained(page: &str) {
     assert!(page.starts_with("<!DOCTYPE html>"));
     assert!(page.trim_end().ends_with("</html>"));
-    for bad in ["src=\"http", "href=\"http", "src=\"//", "<link", "<img", "@import", "url("] {
+    for bad in [
+        "src=\"http",
+        "href=\"http",
+        "src=\"//",
+        "<link",
+        "<img",
+        "@import",
+        "url(",
+    ] {
         assert!(!page.contains(bad), "page fetches something: {bad}");
     }
     let n = charts(page).len();
@@ -42,7 +50,11 @@ fn the_page_of_annotations_has_parameters_fits_savings_and_the_field() {
     );
     self_contained(&page);
     let c = charts(&page);
-    assert_eq!(c, ["geometry", "fit-0", "fit-10", "fit-19", "footage-savings"], "{c:?}");
+    assert_eq!(
+        c,
+        ["geometry", "fit-0", "fit-10", "fit-19", "footage-savings"],
+        "{c:?}"
+    );
     for needle in [
         "Extracted parameters (§4)",
         "Shapes fitted: V in 20 of 20",
@@ -94,7 +106,16 @@ fn the_page_of_an_animation_has_savings_take_off_and_its_charts() {
     assert_eq!(page, again);
     // A params file.
     let p = dir.join("p.json");
-    assert_eq!(code(&run(&["extract", &example_arg("snow_geese_j.csv"), "-o", s(&p), "-q"])), 0);
+    assert_eq!(
+        code(&run(&[
+            "extract",
+            &example_arg("snow_geese_j.csv"),
+            "-o",
+            s(&p),
+            "-q"
+        ])),
+        0
+    );
     let page = report(s(&p), &dir.join("p.html"), &[]);
     self_contained(&page);
     assert!(page.contains("J in 24 of 24"));

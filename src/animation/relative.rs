@@ -43,7 +43,11 @@ impl Animation {
         let mut out: Vec<Relative> = (0..n)
             .map(|i| {
                 let fm = of.get(i).copied().unwrap_or(0);
-                let l = leaders.get(fm).copied().unwrap_or(0).min(n.saturating_sub(1));
+                let l = leaders
+                    .get(fm)
+                    .copied()
+                    .unwrap_or(0)
+                    .min(n.saturating_sub(1));
                 let h = f.heading.get(l).copied().unwrap_or(0.0);
                 let (dx, dy) = (f.x[i] - f.x[l], f.y[i] - f.y[l]);
                 Relative {
@@ -75,12 +79,15 @@ impl Animation {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::animation::{Frame, FormationRecord};
+    use crate::animation::{FormationRecord, Frame};
 
     fn anim(heading: f64) -> Animation {
         // Leader 0 at the origin; bird 1 one wingspan to its right and two behind, in the
         // leader's own frame, placed in the world for this heading.
-        let (d, r) = ((heading.sin(), heading.cos()), (heading.cos(), -heading.sin()));
+        let (d, r) = (
+            (heading.sin(), heading.cos()),
+            (heading.cos(), -heading.sin()),
+        );
         let p1 = (r.0 - 2.0 * d.0, r.1 - 2.0 * d.1);
         let p2 = (-0.5 * r.0 - 1.0 * d.0, -0.5 * r.1 - 1.0 * d.1);
         let mut a = Animation::new(0, 30.0, 1.0, 3);

@@ -350,7 +350,9 @@ fn detect_text(path: &Path, text: &str) -> Result<Format> {
         // Another of formation's own files: say which command reads it.
         let kind = crate::sniff::text_kind(t).unwrap_or(crate::sniff::Kind::Unknown);
         let reader = match kind {
-            crate::sniff::Kind::Shape => Some("`formation power` and `formation plot power` read it"),
+            crate::sniff::Kind::Shape => {
+                Some("`formation power` and `formation plot power` read it")
+            }
             crate::sniff::Kind::Target => Some("`formation solve` reads it"),
             _ => None,
         };

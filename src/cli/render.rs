@@ -77,7 +77,11 @@ pub struct PictureArgs {
     /// Frame rate of the pictures, frames per second (default: the GIF rate, rounded to whole
     /// 1/100 s per frame, for GIF; the animation's own rate for PNG frames and video). JSON, CSV and glTF
     /// keep the animation's frames.
-    #[arg(long = "picture-fps", value_name = "FPS", allow_negative_numbers = true)]
+    #[arg(
+        long = "picture-fps",
+        value_name = "FPS",
+        allow_negative_numbers = true
+    )]
     pub fps: Option<f64>,
     /// Bird wingspan in metres for the .glb (and recorded in the .json) (default: the
     /// animation's).

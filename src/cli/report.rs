@@ -48,21 +48,21 @@ pub fn run(args: ReportArgs, g: Global) -> Result<()> {
             .map(|v| formation::sniff::json_kind(&v))
             .unwrap_or(Kind::Unknown)
     };
-    let (params, animation, threshold): (Option<FormationParams>, Option<Animation>, _) =
-        match kind {
-            Kind::Animation => (None, Some(Animation::read(&args.input)?), None),
-            Kind::Params => (Some(super::steady::read_params(&args.input)?), None, None),
-            _ => {
-                let (_, p, _) = super::extract::read_and_extract(
-                    &args.input,
-                    &args.read,
-                    extract,
-                    g,
-                    super::flags::Cmd::Report,
-                )?;
-                (Some(p), None, Some(extract.inlier_threshold))
-            }
-        };
+    let (params, animation, threshold): (Option<FormationParams>, Option<Animation>, _) = match kind
+    {
+        Kind::Animation => (None, Some(Animation::read(&args.input)?), None),
+        Kind::Params => (Some(super::steady::read_params(&args.input)?), None, None),
+        _ => {
+            let (_, p, _) = super::extract::read_and_extract(
+                &args.input,
+                &args.read,
+                extract,
+                g,
+                super::flags::Cmd::Report,
+            )?;
+            (Some(p), None, Some(extract.inlier_threshold))
+        }
+    };
     if let Some(p) = &params {
         super::warn_params(g, p)?;
     }

@@ -80,7 +80,11 @@ pub fn animation_text(what: &str, anim: &Animation, params: Option<&FormationPar
     let s = formation::animation::stats::AnimationStats::of(anim);
     let mut parts = vec![format!("{what}: {} birds", anim.birds)];
     if let Some(p) = params {
-        parts.push(format!("shape {} (learnt from {})", dominant(p), kinds_text(p)));
+        parts.push(format!(
+            "shape {} (learnt from {})",
+            dominant(p),
+            kinds_text(p)
+        ));
     }
     parts.push(format!(
         "{} formation{}",

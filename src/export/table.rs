@@ -50,7 +50,12 @@ pub fn write_csv<W: Write>(anim: &Animation, w: &mut W) -> std::io::Result<()> {
                 None => String::new(),
             };
             let r = rel[b];
-            let bank = f.bank.as_ref().and_then(|a| a.get(b)).copied().unwrap_or(0.0);
+            let bank = f
+                .bank
+                .as_ref()
+                .and_then(|a| a.get(b))
+                .copied()
+                .unwrap_or(0.0);
             writeln!(
                 w,
                 "{k},{},{b},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{bank}",

@@ -120,9 +120,7 @@ pub fn frame_geometry(f: &FrameParams, wingspan_m: Option<f64>) -> FrameGeometry
         let side: Vec<(f64, f64)> = inl
             .iter()
             .copied()
-            .filter(|p| {
-                p.0 == 0.0 && p.1 == 0.0 || if left { p.0 < 0.0 } else { p.0 > 0.0 }
-            })
+            .filter(|p| p.0 == 0.0 && p.1 == 0.0 || if left { p.0 < 0.0 } else { p.0 > 0.0 })
             .collect();
         if side.iter().all(|p| p.0 == 0.0) {
             return None;
@@ -197,7 +195,13 @@ mod tests {
     fn a_symmetric_v_has_equal_arms_that_sum_to_the_apex() {
         // Arms at 30° from the flight axis: x = y·tan 30°.
         let t = 30f64.to_radians().tan();
-        let f = frame(&[(0.0, 0.0), (-t, 1.0), (t, 1.0), (-2.0 * t, 2.0), (2.0 * t, 2.0)]);
+        let f = frame(&[
+            (0.0, 0.0),
+            (-t, 1.0),
+            (t, 1.0),
+            (-2.0 * t, 2.0),
+            (2.0 * t, 2.0),
+        ]);
         let g = frame_geometry(&f, Some(1.5));
         assert!((g.arm_left_deg.unwrap() - 30.0).abs() < 1e-9);
         assert!((g.arm_right_deg.unwrap() - 30.0).abs() < 1e-9);
@@ -220,7 +224,10 @@ mod tests {
     #[test]
     fn stats_of_an_even_count_take_the_middle_pair() {
         let s = Stat::of(&[4.0, 1.0, 3.0, 2.0]).unwrap();
-        assert_eq!((s.median, s.mean, s.min, s.max, s.frames), (2.5, 2.5, 1.0, 4.0, 4));
+        assert_eq!(
+            (s.median, s.mean, s.min, s.max, s.frames),
+            (2.5, 2.5, 1.0, 4.0, 4)
+        );
         assert!(Stat::of(&[]).is_none());
     }
 }

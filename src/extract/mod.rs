@@ -226,7 +226,8 @@ pub fn extract_with_report(
     for f in &mut frames {
         f.geometry = Some(geometry::frame_geometry(f, opts.wingspan_m));
     }
-    let geometry = geometry::summarise(&frames.iter().filter_map(|f| f.geometry).collect::<Vec<_>>());
+    let geometry =
+        geometry::summarise(&frames.iter().filter_map(|f| f.geometry).collect::<Vec<_>>());
     let mut params = FormationParams {
         format: PARAMS_FORMAT.to_string(),
         source: ann.source.clone(),

@@ -29,8 +29,18 @@ const fn r(source: &'static str, species: &'static str, lo: f64, hi: f64) -> Fie
 /// Induced-power saving of the flock in formation flight, fraction (the same quantity as the
 /// tool's mean `e`).
 pub const FLOCK_SAVING: &[FieldRange] = &[
-    r("Cutts & Speakman 1994", "pink-footed goose, 54 skeins", 0.14, 0.14),
-    r("Speakman & Banks 1998", "greylag goose, 25 formations", 0.27, 0.27),
+    r(
+        "Cutts & Speakman 1994",
+        "pink-footed goose, 54 skeins",
+        0.14,
+        0.14,
+    ),
+    r(
+        "Speakman & Banks 1998",
+        "greylag goose, 25 formations",
+        0.27,
+        0.27,
+    ),
     r("Hainsworth 1987", "Canada goose, 8 formations", 0.36, 0.36),
 ];
 
@@ -39,9 +49,24 @@ pub const FLOCK_SAVING_SPAN: (f64, f64) = (0.14, 0.36);
 
 /// V apex angle, degrees.
 pub const APEX_ANGLE: &[FieldRange] = &[
-    r("Gould & Heppner 1974", "Canada goose, 5 flocks (34 ± 6°)", 28.0, 40.0),
-    r("stereo-filmed wild V", "greater white-fronted goose, 15 birds", 50.0, 73.0),
-    r("O'Malley & Evans 1982", "white pelican, 12 Vs (67 ± 8°)", 59.0, 75.0),
+    r(
+        "Gould & Heppner 1974",
+        "Canada goose, 5 flocks (34 ± 6°)",
+        28.0,
+        40.0,
+    ),
+    r(
+        "stereo-filmed wild V",
+        "greater white-fronted goose, 15 birds",
+        50.0,
+        73.0,
+    ),
+    r(
+        "O'Malley & Evans 1982",
+        "white pelican, 12 Vs (67 ± 8°)",
+        59.0,
+        75.0,
+    ),
     r("Williams et al. 1976", "Canada goose (radar)", 38.0, 124.0),
 ];
 

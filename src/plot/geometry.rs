@@ -54,7 +54,10 @@ impl Chart for GeometryChart {
         let f0 = self.rows.first().map_or(0, |r| r.0) as f64 - 0.5;
         let f1 = self.rows.last().map_or(1, |r| r.0) as f64 + 0.5;
         let mut chart = ChartBuilder::on(&left)
-            .caption("angles per frame (from the flight axis behind the leader)", (FONT_FAMILY, 15))
+            .caption(
+                "angles per frame (from the flight axis behind the leader)",
+                (FONT_FAMILY, 15),
+            )
             .margin(12)
             .x_label_area_size(40)
             .y_label_area_size(50)
@@ -66,7 +69,11 @@ impl Chart for GeometryChart {
             .label_style((FONT_FAMILY, 13))
             .light_line_style(RGBColor(235, 235, 235))
             .draw()?;
-        let shades = [RGBColor(120, 170, 120), RGBColor(120, 140, 200), RGBColor(200, 160, 90)];
+        let shades = [
+            RGBColor(120, 170, 120),
+            RGBColor(120, 140, 200),
+            RGBColor(200, 160, 90),
+        ];
         for (k, fr) in field::APEX_ANGLE.iter().take(3).enumerate() {
             let c = shades[k];
             chart
@@ -75,7 +82,9 @@ impl Chart for GeometryChart {
                     c.mix(0.18).filled(),
                 )))?
                 .label(format!("apex, {}: {}–{}°", fr.source, fr.lo, fr.hi))
-                .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 14, y + 5)], c.mix(0.4).filled()));
+                .legend(move |(x, y)| {
+                    Rectangle::new([(x, y - 5), (x + 14, y + 5)], c.mix(0.4).filled())
+                });
         }
         let series: [(&str, RGBColor, usize); 3] = [
             ("apex angle", RGBColor(20, 20, 20), 1),
@@ -101,7 +110,9 @@ impl Chart for GeometryChart {
             chart
                 .draw_series(LineSeries::new(pts.clone(), c.stroke_width(2)))?
                 .label(name)
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 14, y)], c.stroke_width(2)));
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 14, y)], c.stroke_width(2))
+                });
             chart.draw_series(pts.into_iter().map(|p| Circle::new(p, 3, c.filled())))?;
         }
         chart

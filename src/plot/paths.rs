@@ -79,7 +79,10 @@ impl PathsChart {
         let what = if a.stage("initiation").is_some() {
             "Take-off".to_string()
         } else {
-            format!("No take-off in this file ({}): paths", super::stages_title(a))
+            format!(
+                "No take-off in this file ({}): paths",
+                super::stages_title(a)
+            )
         };
         Ok(PathsChart {
             world,

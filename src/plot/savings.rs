@@ -105,7 +105,10 @@ impl Chart for SavingsChart {
         // Left: saving against rank.
         let max_rank = s.birds.iter().map(|b| b.rank).fold(1.0, f64::max);
         let mut chart = ChartBuilder::on(&left)
-            .caption("each bird in steady flight, by place in its formation", (FONT_FAMILY, 16))
+            .caption(
+                "each bird in steady flight, by place in its formation",
+                (FONT_FAMILY, 16),
+            )
             .margin(12)
             .x_label_area_size(40)
             .y_label_area_size(56)
@@ -141,9 +144,9 @@ impl Chart for SavingsChart {
                 chart.draw_series(std::iter::once(Circle::new(p, 5, c.filled())))?;
             }
         }
-        let flock = s.steady_saving.unwrap_or_else(|| {
-            s.birds.iter().map(|b| b.saving).sum::<f64>() / n.max(1) as f64
-        });
+        let flock = s
+            .steady_saving
+            .unwrap_or_else(|| s.birds.iter().map(|b| b.saving).sum::<f64>() / n.max(1) as f64);
         let grey = RGBColor(90, 90, 90);
         chart
             .draw_series(std::iter::once(DashedPathElement::new(
@@ -163,7 +166,11 @@ impl Chart for SavingsChart {
             .draw()?;
         // Right: the flock's saving over time.
         let t0 = s.saving_over_time.first().map_or(0.0, |p| p.0);
-        let t1 = s.saving_over_time.last().map_or(1.0, |p| p.0).max(t0 + 1e-6);
+        let t1 = s
+            .saving_over_time
+            .last()
+            .map_or(1.0, |p| p.0)
+            .max(t0 + 1e-6);
         let mut chart = ChartBuilder::on(&right)
             .caption("the flock over time (E/N)", (FONT_FAMILY, 16))
             .margin(12)
@@ -186,7 +193,9 @@ impl Chart for SavingsChart {
                     c.mix(0.15).filled(),
                 )))?
                 .label(format!("take-off ({:.1} s)", b - a))
-                .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 14, y + 5)], c.mix(0.4).filled()));
+                .legend(move |(x, y)| {
+                    Rectangle::new([(x, y - 5), (x + 14, y + 5)], c.mix(0.4).filled())
+                });
         }
         let line = RGBColor(40, 60, 140);
         chart
@@ -195,7 +204,9 @@ impl Chart for SavingsChart {
                 line.stroke_width(2),
             ))?
             .label("flock saving")
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 14, y)], line.stroke_width(2)));
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 14, y)], line.stroke_width(2))
+            });
         chart
             .configure_series_labels()
             .background_style(WHITE.mix(0.85))

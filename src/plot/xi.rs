@@ -121,7 +121,9 @@ impl Chart for XiChart {
                     c.mix(0.15).filled(),
                 )))?
                 .label(format!("take-off ({:.1} s)", b - a))
-                .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 14, y + 5)], c.mix(0.4).filled()));
+                .legend(move |(x, y)| {
+                    Rectangle::new([(x, y - 5), (x + 14, y + 5)], c.mix(0.4).filled())
+                });
         }
         let grey = RGBColor(170, 170, 170);
         for &k in &self.key_times {

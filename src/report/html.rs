@@ -199,7 +199,9 @@ fn params_sections(page: &mut Page, p: &FormationParams, s: &Subject<'_>) -> Res
         ],
         &rows,
     );
-    if let Some(c) = crate::plot::geometry::GeometryChart::from_params(p, "Geometry over the annotated frames") {
+    if let Some(c) =
+        crate::plot::geometry::GeometryChart::from_params(p, "Geometry over the annotated frames")
+    {
         page.chart(
             "geometry",
             "Apex and arm angles per frame with field studies' V angles shaded; mean wingtip spacing per frame.",
@@ -216,14 +218,20 @@ fn params_sections(page: &mut Page, p: &FormationParams, s: &Subject<'_>) -> Res
         )?;
     }
     let st = footage_savings(p);
-    page.h2("footage-savings", "Savings in the footage (Hummel's model on the annotated birds)");
+    page.h2(
+        "footage-savings",
+        "Savings in the footage (Hummel's model on the annotated birds)",
+    );
     page.p(&format!(
         "Flock saving averaged over the annotated frames: {}.",
         st.steady_saving.map_or("–".into(), pct)
     ));
     if !st.birds.is_empty() {
         let chart = crate::plot::savings::SavingsChart {
-            title: format!("{}: savings of the annotated birds", crate::plot::power::file_name(s.origin)),
+            title: format!(
+                "{}: savings of the annotated birds",
+                crate::plot::power::file_name(s.origin)
+            ),
             stats: st.clone(),
             takeoff: None,
             time_label: "annotated frame".into(),
@@ -244,7 +252,10 @@ fn animation_sections(page: &mut Page, a: &Animation, s: &Subject<'_>) -> Result
     let mut rows = vec![
         vec!["birds".into(), a.birds.to_string()],
         vec!["formations".into(), st.formations.to_string()],
-        vec!["frames".into(), format!("{} at {} fps", a.frames.len(), a.fps)],
+        vec![
+            "frames".into(),
+            format!("{} at {} fps", a.frames.len(), a.fps),
+        ],
         vec!["stages".into(), crate::plot::stages_title(a)],
         vec!["wingspan".into(), format!("{} m", a.wingspan_m)],
         vec!["seed".into(), a.seed.to_string()],
@@ -290,14 +301,35 @@ fn animation_sections(page: &mut Page, a: &Animation, s: &Subject<'_>) -> Result
                 }
             }
         }
-        let save = |f: &crate::animation::Frame| f.e.as_deref().map_or("–".into(), |e| pct(mean(e)));
+        let save =
+            |f: &crate::animation::Frame| f.e.as_deref().map_or("–".into(), |e| pct(mean(e)));
         let rows = vec![
-            vec!["duration".into(), format!("{:.1} s ({} frames)", st.takeoff_s.unwrap_or(0.0), stage.end - stage.start)],
+            vec![
+                "duration".into(),
+                format!(
+                    "{:.1} s ({} frames)",
+                    st.takeoff_s.unwrap_or(0.0),
+                    stage.end - stage.start
+                ),
+            ],
             vec!["flock saving at the start".into(), save(f0)],
             vec!["flock saving at the hand-over".into(), save(f1)],
-            vec!["mean height at the start / hand-over".into(), format!("{:.2} / {:.2} wingspans", mean(&f0.z), mean(&f1.z))],
-            vec!["mean speed at the start / hand-over".into(), format!("{:.2} / {:.2} wingspans/s", mean(&f0.speed), mean(&f1.speed))],
-            vec!["closest approach of two birds".into(), format!("{closest:.2} wingspans")],
+            vec![
+                "mean height at the start / hand-over".into(),
+                format!("{:.2} / {:.2} wingspans", mean(&f0.z), mean(&f1.z)),
+            ],
+            vec![
+                "mean speed at the start / hand-over".into(),
+                format!(
+                    "{:.2} / {:.2} wingspans/s",
+                    mean(&f0.speed),
+                    mean(&f1.speed)
+                ),
+            ],
+            vec![
+                "closest approach of two birds".into(),
+                format!("{closest:.2} wingspans"),
+            ],
         ];
         page.table(&["", ""], &rows);
         let c = crate::plot::paths::PathsChart::from_animation(a)?;
@@ -329,7 +361,15 @@ fn bird_tables(page: &mut Page, birds: &[BirdStats]) {
         })
         .collect();
     page.table(
-        &["bird", "formation", "leader", "mean rank", "lateral", "behind", "saving"],
+        &[
+            "bird",
+            "formation",
+            "leader",
+            "mean rank",
+            "lateral",
+            "behind",
+            "saving",
+        ],
         &rows,
     );
     let mut pos: Vec<(usize, f64, usize)> = Vec::new();
@@ -355,9 +395,9 @@ fn field_section(page: &mut Page, p: Option<&FormationParams>, a: Option<&Animat
     page.h2("field", "Compared with real formations");
     let mut rows: Vec<Vec<String>> = Vec::new();
     let geo = p.and_then(|p| p.summary.as_ref()).map(|s| s.geometry);
-    let ours_apex = geo
-        .and_then(|g| g.apex_deg)
-        .map_or("–".into(), |s| format!("{:.1}° ({:.1}–{:.1})", s.median, s.min, s.max));
+    let ours_apex = geo.and_then(|g| g.apex_deg).map_or("–".into(), |s| {
+        format!("{:.1}° ({:.1}–{:.1})", s.median, s.min, s.max)
+    });
     for f in field::APEX_ANGLE {
         rows.push(vec![
             "V apex angle".into(),
