@@ -69,7 +69,7 @@ fn the_page_of_annotations_has_parameters_fits_savings_and_the_field() {
         assert!(page.contains(needle), "missing {needle:?}");
     }
     // Every annotated frame has a row.
-    assert_eq!(page.matches("<tr><td>").count() >= 20, true);
+    assert!(page.matches("<tr><td>").count() >= 20);
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -43,13 +43,12 @@ pub fn write_csv<W: Write>(anim: &Animation, w: &mut W) -> std::io::Result<()> {
     let leaders = anim.leaders();
     for (k, f) in anim.frames.iter().enumerate() {
         let rel = anim.relative_with(k, &of, &leaders);
-        for b in 0..anim.birds {
+        for (b, r) in rel.iter().enumerate() {
             let v = |a: &Vec<f64>| a.get(b).copied().unwrap_or(f64::NAN);
             let o = |a: &Option<Vec<f64>>| match a.as_ref().and_then(|a| a.get(b)) {
                 Some(x) => format!("{x}"),
                 None => String::new(),
             };
-            let r = rel[b];
             let bank = f
                 .bank
                 .as_ref()

@@ -236,11 +236,11 @@ pub fn extract_with_report(
         summary: None,
     };
     let warnings = checks::check(ann, &params, &reports, opts, rng);
-    params.summary = Some(ParamsSummary {
+    params.summary = Some(Box::new(ParamsSummary {
         wingspan_m: opts.wingspan_m,
         geometry,
         warnings,
-    });
+    }));
     Ok((params, reports))
 }
 

@@ -23,7 +23,7 @@ pub struct FormationParams {
     /// The movie's geometry over all frames and the warnings of the extraction (issue 16);
     /// absent in files written before it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub summary: Option<ParamsSummary>,
+    pub summary: Option<Box<ParamsSummary>>,
 }
 
 /// What `extract` reports about the whole movie besides the per-frame parameters.
@@ -178,7 +178,7 @@ impl FormationParams {
                 None => counts.push((k, 1)),
             }
         }
-        counts.sort_by(|a, b| b.1.cmp(&a.1));
+        counts.sort_by_key(|c| std::cmp::Reverse(c.1));
         counts
     }
 

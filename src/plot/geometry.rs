@@ -9,13 +9,17 @@ use plotters::prelude::*;
 use super::{field, Chart, DrawResult, FONT_FAMILY};
 use crate::extract::FormationParams;
 
+/// One frame: `(frame index, apex, left arm, right arm, wingtip spacing)`, degrees and
+/// wingspans.
+pub type GeometryRow = (i64, Option<f64>, Option<f64>, Option<f64>, f64);
+
 /// Apex angle and wingtip spacing per frame.
 #[derive(Debug, Clone)]
 pub struct GeometryChart {
     /// Title line.
     pub title: String,
     /// `(frame index, apex, left arm, right arm, wingtip spacing)`.
-    pub rows: Vec<(i64, Option<f64>, Option<f64>, Option<f64>, f64)>,
+    pub rows: Vec<GeometryRow>,
 }
 
 impl GeometryChart {
