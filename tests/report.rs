@@ -64,7 +64,8 @@ fn the_page_of_annotations_has_parameters_fits_savings_and_the_field() {
         "Savings in the footage",
         "Compared with real formations",
         "Gould &amp; Heppner 1974",
-        "position (rank)",
+        "position (arm, place from the leader)",
+        "<td>left 1</td>",
     ] {
         assert!(page.contains(needle), "missing {needle:?}");
     }

@@ -28,10 +28,13 @@ use super::ransac::{Line, Model};
 pub struct FrameGeometry {
     /// Angle of the left arm from the flight axis behind the leader, degrees; `None` without a
     /// bird left of the leader.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub arm_left_deg: Option<f64>,
     /// Angle of the right arm, degrees; `None` without a bird right of the leader.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub arm_right_deg: Option<f64>,
     /// Apex angle, left + right arm, degrees; `None` unless both arms exist.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub apex_deg: Option<f64>,
     /// Farthest inlier behind the leader, wingspans.
     pub depth: f64,
@@ -87,14 +90,19 @@ impl Stat {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct GeometrySummary {
     /// Apex angle, degrees (frames with two arms).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub apex_deg: Option<Stat>,
     /// Left arm angle, degrees.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub arm_left_deg: Option<Stat>,
     /// Right arm angle, degrees.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub arm_right_deg: Option<Stat>,
     /// Depth, wingspans.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub depth: Option<Stat>,
     /// Mean wingtip spacing, wingspans.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub wingtip_spacing: Option<Stat>,
     /// Mean wingtip spacing, metres, when the wingspan in metres is known.
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -10,8 +10,8 @@
 //! between lateral neighbours.
 //!
 //! **Step 2** (per frame): three families are fitted robustly ([`ransac`]): a line (line /
-//! echelon), a line per side of the leader (V; the leader belongs to both sides), and a parabola
-//! opening backward (U or J). The family is chosen by a GRIC/BIC-like criterion (Torr's geometric
+//! echelon), two arms meeting on the leader's line of flight (V: the apex depth and two slopes,
+//! [`ransac::Vee`]), and a parabola opening backward (U or J). The family is chosen by a GRIC/BIC-like criterion (Torr's geometric
 //! robust information criterion with all models being curves, so only the residual and
 //! parameter-count terms differ):
 //!
@@ -22,9 +22,17 @@
 //!
 //! with r_i = (y_i − curve(x_i)) / √(1 + curve'(x_i)²) the first-order distance of bird i
 //! from the curve (so that image noise on a steep arm is not taken for an outlier), T the inlier threshold (`ExtractOptions::inlier_threshold`,
-//! wingspans), n the birds in the frame and k_M the parameter count (line 2, parabola 3, V 4).
+//! wingspans), n the birds in the frame and k_M the parameter count (line 2, parabola 3, V 3).
 //! A bad point costs at most (T/σ)² = 4, so an outlier cannot pull the choice; a more complex
-//! model must buy its extra parameters with a residual drop of ln n each. The lowest S wins. A
+//! model must buy its extra parameters with a residual drop of ln n each. The lowest S wins;
+//! equal scores (within a relative 1e-6, e.g. three birds, which a V and a parabola both fit
+//! exactly) go to the V, then the line, then the parabola: three birds are a V unless the data
+//! say otherwise (issue 16). The paper is silent on the choice; this criterion is ours.
+//!
+//! After the frames, [`checks`] looks for suspicious input (a formation opening forward, a
+//! heading off by 90°, an implausible scale, few frames, 3-bird frames) and [`geometry`]
+//! measures each frame's apex angle per arm, depth and wingtip spacing; both go into
+//! [`FormationParams::summary`]. A
 //! parabola is a **J** when its vertex x_v = −b/(2a) lies more than `j_offset` half-widths from
 //! the centre of the inliers' lateral extent (one arm clearly longer), else a **U**. Birds with
 //! |r| ≤ T are inliers; μ_y, σ_y are the mean and sample standard deviation of the inliers'

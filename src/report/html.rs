@@ -266,7 +266,7 @@ fn animation_sections(page: &mut Page, a: &Animation, s: &Subject<'_>) -> Result
     if let Some(e) = st.steady_saving {
         rows.push(vec!["flock saving in steady flight".into(), pct(e)]);
     }
-    page.table(&["", ""], &rows);
+    page.table(&["quantity", "value"], &rows);
     if !st.birds.is_empty() {
         let c = crate::plot::savings::SavingsChart::from_animation(a, s.origin)?;
         page.chart(
@@ -331,7 +331,7 @@ fn animation_sections(page: &mut Page, a: &Animation, s: &Subject<'_>) -> Result
                 format!("{closest:.2} wingspans"),
             ],
         ];
-        page.table(&["", ""], &rows);
+        page.table(&["quantity", "value"], &rows);
         let c = crate::plot::paths::PathsChart::from_animation(a)?;
         page.chart(
             "paths",
@@ -372,23 +372,52 @@ fn bird_tables(page: &mut Page, birds: &[BirdStats]) {
         ],
         &rows,
     );
-    let mut pos: Vec<(usize, f64, usize)> = Vec::new();
+    // Position in the formation: the leader, or the k-th bird back along the left or right arm
+    // (by mean distance behind the leader), pooled over formations.
+    let mut pos: Vec<(String, f64, usize)> = Vec::new();
     for b in birds {
-        let r = b.rank.round() as usize;
-        match pos.iter_mut().find(|p| p.0 == r) {
+        let label = if b.leader {
+            "leader".to_string()
+        } else {
+            let left = b.lateral < 0.0;
+            let k = 1 + birds
+                .iter()
+                .filter(|o| {
+                    o.formation == b.formation
+                        && !o.leader
+                        && (o.lateral < 0.0) == left
+                        && (o.behind, o.bird) < (b.behind, b.bird)
+                })
+                .count();
+            format!("{} {k}", if left { "left" } else { "right" })
+        };
+        match pos.iter_mut().find(|p| p.0 == label) {
             Some(p) => {
                 p.1 += b.saving;
                 p.2 += 1;
             }
-            None => pos.push((r, b.saving, 1)),
+            None => pos.push((label, b.saving, 1)),
         }
     }
-    pos.sort_by_key(|p| p.0);
+    let key = |l: &str| -> (usize, usize) {
+        match l.split_once(' ') {
+            Some((side, k)) => (k.parse().unwrap_or(0), usize::from(side == "right")),
+            None => (0, 0),
+        }
+    };
+    pos.sort_by_key(|p| key(&p.0));
     let rows: Vec<Vec<String>> = pos
         .iter()
-        .map(|p| vec![p.0.to_string(), p.2.to_string(), pct(p.1 / p.2 as f64)])
+        .map(|p| vec![p.0.clone(), p.2.to_string(), pct(p.1 / p.2 as f64)])
         .collect();
-    page.table(&["position (rank)", "birds", "mean saving"], &rows);
+    page.table(
+        &[
+            "position (arm, place from the leader)",
+            "birds",
+            "mean saving",
+        ],
+        &rows,
+    );
 }
 
 fn field_section(page: &mut Page, p: Option<&FormationParams>, a: Option<&Animation>) {
