@@ -28,7 +28,10 @@ cp "$T/ground/$(printf 'frame_%05d.png' "$g")" "$I/usage-ground.png"
 for sp in goose crane pelican; do
   $B animate "$T/geese.json" --birds 4 --seconds 6 --species "$sp" --seed 3 \
     -o "$T/$sp/" --picture-fps 2 --quiet
-  cp "$T/$sp/frame_00045.png" "$I/species-$sp.png"
+  # Frame 45 (22.5 s) when the flight is that long, else 3 s before its end.
+  f="$T/$sp/frame_00045.png"
+  [ -f "$f" ] || f="$T/$sp/$(ls "$T/$sp" | tail -n 7 | head -n 1)"
+  cp "$f" "$I/species-$sp.png"
 done
 # The README job's GIF, for its size.
 $B animate $E/barnacle_geese_v.json --birds 14 -o "$T/flock.gif" --quiet
@@ -36,5 +39,6 @@ echo "README job GIF: $(stat -c %s "$T/flock.gif") bytes"
 $B plot paths "$T/flock.json" -o "$I/usage-paths.png"
 $B plot xi "$T/flock.json" -o "$I/usage-xi.png"
 $B plot power "$T/flock.json" --key 2 -o "$I/usage-power.png"
+$B plot savings "$T/flock.json" -o "$I/usage-savings.png"
 $B plot wingbeat --species goose -o "$I/usage-wingbeat.png"
 echo "pictures written to $I"
