@@ -718,3 +718,69 @@ fn bad_values_of_the_new_flags_are_one_line() {
     assert!(!dir.join("a.html").exists() && !dir.join("s.json").exists());
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn warnings_fire_on_reversed_and_turned_headings_and_never_on_true_ones() {
+    use formation::annotations::synth::{generate, SynthSpec};
+    use formation::annotations::{parse_str, ReadOptions};
+    use formation::extract::{ShapeKind, WarningKind};
+    let kinds_of = |p: &formation::extract::FormationParams| -> Vec<WarningKind> {
+        p.summary
+            .as_ref()
+            .unwrap()
+            .warnings
+            .iter()
+            .map(|w| w.kind)
+            .collect()
+    };
+    let mut checked = 0;
+    for seed in 0..12u64 {
+        for kind in [ShapeKind::V, ShapeKind::U, ShapeKind::J, ShapeKind::Line] {
+            let heading = [0.0, 37.0, 90.0, 200.0, 300.0][seed as usize % 5];
+            let spec = SynthSpec {
+                kind,
+                birds: 7 + seed as usize,
+                frames: 10,
+                heading_deg: heading,
+                curvature: 0.3,
+                leader_at: if kind == ShapeKind::J || kind == ShapeKind::Line {
+                    0.0
+                } else {
+                    0.5
+                },
+                outliers: (seed % 2) as usize,
+                ..SynthSpec::default()
+            };
+            let flock = generate(&spec, &mut seeded(seed));
+            let text = flock.native_json("synthetic", false, &mut seeded(seed + 100));
+            let path = Path::new("synthetic.json");
+            let read = |turn: f64| {
+                let opts = ReadOptions {
+                    heading: Some(Heading::Degrees(heading + turn)),
+                    ..ReadOptions::default()
+                };
+                let ann = parse_str(path, &text, &opts).unwrap();
+                extract(&ann, &ExtractOptions::default(), &mut seeded(seed)).unwrap()
+            };
+            let truth = read(0.0);
+            assert_eq!(kinds_of(&truth), [], "{kind:?} seed {seed}: false alarm");
+            if kind == ShapeKind::Line {
+                continue;
+            }
+            assert_eq!(
+                kinds_of(&read(180.0)),
+                [WarningKind::OpensForward],
+                "{kind:?} seed {seed}, heading reversed"
+            );
+            for turn in [90.0, -90.0] {
+                let w = kinds_of(&read(turn));
+                assert!(
+                    w.contains(&WarningKind::Heading) || w.contains(&WarningKind::OpensForward),
+                    "{kind:?} seed {seed}, heading {turn:+}: {w:?}"
+                );
+            }
+            checked += 1;
+        }
+    }
+    assert_eq!(checked, 36);
+}

@@ -5,10 +5,10 @@
 //! scores, and gives [`Warning`]s whose messages name the option that fixes the input by its
 //! path (`read.heading`, `read.y_origin`, `read.wingspan_px`); the command line shows its flags.
 //!
-//! - **Opens forward**: the birds, mirrored front to back (what a pixel y axis pointing the
-//!   other way or a flock flying the other way does), fit a formation far better than as
-//!   given: the criterion S of the module [`super`] drops by more than 2 ln n (the price of two
-//!   parameters) in most frames (at most [`MAX_CHECKED_FRAMES`], evenly spaced, are refitted).
+//! - **Opens forward**: the birds with pixel y mirrored (a y axis pointing the other way) or
+//!   with the flight direction reversed (a flock flying the other way) fit a formation far
+//!   better than as given: the criterion S of the module [`super`] drops by more than ln n
+//!   (the price of one parameter) in most frames (at most [`MAX_CHECKED_FRAMES`], evenly spaced, are refitted).
 //!   Typical sign: the leader at a wingtip and the other birds ahead of its arms.
 //! - **Heading**: the same with the flight direction turned 90° either way.
 //! - **Scale**: the median distance from a bird to its nearest neighbour is outside
@@ -122,15 +122,15 @@ pub fn check(
     let path = ann.path.display();
     let n = ann.frames.len();
     let mut out = Vec::new();
-    // Orientation: mirrored front to back, turned +90°, turned −90°.
-    let alternatives = [(true, 0.0), (false, 90.0), (false, -90.0)];
-    let mut wins = [0usize; 3];
+    // Orientation: pixel y mirrored, the flight direction reversed, turned +90°, turned −90°.
+    let alternatives = [(true, 0.0), (false, 180.0), (false, 90.0), (false, -90.0)];
+    let mut wins = [0usize; 4];
     let step = n.div_ceil(MAX_CHECKED_FRAMES).max(1);
     let checked = n.div_ceil(step);
     if opts.kind.is_none() {
         for (f, r) in ann.frames.iter().zip(reports).step_by(step) {
             let Some(s0) = best_score(r) else { continue };
-            let margin = 2.0 * (f.birds.len() as f64).ln();
+            let margin = (f.birds.len() as f64).ln();
             for (k, &(mirror, turn)) in alternatives.iter().enumerate() {
                 let pts = reoriented(f, mirror, turn);
                 let alt = super::choose_model(&pts, opts, rng)
@@ -142,49 +142,51 @@ pub fn check(
         }
     }
     let heading = ann.frames.first().map_or(0.0, |f| f.heading_deg);
-    let (k, &most) = wins
-        .iter()
-        .enumerate()
-        .max_by_key(|&(k, w)| (*w, std::cmp::Reverse(k)))
-        .unwrap_or((0, &0));
     let of = if checked == n {
         format!("{n}")
     } else {
         format!("{checked} checked (of {n})")
     };
-    if 2 * most > checked {
-        if k == 0 {
-            let csv = matches!(ann.format, Format::LongCsv | Format::Dltdv);
-            let fix = if csv {
-                let other = if ann.y_up { "top" } else { "bottom" };
-                format!(
-                    "pixel y probably grows {}; give read.y_origin {other} (or read.heading {} if the flock flies the other way)",
-                    if ann.y_up { "downward" } else { "upward" },
-                    heading_word(heading + 180.0)
-                )
-            } else {
-                format!(
-                    "the flock probably flies the other way, or pixel y grows upward; give read.heading {}",
-                    heading_word(heading + 180.0)
-                )
-            };
-            out.push(Warning {
-                kind: WarningKind::OpensForward,
-                message: format!(
-                    "{path}: the formation opens forward in {most} of {of} frames (birds ahead of the leader's arms): {fix}"
-                ),
-            });
-        } else {
-            let turn = alternatives[k].1;
-            out.push(Warning {
-                kind: WarningKind::Heading,
-                message: format!(
-                    "{path}: the birds fit a line formation far better with the flight direction turned {turn:+}° in {most} of {of} frames: the heading ({}) is probably wrong; give read.heading {}",
-                    heading_word(heading),
-                    heading_word(heading + turn)
-                ),
-            });
-        }
+    let (mirrored, reversed) = (wins[0], wins[1]);
+    let turned = wins[2].max(wins[3]);
+    let forward = mirrored.max(reversed);
+    if 2 * forward > checked && forward >= turned {
+        let csv = matches!(ann.format, Format::LongCsv | Format::Dltdv);
+        let back = heading_word(heading + 180.0);
+        let origin = if ann.y_up { "top" } else { "bottom" };
+        let grows = if ann.y_up { "downward" } else { "upward" };
+        // CSV: the y origin is the likely cause unless only reversing the flight explains it.
+        let fix = match (csv, reversed > mirrored, reversed >= mirrored) {
+            (true, false, _) => format!(
+                "pixel y probably grows {grows}; give read.y_origin {origin} (or read.heading {back} if the flock flies the other way)"
+            ),
+            (true, true, _) => format!(
+                "the flock probably flies the other way; give read.heading {back} (or read.y_origin {origin} if pixel y grows {grows})"
+            ),
+            (false, _, true) => format!(
+                "the flock probably flies the other way, or pixel y grows upward; give read.heading {back}"
+            ),
+            (false, _, false) => format!(
+                "pixel y probably grows upward; give read.heading {} (left and right are then swapped)",
+                heading_word(180.0 - heading)
+            ),
+        };
+        out.push(Warning {
+            kind: WarningKind::OpensForward,
+            message: format!(
+                "{path}: the formation opens forward in {forward} of {of} frames (birds ahead of the leader's arms): {fix}"
+            ),
+        });
+    } else if 2 * turned > checked {
+        let turn = if wins[2] >= wins[3] { 90.0 } else { -90.0 };
+        out.push(Warning {
+            kind: WarningKind::Heading,
+            message: format!(
+                "{path}: the birds fit a line formation far better with the flight direction turned {turn:+}° in {turned} of {of} frames: the heading ({}) is probably wrong; give read.heading {}",
+                heading_word(heading),
+                heading_word(heading + turn)
+            ),
+        });
     }
     // Scale: median nearest-neighbour distance over every bird of every frame.
     let mut nn: Vec<f64> = Vec::new();

@@ -38,7 +38,7 @@ pub struct Parabola {
 }
 
 /// Two straight arms meeting at the leader's lateral position (x = 0):
-/// `y = c + sl·x` for x < 0 and `y = c + sr·x` for x ≥ 0. Three parameters: the apex's depth
+/// `y = c + sl·x` for x < 0 and `y = c + sr·x` for x ≥ 0, both swept back (`sl ≤ 0 ≤ sr`). Three parameters: the apex's depth
 /// and the two slopes (the apex lies on the leader's line of flight by construction, §4 step 1
 /// puts the leader at x = 0).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -187,6 +187,11 @@ impl Model for Vee {
         } else {
             self.sr
         }
+    }
+    /// Both arms swept back (or flat): an arm reaching forward of the leader's flank is no V
+    /// (it is what a formation opening forward looks like, see `extract::checks`).
+    fn valid(&self) -> bool {
+        self.sl <= 0.0 && self.sr >= 0.0
     }
 }
 
