@@ -162,6 +162,9 @@ impl Config {
 pub struct Report {
     /// Model-selection scores of every annotated frame (empty when the input was parameters).
     pub extract: Vec<FrameReport>,
+    /// The formation parameters the steady flight was made from (read or extracted), with
+    /// their summary and warnings.
+    pub params: FormationParams,
     /// Algorithm 1's correspondence, ranges and key-shape statistics.
     pub steady: SteadyReport,
     /// The initiation's statistics (`None` without initiation).
@@ -251,6 +254,7 @@ impl Pipeline {
             anim,
             Report {
                 extract: extract_report,
+                params,
                 steady: steady_report,
                 initiate: initiate_report,
                 course,

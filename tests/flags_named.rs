@@ -19,6 +19,7 @@ const SWITCHES: &[&str] = &[
     "--no-initiation",
     "--sun",
     "--loop",
+    "--strict",
 ];
 
 /// The flags `formation ARGS --help` lists.
@@ -103,6 +104,7 @@ fn commands() -> Vec<Command> {
     ];
     let initiate: Vec<(&str, &str, Option<String>)> = vec![
         ("--max-steps", "0", None),
+        ("--max-seconds", "-1", None),
         ("--perception", "psychic", None),
         ("--hpr-gamma", "9", None),
         ("--fov", "500", None),
@@ -149,7 +151,16 @@ fn commands() -> Vec<Command> {
             cases: cat(vec![
                 read.clone(),
                 fit.clone(),
-                vec![o("OUT/p.txt"), seed.clone()],
+                vec![("--wingspan-m", "0", None), o("OUT/p.txt"), seed.clone()],
+            ]),
+        },
+        Command {
+            name: &["report"],
+            base: strings(&["report", &geese, "-o", "OUT/r.html"]),
+            cases: cat(vec![
+                read.clone(),
+                fit.clone(),
+                vec![("--wingspan-m", "-1", None), o("OUT/r.txt"), seed.clone()],
             ]),
         },
         Command {
@@ -187,6 +198,7 @@ fn commands() -> Vec<Command> {
                 vec![
                     ("--cruise-altitude", "1e9", None),
                     ("--frames", "0", None),
+                    ("--seconds", "-1", None),
                     ("--report", "OUT/r.txt", None),
                     o("OUT/s.txt"),
                     seed.clone(),
@@ -241,7 +253,7 @@ fn commands() -> Vec<Command> {
                 scene,
                 vec![
                     ("--size", "0x0", None),
-                    ("--fps", "0", None),
+                    ("--picture-fps", "0", None),
                     ("--wingspan-m", "0", None),
                     o("OUT/r.txt"),
                     seed.clone(),
@@ -272,6 +284,11 @@ fn commands() -> Vec<Command> {
                 fit,
                 vec![("--frame", "999", None), o("OUT/s.txt"), seed.clone()],
             ]),
+        },
+        Command {
+            name: &["plot", "savings"],
+            base: strings(&["plot", "savings", &flock, "-o", "OUT/s.png"]),
+            cases: vec![o("OUT/s.txt"), seed.clone()],
         },
         Command {
             name: &["plot", "paths"],

@@ -36,11 +36,15 @@ impl PathFlags {
     }
 }
 
-/// Prints the course step's warnings on stderr, one line each.
-pub fn warn(report: &CourseReport) {
-    for w in &report.warnings {
-        eprintln!("warning: {w}");
-    }
+/// Prints the course step's warnings on stderr, one line each (with `--strict`, the first is
+/// the error instead).
+pub fn warn(
+    cmd: super::flags::Cmd,
+    g: super::Global,
+    report: &CourseReport,
+) -> formation::Result<()> {
+    let lines: Vec<&str> = report.warnings.iter().map(String::as_str).collect();
+    super::warn_lines(cmd, g, &lines)
 }
 
 /// For `initiate --path`: the config the course step needs (the steady file's cruise speed and

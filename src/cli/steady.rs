@@ -25,9 +25,12 @@ pub struct SteadyArgs {
     /// Number of birds to animate (N ≥ 2).
     #[arg(long)]
     pub birds: usize,
-    /// Number of frames (F ≥ 1).
-    #[arg(long)]
-    pub frames: usize,
+    /// Number of frames (F ≥ 1); or give --seconds.
+    #[arg(long, conflicts_with = "seconds")]
+    pub frames: Option<usize>,
+    /// Length of the steady flight, seconds (frames = seconds × --fps); or give --frames.
+    #[arg(long, allow_negative_numbers = true)]
+    pub seconds: Option<f64>,
     /// Outputs by extension: .json (the animation file), .csv, and also .gif, DIR/, .glb; may be
     /// repeated.
     #[arg(short = 'o', long = "output", required = true)]
@@ -110,11 +113,17 @@ impl SteadyFlags {
 
 /// Runs `formation steady`.
 pub fn run(args: SteadyArgs, g: Global) -> Result<()> {
+    if args.frames.is_none() && args.seconds.is_none() {
+        return Err(Error::parameter(
+            "--frames",
+            "give the length of the steady flight: --frames F or --seconds S",
+        ));
+    }
     let config = Config {
         seed: g.seed,
-        seconds: None,
+        seconds: args.seconds,
         steady: SteadyOptions {
-            frames: args.frames,
+            frames: args.frames.unwrap_or(SteadyOptions::default().frames),
             ..args.steady.options(args.birds)
         },
         wingbeat: args.wingbeat.options()?,
@@ -148,10 +157,11 @@ pub fn run(args: SteadyArgs, g: Global) -> Result<()> {
     }
     let path = config.course.load(config.steady.wingspan_m)?;
     let params = read_params(&args.params)?;
+    super::warn_params(g, &params)?;
     let progress = TermProgress::new(g.quiet);
     let (mut anim, report) = steady_stage(&params, &config, &progress)?;
     let course = formation::pipeline::course_stage(&mut anim, path.as_ref(), &config)?;
-    super::course::warn(&course);
+    super::course::warn(super::flags::Cmd::Steady, g, &course)?;
     formation::wingbeat::assign_phases(&mut anim, &config.wingbeat)?;
     super::write_animation(&anim, &args.output, &args.scene.options(), g)?;
     if let Some(r) = &args.report {
@@ -159,10 +169,14 @@ pub fn run(args: SteadyArgs, g: Global) -> Result<()> {
     }
     if !g.quiet {
         let k = &report.keys;
-        eprintln!(
-            "steady: {} key shapes ({} draws, {} redraws, {} damped, {} held, {} kept the previous lateral positions, min λ {:.3}), max key residual {:.1e}, max jump {:.2} wingspans",
+        let text = format!(
+            "{}\nkey shapes: {} ({} draws, {} redraws, {} damped, {} held, {} kept the previous lateral positions, min λ {:.3}), max key residual {:.1e}, max jump {:.2} wingspans",
+            super::summary::animation_text("steady", &anim, Some(&params)),
             k.keys, k.draws, k.redraws, k.damped, k.held, k.lateral_held, k.min_damping, k.max_residual, k.max_jump
         );
+        let mut files = args.output.clone();
+        files.extend(args.report.iter().cloned());
+        super::summary::defer(text, &files);
     }
     Ok(())
 }
