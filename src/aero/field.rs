@@ -322,7 +322,10 @@ mod tests {
                 };
                 let fast = far_a_term(x * x) + far_odd(x * x, y);
                 let err = (exact - fast).abs();
-                assert!(err < 3e-8 * exact.abs() + 1e-15, "x={x} y={y}: {exact} vs {fast}");
+                assert!(
+                    err < 3e-8 * exact.abs() + 1e-15,
+                    "x={x} y={y}: {exact} vs {fast}"
+                );
                 worst = worst.max(TWO_OVER_PI2 * err);
             }
         }
@@ -411,7 +414,11 @@ mod flock_tests {
             let jv = field.jacobian_times(&y, &near, &v);
             for i in 0..n {
                 let want: f64 = (0..n).map(|k| jac[i * n + k] * v[k]).sum();
-                assert!((jv[i] - want).abs() < 1e-12, "seed {seed} bird {i}: {} vs {want}", jv[i]);
+                assert!(
+                    (jv[i] - want).abs() < 1e-12,
+                    "seed {seed} bird {i}: {} vs {want}",
+                    jv[i]
+                );
             }
         }
     }

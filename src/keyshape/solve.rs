@@ -545,11 +545,7 @@ fn newton_krylov(
     let fixed = (0..n)
         .min_by(|&a, &b| y0[a].total_cmp(&y0[b]).then(a.cmp(&b)))
         .unwrap_or(0);
-    let pf = field
-        .order()
-        .iter()
-        .position(|&i| i == fixed)
-        .unwrap_or(0);
+    let pf = field.order().iter().position(|&i| i == fixed).unwrap_or(0);
     // Free birds in lateral order: position p ↔ bird free[p].
     let free: Vec<usize> = field
         .order()
@@ -565,7 +561,8 @@ fn newton_krylov(
     let mut near = Vec::new();
     let mut y = y0.to_vec();
     let mut e = field.power_band(&y, Some(&mut full_band), Some(&mut near));
-    let resid = |e: &[f64]| -> Vec<f64> { e.iter().zip(target).map(|(e, t)| e * inv - t).collect() };
+    let resid =
+        |e: &[f64]| -> Vec<f64> { e.iter().zip(target).map(|(e, t)| e * inv - t).collect() };
     let mut r = resid(&e);
     let mut norm = merit(&r);
     let norm0 = norm;
@@ -591,7 +588,11 @@ fn newton_krylov(
             }
             // Not positive definite in floating point: shift the diagonal.
             let mean = (0..m).map(|p| band[p * w_of(b)]).sum::<f64>() / m as f64;
-            shift = if shift == 0.0 { 1e-10 * mean } else { shift * 10.0 };
+            shift = if shift == 0.0 {
+                1e-10 * mean
+            } else {
+                shift * 10.0
+            };
             if !(shift < mean) {
                 break None;
             }
