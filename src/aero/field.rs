@@ -65,6 +65,8 @@ fn far_slope(x2: f64, y: f64) -> f64 {
 #[derive(Debug, Clone)]
 pub struct Field {
     opts: AeroOptions,
+    /// Lateral positions, input order.
+    x: Vec<f64>,
     /// Bird at each sorted position (ties: lower index first).
     order: Vec<usize>,
     /// x at each sorted position.
@@ -127,6 +129,7 @@ impl Field {
         }
         Field {
             opts: *opts,
+            x: x.to_vec(),
             order,
             xs,
             far_start,
@@ -135,6 +138,11 @@ impl Field {
             band_span,
             band_width,
         }
+    }
+
+    /// The lateral positions, input order.
+    pub fn x(&self) -> &[f64] {
+        &self.x
     }
 
     /// Number of birds.

@@ -261,13 +261,18 @@ pub fn solve(
 ) -> Result<SolveReport> {
     let aero = &opts.aero;
     let target = validate(x, xi_target, y0, aero)?;
-    let total = aero.munk_total(x)?;
+    let n = x.len();
+    // Large flocks: the sorted field, built once, gives E and every evaluation of the solve.
+    let field = (n > opts.dense_limit).then(|| Field::new(aero, x, opts.band_span));
+    let total = match field.as_ref().map(Field::munk_total) {
+        Some(t) if t.is_finite() => t,
+        _ => aero.munk_total(x)?,
+    };
     if !(total > 0.0) {
         return Err(Error::Unreachable(format!(
             "these lateral positions give the flock a total saving E = {total:.6} ≤ 0 (wingtips overlap so much that the birds fly in one another's downwash); no placement shares out a positive saving; widen the lateral gaps"
         )));
     }
-    let n = x.len();
     let small = n <= opts.check_limit;
     let starts: Vec<Vec<f64>> = match y0 {
         Some(y) => vec![y.to_vec()],
@@ -295,10 +300,9 @@ pub fn solve(
                 continue;
             }
         }
-        let rep = if n <= opts.dense_limit {
-            newton(x, &target, total, &start, opts)
-        } else {
-            newton_krylov(x, &target, total, &start, opts)
+        let rep = match &field {
+            None => newton(x, &target, total, &start, opts),
+            Some(f) => newton_krylov(f, &target, total, &start, opts),
         };
         evaluations += rep.evaluations;
         if rep.converged {
@@ -533,14 +537,14 @@ fn band_solve(l: &[f64], m: usize, b: usize, r: &[f64]) -> Vec<f64> {
 /// η = min(10⁻², ‖r‖/‖r₀‖) of the residual (superlinear convergence); a step is shortened to keep
 /// the fore-aft order of overlapping pairs and halved until ‖r‖ decreases.
 fn newton_krylov(
-    x: &[f64],
+    field: &Field,
     target: &[f64],
     total: f64,
     y0: &[f64],
     opts: &SolveOptions,
 ) -> SolveReport {
-    let n = x.len();
-    let field = Field::new(&opts.aero, x, opts.band_span);
+    let n = field.len();
+    let x = field.x();
     let b = field.band_width();
     let fixed = (0..n)
         .min_by(|&a, &b| y0[a].total_cmp(&y0[b]).then(a.cmp(&b)))
