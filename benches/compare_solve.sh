@@ -4,7 +4,7 @@
 #   bash benches/compare_solve.sh            # N = 40, 200, 1000 for both, 10 000 for formation
 #   SIZES=40,200 bash benches/compare_solve.sh
 # 1. `cargo bench --bench solve` (criterion: `keyshape::solve` alone) for SIZES;
-# 2. the whole process, `formation solve tN.json -o sN.json --quiet` under /usr/bin/time, on the
+# 2. the whole process, `formation solve tN.json -o sN.json --quiet` under bash's `time`, on the
 #    same targets and start written by benches/solve_scipy.py (sizes up to 1000);
 # 3. scipy's solver alone (benches/solve_scipy.py) for the sizes up to 1000 (its dense QR grows
 #    like N³: about a minute at 1000).
@@ -20,9 +20,9 @@ DIR=$(mktemp -d)
 trap 'rm -rf "$DIR"' EXIT
 python3 benches/solve_scipy.py --write-targets "$DIR" $SMALL
 for n in $SMALL; do
-    for run in 1 2 3; do
-        /usr/bin/time -f "formation solve (whole process) N=$n run $run: %e s wall, %U s user" \
-            target/release/formation solve "$DIR/t$n.json" -o "$DIR/s$n.json" --quiet
+    for run in 1 2 3 4 5; do
+        TIMEFORMAT="formation solve (whole process) N=$n run $run: %3R s wall, %3U s user"
+        time target/release/formation solve "$DIR/t$n.json" -o "$DIR/s$n.json" --quiet
     done
 done
 env -u OPENBLAS_CORETYPE -u OPENBLAS_L2_SIZE python3 benches/solve_scipy.py $SMALL

@@ -1,7 +1,9 @@
 //! The key-shape solve of eq. (4): given the birds' lateral positions and target relative savings
 //! ξ̂, find the longitudinal positions that realise them, by Newton's method on the symmetric
-//! system (a Levenberg–Marquardt damping when a full step does not lower the residual) with a
-//! Cholesky factorisation per step.
+//! system: up to [`SolveOptions::dense_limit`] birds with a dense Cholesky factorisation per step
+//! (a Levenberg–Marquardt damping when a full step does not lower the residual), beyond by
+//! conjugate gradients on the exact Jacobian with a banded Cholesky preconditioner
+//! ([`crate::aero::Field`] sums every pair in O(N²) without storing anything of that size).
 //!
 //! ```math
 //! e_i(y) = \hat\xi_i\,E, \qquad i = 1..N, \qquad E = \sum_{i<j} 2\,g(|x_i - x_j|, 0)
@@ -45,7 +47,8 @@ pub struct SolveOptions {
     /// flow, O(N³) in the worst case), birds.
     pub check_limit: usize,
     /// Largest flock solved with the exact dense Jacobian (one dense Cholesky per step, O(N³)),
-    /// birds. Larger flocks use [`SolveOptions::band_span`].
+    /// birds. Larger flocks use Newton–conjugate gradients preconditioned by the band of
+    /// [`SolveOptions::band_span`].
     pub dense_limit: usize,
     /// For flocks above `dense_limit`: the preconditioner of the Newton steps' conjugate
     /// gradients is the Jacobian of the pairs less than this far apart laterally (∂g/∂y decays
@@ -66,7 +69,7 @@ impl Default for SolveOptions {
             patience: 100,
             check_reachable: true,
             check_limit: 200,
-            dense_limit: 300,
+            dense_limit: 100,
             band_span: 60.0,
             cg_limit: 50,
             aero: AeroOptions::default(),
