@@ -86,6 +86,7 @@ pub const FLAGS: &[(&str, &str, &[Cmd])] = &[
     ("steady.wingspan_m", "--wingspan-m", STEADY),
     ("steady.max_jump", "--max-jump", STEADY),
     ("initiate.max_steps", "--max-steps", INITIATE),
+    ("initiate.max_time", "--max-seconds", INITIATE),
     ("initiate.perception.mode", "--perception", INITIATE),
     (
         "initiate.perception.mode.hpr.gamma",
