@@ -5,7 +5,8 @@ the start is that V with each bird moved by 0.3·cos(2.3k) wingspans, unknowns a
 longitudinal positions, residuals ξ_i − ξ̂_i, analytic Jacobian. Same stable form of Hummel's g as
 src/aero. Prints one line per N with the median wall time of several runs.
 
-Usage: pip install numpy scipy && python3 benches/solve_scipy.py
+Usage: pip install numpy scipy && python3 benches/solve_scipy.py [N ...]
+       python3 benches/solve_scipy.py --write-targets DIR N ...   (target files for `formation solve`)
 (Unset OPENBLAS_CORETYPE/OPENBLAS_L2_SIZE for this command only, if set, to let numpy pick its
 fastest kernel: env -u OPENBLAS_CORETYPE -u OPENBLAS_L2_SIZE python3 benches/solve_scipy.py)
 """
@@ -99,8 +100,29 @@ def solve(n):
     return dt, resid, res.nfev
 
 
+def write_targets(directory, sizes):
+    """Writes DIR/tN.json ({"x", "xi", "y"}: the targets and the perturbed start) for
+    `formation solve`, the whole-process side of benches/compare_solve.sh."""
+    import json
+    import os
+
+    os.makedirs(directory, exist_ok=True)
+    for n in sizes:
+        x, y, guess = problem(n)
+        total, e_and_jac = model(x) if n <= 2000 else (None, None)
+        if e_and_jac is None:
+            raise SystemExit("--write-targets: at most 2000 birds (dense numpy model)")
+        xi_hat = e_and_jac(y)[0] / total
+        with open(os.path.join(directory, f"t{n}.json"), "w") as f:
+            json.dump({"x": x.tolist(), "xi": xi_hat.tolist(), "y": guess.tolist()}, f)
+
+
 def main():
-    sizes = [int(a) for a in sys.argv[1:]] or [10, 40, 200, 1000]
+    args = sys.argv[1:]
+    if args and args[0] == "--write-targets":
+        write_targets(args[1], [int(a) for a in args[2:]])
+        return
+    sizes = [int(a) for a in args] or [10, 40, 200, 1000]
     for n in sizes:
         runs = 5 if n <= 200 else 1
         times = []

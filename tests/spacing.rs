@@ -121,8 +121,23 @@ fn j_footage_spacing_is_kept_for_as_many_birds_or_more() {
 }
 
 #[test]
-fn u_footage_lateral_spacing_is_kept() {
-    // Lateral spacing only: the U's longitudinal spacing is 28–35 % deeper (see docs/model.md).
+fn u_footage_spacing_is_kept_for_as_many_birds() {
+    check("pelicans_u_labelme", None, &[12]);
+}
+
+/// Not met yet (issue 12): the J with fewer birds than the footage and the U with a different
+/// number of birds miss the 20 % longitudinal bound (J, N = 7: −61 %; U, N = 7: +27 %, N = 30:
+/// +30 %): see docs/model.md.
+#[test]
+#[ignore = "open in issue 12: J with N = 7 and U with N = 7 or 30 miss the 20 % longitudinal bound"]
+fn j_and_u_spacing_when_n_differs_from_the_footage() {
+    check("snow_geese_j.csv", None, &[7]);
+    check("pelicans_u_labelme", None, &[7, 30]);
+}
+
+#[test]
+fn u_footage_lateral_spacing_is_kept_for_other_counts() {
+    // Lateral spacing only for N = 7 and 30 (the longitudinal one is the ignored test above).
     let p = params("pelicans_u_labelme", None);
     let footage: Vec<Vec<(f64, f64)>> = p
         .frames
@@ -130,7 +145,7 @@ fn u_footage_lateral_spacing_is_kept() {
         .map(|f| f.positions.iter().map(|b| (b.x, b.y)).collect())
         .collect();
     let (lat0, _) = medians(&footage);
-    for n in [12, 7, 30] {
+    for n in [7, 30] {
         let opts = SteadyOptions {
             birds: n,
             frames: 900,

@@ -261,7 +261,12 @@ pub fn initial_shapes(
                     if i == corr.leader {
                         return 0.0;
                     }
-                    let base = curve_y(&f.shape, xi, scale_left, scale_right);
+                    let base = curve_y(
+                        &f.shape,
+                        depth_x(&f.shape, xi, i, corr.leader, f.mu_x),
+                        scale_left,
+                        scale_right,
+                    );
                     let carried = corr.movie[i].and_then(|id| {
                         if f.outliers.contains(&id) {
                             f.positions.iter().find(|p| p.id == id).map(|p| p.dy)
@@ -289,6 +294,22 @@ pub fn initial_shapes(
             Shape::from_xy(&x, &y)
         })
         .collect()
+}
+
+/// Where a bird's depth is read on the frame's curve: its lateral offset `x` for V and line
+/// curves, and for U and J parabolas its **rank** from the leader times the frame's mean lateral
+/// gap `mu_x` (signed like `x`). A parabola's step between neighbours grows with the square of the
+/// lateral offset, so reading it at the noisy drawn offsets would turn every wide gap near the
+/// flock's ends into a deep step (the U's and J's neighbours would sit about a third farther
+/// apart fore and aft than the footage's); by rank, each bird sits behind its neighbour by what
+/// the movie bird of the same relative rank does.
+pub fn depth_x(model: &ShapeModel, x: f64, index: usize, leader: usize, mu_x: f64) -> f64 {
+    match model {
+        ShapeModel::U { .. } | ShapeModel::J { .. } if mu_x > 0.0 && mu_x.is_finite() => {
+            (index as f64 - leader as f64) * mu_x
+        }
+        _ => x,
+    }
 }
 
 /// The factors that map animated lateral offsets onto the movie's curve for U and J shapes (see

@@ -1,7 +1,9 @@
 //! The key-shape solve of eq. (4): given the birds' lateral positions and target relative savings
 //! ξ̂, find the longitudinal positions that realise them, by Newton's method on the symmetric
-//! system (a Levenberg–Marquardt damping when a full step does not lower the residual) with a
-//! Cholesky factorisation per step.
+//! system: up to [`SolveOptions::dense_limit`] birds with a dense Cholesky factorisation per step
+//! (a Levenberg–Marquardt damping when a full step does not lower the residual), beyond by
+//! conjugate gradients on the exact Jacobian with a banded Cholesky preconditioner
+//! ([`crate::aero::Field`] sums every pair in O(N²) without storing anything of that size).
 //!
 //! ```math
 //! e_i(y) = \hat\xi_i\,E, \qquad i = 1..N, \qquad E = \sum_{i<j} 2\,g(|x_i - x_j|, 0)
@@ -27,7 +29,7 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use crate::aero::{AeroOptions, COLLISION_SPAN};
+use crate::aero::{AeroOptions, Field, COLLISION_SPAN};
 use crate::error::{Error, Result};
 
 /// Options of [`solve`].
@@ -45,12 +47,17 @@ pub struct SolveOptions {
     /// flow, O(N³) in the worst case), birds.
     pub check_limit: usize,
     /// Largest flock solved with the exact dense Jacobian (one dense Cholesky per step, O(N³)),
-    /// birds. Larger flocks use [`SolveOptions::band_span`].
+    /// birds. Larger flocks use Newton–conjugate gradients preconditioned by the band of
+    /// [`SolveOptions::band_span`].
     pub dense_limit: usize,
-    /// For flocks above `dense_limit`: the Newton steps use the Jacobian of the pairs less than
-    /// this far apart laterally (∂g/∂y decays like a²/R³), a banded matrix once the birds are
-    /// sorted by x, factorised in O(N·b²); the residual stays exact. Wingspans.
+    /// For flocks above `dense_limit`: the preconditioner of the Newton steps' conjugate
+    /// gradients is the Jacobian of the pairs less than this far apart laterally (∂g/∂y decays
+    /// like a²/R³), a banded matrix once the birds are sorted by x, factorised in O(N·b²); the
+    /// residual and the Jacobian products stay exact. Wingspans, at most
+    /// [`crate::aero::FAR_FIELD`] (larger values act as it).
     pub band_span: f64,
+    /// For flocks above `dense_limit`: most conjugate-gradient products per Newton step.
+    pub cg_limit: usize,
     /// The aerodynamic model's core radius and collision distance.
     pub aero: AeroOptions,
 }
@@ -62,8 +69,9 @@ impl Default for SolveOptions {
             patience: 100,
             check_reachable: true,
             check_limit: 200,
-            dense_limit: 300,
-            band_span: 120.0,
+            dense_limit: 100,
+            band_span: 60.0,
+            cg_limit: 50,
             aero: AeroOptions::default(),
         }
     }
@@ -256,13 +264,18 @@ pub fn solve(
 ) -> Result<SolveReport> {
     let aero = &opts.aero;
     let target = validate(x, xi_target, y0, aero)?;
-    let total = aero.munk_total(x)?;
+    let n = x.len();
+    // Large flocks: the sorted field, built once, gives E and every evaluation of the solve.
+    let field = (n > opts.dense_limit).then(|| Field::new(aero, x, opts.band_span));
+    let total = match field.as_ref().map(Field::munk_total) {
+        Some(t) if t.is_finite() => t,
+        _ => aero.munk_total(x)?,
+    };
     if !(total > 0.0) {
         return Err(Error::Unreachable(format!(
             "these lateral positions give the flock a total saving E = {total:.6} ≤ 0 (wingtips overlap so much that the birds fly in one another's downwash); no placement shares out a positive saving; widen the lateral gaps"
         )));
     }
-    let n = x.len();
     let small = n <= opts.check_limit;
     let starts: Vec<Vec<f64>> = match y0 {
         Some(y) => vec![y.to_vec()],
@@ -290,10 +303,9 @@ pub fn solve(
                 continue;
             }
         }
-        let rep = if n <= opts.dense_limit {
-            newton(x, &target, total, &start, opts)
-        } else {
-            newton_banded(x, &target, total, &start, opts)
+        let rep = match &field {
+            None => newton(x, &target, total, &start, opts),
+            Some(f) => newton_krylov(f, &target, total, &start, opts),
         };
         evaluations += rep.evaluations;
         if rep.converged {
@@ -325,17 +337,17 @@ pub fn solve(
     }
 }
 
-/// Builds the report for positions `y` (shifted so that the front-most bird is at 0).
+/// Builds the report for positions `y` (shifted so that the front-most bird is at 0) with their
+/// savings `e`.
 fn report(
-    x: &[f64],
     target: &[f64],
     total: f64,
     mut y: Vec<f64>,
+    e: Vec<f64>,
     evaluations: usize,
     opts: &SolveOptions,
     termination: String,
 ) -> SolveReport {
-    let e = opts.aero.power_unchecked(x, &y);
     let xi: Vec<f64> = e.iter().map(|v| v / total).collect();
     let residual = norm_diff(&xi, target);
     let front = y.iter().copied().fold(f64::INFINITY, f64::min);
@@ -430,14 +442,7 @@ fn newton(x: &[f64], target: &[f64], total: f64, y0: &[f64], opts: &SolveOptions
                 full_step[i] = step[a];
             }
             // Keep the fore-aft order of laterally overlapping pairs.
-            let mut alpha: f64 = 1.0;
-            for &(f, b) in &order {
-                let gap = y[b] - y[f];
-                let closing = full_step[f] - full_step[b];
-                if closing > 0.0 && closing * alpha >= 0.9 * gap {
-                    alpha = alpha.min(0.9 * gap / closing);
-                }
-            }
+            let alpha = order_preserving_length(&order, &y, &full_step);
             let trial: Vec<f64> = y
                 .iter()
                 .zip(&full_step)
@@ -461,11 +466,12 @@ fn newton(x: &[f64], target: &[f64], total: f64, y0: &[f64], opts: &SolveOptions
             }
         }
     }
+    let e = aero.power_unchecked(x, &y);
     report(
-        x,
         target,
         total,
         y,
+        e,
         evaluations,
         opts,
         format!("symmetric Newton–Levenberg–Marquardt: {why}"),
@@ -521,76 +527,60 @@ fn band_solve(l: &[f64], m: usize, b: usize, r: &[f64]) -> Vec<f64> {
     z
 }
 
-/// [`newton`] for large flocks: the same damped Newton iteration on the exact residual, with
-/// the Jacobian restricted to the pairs less than `band_span` apart laterally. Sorted by x, that
-/// matrix is a weighted graph Laplacian with a narrow band, factorised in O(N·b²) instead of
-/// O(N³); the dropped entries (∂g/∂y ~ a²/R³ for distant pairs) make the step slightly too
-/// long for the flock's slowest modes, which the damping and a few more steps absorb.
-fn newton_banded(
-    x: &[f64],
+/// [`newton`] for large flocks: inexact Newton steps on the exact residual, each step's linear
+/// system J δ = −r solved by conjugate gradients on the **exact** Jacobian (J symmetric positive
+/// definite once one bird is fixed), preconditioned by the band of the pairs less than
+/// `band_span` apart laterally (a weighted graph Laplacian with a narrow band once the birds are
+/// sorted by x, factorised by Cholesky in O(N·b²)). The residual and the band come from one pass
+/// of [`Field::power_band`], each product J·v from one pass of [`Field::jacobian_times`] (far
+/// pairs by their expansion), so nothing of size N² is stored. The band alone misses the far
+/// pairs' coupling (∂g/∂y ~ a²/R³ summed over the flock), which matters for the slow, flock-wide
+/// modes: as a preconditioner it leaves J's spectrum within a small factor, and conjugate
+/// gradients converge in a few products. Each linear solve is accurate to a fraction
+/// η = min(10⁻², ‖r‖/‖r₀‖) of the residual (superlinear convergence); a step is shortened to keep
+/// the fore-aft order of overlapping pairs and halved until ‖r‖ decreases.
+fn newton_krylov(
+    field: &Field,
     target: &[f64],
     total: f64,
     y0: &[f64],
     opts: &SolveOptions,
 ) -> SolveReport {
-    let n = x.len();
-    let aero = &opts.aero;
+    let n = field.len();
+    let x = field.x();
+    let b = field.band_width();
     let fixed = (0..n)
         .min_by(|&a, &b| y0[a].total_cmp(&y0[b]).then(a.cmp(&b)))
         .unwrap_or(0);
+    let pf = field.order().iter().position(|&i| i == fixed).unwrap_or(0);
     // Free birds in lateral order: position p ↔ bird free[p].
-    let mut free: Vec<usize> = (0..n).filter(|&i| i != fixed).collect();
-    free.sort_by(|&a, &b| x[a].total_cmp(&x[b]).then(a.cmp(&b)));
+    let free: Vec<usize> = field
+        .order()
+        .iter()
+        .copied()
+        .filter(|&i| i != fixed)
+        .collect();
     let m = free.len();
-    // Pairs kept in the Jacobian (free–free within the span) and the fixed bird's pairs (which
-    // only add to the diagonal).
-    let mut near: Vec<(usize, usize)> = Vec::new();
-    let mut b = 0;
-    for p in 0..m {
-        for q in (p + 1)..m {
-            if x[free[q]] - x[free[p]] >= opts.band_span {
-                break;
-            }
-            near.push((p, q));
-            b = b.max(q - p);
-        }
-    }
-    let w = b + 1;
     let order = ordered_pairs(x, y0);
     let merit = |r: &[f64]| -> f64 { free.iter().map(|&i| r[i] * r[i]).sum::<f64>().sqrt() };
-    let residual = |y: &[f64]| -> Vec<f64> {
-        aero.power_unchecked(x, y)
-            .iter()
-            .zip(target)
-            .map(|(e, t)| e / total - t)
-            .collect()
-    };
     let inv = 1.0 / total;
-    let band_at = |y: &[f64]| -> Vec<f64> {
-        let mut band = vec![0.0; m * w];
-        for &(p, q) in &near {
-            let (i, j) = (free[p], free[q]);
-            let s = aero.dg_dy((x[i] - x[j]).abs(), y[i] - y[j]) * inv;
-            band[q * w + (q - p)] -= s;
-            band[p * w] += s;
-            band[q * w] += s;
-        }
-        for (p, &i) in free.iter().enumerate() {
-            if (x[i] - x[fixed]).abs() < opts.band_span {
-                band[p * w] += aero.dg_dy((x[i] - x[fixed]).abs(), y[i] - y[fixed]) * inv;
-            }
-        }
-        band
-    };
+    let mut full_band = Vec::new();
+    let mut near = Vec::new();
     let mut y = y0.to_vec();
-    let mut r = residual(&y);
+    let mut e = field.power_band(&y, Some(&mut full_band), Some(&mut near));
+    let resid =
+        |e: &[f64]| -> Vec<f64> { e.iter().zip(target).map(|(e, t)| e * inv - t).collect() };
+    let mut r = resid(&e);
     let mut norm = merit(&r);
+    let norm0 = norm;
     let mut evaluations = 1;
-    let mut lambda = 1e-6;
+    let mut products = 0;
     let mut why = "iteration budget exhausted";
     let stop = opts.tolerance * 1e-3;
-    'outer: for _ in 0..opts.patience.max(1) {
-        if norm <= stop {
+    // Converged (with a margin of 10) on the full residual, the fixed bird's included.
+    let done = |r: &[f64]| r.iter().map(|v| v * v).sum::<f64>().sqrt() <= 0.1 * opts.tolerance;
+    for _ in 0..opts.patience.max(1) {
+        if norm <= stop || done(&r) {
             why = "residual below tolerance";
             break;
         }
@@ -598,66 +588,156 @@ fn newton_banded(
             why = "the start has an infinite saving (birds abreast with overlapping wingtips)";
             break;
         }
-        let band = band_at(&y);
-        let mean_diag = (0..m).map(|p| band[p * w]).sum::<f64>() / m as f64;
-        let rhs: Vec<f64> = free.iter().map(|&i| -r[i]).collect();
-        loop {
-            let mut damped = band.clone();
-            for p in 0..m {
-                damped[p * w] += lambda * mean_diag;
+        let band = drop_position(&full_band, n, b, pf, inv);
+        let mut damped = band.clone();
+        let mut shift = 0.0;
+        let l = loop {
+            if let Some(l) = band_cholesky(&damped, m, b) {
+                break Some(l);
             }
-            let Some(l) = band_cholesky(&damped, m, b) else {
-                lambda *= 10.0;
-                if lambda > 1e12 {
-                    why = "damped Jacobian not positive definite";
-                    break 'outer;
-                }
-                continue;
+            // Not positive definite in floating point: shift the diagonal.
+            let mean = (0..m).map(|p| band[p * w_of(b)]).sum::<f64>() / m as f64;
+            shift = if shift == 0.0 {
+                1e-10 * mean
+            } else {
+                shift * 10.0
             };
-            let step = band_solve(&l, m, b, &rhs);
-            let mut full_step = vec![0.0; n];
+            if !(shift < mean) {
+                break None;
+            }
+            damped = band.clone();
+            for p in 0..m {
+                damped[p * w_of(b)] += shift;
+            }
+        };
+        let Some(l) = l else {
+            why = "band preconditioner not positive definite";
+            break;
+        };
+        // Conjugate gradients on J δ = −r (free birds, sorted positions).
+        let rhs: Vec<f64> = free.iter().map(|&i| -r[i]).collect();
+        let eta = (norm / norm0).min(1e-2).max(stop / norm * 0.1);
+        let rhs_norm = dot(&rhs, &rhs).sqrt();
+        let mut delta = vec![0.0; m];
+        let mut res = rhs.clone();
+        let mut z = band_solve(&l, m, b, &res);
+        let mut dir = z.clone();
+        let mut rz = dot(&res, &z);
+        let mut v = vec![0.0; n];
+        for _ in 0..opts.cg_limit.max(1) {
             for (p, &i) in free.iter().enumerate() {
-                full_step[i] = step[p];
+                v[i] = dir[p];
             }
-            let mut alpha: f64 = 1.0;
-            for &(f, bk) in &order {
-                let gap = y[bk] - y[f];
-                let closing = full_step[f] - full_step[bk];
-                if closing > 0.0 && closing * alpha >= 0.9 * gap {
-                    alpha = alpha.min(0.9 * gap / closing);
-                }
+            let jv = field.jacobian_times(&y, &near, &v);
+            products += 1;
+            let ad: Vec<f64> = free.iter().map(|&i| jv[i] * inv).collect();
+            let curv = dot(&dir, &ad);
+            if !(curv > 0.0) {
+                break;
             }
+            let alpha = rz / curv;
+            for p in 0..m {
+                delta[p] += alpha * dir[p];
+                res[p] -= alpha * ad[p];
+            }
+            if dot(&res, &res).sqrt() <= eta * rhs_norm {
+                break;
+            }
+            z = band_solve(&l, m, b, &res);
+            let rz_new = dot(&res, &z);
+            let beta = rz_new / rz;
+            rz = rz_new;
+            for p in 0..m {
+                dir[p] = z[p] + beta * dir[p];
+            }
+        }
+        let mut full_step = vec![0.0; n];
+        for (p, &i) in free.iter().enumerate() {
+            full_step[i] = delta[p];
+        }
+        let mut alpha = order_preserving_length(&order, &y, &full_step);
+        let mut accepted = false;
+        for _ in 0..30 {
             let trial: Vec<f64> = y
                 .iter()
                 .zip(&full_step)
                 .map(|(v, s)| v + alpha * s)
                 .collect();
-            let tr = residual(&trial);
+            let mut tband = Vec::new();
+            let mut tnear = Vec::new();
+            let te = field.power_band(&trial, Some(&mut tband), Some(&mut tnear));
             evaluations += 1;
+            let tr = resid(&te);
             let tnorm = merit(&tr);
             if tnorm.is_finite() && tnorm < norm {
                 y = trial;
+                e = te;
                 r = tr;
                 norm = tnorm;
-                lambda = (lambda / 10.0).max(1e-15);
+                full_band = tband;
+                near = tnear;
+                accepted = true;
                 break;
             }
-            lambda *= 10.0;
-            if lambda > 1e12 {
-                why = "no step lowers the residual";
-                break 'outer;
-            }
+            alpha *= 0.5;
+        }
+        if !accepted {
+            why = "no step lowers the residual";
+            break;
         }
     }
     report(
-        x,
         target,
         total,
         y,
+        e,
         evaluations,
         opts,
-        format!("banded Newton–Levenberg–Marquardt (bandwidth {b}): {why}"),
+        format!(
+            "Newton–conjugate gradients, band preconditioner (bandwidth {b}, {products} Jacobian products): {why}"
+        ),
     )
+}
+
+fn w_of(b: usize) -> usize {
+    b + 1
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(p, q)| p * q).sum()
+}
+
+/// The band matrix of [`Field::power_band`] (n sorted positions, half-bandwidth b) without row
+/// and column `pf` (the fixed bird), times `scale`: still a band of half-bandwidth b.
+fn drop_position(full: &[f64], n: usize, b: usize, pf: usize, scale: f64) -> Vec<f64> {
+    let w = b + 1;
+    let m = n - 1;
+    let mut out = vec![0.0; m * w];
+    for i in 0..m {
+        let oi = i + usize::from(i >= pf);
+        for k in 0..=b.min(i) {
+            let j = i - k;
+            let oj = j + usize::from(j >= pf);
+            if oi - oj <= b {
+                out[i * w + k] = full[oi * w + (oi - oj)] * scale;
+            }
+        }
+    }
+    out
+}
+
+/// The longest fraction (≤ 1) of `step` that keeps every laterally overlapping pair of `order`
+/// (front, rear) in its fore-aft order: at most 90 % of the way to abreast.
+fn order_preserving_length(order: &[(usize, usize)], y: &[f64], step: &[f64]) -> f64 {
+    let mut alpha: f64 = 1.0;
+    for &(f, bk) in order {
+        let gap = y[bk] - y[f];
+        let closing = step[f] - step[bk];
+        if closing > 0.0 && closing * alpha >= 0.9 * gap {
+            alpha = alpha.min(0.9 * gap / closing);
+        }
+    }
+    alpha
 }
 
 /// Decides whether renormalised targets `target` (Σ = 1) are reachable for lateral positions `x`
