@@ -67,6 +67,7 @@ pub mod plot;
 pub mod progress;
 pub mod rng;
 pub mod shape;
+pub mod skein;
 pub mod sniff;
 pub mod wingbeat;
 

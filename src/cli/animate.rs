@@ -60,6 +60,8 @@ pub struct AnimateArgs {
     #[command(flatten)]
     pub steady: SteadyFlags,
     #[command(flatten)]
+    pub skein: super::steady::SkeinFlags,
+    #[command(flatten)]
     pub initiate: InitiateFlags,
     #[command(flatten)]
     pub wingbeat: WingbeatFlags,
@@ -76,6 +78,7 @@ pub fn run(args: AnimateArgs, g: Global) -> Result<()> {
         read: args.read.options(),
         extract: ExtractOptions::default(),
         steady: args.steady.options(args.birds),
+        skein: args.skein.options(),
         ..Config::default()
     };
     // In the order the stages run: the steady flight's options are checked first.
@@ -98,6 +101,10 @@ pub fn run(args: AnimateArgs, g: Global) -> Result<()> {
         formation::export::bird_model::load(p, config.wingbeat.species)?;
     }
     let progress = TermProgress::new(g.quiet);
-    let (anim, _report) = Pipeline::from_path(&args.input).run_with(&config, &progress)?;
-    super::write_animation(&anim, &args.output, &config.render, g)
+    let (anim, report) = Pipeline::from_path(&args.input).run_with(&config, &progress)?;
+    super::write_animation(&anim, &args.output, &config.render, g)?;
+    if let (Some(f), false) = (&report.skein, g.quiet) {
+        eprintln!("{}", super::steady::flock_summary(f));
+    }
+    Ok(())
 }

@@ -85,6 +85,9 @@ pub const FLAGS: &[(&str, &str, &[Cmd])] = &[
     ("steady.c2", "--c2", STEADY),
     ("steady.wingspan_m", "--wingspan-m", STEADY),
     ("steady.max_jump", "--max-jump", STEADY),
+    ("skein.formations", "--formations", STEADY),
+    ("skein.formation_size", "--formation-size", STEADY),
+    ("skein.clearance", "--clearance", STEADY),
     ("initiate.max_steps", "--max-steps", INITIATE),
     ("initiate.perception.mode", "--perception", INITIATE),
     (

@@ -8,7 +8,8 @@ use formation::animation::Animation;
 use formation::extract::params::FormationParams;
 use formation::io::{write_json_atomic, OutputKind};
 use formation::keyshape::SteadyOptions;
-use formation::pipeline::{steady_stage, Config};
+use formation::pipeline::{flock_steady_stage, Config, SteadyOutcome};
+use formation::skein::SkeinOptions;
 use formation::plot::power::{PowerChart, PowerMetric, PowerOf};
 use formation::plot::xi::XiChart;
 use formation::shape::Shape;
@@ -34,6 +35,8 @@ pub struct SteadyArgs {
     pub output: Vec<PathBuf>,
     #[command(flatten)]
     pub steady: SteadyFlags,
+    #[command(flatten)]
+    pub skein: SkeinFlags,
     #[command(flatten)]
     pub wingbeat: super::wingbeat::WingbeatFlags,
     #[command(flatten)]
@@ -92,6 +95,34 @@ impl SteadyFlags {
     }
 }
 
+/// Flags of flocks of several formations, shared by `steady` and `animate` (the `skein` section
+/// of the library's `Config`).
+#[derive(Debug, Clone, Args)]
+pub struct SkeinFlags {
+    /// Number of formations (skeins) the flock flies as (default: formations of about the
+    /// footage's size; one formation up to twice its birds). 1 = one formation of all birds.
+    #[arg(long, value_name = "K")]
+    pub formations: Option<usize>,
+    /// Typical number of birds of a formation instead of the footage's (at least 2).
+    #[arg(long = "formation-size", value_name = "M")]
+    pub formation_size: Option<usize>,
+    /// Smallest distance between birds of different formations, wingspans.
+    #[arg(long, default_value_t = SkeinOptions::default().clearance, allow_negative_numbers = true)]
+    pub clearance: f64,
+}
+
+impl SkeinFlags {
+    /// The library options.
+    pub fn options(&self) -> SkeinOptions {
+        SkeinOptions {
+            formations: self.formations,
+            formation_size: self.formation_size,
+            clearance: self.clearance,
+            ..SkeinOptions::default()
+        }
+    }
+}
+
 /// Runs `formation steady`.
 pub fn run(args: SteadyArgs, g: Global) -> Result<()> {
     let config = Config {
@@ -102,6 +133,7 @@ pub fn run(args: SteadyArgs, g: Global) -> Result<()> {
             ..args.steady.options(args.birds)
         },
         wingbeat: args.wingbeat.options()?,
+        skein: args.skein.options(),
         ..Config::default()
     };
     config.steady_options()?;
@@ -126,20 +158,39 @@ pub fn run(args: SteadyArgs, g: Global) -> Result<()> {
     }
     let params = read_params(&args.params)?;
     let progress = TermProgress::new(g.quiet);
-    let (mut anim, report) = steady_stage(&params, &config, &progress)?;
+    let (mut anim, outcome) = flock_steady_stage(&params, &config, &progress)?;
     formation::wingbeat::assign_phases(&mut anim, &config.wingbeat)?;
     super::write_animation(&anim, &args.output, &args.scene.options(), g)?;
     if let Some(r) = &args.report {
-        write_json_atomic(r, &report)?;
+        write_json_atomic(r, &outcome)?;
     }
     if !g.quiet {
-        let k = &report.keys;
-        eprintln!(
-            "steady: {} key shapes ({} draws, {} redraws, {} damped, {} held, min λ {:.3}), max key residual {:.1e}, max jump {:.2} wingspans",
-            k.keys, k.draws, k.redraws, k.damped, k.held, k.min_damping, k.max_residual, k.max_jump
-        );
+        match &outcome {
+            SteadyOutcome::One(report) => {
+                let k = &report.keys;
+                eprintln!(
+                    "steady: {} key shapes ({} draws, {} redraws, {} damped, {} held, min λ {:.3}), max key residual {:.1e}, max jump {:.2} wingspans",
+                    k.keys, k.draws, k.redraws, k.damped, k.held, k.min_damping, k.max_residual, k.max_jump
+                );
+            }
+            SteadyOutcome::Flock(f) => eprintln!("{}", flock_summary(f)),
+        }
     }
     Ok(())
+}
+
+/// One line about a flock of several formations: how many, their sizes, lanes, separation.
+pub fn flock_summary(f: &formation::skein::SkeinReport) -> String {
+    let lo = f.sizes.iter().min().copied().unwrap_or(0);
+    let hi = f.sizes.iter().max().copied().unwrap_or(0);
+    format!(
+        "flock: {} birds in {} formations of {lo} to {hi} birds, {} lanes; birds of different formations at least {:.1} wingspans apart (clearance {})",
+        f.sizes.iter().sum::<usize>(),
+        f.sizes.len(),
+        f.lanes,
+        f.min_separation,
+        f.clearance
+    )
 }
 
 /// Reads a params file, telling other `formation` files apart before serde's field errors.
