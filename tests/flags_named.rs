@@ -89,6 +89,9 @@ fn commands() -> Vec<Command> {
         ("--c2", "3", None),
         ("--wingspan-m", "0", None),
         ("--max-jump", "0", None),
+        ("--formations", "0", None),
+        ("--formation-size", "1", None),
+        ("--clearance", "-1", None),
     ];
     let wingbeat: Vec<(&str, &str, Option<String>)> = vec![
         ("--species", "dodo", None),
@@ -246,6 +249,7 @@ fn commands() -> Vec<Command> {
                 ("--key", "5", None),
                 ("--frame", "100000", None),
                 ("--metric", "watts", None),
+                ("--formation", "5", None),
                 o("OUT/p.txt"),
                 seed.clone(),
             ],
@@ -253,7 +257,7 @@ fn commands() -> Vec<Command> {
         Command {
             name: &["plot", "xi"],
             base: strings(&["plot", "xi", &flock, "-o", "OUT/x.png"]),
-            cases: vec![o("OUT/x.txt"), seed.clone()],
+            cases: vec![("--formation", "5", None), o("OUT/x.txt"), seed.clone()],
         },
         Command {
             name: &["plot", "shape"],
@@ -267,7 +271,7 @@ fn commands() -> Vec<Command> {
         Command {
             name: &["plot", "paths"],
             base: strings(&["plot", "paths", &flock, "-o", "OUT/p.png"]),
-            cases: vec![o("OUT/p.txt"), seed.clone()],
+            cases: vec![("--formation", "5", None), o("OUT/p.txt"), seed.clone()],
         },
         Command {
             name: &["plot", "wingbeat"],

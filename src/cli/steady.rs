@@ -236,6 +236,40 @@ pub struct PlotPowerArgs {
     /// Quantity to plot.
     #[arg(long, value_enum, default_value_t = MetricArg::Xi)]
     pub metric: MetricArg,
+    #[command(flatten)]
+    pub formation: FormationArg,
+}
+
+/// `--formation K` of the charts of one formation.
+#[derive(Debug, Clone, Args)]
+pub struct FormationArg {
+    /// Formation of a flock of several formations to chart (index into the file's formations;
+    /// default 0).
+    #[arg(long, value_name = "K")]
+    pub formation: Option<usize>,
+}
+
+impl FormationArg {
+    /// The formation asked for of `anim` (read from `origin`) as an animation of its own, and
+    /// the words a chart's title adds (`None` for a flock of one formation).
+    pub fn pick(&self, anim: Animation, origin: &Path) -> Result<(Animation, Option<String>)> {
+        let count = anim.formation_count();
+        let k = self.formation.unwrap_or(0);
+        if anim.formations.is_none() && k == 0 {
+            return Ok((anim, None));
+        }
+        let one = anim.formation(k).ok_or_else(|| {
+            Error::parameter(
+                "plot.formation",
+                format!(
+                    "{k}: {} has {count} formation(s) (0..{})",
+                    origin.display(),
+                    count - 1
+                ),
+            )
+        })?;
+        Ok((one, Some(format!(", formation {k} of {count}"))))
+    }
 }
 
 /// Runs `formation plot power`.
@@ -248,13 +282,26 @@ pub fn run_plot_power(args: PlotPowerArgs, _g: Global) -> Result<()> {
     let value: serde_json::Value = formation::io::read_json(&args.input)?;
     let is_animation = formation::sniff::json_kind(&value) == formation::sniff::Kind::Animation;
     let chart = if is_animation {
-        let anim = Animation::read(&args.input)?;
+        let (anim, which) = args
+            .formation
+            .pick(Animation::read(&args.input)?, &args.input)?;
         let of = match (args.frame, args.key) {
             (Some(k), _) => PowerOf::Frame(k),
             (None, k) => PowerOf::Key(k.unwrap_or(0)),
         };
-        PowerChart::from_animation(&anim, &args.input, of, metric)?
+        let mut chart = PowerChart::from_animation(&anim, &args.input, of, metric)?;
+        chart.title.push_str(which.as_deref().unwrap_or(""));
+        chart
     } else {
+        if args.formation.formation.is_some() {
+            return Err(Error::parameter(
+                "plot.formation",
+                format!(
+                    "{} is a shape file, which has no formations",
+                    args.input.display()
+                ),
+            ));
+        }
         if args.key.is_some() || args.frame.is_some() {
             return Err(Error::parameter(
                 "--key/--frame",
@@ -282,12 +329,17 @@ pub struct PlotXiArgs {
     /// Output chart (.png or .svg).
     #[arg(short = 'o', long = "output")]
     pub output: PathBuf,
+    #[command(flatten)]
+    pub formation: FormationArg,
 }
 
 /// Runs `formation plot xi`.
 pub fn run_plot_xi(args: PlotXiArgs, _g: Global) -> Result<()> {
     OutputKind::from_path(&args.output, &[OutputKind::Png, OutputKind::Svg])?;
-    let anim = Animation::read(&args.input)?;
-    let chart = XiChart::from_animation(&anim, &args.input)?;
+    let (anim, which) = args
+        .formation
+        .pick(Animation::read(&args.input)?, &args.input)?;
+    let mut chart = XiChart::from_animation(&anim, &args.input)?;
+    chart.title.push_str(which.as_deref().unwrap_or(""));
     formation::plot::save(&chart, &args.output)
 }

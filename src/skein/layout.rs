@@ -9,7 +9,7 @@
 //! small, smooth, bounded differences of speed and heading.
 //!
 //! **Arrangement.** Formations are dealt, in a random order, into L lanes side by side across the
-//! course (L ≈ √(1.5 K · pitch_y / pitch_x), so the flock is about 1.5 times as wide as deep) and,
+//! course (L ≈ √(2 K · pitch_y / pitch_x), so the flock is about twice as wide as deep) and,
 //! in each lane, one behind the other. Each formation's *envelope* is measured over the whole
 //! animation, take-off, drift and key-shape changes included: its lateral extent over all frames,
 //! and its fore-aft extent frame by frame. Lanes are as wide as their widest envelope and are
@@ -31,7 +31,7 @@ use crate::animation::Animation;
 pub const DRIFT_PERIOD_S: [f64; 2] = [60.0, 120.0];
 
 /// Width : depth of the whole arrangement (wingspans over wingspans) the lane count aims at.
-pub const ASPECT: f64 = 1.5;
+pub const ASPECT: f64 = 2.0;
 
 /// A formation's slow wander about its place (see the module doc).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -175,8 +175,8 @@ pub fn arrange(env: &[Envelope], clearance: f64, spread: f64, rng: &mut impl Rng
     let k = env.len();
     let w_med = median(env.iter().map(Envelope::width).collect());
     let d_med = median(env.iter().map(Envelope::depth).collect());
-    let pitch_x = w_med + clearance + 0.5 * spread * w_med;
-    let pitch_y = d_med + clearance + 0.5 * spread * d_med;
+    let pitch_x = w_med + clearance + spread * w_med;
+    let pitch_y = d_med + clearance + 0.5 * spread * w_med;
     let lanes = ((ASPECT * k as f64 * pitch_y / pitch_x.max(1e-9)).sqrt().round() as usize).clamp(1, k.max(1));
     // A random order, dealt into lanes.
     let mut order: Vec<usize> = (0..k).collect();
@@ -197,7 +197,7 @@ pub fn arrange(env: &[Envelope], clearance: f64, spread: f64, rng: &mut impl Rng
     ];
     let mut left = 0.0;
     for (l, m) in members.iter().enumerate() {
-        let lane_w = m.iter().map(|&f| env[f].width()).fold(0.0, f64::max);
+        let lane_w = m.iter().map(|&f| env[f].width()).fold(0.0, f64::max) + 0.5 * spread * w_med;
         let mut ahead: Option<(usize, f64)> = None;
         for (row, &f) in m.iter().enumerate() {
             let e = &env[f];
@@ -212,7 +212,7 @@ pub fn arrange(env: &[Envelope], clearance: f64, spread: f64, rng: &mut impl Rng
                         .zip(&e.front)
                         .map(|(r, fr)| r - fr)
                         .fold(f64::INFINITY, f64::min);
-                    ya + closest - clearance - spread * d_med * rng.random_range(0.0..=1.0)
+                    ya + closest - clearance - spread * w_med * rng.random_range(0.0..=1.0)
                 }
             };
             out[f] = Placement {
@@ -222,7 +222,7 @@ pub fn arrange(env: &[Envelope], clearance: f64, spread: f64, rng: &mut impl Rng
             };
             ahead = Some((f, y));
         }
-        left += lane_w + clearance + spread * w_med * rng.random_range(0.0..=1.0);
+        left += lane_w + clearance + 0.5 * spread * w_med * rng.random_range(0.0..=1.0);
     }
     out
 }
