@@ -154,7 +154,11 @@ impl Config {
             ..self.initiate.clone()
         };
         o.validate()?;
-        initiate::check_size(self.steady.birds, 0, o.max_steps)?;
+        // The memory bound of the take-off's frames matters only when it is flown (a large
+        // flock's steady flight alone may hold more birds than a take-off of max_steps could).
+        if self.initiation {
+            initiate::check_size(self.steady.birds, 0, o.max_steps)?;
+        }
         Ok(o)
     }
 

@@ -83,7 +83,10 @@ pub fn run(args: AnimateArgs, g: Global) -> Result<()> {
     };
     // In the order the stages run: the steady flight's options are checked first.
     config.steady_options()?;
-    config.initiate = args.initiate.options(g.seed, args.birds)?;
+    // Without the take-off its flags are still checked, but not its memory bound for the
+    // flock's size (10 000 birds of steady flight need no take-off frames).
+    let takeoff_birds = if args.no_initiation { 2 } else { args.birds };
+    config.initiate = args.initiate.options(g.seed, takeoff_birds)?;
     config.wingbeat = args.wingbeat.options()?;
     config.render = RenderOptions {
         width: args.size.width,

@@ -273,6 +273,12 @@ fn finish(
     let k = anims.len();
     let sizes: Vec<usize> = anims.iter().map(|a| a.birds).collect();
     if let Some(init) = o.initiate {
+        if matches!(init.start, initiate::Start::Given(_)) {
+            return Err(Error::parameter(
+                "initiate.start",
+                format!("a start file places the birds of one formation; a flock of {k} formations takes off from the ground or starts in the air (or give skein.formations 1)"),
+            ));
+        }
         progress.start("formations: take-off", k as u64);
         let runs = par_map(k, |f| {
             let r = takeoff_run(&anims[f], init, o.seed, f);
