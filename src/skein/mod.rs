@@ -529,13 +529,15 @@ fn join(anims: &[Animation], reports: &[FormationReport]) -> Result<Animation> {
 }
 
 /// Smallest 3-D distance between two birds of different formations over every frame of `anim`,
-/// wingspans (infinite for one formation). Pairs of formations whose boxes are farther apart
-/// than the best so far are skipped.
+/// wingspans (infinite for one formation). In each frame the formations' boxes are swept west to
+/// east, and only pairs whose boxes are closer than the best distance so far are compared bird
+/// by bird.
 pub fn min_separation(anim: &Animation) -> f64 {
     let Some(fs) = &anim.formations else {
         return f64::INFINITY;
     };
     let mut best = f64::INFINITY;
+    let mut order: Vec<usize> = (0..fs.len()).collect();
     for f in &anim.frames {
         let boxes: Vec<[f64; 4]> = fs
             .iter()
@@ -546,8 +548,13 @@ pub fn min_separation(anim: &Animation) -> f64 {
                 )
             })
             .collect();
-        for a in 0..fs.len() {
-            for b in 0..a {
+        order.sort_by(|&a, &b| boxes[a][0].total_cmp(&boxes[b][0]).then(a.cmp(&b)));
+        for (p, &a) in order.iter().enumerate() {
+            for &b in &order[p + 1..] {
+                // Sorted by west edge: every later box starts at least this far east.
+                if boxes[b][0] - boxes[a][2] >= best {
+                    break;
+                }
                 let gx = (boxes[a][0] - boxes[b][2]).max(boxes[b][0] - boxes[a][2]).max(0.0);
                 let gy = (boxes[a][1] - boxes[b][3]).max(boxes[b][1] - boxes[a][3]).max(0.0);
                 if gx.hypot(gy) >= best {
@@ -645,4 +652,86 @@ fn par_map<T: Send>(k: usize, f: impl Fn(usize) -> Result<T> + Sync) -> Result<V
         .into_iter()
         .map(|s| s.unwrap_or_else(|| Err(Error::Internal("a worker thread failed".into()))))
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The numbers `docs/large-flocks.md` gives for Hummel's g at the default clearance.
+    #[test]
+    fn hummels_g_at_the_clearance_is_small() {
+        let aero = crate::aero::AeroOptions::default();
+        let side = aero.g(5.0, 0.0);
+        let diag = aero.g(5.0, 5.0);
+        let far = aero.g(0.5, 50.0);
+        println!(
+            "g(5,0) = {side:.5}, 2g(5,0) = {:.5}, g(5,5) = {diag:.5}, g(0.5,50) = {far:.5}",
+            2.0 * side
+        );
+        assert!(side > 0.0 && side < 0.01);
+        assert!(diag > side && diag < 2.0 * side);
+        // Directly behind, the model's infinite trailing vortices still give downwash.
+        assert!(far < 0.0);
+    }
+
+    #[test]
+    fn option_errors_name_the_option() {
+        let bad = [
+            (SkeinOptions { formations: Some(0), ..SkeinOptions::default() }, "skein.formations: "),
+            (SkeinOptions { formations: Some(6), ..SkeinOptions::default() }, "skein.formations: "),
+            (SkeinOptions { formation_size: Some(1), ..SkeinOptions::default() }, "skein.formation_size: "),
+            (
+                SkeinOptions { formations: Some(3), formation_size: Some(5), ..SkeinOptions::default() },
+                "skein.formations/skein.formation_size: ",
+            ),
+            (SkeinOptions { clearance: f64::NAN, ..SkeinOptions::default() }, "skein.clearance: "),
+            (SkeinOptions { spread: -1.0, ..SkeinOptions::default() }, "skein.spread: "),
+        ];
+        for (o, want) in bad {
+            let e = o.validate(10).unwrap_err().to_string();
+            assert!(e.starts_with(want), "{e}");
+            assert_eq!(e.lines().count(), 1);
+        }
+        let ok = SkeinOptions { formations: Some(1), formation_size: Some(10), ..SkeinOptions::default() };
+        assert!(ok.validate(10).is_ok());
+        assert_eq!(SkeinOptions::default().sizes(14, 9, 0).unwrap(), vec![14]);
+        assert_eq!(SkeinOptions::default().sizes(19, 9, 0).unwrap().len(), 2);
+    }
+
+    #[test]
+    fn a_delayed_run_waits_at_its_start_state() {
+        let run = InitiationRun {
+            fps: 10.0,
+            pos: vec![vec![DVec2::new(1.0, 2.0)], vec![DVec2::new(1.0, 3.0)]],
+            z: vec![vec![0.0], vec![0.1]],
+            heading: vec![vec![0.0], vec![0.0]],
+            speed: vec![vec![10.0], vec![10.0]],
+            bank: vec![vec![0.0], vec![0.0]],
+            slot: vec![Some(0)],
+            stats: InitiateStats {
+                birds: 1,
+                steps: 1,
+                seconds: 0.1,
+                planned_seconds: 0.1,
+                converged: true,
+                min_distance: f64::INFINITY,
+                max_turn_rate: 0.0,
+                max_turn_accel: 0.0,
+                max_accel: 0.0,
+                max_bank: 0.0,
+                max_stray: 0.0,
+                last_liftoff: 0.0,
+                leader_changes: 0,
+                birds_in_slot: 1,
+                field_per_eye: 1.0,
+            },
+        };
+        let d = delayed(run, 3);
+        assert_eq!(d.pos.len(), 5);
+        // Flying straight north at 10 wingspans/s before the start: one wingspan per frame.
+        let ys: Vec<f64> = d.pos.iter().map(|p| p[0].y).collect();
+        assert_eq!(ys, vec![-1.0, 0.0, 1.0, 2.0, 3.0]);
+        assert_eq!(d.stats.steps, 4);
+    }
 }
