@@ -9,18 +9,19 @@
 //! small, smooth, bounded differences of speed and heading.
 //!
 //! **Arrangement.** Formations are dealt, in a random order, into L lanes side by side across the
-//! course (L ≈ √(2 K · pitch_y / pitch_x), so the flock is about twice as wide as deep) and,
-//! in each lane, one behind the other. Each formation's *envelope* is measured over the whole
+//! course (L ≈ √(2K · pitch_y / pitch_x), so the flock is about twice as wide as deep) and, in
+//! each lane, one behind the other. Each formation's *envelope* is measured over the whole
 //! animation, take-off, drift and key-shape changes included: its lateral extent over all frames,
-//! and its fore-aft extent frame by frame. Lanes are as wide as their widest envelope and are
-//! separated by the clearance plus `spread` × u × the median formation width (u uniform in
-//! [0, 1], drawn per gap); in a lane a formation sits at a random place across the lane's slack.
-//! Along a lane, each formation is placed behind the one ahead so that in *every frame* its
-//! front-most bird is the clearance plus `spread` × u × the median formation depth behind the
-//! rear-most bird of the one ahead; the first formation of each lane is set back by a random
-//! fraction of a row (staggered rows). Birds of different formations are therefore never within
-//! the clearance in any frame: in different lanes they are that far apart across the course, in
-//! one lane along it.
+//! and its fore-aft extent frame by frame. With w̃ the median envelope width and s = `spread`:
+//! a lane is s·w̃/2 wider than its widest envelope and each formation sits at a random place
+//! across it; neighbouring lanes are the clearance plus s·u·w̃/2 apart (u uniform in [0, 1], drawn
+//! per gap). Along a lane, each formation is placed behind the one ahead so that in *every frame*
+//! its front-most bird is the clearance plus s·u·w̃ behind the rear-most bird of the one ahead
+//! (line formations are wider than deep, so the width sets the scale of the gaps both ways); the
+//! first formation of each lane is set back by a random fraction of a row (staggered rows). After
+//! a take-off, the formations of a lane are ordered by the time they leave the ground, the first
+//! to leave in front. Birds of different formations are therefore never within the clearance in
+//! any frame: in different lanes they are that far apart across the course, in one lane along it.
 
 use rand::Rng;
 use serde::Serialize;
@@ -170,8 +171,17 @@ fn median(mut v: Vec<f64>) -> f64 {
 }
 
 /// The arrangement of formations with envelopes `env` (all over the same frames), `clearance`
-/// wingspans apart at least, loosened by `spread` (see the module doc).
-pub fn arrange(env: &[Envelope], clearance: f64, spread: f64, rng: &mut impl Rng) -> Vec<Placement> {
+/// wingspans apart at least, loosened by `spread` (see the module doc). In each lane the
+/// formations are ordered front to back by `first` (ascending; ties keep the dealt order): the
+/// take-off passes each formation's departure time, so that the formations that leave first fly
+/// ahead and no formation has to pass over another's patch.
+pub fn arrange(
+    env: &[Envelope],
+    first: &[f64],
+    clearance: f64,
+    spread: f64,
+    rng: &mut impl Rng,
+) -> Vec<Placement> {
     let k = env.len();
     let w_med = median(env.iter().map(Envelope::width).collect());
     let d_med = median(env.iter().map(Envelope::depth).collect());
@@ -185,7 +195,14 @@ pub fn arrange(env: &[Envelope], clearance: f64, spread: f64, rng: &mut impl Rng
         order.swap(i, j);
     }
     let members: Vec<Vec<usize>> = (0..lanes)
-        .map(|l| order.iter().copied().skip(l).step_by(lanes).collect())
+        .map(|l| {
+            let mut m: Vec<usize> = order.iter().copied().skip(l).step_by(lanes).collect();
+            m.sort_by(|&a, &b| {
+                let key = |f: usize| first.get(f).copied().unwrap_or(0.0);
+                key(a).total_cmp(&key(b))
+            });
+            m
+        })
         .collect();
     let mut out = vec![
         Placement {
@@ -277,7 +294,8 @@ mod tests {
             let anims: Vec<Animation> = (0..13).map(|k| moving(3 + k % 5, 0.5 + k as f64 * 0.3)).collect();
             let env: Vec<Envelope> = anims.iter().map(Envelope::of).collect();
             let mut rng = crate::rng::seeded(seed);
-            let p = arrange(&env, 5.0, 1.0, &mut rng);
+            let first: Vec<f64> = (0..env.len()).map(|k| (k % 3) as f64).collect();
+            let p = arrange(&env, &first, 5.0, 1.0, &mut rng);
             assert!(p.iter().map(|p| p.lane).max().unwrap() >= 1);
             for j in 0..50 {
                 for a in 0..anims.len() {

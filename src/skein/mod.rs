@@ -68,7 +68,7 @@ impl Default for SkeinOptions {
             formations: None,
             formation_size: None,
             clearance: 5.0,
-            spread: 1.0,
+            spread: 0.5,
             max_heading_deg: 1.0,
             max_speed_diff: 0.02,
         }
@@ -299,8 +299,10 @@ fn finish(
         }
     }
     let env: Vec<Envelope> = anims.iter().map(Envelope::of).collect();
+    let departures: Vec<f64> = reports.iter().map(|r| r.takeoff_delay_s).collect();
     let placements = layout::arrange(
         &env,
+        &departures,
         o.skein.clearance,
         o.skein.spread,
         &mut stream(o.seed, "skein/layout"),
