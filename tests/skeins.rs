@@ -232,3 +232,35 @@ fn bad_formation_flags_are_one_line_errors() {
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }
+
+#[test]
+fn the_follow_camera_frames_the_whole_sky_of_formations() {
+    use formation::export::pictures::Film;
+    use formation::export::RenderOptions;
+    let mut c = config(200, 0, 4.0);
+    c.initiation = false;
+    let (a, _) = Pipeline::from_path(example("barnacle_geese_v.json"))
+        .run(&c)
+        .unwrap();
+    let opts = RenderOptions {
+        width: 1280,
+        height: 720,
+        ..RenderOptions::default()
+    };
+    let film = Film::with_options(&a, 25.0, &opts);
+    assert!(film.len() > 50);
+    for (k, (v, st)) in film.views.iter().zip(&film.states).enumerate() {
+        assert!(v.scale() >= 3.0 - 1e-9, "frame {k}: {} px per wingspan", v.scale());
+        for b in st {
+            let (x, y) = v.to_pixel(b.x, b.y, 1280, 720);
+            assert!(
+                (0.0..1280.0).contains(&x) && (0.0..720.0).contains(&y),
+                "frame {k}: a bird at ({x:.0}, {y:.0}) is outside the picture"
+            );
+        }
+    }
+    // One formation of the same flock is not framed whole: its birds stay at least 12 px.
+    let one = a.formation(0).unwrap();
+    let film = Film::with_options(&one, 25.0, &opts);
+    assert!(film.views.iter().all(|v| v.scale() >= 12.0 - 1e-9));
+}
