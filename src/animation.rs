@@ -485,7 +485,10 @@ impl Animation {
         };
         let fm = fs.get(k)?;
         let pick = |v: &Vec<f64>| -> Vec<f64> {
-            fm.birds.iter().map(|&b| v.get(b).copied().unwrap_or(0.0)).collect()
+            fm.birds
+                .iter()
+                .map(|&b| v.get(b).copied().unwrap_or(0.0))
+                .collect()
         };
         let pick_opt = |v: &Option<Vec<f64>>| v.as_ref().map(pick);
         let mut a = Animation::new(self.seed, self.fps, self.wingspan_m, fm.birds.len());

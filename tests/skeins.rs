@@ -71,14 +71,20 @@ fn a_thousand_geese_take_off_into_many_line_formations() {
                 if i == l {
                     continue;
                 }
-                assert!(fr.y[i] < fr.y[l] - 0.05, "frame {f}: bird {i} not behind its leader {l}");
+                assert!(
+                    fr.y[i] < fr.y[l] - 0.05,
+                    "frame {f}: bird {i} not behind its leader {l}"
+                );
                 let near = fm
                     .birds
                     .iter()
                     .filter(|&&j| j != i && fr.y[j] > fr.y[i])
                     .map(|&j| (fr.x[j] - fr.x[i]).hypot(fr.y[j] - fr.y[i]))
                     .fold(f64::INFINITY, f64::min);
-                assert!(near < 3.0, "frame {f}: bird {i} is {near} wingspans from the bird ahead");
+                assert!(
+                    near < 3.0,
+                    "frame {f}: bird {i} is {near} wingspans from the bird ahead"
+                );
             }
         }
     }
@@ -95,7 +101,10 @@ fn a_thousand_geese_take_off_into_many_line_formations() {
             for j in 0..i {
                 if of[i] != of[j] {
                     let d = (fr.x[i] - fr.x[j]).hypot(fr.y[i] - fr.y[j]);
-                    assert!(d >= 5.0, "frame {f}: birds {i} and {j} of different formations {d} apart");
+                    assert!(
+                        d >= 5.0,
+                        "frame {f}: birds {i} and {j} of different formations {d} apart"
+                    );
                 }
             }
         }
@@ -131,7 +140,11 @@ fn small_flocks_and_formations_one_stay_one_formation() {
         let o = run(&args);
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
         let a = Animation::read(&out).unwrap();
-        assert_eq!(a.formations.as_ref().map(|f| f.len()), want, "{birds} {extra:?}");
+        assert_eq!(
+            a.formations.as_ref().map(|f| f.len()),
+            want,
+            "{birds} {extra:?}"
+        );
         if want.is_none() {
             let text = std::fs::read_to_string(&out).unwrap();
             assert!(!text.contains("\"formations\""));
@@ -145,10 +158,24 @@ fn equal_seeds_give_equal_bytes_and_other_seeds_another_flock() {
     let dir = scratch("skeins-seeds");
     let geese = example("barnacle_geese_v.json");
     let make = |seed: &str, name: &str| {
-        let (j, c) = (dir.join(format!("{name}.json")), dir.join(format!("{name}.csv")));
+        let (j, c) = (
+            dir.join(format!("{name}.json")),
+            dir.join(format!("{name}.csv")),
+        );
         let o = run(&[
-            "animate", s(&geese), "--birds", "120", "--seconds", "3", "--seed", seed, "-q",
-            "-o", s(&j), "-o", s(&c),
+            "animate",
+            s(&geese),
+            "--birds",
+            "120",
+            "--seconds",
+            "3",
+            "--seed",
+            seed,
+            "-q",
+            "-o",
+            s(&j),
+            "-o",
+            s(&c),
         ]);
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
         (std::fs::read(j).unwrap(), std::fs::read(c).unwrap())
@@ -185,8 +212,20 @@ fn a_steady_flock_file_takes_off_formation_by_formation() {
     let dir = scratch("skeins-initiate");
     let (p, st, init) = (dir.join("p.json"), dir.join("s.json"), dir.join("i.json"));
     let geese = example("barnacle_geese_v.json");
-    assert!(run(&["extract", s(&geese), "-q", "-o", s(&p)]).status.success());
-    let o = run(&["steady", s(&p), "--birds", "60", "--frames", "60", "-q", "-o", s(&st)]);
+    assert!(run(&["extract", s(&geese), "-q", "-o", s(&p)])
+        .status
+        .success());
+    let o = run(&[
+        "steady",
+        s(&p),
+        "--birds",
+        "60",
+        "--frames",
+        "60",
+        "-q",
+        "-o",
+        s(&st),
+    ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let o = run(&["initiate", s(&st), "-q", "-o", s(&init)]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
@@ -197,9 +236,21 @@ fn a_steady_flock_file_takes_off_formation_by_formation() {
     let chart = dir.join("k.png");
     for cmd in ["power", "xi", "paths"] {
         let o = run(&["plot", cmd, s(&init), "--formation", "6", "-o", s(&chart)]);
-        assert!(o.status.success(), "{cmd}: {}", String::from_utf8_lossy(&o.stderr));
+        assert!(
+            o.status.success(),
+            "{cmd}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
     }
-    let o = run(&["plot", "power", s(&init), "--formation", "7", "-o", s(&chart)]);
+    let o = run(&[
+        "plot",
+        "power",
+        s(&init),
+        "--formation",
+        "7",
+        "-o",
+        s(&chart),
+    ]);
     assert_usage_error(&o, &["--formation", "7", "7 formation(s)"]);
 }
 
@@ -210,8 +261,14 @@ fn bad_formation_flags_are_one_line_errors() {
     let out = dir.join("never.json");
     let cases: [(&[&str], &[&str]); 6] = [
         (&["--formations", "0"], &["--formations", "at least 1"]),
-        (&["--formations", "101"], &["--formations", "101", "at most 50"]),
-        (&["--formations", "51"], &["--formations", "at least 2 birds"]),
+        (
+            &["--formations", "101"],
+            &["--formations", "101", "at most 50"],
+        ),
+        (
+            &["--formations", "51"],
+            &["--formations", "at least 2 birds"],
+        ),
         (&["--formation-size", "1"], &["--formation-size", "1"]),
         (
             &["--formations", "3", "--formation-size", "10"],
@@ -227,8 +284,20 @@ fn bad_formation_flags_are_one_line_errors() {
     }
     // Consistent flags are accepted.
     let o = run(&[
-        "animate", s(&geese), "--birds", "100", "--formations", "10", "--formation-size", "10",
-        "--no-initiation", "--seconds", "1", "-q", "-o", s(&out),
+        "animate",
+        s(&geese),
+        "--birds",
+        "100",
+        "--formations",
+        "10",
+        "--formation-size",
+        "10",
+        "--no-initiation",
+        "--seconds",
+        "1",
+        "-q",
+        "-o",
+        s(&out),
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }
@@ -250,7 +319,11 @@ fn the_follow_camera_frames_the_whole_sky_of_formations() {
     let film = Film::with_options(&a, 25.0, &opts);
     assert!(film.len() > 50);
     for (k, (v, st)) in film.views.iter().zip(&film.states).enumerate() {
-        assert!(v.scale() >= 3.0 - 1e-9, "frame {k}: {} px per wingspan", v.scale());
+        assert!(
+            v.scale() >= 3.0 - 1e-9,
+            "frame {k}: {} px per wingspan",
+            v.scale()
+        );
         for b in st {
             let (x, y) = v.to_pixel(b.x, b.y, 1280, 720);
             assert!(

@@ -155,7 +155,11 @@ pub const FLAGS: &[(&str, &str, &[Cmd])] = &[
     ("render.gif_tolerance", "--gif-tolerance", PICTURES),
     // Chart selections (`plot::power::PowerOf`, `plot::shape::ShapeChart::from_params`).
     ("plot.key", "--key", &[PlotPower]),
-    ("plot.formation", "--formation", &[PlotPower, PlotXi, PlotPaths]),
+    (
+        "plot.formation",
+        "--formation",
+        &[PlotPower, PlotXi, PlotPaths],
+    ),
     ("plot.frame", "--frame", &[PlotPower, PlotShape]),
 ];
 

@@ -9,10 +9,10 @@ use formation::extract::params::FormationParams;
 use formation::io::{write_json_atomic, OutputKind};
 use formation::keyshape::SteadyOptions;
 use formation::pipeline::{flock_steady_stage, Config, SteadyOutcome};
-use formation::skein::SkeinOptions;
 use formation::plot::power::{PowerChart, PowerMetric, PowerOf};
 use formation::plot::xi::XiChart;
 use formation::shape::Shape;
+use formation::skein::SkeinOptions;
 use formation::{Error, Result};
 
 use super::progress::TermProgress;

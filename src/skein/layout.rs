@@ -129,10 +129,11 @@ impl Envelope {
             for &v in &f.x {
                 x = [x[0].min(v), x[1].max(v)];
             }
-            let (lo, hi) = f
-                .y
-                .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
+            let (lo, hi) =
+                f.y.iter()
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+                        (a.min(v), b.max(v))
+                    });
             rear.push(lo);
             front.push(hi);
         }
@@ -187,7 +188,10 @@ pub fn arrange(
     let d_med = median(env.iter().map(Envelope::depth).collect());
     let pitch_x = w_med + clearance + spread * w_med;
     let pitch_y = d_med + clearance + 0.5 * spread * w_med;
-    let lanes = ((ASPECT * k as f64 * pitch_y / pitch_x.max(1e-9)).sqrt().round() as usize).clamp(1, k.max(1));
+    let lanes = ((ASPECT * k as f64 * pitch_y / pitch_x.max(1e-9))
+        .sqrt()
+        .round() as usize)
+        .clamp(1, k.max(1));
     // A random order, dealt into lanes.
     let mut order: Vec<usize> = (0..k).collect();
     for i in (1..k).rev() {
@@ -276,8 +280,12 @@ mod tests {
                 let t = j as f64 / 10.0;
                 Frame {
                     t,
-                    x: (0..n).map(|i| i as f64 + wobble * (t + i as f64).sin()).collect(),
-                    y: (0..n).map(|i| 10.0 * t - 0.5 * i as f64 + wobble * (2.0 * t).cos()).collect(),
+                    x: (0..n)
+                        .map(|i| i as f64 + wobble * (t + i as f64).sin())
+                        .collect(),
+                    y: (0..n)
+                        .map(|i| 10.0 * t - 0.5 * i as f64 + wobble * (2.0 * t).cos())
+                        .collect(),
                     z: vec![0.0; n],
                     heading: vec![0.0; n],
                     speed: vec![10.0; n],
@@ -291,7 +299,9 @@ mod tests {
     #[test]
     fn arranged_formations_keep_the_clearance_in_every_frame() {
         for seed in 0..20 {
-            let anims: Vec<Animation> = (0..13).map(|k| moving(3 + k % 5, 0.5 + k as f64 * 0.3)).collect();
+            let anims: Vec<Animation> = (0..13)
+                .map(|k| moving(3 + k % 5, 0.5 + k as f64 * 0.3))
+                .collect();
             let env: Vec<Envelope> = anims.iter().map(Envelope::of).collect();
             let mut rng = crate::rng::seeded(seed);
             let first: Vec<f64> = (0..env.len()).map(|k| (k % 3) as f64).collect();

@@ -31,7 +31,7 @@ pub mod sizes;
 use glam::{DVec2, DVec3};
 use serde::{Deserialize, Serialize};
 
-use crate::animation::{Animation, Frame, FormationRecord, Stage};
+use crate::animation::{Animation, FormationRecord, Frame, Stage};
 use crate::error::{Error, Result};
 use crate::extract::params::FormationParams;
 use crate::initiate::{self, InitiateOptions, InitiateStats, InitiationRun};
@@ -152,7 +152,10 @@ impl SkeinOptions {
         if !(self.max_speed_diff.is_finite() && (0.0..=0.2).contains(&self.max_speed_diff)) {
             return p(
                 "skein.max_speed_diff",
-                format!("{}: must be in [0, 0.2] of the cruise speed", self.max_speed_diff),
+                format!(
+                    "{}: must be in [0, 0.2] of the cruise speed",
+                    self.max_speed_diff
+                ),
             );
         }
         Ok(())
@@ -389,7 +392,8 @@ fn takeoff_run(
 ) -> Result<InitiationRun> {
     let n = steady.birds;
     let name = format!("formation {f}");
-    initiate::check_steady(steady, std::path::Path::new(&name)).map_err(|e| in_formation(e, f, n))?;
+    initiate::check_steady(steady, std::path::Path::new(&name))
+        .map_err(|e| in_formation(e, f, n))?;
     let (target, cruise) = initiate::steady_target(steady).map_err(|e| in_formation(e, f, n))?;
     let run = initiate::simulate(
         &target,
@@ -432,7 +436,7 @@ fn delayed(mut run: InitiationRun, wait: usize) -> InitiationRun {
         .collect();
     fn front<T: Clone>(v: &mut Vec<Vec<T>>, wait: usize) {
         let first = v[0].clone();
-        v.splice(0..0, std::iter::repeat_n(first, wait));
+        v.splice(0..0, std::iter::repeat(first).take(wait));
     }
     run.pos.splice(0..0, before);
     front(&mut run.z, wait);
@@ -447,7 +451,12 @@ fn delayed(mut run: InitiationRun, wait: usize) -> InitiationRun {
 /// along it the middle of the start (take-off) or the front-most bird (steady flight, whose
 /// leader starts at the origin for one formation).
 fn centre_of(env: &[Envelope], p: &[Placement], takeoff: bool) -> [f64; 2] {
-    let (mut x0, mut x1, mut y0, mut y1) = (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY);
+    let (mut x0, mut x1, mut y0, mut y1) = (
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    );
     for (e, p) in env.iter().zip(p) {
         x0 = x0.min(e.x[0] + p.offset[0]);
         x1 = x1.max(e.x[1] + p.offset[0]);
@@ -545,8 +554,20 @@ pub fn min_separation(anim: &Animation) -> f64 {
             .iter()
             .map(|fm| {
                 fm.birds.iter().fold(
-                    [f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY],
-                    |b, &i| [b[0].min(f.x[i]), b[1].min(f.y[i]), b[2].max(f.x[i]), b[3].max(f.y[i])],
+                    [
+                        f64::INFINITY,
+                        f64::INFINITY,
+                        f64::NEG_INFINITY,
+                        f64::NEG_INFINITY,
+                    ],
+                    |b, &i| {
+                        [
+                            b[0].min(f.x[i]),
+                            b[1].min(f.y[i]),
+                            b[2].max(f.x[i]),
+                            b[3].max(f.y[i]),
+                        ]
+                    },
                 )
             })
             .collect();
@@ -557,8 +578,12 @@ pub fn min_separation(anim: &Animation) -> f64 {
                 if boxes[b][0] - boxes[a][2] >= best {
                     break;
                 }
-                let gx = (boxes[a][0] - boxes[b][2]).max(boxes[b][0] - boxes[a][2]).max(0.0);
-                let gy = (boxes[a][1] - boxes[b][3]).max(boxes[b][1] - boxes[a][3]).max(0.0);
+                let gx = (boxes[a][0] - boxes[b][2])
+                    .max(boxes[b][0] - boxes[a][2])
+                    .max(0.0);
+                let gy = (boxes[a][1] - boxes[b][3])
+                    .max(boxes[b][1] - boxes[a][3])
+                    .max(0.0);
                 if gx.hypot(gy) >= best {
                     continue;
                 }
@@ -680,22 +705,60 @@ mod tests {
     #[test]
     fn option_errors_name_the_option() {
         let bad = [
-            (SkeinOptions { formations: Some(0), ..SkeinOptions::default() }, "skein.formations: "),
-            (SkeinOptions { formations: Some(6), ..SkeinOptions::default() }, "skein.formations: "),
-            (SkeinOptions { formation_size: Some(1), ..SkeinOptions::default() }, "skein.formation_size: "),
             (
-                SkeinOptions { formations: Some(3), formation_size: Some(5), ..SkeinOptions::default() },
+                SkeinOptions {
+                    formations: Some(0),
+                    ..SkeinOptions::default()
+                },
+                "skein.formations: ",
+            ),
+            (
+                SkeinOptions {
+                    formations: Some(6),
+                    ..SkeinOptions::default()
+                },
+                "skein.formations: ",
+            ),
+            (
+                SkeinOptions {
+                    formation_size: Some(1),
+                    ..SkeinOptions::default()
+                },
+                "skein.formation_size: ",
+            ),
+            (
+                SkeinOptions {
+                    formations: Some(3),
+                    formation_size: Some(5),
+                    ..SkeinOptions::default()
+                },
                 "skein.formations/skein.formation_size: ",
             ),
-            (SkeinOptions { clearance: f64::NAN, ..SkeinOptions::default() }, "skein.clearance: "),
-            (SkeinOptions { spread: -1.0, ..SkeinOptions::default() }, "skein.spread: "),
+            (
+                SkeinOptions {
+                    clearance: f64::NAN,
+                    ..SkeinOptions::default()
+                },
+                "skein.clearance: ",
+            ),
+            (
+                SkeinOptions {
+                    spread: -1.0,
+                    ..SkeinOptions::default()
+                },
+                "skein.spread: ",
+            ),
         ];
         for (o, want) in bad {
             let e = o.validate(10).unwrap_err().to_string();
             assert!(e.starts_with(want), "{e}");
             assert_eq!(e.lines().count(), 1);
         }
-        let ok = SkeinOptions { formations: Some(1), formation_size: Some(10), ..SkeinOptions::default() };
+        let ok = SkeinOptions {
+            formations: Some(1),
+            formation_size: Some(10),
+            ..SkeinOptions::default()
+        };
         assert!(ok.validate(10).is_ok());
         assert_eq!(SkeinOptions::default().sizes(14, 9, 0).unwrap(), vec![14]);
         assert_eq!(SkeinOptions::default().sizes(19, 9, 0).unwrap().len(), 2);

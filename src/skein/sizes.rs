@@ -59,7 +59,10 @@ pub fn formation_sizes(n: usize, k: usize, rng: &mut impl Rng) -> Result<Vec<usi
     if 2 * k > n {
         return Err(Error::parameter(
             "skein.formations",
-            format!("{k} formations of {n} birds: a formation needs at least 2 birds, so at most {}", n / 2),
+            format!(
+                "{k} formations of {n} birds: a formation needs at least 2 birds, so at most {}",
+                n / 2
+            ),
         ));
     }
     let (lo, hi) = size_bounds(n, k);
@@ -125,7 +128,14 @@ mod tests {
     #[test]
     fn sizes_sum_to_the_flock_and_stay_in_bounds_for_many_seeds() {
         for seed in 0..50 {
-            for &(n, k) in &[(1000, 111), (19, 2), (200, 22), (10, 5), (7, 3), (10_000, 1111)] {
+            for &(n, k) in &[
+                (1000, 111),
+                (19, 2),
+                (200, 22),
+                (10, 5),
+                (7, 3),
+                (10_000, 1111),
+            ] {
                 let mut rng = crate::rng::seeded(seed);
                 let s = formation_sizes(n, k, &mut rng).unwrap();
                 let (lo, hi) = size_bounds(n, k);
