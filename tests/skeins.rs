@@ -337,3 +337,23 @@ fn the_follow_camera_frames_the_whole_sky_of_formations() {
     let film = Film::with_options(&one, 25.0, &opts);
     assert!(film.views.iter().all(|v| v.scale() >= 12.0 - 1e-9));
 }
+
+#[test]
+fn a_formation_whose_take_off_falls_short_flies_it_again() {
+    // Seed 4: formation 99's first take-off leaves 2 of its 13 birds short of their slots.
+    let c = config(1000, 4, 2.0);
+    let (a, report) = Pipeline::from_path(example("barnacle_geese_v.json"))
+        .run(&c)
+        .unwrap();
+    assert!(report.initiate.unwrap().converged);
+    let sk = report.skein.unwrap();
+    let retried: Vec<usize> = (0..sk.formations.len())
+        .filter(|&f| sk.formations[f].takeoff_tries > 1)
+        .collect();
+    assert!(!retried.is_empty());
+    assert!(sk
+        .formations
+        .iter()
+        .all(|f| (1..=formation::skein::TAKEOFF_TRIES).contains(&f.takeoff_tries)));
+    assert!(min_separation(&a) >= 5.0);
+}

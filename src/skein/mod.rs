@@ -196,6 +196,8 @@ pub struct FormationReport {
     pub frame_rotation: Option<usize>,
     /// Time it waited on the ground before its take-off, seconds (0 without take-off).
     pub takeoff_delay_s: f64,
+    /// Take-offs flown until one converged (0 without take-off; see [`TAKEOFF_TRIES`]).
+    pub takeoff_tries: usize,
     /// Algorithm 1's report of its steady flight (`None`: from a steady-flight file).
     pub steady: Option<SteadyReport>,
     /// Its take-off's statistics (`None` without take-off).
@@ -228,13 +230,14 @@ pub fn fly(
     let k = sizes.len();
     progress.start("formations: steady flight", k as u64);
     let steadies = par_map(k, |f| {
-        let r = steady_of(params, sizes[f], f, o);
+        let r = steady_of(params, sizes[f], f, 0, o);
         progress.advance(1);
         r
     })?;
     progress.finish();
     let (anims, reports): (Vec<Animation>, Vec<FormationReport>) = steadies.into_iter().unzip();
-    finish(anims, reports, o, progress)
+    let redo = |f: usize, t: usize| steady_of(params, sizes[f], f, t, o);
+    finish(anims, reports, o, Some(&redo), progress)
 }
 
 /// §6 take-off of a flock of several formations whose steady flight is `steady` (a file written
@@ -258,19 +261,25 @@ pub fn initiate_flock(
             drift: None,
             frame_rotation: None,
             takeoff_delay_s: 0.0,
+            takeoff_tries: 0,
             steady: None,
             initiate: None,
         });
     }
-    finish(anims, reports, o, progress)
+    finish(anims, reports, o, None, progress)
 }
 
+/// Formation `f`'s steady flight drawn afresh for try `t` of its take-off.
+type Redo<'a> = &'a (dyn Fn(usize, usize) -> Result<(Animation, FormationReport)> + Sync);
+
 /// The take-off (when asked) of every formation of `anims` (steady flights in their own
-/// coordinates), then the arrangement and the joined animation.
+/// coordinates), then the arrangement and the joined animation. `redo` draws a formation's
+/// steady flight afresh when its take-off does not converge (see [`takeoff_run`]).
 fn finish(
     mut anims: Vec<Animation>,
     mut reports: Vec<FormationReport>,
     o: &FlockOptions,
+    redo: Option<Redo>,
     progress: &dyn Progress,
 ) -> Result<(Animation, SkeinReport)> {
     let k = anims.len();
@@ -284,13 +293,18 @@ fn finish(
         }
         progress.start("formations: take-off", k as u64);
         let runs = par_map(k, |f| {
-            let r = takeoff_run(&anims[f], init, o.seed, f);
+            let r = takeoff_run(&anims[f], init, o.seed, f, redo);
             progress.advance(1);
             r
         })?;
         progress.finish();
-        let frames = runs.iter().map(|r| r.pos.len()).max().unwrap_or(1);
-        for (f, run) in runs.into_iter().enumerate() {
+        let frames = runs.iter().map(|(r, _, _)| r.pos.len()).max().unwrap_or(1);
+        for (f, (run, tries, fresh)) in runs.into_iter().enumerate() {
+            if let Some((a, r)) = fresh {
+                anims[f] = a;
+                reports[f] = r;
+            }
+            reports[f].takeoff_tries = tries;
             let wait = frames - run.pos.len();
             reports[f].takeoff_delay_s = wait as f64 / anims[f].fps;
             let run = delayed(run, wait);
@@ -339,15 +353,26 @@ fn finish(
 }
 
 /// Formation `f`'s steady flight (local coordinates: its leader starts at the origin) with its
-/// drift applied, and the start of its report.
+/// drift applied, and the start of its report; try `t` > 0 draws it from fresh streams.
 fn steady_of(
     params: &FormationParams,
     n: usize,
     f: usize,
+    t: usize,
     o: &FlockOptions,
 ) -> Result<(Animation, FormationReport)> {
     use rand::Rng;
-    let mut own = formation_stream(o.seed, Stream::Skein, f);
+    let (mut own, mut steady_rng) = if t == 0 {
+        (
+            formation_stream(o.seed, Stream::Skein, f),
+            formation_stream(o.seed, Stream::Steady, f),
+        )
+    } else {
+        (
+            stream(o.seed, format!("skein/formation/{f}/try/{t}").as_str()),
+            stream(o.seed, format!("steady/formation/{f}/try/{t}").as_str()),
+        )
+    };
     let rotation = own.random_range(0..params.frames.len().max(1));
     let mut p = params.clone();
     p.frames.rotate_left(rotation);
@@ -355,13 +380,8 @@ fn steady_of(
         birds: n,
         ..o.steady.clone()
     };
-    let (mut anim, steady) = steady_flight_report(
-        &p,
-        &opts,
-        &mut formation_stream(o.seed, Stream::Steady, f),
-        &Silent,
-    )
-    .map_err(|e| in_formation(e, f, n))?;
+    let (mut anim, steady) = steady_flight_report(&p, &opts, &mut steady_rng, &Silent)
+        .map_err(|e| in_formation(e, f, n))?;
     let drift = Drift::draw(
         opts.speed,
         o.skein.max_heading_deg,
@@ -376,44 +396,68 @@ fn steady_of(
             drift: Some(drift),
             frame_rotation: Some(rotation),
             takeoff_delay_s: 0.0,
+            takeoff_tries: 0,
             steady: Some(steady),
             initiate: None,
         },
     ))
 }
 
+/// Take-offs a formation may fly before the flock's run fails: one from its own stream, then
+/// from fresh random starts.
+pub const TAKEOFF_TRIES: usize = 4;
+
 /// Formation `f`'s take-off into the first key shape of its steady flight `steady` (not yet
-/// handed over), from its own start drawn around the origin.
+/// handed over), from its own start drawn around the origin; the number of tries it took, and
+/// the formation's new steady flight if it was drawn afresh. A take-off that does not converge
+/// within the time limit is flown again, up to [`TAKEOFF_TRIES`] in all, from a fresh random start
+/// (stream `initiate/formation/f/try/t`) into a fresh steady flight (`redo`, when the flock was
+/// made from formation parameters; its first key shape is what the take-off failed to reach):
+/// now and then the §6 rules leave a bird or two of a formation short of their slots (issue 18),
+/// and a flock of a hundred formations should not fail for one of them.
+#[allow(clippy::type_complexity)]
 fn takeoff_run(
     steady: &Animation,
     opts: &InitiateOptions,
     seed: u64,
     f: usize,
-) -> Result<InitiationRun> {
+    redo: Option<Redo>,
+) -> Result<(InitiationRun, usize, Option<(Animation, FormationReport)>)> {
     let n = steady.birds;
-    let name = format!("formation {f}");
-    initiate::check_steady(steady, std::path::Path::new(&name))
-        .map_err(|e| in_formation(e, f, n))?;
-    let (target, cruise) = initiate::steady_target(steady).map_err(|e| in_formation(e, f, n))?;
-    let run = initiate::simulate(
-        &target,
-        steady.fps,
-        &cruise,
-        opts,
-        &mut formation_stream(seed, Stream::Initiate, f),
-        &Silent,
-    )
-    .map_err(|e| in_formation(e, f, n))?;
-    if !run.stats.converged {
-        return Err(Error::NotConverged(format!(
-            "formation {f} ({n} birds) did not converge into its key shape within {:.0} s of flight ({} of {n} birds within {} wingspans of their slots, last lift-off at {:.1} s); the time limit is the smaller of initiate.max_time and initiate.max_steps / fps",
-            opts.time_limit(steady.fps),
-            run.stats.birds_in_slot,
-            opts.tolerance,
-            run.stats.last_liftoff
-        )));
+    let mut last = None;
+    let mut fresh: Option<(Animation, FormationReport)> = None;
+    for t in 0..TAKEOFF_TRIES {
+        if t > 0 {
+            if let Some(redo) = redo {
+                fresh = Some(redo(f, t)?);
+            }
+        }
+        let steady = fresh.as_ref().map_or(steady, |(a, _)| a);
+        let name = format!("formation {f}");
+        initiate::check_steady(steady, std::path::Path::new(&name))
+            .map_err(|e| in_formation(e, f, n))?;
+        let (target, cruise) =
+            initiate::steady_target(steady).map_err(|e| in_formation(e, f, n))?;
+        let mut rng = if t == 0 {
+            formation_stream(seed, Stream::Initiate, f)
+        } else {
+            stream(seed, format!("initiate/formation/{f}/try/{t}").as_str())
+        };
+        let run = initiate::simulate(&target, steady.fps, &cruise, opts, &mut rng, &Silent)
+            .map_err(|e| in_formation(e, f, n))?;
+        if run.stats.converged {
+            return Ok((run, t + 1, fresh));
+        }
+        last = Some(run.stats);
     }
-    Ok(run)
+    let stats = last.expect("at least one try");
+    Err(Error::NotConverged(format!(
+        "formation {f} ({n} birds) did not converge into its key shape in {TAKEOFF_TRIES} take-offs of up to {:.0} s of flight (last: {} of {n} birds within {} wingspans of their slots, last lift-off at {:.1} s); the time limit is the smaller of initiate.max_time and initiate.max_steps / fps",
+        opts.time_limit(steady.fps),
+        stats.birds_in_slot,
+        opts.tolerance,
+        stats.last_liftoff
+    )))
 }
 
 /// `run` with `wait` frames in front: before its start every bird kept its start state, at rest
