@@ -101,6 +101,7 @@ fn commands() -> Vec<Command> {
     ];
     let initiate: Vec<(&str, &str, Option<String>)> = vec![
         ("--max-steps", "0", None),
+        ("--max-seconds", "-1", None),
         ("--perception", "psychic", None),
         ("--hpr-gamma", "9", None),
         ("--fov", "500", None),

@@ -54,10 +54,8 @@ fn check_rate(n: usize, seeds: u64, min_ok: u64) {
     let opts = InitiateOptions::default();
     let (ok, mind, turn, steps) = convergence(n, seeds, &opts);
     assert!(ok >= min_ok, "{n} birds: {ok}/{seeds} converged");
-    // Ground take-off (issue 18): 9 and 14 birds stay ≥ 0.6 wingspans apart over 10 seeds (the
-    // test in tests/takeoff.rs asserts 0.3); 41 birds came 0.15 close in 1 of 10 seeds (mid-air
-    // crossings at the cruise altitude), short of the issue's 0.3: recorded in docs/initiation.md.
-    let floor = if n >= 41 { 0.1 } else { 0.3 };
+    // Issue 18: closest approach at least 0.3 wingspans (3-D).
+    let floor = 0.3;
     assert!(
         mind >= floor,
         "{n} birds: two birds came {mind:.3} wingspans close"

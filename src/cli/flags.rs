@@ -89,6 +89,7 @@ pub const FLAGS: &[(&str, &str, &[Cmd])] = &[
     ("skein.formation_size", "--formation-size", STEADY),
     ("skein.clearance", "--clearance", STEADY),
     ("initiate.max_steps", "--max-steps", INITIATE),
+    ("initiate.max_time", "--max-seconds", INITIATE),
     ("initiate.perception.mode", "--perception", INITIATE),
     (
         "initiate.perception.mode.hpr.gamma",

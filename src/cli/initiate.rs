@@ -7,11 +7,12 @@ use clap::{Args, ValueEnum};
 use formation::animation::Animation;
 use formation::initiate::{
     self, GroundStart, InitiateOptions, PerceptionMode, Start, StartRegion, StartState,
-    HPR_GAMMA_DEFAULT,
+    TakeoffPlan, HPR_GAMMA_DEFAULT,
 };
 use formation::io::OutputKind;
 use formation::{Error, Result};
 
+use super::flags::Cmd;
 use super::progress::TermProgress;
 use super::Global;
 
@@ -44,69 +45,95 @@ pub struct InitiateArgs {
     pub json: bool,
 }
 
-/// Initiation flags shared by `initiate` and `animate`.
+/// The library's defaults, for the flags' `default_value_t`.
+fn d() -> InitiateOptions {
+    InitiateOptions::default()
+}
+
+/// An angle of the library's defaults (radians) as the degrees a flag shows.
+fn deg(rad: f64) -> f64 {
+    initiate::display_degrees(rad)
+}
+
+/// The radians of a flag given in degrees: the library's own value when the flag shows its
+/// default, so that the default options are exactly the library's.
+fn rad(degrees: f64, default: f64) -> f64 {
+    if degrees == deg(default) {
+        default
+    } else {
+        degrees.to_radians()
+    }
+}
+
+/// Initiation flags shared by `initiate` and `animate`; every default is the library's
+/// ([`InitiateOptions::default`]), every check the library's ([`InitiateOptions::validate`]).
 #[derive(Debug, Clone, Args)]
 pub struct InitiateFlags {
-    /// Frame limit of the take-off at the output --fps (the time limit is also at most 300 s of
-    /// flight); no convergence within it fails with exit 1.
-    #[arg(long, default_value_t = InitiateOptions::default().max_steps)]
+    /// Frame limit of the take-off at the animation's frame rate; no convergence within it (or
+    /// within --max-seconds) fails with exit 1.
+    #[arg(long, default_value_t = d().max_steps)]
     pub max_steps: usize,
-    /// Take-off duration, seconds: a longer take-off than the flock's natural one stretches the
-    /// departures; a shorter one is not possible yet (warned) [default: the natural one, about
-    /// 7 + 1.1 × birds seconds: 17 s for 9 birds, 22 s for 14, 52 s for 41; `--json` reports it].
+    /// Time limit of the take-off, seconds of flight; no convergence within it (or within
+    /// --max-steps frames) fails with exit 1.
+    #[arg(long, allow_negative_numbers = true, default_value_t = d().max_time)]
+    pub max_seconds: f64,
+    /// Take-off duration, seconds: the birds start closer or farther apart and drive harder or
+    /// softer to form in about this time (a range of about 0.7 to 2 times the flock's natural
+    /// one is reachable; outside it a warning) [default: the natural one, which grows with the
+    /// flock size; `--json` reports it as planned_seconds].
     #[arg(long, allow_negative_numbers = true)]
     pub takeoff: Option<f64>,
     /// Cruise altitude of the steady flight above the ground (`z`), wingspans.
-    #[arg(long, allow_negative_numbers = true, default_value_t = InitiateOptions::default().cruise_altitude)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = d().cruise_altitude)]
     pub cruise_altitude: f64,
-    /// Largest climb rate after lift-off, wingspans per second.
-    #[arg(long, allow_negative_numbers = true, default_value_t = InitiateOptions::default().climb_rate)]
+    /// Largest climb rate after lift-off, wingspans per second (scaled by the take-off's drive).
+    #[arg(long, allow_negative_numbers = true, default_value_t = d().climb_rate)]
     pub climb_rate: f64,
     /// Occlusion model.
-    #[arg(long, value_enum, default_value_t = PerceptionArg::Hpr)]
+    #[arg(long, value_enum, default_value_t = PerceptionArg::of(&d().perception.mode))]
     pub perception: PerceptionArg,
     /// HPR radius exponent γ: R = (distance of the farthest bird) · 10^γ.
     #[arg(long, allow_negative_numbers = true, default_value_t = HPR_GAMMA_DEFAULT)]
     pub hpr_gamma: f64,
     /// Visual field per eye, degrees from straight ahead (paper: 90); widened when the key shape
     /// needs it for a bird to see its reference from its slot (docs/initiation.md).
-    #[arg(long, allow_negative_numbers = true, default_value_t = 90.0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = deg(d().perception.fov_per_eye))]
     pub fov: f64,
     /// Cone per eye in which the closest visible bird is the preferred reference, degrees
-    /// (paper: 0.35π = 63).
-    #[arg(long, allow_negative_numbers = true, default_value_t = 63.0)]
+    /// (paper: 0.35π).
+    #[arg(long, allow_negative_numbers = true, default_value_t = deg(d().perception.reference_cone))]
     pub reference_cone: f64,
     /// α of eq. (6) (heading gain).
-    #[arg(long, allow_negative_numbers = true, default_value_t = 0.2)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = d().alpha)]
     pub alpha: f64,
     /// |K| of eq. (5) (speed gain).
-    #[arg(long, allow_negative_numbers = true, default_value_t = 0.06)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = d().k)]
     pub k: f64,
     /// Maximum turn rate, degrees per second.
-    #[arg(long, allow_negative_numbers = true, default_value_t = 90.0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = deg(d().max_turn_rate))]
     pub max_turn_rate: f64,
-    /// Maximum acceleration, wingspans per second squared [default: 4].
-    #[arg(long, allow_negative_numbers = true)]
-    pub max_accel: Option<f64>,
-    /// Minimum flight speed, fraction of the cruise speed [default: 0.5].
-    #[arg(long, allow_negative_numbers = true)]
-    pub min_speed: Option<f64>,
-    /// Maximum flight speed, fraction of the cruise speed [default: 1.6].
-    #[arg(long, allow_negative_numbers = true)]
-    pub max_speed: Option<f64>,
-    /// Separation drive distance, wingspans [default: 10, as in the paper].
-    #[arg(long, allow_negative_numbers = true)]
-    pub separation: Option<f64>,
-    /// Collision avoidance: predicted closest approach that triggers evasion, wingspans
-    /// [default: 0.8].
-    #[arg(long, allow_negative_numbers = true)]
-    pub avoid_distance: Option<f64>,
-    /// Convergence: every bird within this distance of its slot, wingspans [default: 0.1].
-    #[arg(long, allow_negative_numbers = true)]
-    pub tolerance: Option<f64>,
-    /// Convergence: for this long, seconds (also the hand-over blend window) [default: 1].
-    #[arg(long, allow_negative_numbers = true)]
-    pub hold: Option<f64>,
+    /// Maximum acceleration, wingspans per second squared.
+    #[arg(long, allow_negative_numbers = true, default_value_t = d().max_accel)]
+    pub max_accel: f64,
+    /// Minimum flight speed, fraction of the cruise speed.
+    #[arg(long, allow_negative_numbers = true, default_value_t = d().min_speed)]
+    pub min_speed: f64,
+    /// Maximum flight speed, fraction of the cruise speed.
+    #[arg(long, allow_negative_numbers = true, default_value_t = d().max_speed)]
+    pub max_speed: f64,
+    /// Separation drive distance, wingspans (paper: 10).
+    #[arg(long, allow_negative_numbers = true, default_value_t = d().separation_distance)]
+    pub separation: f64,
+    /// Collision avoidance: predicted closest approach that triggers evasion, wingspans (birds
+    /// settling into neighbouring slots keep half their slots' distance instead).
+    #[arg(long, allow_negative_numbers = true, default_value_t = d().avoid_distance)]
+    pub avoid_distance: f64,
+    /// Convergence: every bird within this distance of its slot, wingspans.
+    #[arg(long, allow_negative_numbers = true, default_value_t = d().tolerance)]
+    pub tolerance: f64,
+    /// Convergence: for this long, seconds (also the hand-over blend window).
+    #[arg(long, allow_negative_numbers = true, default_value_t = d().hold)]
+    pub hold: f64,
     /// Start: `ground` (at rest in a take-off area, leaving one after another, climbing to the
     /// cruise altitude), `air` (the paper's: scattered in the air at the cruise altitude), or a
     /// start file: JSON {"x": [...], "y": [...], "heading": [...], "speed": [...]} (world frame,
@@ -114,90 +141,86 @@ pub struct InitiateFlags {
     #[arg(long, default_value = "ground")]
     pub start: String,
     /// Width of the take-off area (ground) or start region (air) across the cruise heading,
-    /// wingspans [default: ground 4.5√N (with the depth, about 10 square wingspans per bird);
-    /// air 30, or 6√N for large flocks].
+    /// wingspans [default: from the flock size and --takeoff (ground: about 10 square wingspans
+    /// per bird with the depth); air 30, or 6√N for large flocks].
     #[arg(long, allow_negative_numbers = true)]
     pub start_width: Option<f64>,
     /// Depth of the take-off area or start region along the cruise heading, wingspans
-    /// [default: ground 2.2√N; air the width].
+    /// [default: ground half the width; air the width].
     #[arg(long, allow_negative_numbers = true)]
     pub start_depth: Option<f64>,
-    /// Start headings are uniform within this many degrees of the cruise heading [default: 5
-    /// on the ground, 180 (any) in the air].
-    #[arg(long)]
+    /// Start headings are uniform within this many degrees of the cruise heading [default:
+    /// ground 5, air 180 (any)].
+    #[arg(long, allow_negative_numbers = true)]
     pub heading_spread: Option<f64>,
 }
 
+impl PerceptionArg {
+    /// The flag value of a perception mode.
+    fn of(mode: &PerceptionMode) -> PerceptionArg {
+        match mode {
+            PerceptionMode::Hpr { .. } => PerceptionArg::Hpr,
+            PerceptionMode::Exact => PerceptionArg::Exact,
+        }
+    }
+}
+
 impl InitiateFlags {
-    /// The library options these flags describe (validated by the library).
+    /// The library options these flags describe, checked by the library
+    /// ([`InitiateOptions::validate`]; its errors name option paths, which the command line
+    /// turns into these flags). A take-off duration the rules cannot reach is warned about.
     pub fn options(&self, seed: u64, birds: usize) -> Result<InitiateOptions> {
+        let def = InitiateOptions::default();
         let mut o = InitiateOptions {
             seed,
             max_steps: self.max_steps,
+            max_time: self.max_seconds,
+            takeoff: self.takeoff,
+            cruise_altitude: self.cruise_altitude,
+            climb_rate: self.climb_rate,
             alpha: self.alpha,
             k: self.k,
-            max_turn_rate: self.max_turn_rate.to_radians(),
-            ..Default::default()
+            max_turn_rate: rad(self.max_turn_rate, def.max_turn_rate),
+            max_accel: self.max_accel,
+            min_speed: self.min_speed,
+            max_speed: self.max_speed,
+            separation_distance: self.separation,
+            avoid_distance: self.avoid_distance,
+            tolerance: self.tolerance,
+            hold: self.hold,
+            ..def.clone()
         };
-        o.perception.fov_per_eye = self.fov.to_radians();
-        o.perception.reference_cone = self.reference_cone.to_radians();
+        o.perception.fov_per_eye = rad(self.fov, def.perception.fov_per_eye);
+        o.perception.reference_cone = rad(self.reference_cone, def.perception.reference_cone);
         o.perception.mode = match self.perception {
             PerceptionArg::Hpr => PerceptionMode::Hpr {
                 gamma: self.hpr_gamma,
             },
             PerceptionArg::Exact => PerceptionMode::Exact,
         };
-        let set = |field: &mut f64, v: Option<f64>| {
-            if let Some(v) = v {
-                *field = v;
-            }
-        };
-        set(&mut o.max_accel, self.max_accel);
-        set(&mut o.min_speed, self.min_speed);
-        set(&mut o.max_speed, self.max_speed);
-        set(&mut o.separation_distance, self.separation);
-        set(&mut o.avoid_distance, self.avoid_distance);
-        set(&mut o.tolerance, self.tolerance);
-        set(&mut o.hold, self.hold);
-        o.takeoff = self.takeoff;
-        if let Some(t) = self.takeoff {
-            let natural = formation::initiate::TakeoffPlan::natural_seconds(birds);
-            if t.is_finite() && t > 0.0 && t < 0.8 * natural {
-                eprintln!(
-                    "warning: --takeoff {t}: {birds} birds need about {natural:.0} s to form with these rules (docs/initiation.md); the take-off will last about that long"
-                );
-            }
-        }
-        o.cruise_altitude = self.cruise_altitude;
-        o.climb_rate = self.climb_rate;
-        if let Some(h) = self.heading_spread {
-            if !(h.is_finite() && (0.0..=180.0).contains(&h)) {
-                return Err(Error::parameter(
-                    "--heading-spread",
-                    format!("must be in [0, 180] degrees, got {h}"),
-                ));
-            }
-        }
         o.start = match self.start.as_str() {
             "ground" => {
-                let d = GroundStart::default();
+                let g = GroundStart::default();
                 Start::Ground(GroundStart {
                     width: self.start_width,
                     depth: self.start_depth,
                     heading_spread: self
                         .heading_spread
-                        .map_or(d.heading_spread, f64::to_radians),
-                    ..d
+                        .map_or(g.heading_spread, |h| rad(h, g.heading_spread)),
+                    ..g
                 })
             }
-            "air" => Start::Random(StartRegion {
-                width: self.start_width,
-                depth: self.start_depth,
-                heading_spread: self
-                    .heading_spread
-                    .map_or(std::f64::consts::PI, f64::to_radians),
-                ..Default::default()
-            }),
+            "air" => {
+                let r = StartRegion::default();
+                Start::Random(StartRegion {
+                    width: self.start_width,
+                    depth: self.start_depth,
+                    heading_spread: self
+                        .heading_spread
+                        .map_or(r.heading_spread, |h| rad(h, r.heading_spread)),
+                    ..r
+                })
+            }
             path => {
                 for (flag, given) in [
                     ("--start-width", self.start_width.is_some()),
@@ -215,7 +238,10 @@ impl InitiateFlags {
             }
         };
         o.validate()?;
-        formation::initiate::check_size(birds, 0, self.max_steps)?;
+        initiate::check_size(birds, 0, o.max_steps)?;
+        if let Some(w) = TakeoffPlan::warning(birds, &o) {
+            eprintln!("warning: {}", super::flags::rewrite(Cmd::Initiate, &w));
+        }
         Ok(o)
     }
 }

@@ -111,8 +111,9 @@ pub struct InitiateOptions {
     /// Acceleration of the take-off run on the ground, wingspans per second squared.
     pub run_accel: f64,
     /// Wanted take-off duration, seconds (`None`: the natural one of the flock size, see
-    /// [`TakeoffPlan::natural_seconds`]). A longer one stretches the departures; the simulation
-    /// is never cut.
+    /// [`TakeoffPlan::natural_seconds`]). The take-off plan scales the start area, the departure
+    /// stagger and how hard the birds drive (accelerations, climb, approach) to it
+    /// ([`TakeoffPlan::drive`]); the simulation is never cut.
     pub takeoff: Option<f64>,
     /// Separation drive threshold, wingspans (paper: 10).
     pub separation_distance: f64,
@@ -148,6 +149,21 @@ pub struct InitiateOptions {
     /// Speed of the leader while flockmates are still on the ground or running, as a fraction
     /// of the cruise speed (at least the minimum speed).
     pub gather_speed: f64,
+    /// Slots assigned once at the start, in the order of the birds' positions across the cruise
+    /// heading (no sideways crossings; the departures follow the slots' depth), instead of the
+    /// paper's §6.2.1 correspondence through reference birds, re-evaluated at every decision
+    /// (docs/initiation.md).
+    pub assign_slots: bool,
+    /// Final approach: within this distance of its slot a bird steers by the formation-frame
+    /// controller (slot error and the leader's velocity) instead of eqs. (5)–(6); blended out to
+    /// twice it, wingspans.
+    pub approach_distance: f64,
+    /// Final approach: time constant of the sideways slot error, seconds (along the heading
+    /// 0.7 of it).
+    pub approach_time: f64,
+    /// Final approach: deceleration that brakes the closing speed on the slot, wingspans per
+    /// second squared.
+    pub approach_brake: f64,
     /// Convergence: distance of every bird from its slot and from the cruise altitude, wingspans.
     pub tolerance: f64,
     /// Convergence: heading difference from the cruise heading, radians.
@@ -192,8 +208,8 @@ impl Default for InitiateOptions {
             roll_lag: 0.2,
             max_roll_accel: 400f64.to_radians(),
             cruise_altitude: 10.0,
-            climb_rate: 2.0,
-            vertical_accel: 1.5,
+            climb_rate: 2.5,
+            vertical_accel: 2.0,
             run_accel: 3.0,
             takeoff: None,
             separation_distance: 10.0,
@@ -210,6 +226,10 @@ impl Default for InitiateOptions {
             catchup_distance: 1.5,
             gap_speed: true,
             gather_speed: 0.6,
+            assign_slots: true,
+            approach_distance: 5.0,
+            approach_time: 1.2,
+            approach_brake: 2.0,
             tolerance: 0.1,
             heading_tolerance: 2f64.to_radians(),
             speed_tolerance: 0.02,
@@ -281,14 +301,26 @@ pub struct TakeoffPlan {
     pub k: f64,
     /// Catch-up distance of eq. (5) used, wingspans.
     pub catchup_distance: f64,
+    /// How hard the birds drive: the natural duration over the wanted one, within
+    /// [[`TakeoffPlan::MIN_DRIVE`], [`TakeoffPlan::MAX_DRIVE`]]. The run and vertical
+    /// accelerations and the climb rate are multiplied by it, the approach time divided by it;
+    /// the departure stagger is 1 s over it; below 1 the take-off area also grows by 1/drive.
+    pub drive: f64,
 }
 
 impl TakeoffPlan {
-    /// The shortest take-off the rules give `n` birds from the ground, about, seconds: measured
-    /// medians 17 s for 9 birds, 22 s for 14, 53 s for 41 (docs/initiation.md; arms fill one bird
-    /// at a time, so it grows with the flock size).
+    /// The weakest drive: a take-off at most about twice the natural one.
+    pub const MIN_DRIVE: f64 = 0.45;
+    /// The strongest drive: a take-off down to about 0.7 of the natural one (the climb to the
+    /// cruise altitude bounds it).
+    pub const MAX_DRIVE: f64 = 1.6;
+
+    /// The natural take-off of `n` birds from the ground at the default options, seconds:
+    /// measured medians (docs/initiation.md) about 10.5 s for 9–14 birds, 12.5 s for 41, 18.5 s
+    /// for 100, 37 s for 300 (the lift-off and climb to 10 wingspans take about 8 s; the rest
+    /// grows with the width of the V).
     pub fn natural_seconds(n: usize) -> f64 {
-        7.0 + 1.1 * n.max(1) as f64
+        9.5 + 0.09 * n.max(1) as f64
     }
 
     /// The automatic take-off duration of `n` birds, seconds: the natural one.
@@ -296,24 +328,41 @@ impl TakeoffPlan {
         Self::natural_seconds(n)
     }
 
-    /// The plan for `n` birds under `opts` (its `takeoff`, or the automatic duration). A longer
-    /// take-off than the natural one stretches the departures (each second of stagger beyond
-    /// the first adds about 1.3 s, measured); a shorter one cannot be had from these rules and
-    /// gets the natural plan (the CLI warns).
+    /// A warning when the take-off duration of `opts` is outside what the drive can reach for
+    /// `n` birds (about 0.75 to 2 times the natural duration), naming `initiate.takeoff`.
+    pub fn warning(n: usize, opts: &InitiateOptions) -> Option<String> {
+        let t = opts.takeoff?;
+        let natural = Self::natural_seconds(n);
+        let (lo, hi) = (0.75 * natural, 2.0 * natural);
+        if t < lo || t > hi {
+            let near = t.clamp(lo, hi);
+            Some(format!(
+                "initiate.takeoff {t} s: {n} birds form in about {lo:.0} to {hi:.0} s with these rules (docs/initiation.md); the take-off will last about {near:.0} s"
+            ))
+        } else {
+            None
+        }
+    }
+
+    /// The plan for `n` birds under `opts` (its `takeoff`, or the automatic duration): the
+    /// drive is the natural duration over the wanted one (bounded), which scales the departure
+    /// stagger, the accelerations, the climb rate, the approach and (for a longer take-off) the
+    /// take-off area, so that every part of the take-off takes about `seconds / natural` times
+    /// as long. The simulation itself is never cut.
     pub fn new(n: usize, opts: &InitiateOptions) -> TakeoffPlan {
         let natural = Self::natural_seconds(n);
         let seconds = opts.takeoff.unwrap_or(natural);
+        let drive = (natural / seconds).clamp(Self::MIN_DRIVE, Self::MAX_DRIVE);
         let root = (n.max(1) as f64).sqrt();
         let (width, depth, stagger) = match &opts.start {
             Start::Ground(g) => {
                 // About 10 square wingspans per bird (1.6 times what random packing of birds
-                // `min_spacing` = 2 apart needs).
-                let base = (1.6 * g.min_spacing * root).max(4.0 * g.min_spacing);
+                // `min_spacing` = 2 apart needs), more for a slow take-off.
+                let base = (1.6 * g.min_spacing * root).max(4.0 * g.min_spacing) / drive.min(1.0);
                 (
                     g.width.unwrap_or(1.4 * base),
                     g.depth.unwrap_or(0.7 * base),
-                    g.stagger
-                        .unwrap_or(1.0 + (seconds - natural).max(0.0) / 1.3),
+                    g.stagger.unwrap_or(1.0 / drive),
                 )
             }
             Start::Random(r) => {
@@ -323,13 +372,26 @@ impl TakeoffPlan {
             Start::Given(_) => (0.0, 0.0, 0.0),
         };
         TakeoffPlan {
-            seconds: seconds.max(natural),
+            seconds,
             width,
             depth,
             stagger,
             k: opts.k,
             catchup_distance: opts.catchup_distance,
+            drive,
         }
+    }
+}
+
+/// An angle in radians as degrees for a message or a flag's default, rounded to 10⁻⁹° so that
+/// a value given in degrees and converted to radians reads back as given.
+pub fn display_degrees(rad: f64) -> f64 {
+    let d = rad.to_degrees();
+    let r = (d * 1e9).round() / 1e9;
+    if r.is_finite() {
+        r
+    } else {
+        d
     }
 }
 
@@ -569,13 +631,46 @@ impl InitiateOptions {
             ));
         }
         pos("initiate.k", self.k)?;
-        pos("initiate.max_turn_rate", self.max_turn_rate)?;
+        let pos_deg = |name: &str, v: f64, unit: &str| -> Result<()> {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                Err(Error::parameter(
+                    name,
+                    format!(
+                        "must be a positive number of {unit}, got {}",
+                        display_degrees(v)
+                    ),
+                ))
+            }
+        };
+        pos_deg(
+            "initiate.max_turn_rate",
+            self.max_turn_rate,
+            "degrees per second",
+        )?;
         pos("initiate.max_accel", self.max_accel)?;
-        pos("initiate.max_turn_accel", self.max_turn_accel)?;
+        pos_deg(
+            "initiate.max_turn_accel",
+            self.max_turn_accel,
+            "degrees per second squared",
+        )?;
         pos("initiate.max_jerk", self.max_jerk)?;
-        pos("initiate.max_turn_jerk", self.max_turn_jerk)?;
-        pos("initiate.max_roll_rate", self.max_roll_rate)?;
-        pos("initiate.max_roll_accel", self.max_roll_accel)?;
+        pos_deg(
+            "initiate.max_turn_jerk",
+            self.max_turn_jerk,
+            "degrees per second cubed",
+        )?;
+        pos_deg(
+            "initiate.max_roll_rate",
+            self.max_roll_rate,
+            "degrees per second",
+        )?;
+        pos_deg(
+            "initiate.max_roll_accel",
+            self.max_roll_accel,
+            "degrees per second squared",
+        )?;
         pos("initiate.climb_rate", self.climb_rate)?;
         pos("initiate.vertical_accel", self.vertical_accel)?;
         pos("initiate.run_accel", self.run_accel)?;
@@ -666,6 +761,9 @@ impl InitiateOptions {
         pos("initiate.linear_zone", self.linear_zone)?;
         pos("initiate.catchup_distance", self.catchup_distance)?;
         pos("initiate.gather_speed", self.gather_speed)?;
+        pos("initiate.approach_distance", self.approach_distance)?;
+        pos("initiate.approach_time", self.approach_time)?;
+        pos("initiate.approach_brake", self.approach_brake)?;
         let memory = self.reference_memory();
         if !(memory.is_finite() && (0.0..=60.0).contains(&memory)) {
             return Err(Error::parameter(
@@ -733,7 +831,7 @@ impl InitiateOptions {
             if let Some(w) = g.stagger {
                 if !(w.is_finite() && w >= 0.0 && w <= self.max_time) {
                     return Err(Error::parameter(
-                        "initiate.stagger",
+                        "initiate.start.ground.stagger",
                         format!(
                             "must be a number of seconds between 0 and the time limit, got {w}"
                         ),
@@ -743,7 +841,10 @@ impl InitiateOptions {
             if !(g.heading_spread.is_finite() && (0.0..=PI).contains(&g.heading_spread)) {
                 return Err(Error::parameter(
                     "initiate.start.ground.heading_spread",
-                    "must be in [0, 180] degrees",
+                    format!(
+                        "must be in [0, 180] degrees, got {}",
+                        display_degrees(g.heading_spread)
+                    ),
                 ));
             }
             if !(g.min_spacing.is_finite() && g.min_spacing > 0.0) {
@@ -773,7 +874,7 @@ impl InitiateOptions {
                     "initiate.start.random.heading_spread",
                     format!(
                         "must be in [0, 180] degrees, got {}",
-                        r.heading_spread.to_degrees()
+                        display_degrees(r.heading_spread)
                     ),
                 ));
             }
@@ -839,7 +940,24 @@ impl InitiateOptions {
             catchup_distance: catchup,
             gap_speed: self.gap_speed,
             gather_speed: self.gather_speed * vc,
+            assign_slots: self.assign_slots,
+            approach_distance: self.approach_distance,
+            approach_time: self.approach_time,
+            approach_brake: self.approach_brake,
         }
+    }
+
+    /// The simulation's parameters for a cruise under a take-off plan: [`Self::step_params`]
+    /// with the plan's gain and drive (accelerations of the run and the climb, the climb rate
+    /// and the approach scaled by it).
+    pub fn plan_params(&self, cruise: &Cruise, plan: &TakeoffPlan) -> StepParams {
+        let mut p = self.step_params(cruise, plan.k, plan.catchup_distance);
+        p.run_accel *= plan.drive;
+        p.climb_rate *= plan.drive;
+        p.vertical_accel *= plan.drive;
+        p.approach_time /= plan.drive;
+        p.approach_brake *= plan.drive;
+        p
     }
 
     /// The convergence tolerances: the options' distance, heading and speed, and steady flight
@@ -1009,8 +1127,9 @@ pub fn random_start(
 /// A take-off area: positions uniform in the plan's rectangle at least `min_spacing` apart, at
 /// rest (speed 0, z = 0), facing within the spread of the cruise heading, with departure times
 /// front to back over the stagger window (the front-most bird leaves at 0 and leads; a small
-/// random jitter of a tenth of the window mixes neighbours). An area too small for the flock is
-/// an error naming the flags.
+/// random jitter of a tenth of the window mixes neighbours). With assigned slots the simulation
+/// hands these times out again by slot depth ([`Simulation::new`]). An area too small for the
+/// flock is an error naming the option paths.
 pub fn ground_start(
     n: usize,
     g: &GroundStart,
@@ -1090,7 +1209,7 @@ pub fn start_simulation(
     }
     let n = target.len();
     let plan = TakeoffPlan::new(n, opts);
-    let mut params = opts.step_params(cruise, plan.k, plan.catchup_distance);
+    let mut params = opts.plan_params(cruise, &plan);
     if opts.widen_field {
         let field = &mut params.perception.fov_per_eye;
         *field = field.max(target.required_field(FIELD_MARGIN));

@@ -4,6 +4,10 @@
 //! Output frames are samples of this one simulation, so the same seed gives the same take-off at
 //! any output frame rate.
 //!
+//! With assigned slots (the default, [`StepParams::assign_slots`]) every bird has its slot from
+//! the start ([`assign_slots`]) and flies the final approach in the formation frame
+//! (`Simulation::settle`); the paper's correspondence below applies otherwise.
+//!
 //! Each decision: every departed bird perceives the departed flock as it was (Jacobi update), in
 //! the horizontal plane; it chooses its reference bird and side, derives its target position
 //! from the correspondence with the target shape and asks for a turn rate (eq. 6 as a rate,
@@ -126,6 +130,18 @@ pub struct StepParams {
     pub gap_speed: bool,
     /// Speed of the leader while flockmates are still on the ground, wingspans per second.
     pub gather_speed: f64,
+    /// Slots assigned once at the start ([`assign_slots`]) instead of the paper's §6.2.1
+    /// correspondence through reference birds re-evaluated at every decision.
+    pub assign_slots: bool,
+    /// Final approach: within this distance of its slot a bird flies the formation-frame
+    /// controller alone; between it and twice it the controller and eqs. (5)–(6) are blended,
+    /// wingspans.
+    pub approach_distance: f64,
+    /// Final approach: time constant of the slot error across the formation, seconds.
+    pub approach_time: f64,
+    /// Final approach: deceleration the closing speed on the slot is braked with, wingspans per
+    /// second squared.
+    pub approach_brake: f64,
 }
 
 impl StepParams {
@@ -143,6 +159,31 @@ pub const SLOT_CLAIM_MARGIN: f64 = 1.0;
 /// (the separation drive's distance threshold only lets birds far apart share a reference while
 /// neither is in the slot yet).
 pub const SETTLED_DISTANCE: f64 = 1.0;
+
+/// Collision avoidance yields to the shape's geometry between two birds both closer than this
+/// to their own slots, wingspans: their threshold is [`YIELD_FRACTION`] of their slots' distance
+/// (at least [`YIELD_FLOOR`]) when that is below the avoidance distance.
+pub const YIELD_DISTANCE: f64 = 3.0;
+
+/// Fraction of two slots' distance that two birds settling into them keep apart.
+pub const YIELD_FRACTION: f64 = 0.5;
+
+/// Least avoidance threshold between two birds settling into their slots, wingspans.
+pub const YIELD_FLOOR: f64 = 0.35;
+
+/// Height between the two layers of birds away from their slots, wingspans.
+pub const LAYER_HEIGHT: f64 = 0.6;
+
+/// Birds closer to their slots than this fly at the cruise altitude; from twice it on in their
+/// layer (smoothstep in between), wingspans.
+pub const LAYER_MERGE: f64 = 1.0;
+
+/// Width of a take-off run's lane: a bird on the ground leaves only after every bird ahead of it
+/// closer than this across the heading, wingspans.
+pub const RUN_LANE: f64 = 1.5;
+
+/// Least time between the departures of two birds in one run lane, seconds.
+pub const RUN_GAP: f64 = 0.2;
 
 /// Flocks at least this large decide in parallel (one thread per core).
 pub const PARALLEL_MIN_BIRDS: usize = 128;
@@ -336,6 +377,17 @@ pub struct Simulation {
     vel: Vec<DVec3>,
     dir: Vec<DVec2>,
     decisions: Vec<Decision>,
+    /// Slot positions (leader frame, cruise heading) for the current decision.
+    slot_pos: Vec<DVec2>,
+    /// Horizontal velocity of the leader for the current decision, wingspans per second.
+    lead_vel: DVec2,
+    /// Distance of each bird from its slot for the current decision (∞ when unmatched).
+    slot_err: Vec<f64>,
+    /// With assigned slots, the bird of every slot.
+    bird_of_slot: Vec<usize>,
+    /// With assigned slots, each bird's layer while away from its slot: +½ or −½, alternating
+    /// across the formation.
+    layer: Vec<f64>,
     next_reference: Vec<Option<usize>>,
     next_side: Vec<Option<Side>>,
     next_branch: Vec<Option<usize>>,
@@ -510,15 +562,94 @@ impl Simulation {
             vel: Vec::new(),
             dir: Vec::new(),
             decisions: Vec::new(),
+            slot_pos: Vec::new(),
+            lead_vel: DVec2::ZERO,
+            slot_err: Vec::new(),
+            bird_of_slot: Vec::new(),
+            layer: Vec::new(),
             next_reference: vec![None; n],
             next_side: vec![None; n],
             next_branch: vec![None; n],
             next_unseen: vec![0; n],
         };
-        sim.update_departed();
-        let dc = direction(sim.params.cruise_heading);
-        sim.flock.leader = sim.front_most(dc).unwrap_or(0);
-        sim.match_slots();
+        if sim.params.assign_slots && n > 0 {
+            let (slot, leader) =
+                assign_slots(&sim.target, &sim.flock.pos, sim.params.cruise_heading);
+            sim.flock.leader = leader;
+            // The departure times, earliest first, go to the birds by the depth of their slot
+            // behind the leader's (the leader leaves first; the tails of the arms last).
+            let mut times = sim.flock.depart.clone();
+            times.sort_by(f64::total_cmp);
+            let sl = sim.target.slots[sim.target.leader];
+            let mut order: Vec<usize> = (0..n).collect();
+            order.sort_by(|&a, &b| {
+                let da = sim.target.slots[slot[a]] - sl;
+                let db = sim.target.slots[slot[b]] - sl;
+                (a != leader)
+                    .cmp(&(b != leader))
+                    .then(da.y.total_cmp(&db.y))
+                    .then(da.x.abs().total_cmp(&db.x.abs()))
+                    .then(a.cmp(&b))
+            });
+            for (k, &i) in order.iter().enumerate() {
+                sim.flock.depart[i] = times[k];
+            }
+            // No bird runs into one still on the ground ahead of it: front to back, a bird leaves
+            // after every bird ahead of it within a run lane (a wingspan and a half across).
+            let mut front: Vec<usize> = (0..n).collect();
+            let dc = direction(sim.params.cruise_heading);
+            let rc = right_of(sim.params.cruise_heading);
+            let f = &sim.flock;
+            front.sort_by(|&a, &b| {
+                f.pos[b]
+                    .dot(dc)
+                    .total_cmp(&f.pos[a].dot(dc))
+                    .then(a.cmp(&b))
+            });
+            for (k, &i) in front.iter().enumerate() {
+                if sim.flock.phase[i] == Phase::Airborne {
+                    continue;
+                }
+                let f = &sim.flock;
+                let after = front[..k]
+                    .iter()
+                    .filter(|&&a| {
+                        f.phase[a] != Phase::Airborne
+                            && (f.pos[a] - f.pos[i]).dot(rc).abs() < RUN_LANE
+                    })
+                    .map(|&a| f.depart[a] + RUN_GAP)
+                    .fold(f.depart[i], f64::max);
+                sim.flock.depart[i] = after;
+            }
+            for i in 0..n {
+                let t = sim.flock.depart[i];
+                if sim.flock.phase[i] != Phase::Airborne {
+                    sim.flock.phase[i] = if t <= 0.0 {
+                        Phase::Running
+                    } else {
+                        Phase::Waiting
+                    };
+                }
+            }
+            sim.bird_of_slot = vec![0; n];
+            for (i, &s) in slot.iter().enumerate() {
+                sim.bird_of_slot[s] = i;
+            }
+            let mut across: Vec<usize> = (0..n).collect();
+            let ts = &sim.target.slots;
+            across.sort_by(|&a, &b| ts[slot[a]].x.total_cmp(&ts[slot[b]].x).then(a.cmp(&b)));
+            sim.layer = vec![0.0; n];
+            for (k, &i) in across.iter().enumerate() {
+                sim.layer[i] = if k % 2 == 0 { 0.5 } else { -0.5 };
+            }
+            sim.flock.slot = slot.iter().map(|&s| Some(s)).collect();
+            sim.update_departed();
+        } else {
+            sim.update_departed();
+            let dc = direction(sim.params.cruise_heading);
+            sim.flock.leader = sim.front_most(dc).unwrap_or(0);
+            sim.match_slots();
+        }
         sim
     }
 
@@ -775,9 +906,10 @@ impl Simulation {
             return;
         }
         let dc = direction(p.cruise_heading);
-        // The leader is the front-most departed bird (with hysteresis against flip-flopping).
+        // The leader is the front-most departed bird (with hysteresis against flip-flopping);
+        // with assigned slots it is the one of the leader slot throughout.
         let lead = self.flock.leader;
-        if let Some(front) = self.front_most(dc) {
+        if let Some(front) = self.front_most(dc).filter(|_| !p.assign_slots) {
             let lead_gone = self.flock.phase[lead] == Phase::Waiting;
             if front != lead
                 && (lead_gone
@@ -789,6 +921,16 @@ impl Simulation {
             }
         }
         self.build_holders();
+        self.slot_pos = self.slot_positions();
+        let lead = self.flock.leader;
+        self.lead_vel = direction(self.flock.heading[lead]) * self.flock.speed[lead];
+        let mut err = std::mem::take(&mut self.slot_err);
+        err.clear();
+        err.extend((0..n).map(|i| match self.flock.slot[i] {
+            Some(s) if s < self.slot_pos.len() => (self.flock.pos[i] - self.slot_pos[s]).length(),
+            _ => f64::INFINITY,
+        }));
+        self.slot_err = err;
         let mut vel = std::mem::take(&mut self.vel);
         vel.clear();
         vel.extend((0..n).map(|i| {
@@ -874,7 +1016,9 @@ impl Simulation {
         std::mem::swap(&mut f.side, &mut self.next_side);
         std::mem::swap(&mut f.branch, &mut self.next_branch);
         std::mem::swap(&mut f.unseen, &mut self.next_unseen);
-        self.match_slots();
+        if !p.assign_slots {
+            self.match_slots();
+        }
     }
 
     /// The table of birds by slot the decisions read (counting sort, O(N)).
@@ -927,6 +1071,26 @@ impl Simulation {
                 p.cruise_speed
             };
             (p.alpha * dd / tau, v, None, None, None)
+        } else if let Some(c) = f.slot[i].filter(|_| p.assign_slots) {
+            // Assigned slot: the reference is the bird of the nearest airborne ancestor of the
+            // slot (its reference slot, or farther up the tree while that bird is on the ground).
+            let mut s = c;
+            let j = loop {
+                match self.target.parent[s] {
+                    Some(ps) => {
+                        let j = self.bird_of_slot[ps];
+                        if f.phase[j] == Phase::Airborne || ps == self.target.leader {
+                            break j;
+                        }
+                        s = ps;
+                    }
+                    None => break f.leader,
+                }
+            };
+            // The whole way in the formation frame: eqs. (5)–(6) relative to a reference bird
+            // that is itself still far from its slot would pass its lag down the arm.
+            let (w, v) = self.settle(i, c);
+            (w, v, Some(j), self.target.side_of(c), Some(c))
         } else {
             // Perception: departed flockmates within the visual range.
             self.grid.within(&f.pos, f.pos[i], p.visual_range, near);
@@ -935,7 +1099,7 @@ impl Simulation {
             match self.choose(i, visible) {
                 Some((j, side, c, u)) => {
                     unseen = u;
-                    let (w, v) = self.pursue(i, j, c);
+                    let (w, v) = self.steer(i, j, c);
                     (w, v, Some(j), Some(side), Some(c))
                 }
                 None if near.is_empty() => {
@@ -987,7 +1151,16 @@ impl Simulation {
         };
         let (mut w, mut v) = (turn.clamp(-p.max_turn, p.max_turn), want_speed);
         self.grid.within(&f.pos, f.pos[i], p.avoid_range, near);
-        let mut alt_offset = 0.0;
+        // With assigned slots, neighbours across the formation fly in two layers while they are
+        // away from their slots (half a wingspan apart in height), merging as they settle, so
+        // that two birds passing each other on the way are apart in 3-D.
+        let mut alt_offset = match (self.layer.get(i), self.slot_err.get(i)) {
+            (Some(&l), Some(&e)) if e.is_finite() => {
+                let u = ((e - LAYER_MERGE) / LAYER_MERGE).clamp(0.0, 1.0);
+                l * LAYER_HEIGHT * u * u * (3.0 - 2.0 * u)
+            }
+            _ => 0.0,
+        };
         if let Some((turn, slow, dz)) = self.avoidance(i, w, near) {
             w = turn;
             alt_offset = dz;
@@ -1042,6 +1215,67 @@ impl Simulation {
             },
         );
         reference.zip(chosen).map(|(j, (side, c))| (j, side, c, 0))
+    }
+
+    /// The request of bird `i` following `j` into slot `c`: eqs. (5)–(6) ([`Self::pursue`]) far
+    /// from the slot, the formation-frame controller ([`Self::settle`]) within the approach
+    /// distance of it, blended (smoothstep) in between, so the request never jumps.
+    fn steer(&self, i: usize, j: usize, c: usize) -> (f64, f64) {
+        let p = &self.params;
+        let Some(&slot) = self.slot_pos.get(c) else {
+            return self.pursue(i, j, c);
+        };
+        let r = (self.flock.pos[i] - slot).length();
+        let near = p.approach_distance;
+        if r >= 2.0 * near {
+            return self.pursue(i, j, c);
+        }
+        let settle = self.settle(i, c);
+        if r <= near {
+            return settle;
+        }
+        let u = (2.0 * near - r) / near;
+        let w = u * u * (3.0 - 2.0 * u);
+        let far = self.pursue(i, j, c);
+        (
+            far.0 + w * (settle.0 - far.0),
+            far.1 + w * (settle.1 - far.1),
+        )
+    }
+
+    /// Final approach in the formation frame: the bird wants the formation's velocity (the
+    /// leader's) plus a closing velocity on its slot (leader position plus the slot's offset
+    /// along the cruise heading), linear in the slot error near it
+    /// (time constant `approach_time`; across the formation the slower, since a sideways move
+    /// needs a turn first) and braked (√(2 a e)) farther out, bounded so that the wanted
+    /// velocity stays within the speed range and never points backwards. It is flown as a
+    /// heading (turn rate = heading error / (3 τ_ω)) and a speed: a well-damped second-order
+    /// approach whose time does not depend on where the reference bird is (no cascade down the
+    /// arms). Requested turn rate (rad/s) and speed (wingspans/s).
+    fn settle(&self, i: usize, c: usize) -> (f64, f64) {
+        let p = &self.params;
+        let f = &self.flock;
+        let vf = self.lead_vel;
+        let e = self.slot_pos[c] - f.pos[i];
+        let dc = direction(p.cruise_heading);
+        let rc = right_of(p.cruise_heading);
+        let speed_f = vf.length().max(p.min_speed);
+        let shape = |e: f64, t: f64, lo: f64, hi: f64| -> f64 {
+            let mag = (e.abs() / t).min((2.0 * p.approach_brake * e.abs()).sqrt());
+            (mag * e.signum()).clamp(lo, hi)
+        };
+        let ua = shape(
+            e.dot(dc),
+            0.7 * p.approach_time,
+            -0.8 * (speed_f - p.min_speed).max(0.0),
+            0.8 * (p.max_speed - speed_f).max(0.0),
+        );
+        let lat = 0.5 * speed_f;
+        let uc = shape(e.dot(rc), p.approach_time, -lat, lat);
+        let want = vf + dc * ua + rc * uc;
+        let h = want.x.atan2(want.y);
+        let w = wrap_angle(h - f.heading[i]) / (3.0 * p.turn_lag.max(0.05));
+        (w, want.length())
     }
 
     /// Eqs. (5) and (6) with the fixes of docs/initiation.md, in physical time: requested turn
@@ -1161,7 +1395,21 @@ impl Simulation {
             let closing = dv.length() >= AVOID_MIN_RELATIVE_SPEED * p.cruise_speed;
             let m = miss(dp, dv);
             let d = dp.length();
-            let is_threat = (closing && m < p.avoid_distance) || d < p.avoid_distance;
+            // Two birds near their own slots only keep their slots' distance apart: the
+            // threshold yields to the shape's geometry (slots may overlap wingtips).
+            let limit = match (f.slot[i], f.slot[k]) {
+                (Some(a), Some(b))
+                    if self.slot_err.get(i).is_some_and(|&e| e < YIELD_DISTANCE)
+                        && self.slot_err.get(k).is_some_and(|&e| e < YIELD_DISTANCE) =>
+                {
+                    p.avoid_distance.min(
+                        (YIELD_FRACTION * (self.target.slots[a] - self.target.slots[b]).length())
+                            .max(YIELD_FLOOR),
+                    )
+                }
+                _ => p.avoid_distance,
+            };
+            let is_threat = (closing && m < limit) || d < limit;
             if is_threat && threat.map_or(true, |t| d < t.0) {
                 threat = Some((d, dp, k));
             }
@@ -1313,6 +1561,40 @@ impl Simulation {
             .collect();
         min_pair_distance(&pts)
     }
+}
+
+/// The slot of every bird and the leader for start positions `pos` (wingspans) of a flock
+/// flying along `heading`: the leader is the front-most bird of the middle half across the
+/// heading; the other birds take the other slots in the order of their positions across the
+/// heading (the leftmost bird the leftmost slot, ties along the heading), so that no two birds
+/// cross sideways on their way to their slots.
+pub fn assign_slots(target: &TargetShape, pos: &[DVec2], heading: f64) -> (Vec<usize>, usize) {
+    let n = pos.len().min(target.len());
+    let dc = direction(heading);
+    let rc = right_of(heading);
+    let across = |i: usize| pos[i].dot(rc);
+    let along = |i: usize| pos[i].dot(dc);
+    let mut by_x: Vec<usize> = (0..n).collect();
+    by_x.sort_by(|&a, &b| across(a).total_cmp(&across(b)).then(a.cmp(&b)));
+    let (lo, hi) = (n / 4, (n - n / 4).max(n / 4 + 1).min(n));
+    let leader = by_x[lo..hi]
+        .iter()
+        .copied()
+        .max_by(|&a, &b| along(a).total_cmp(&along(b)).then(b.cmp(&a)))
+        .unwrap_or(0);
+    let mut slots: Vec<usize> = (0..target.len()).filter(|&s| s != target.leader).collect();
+    slots.sort_by(|&a, &b| {
+        let (pa, pb) = (target.slots[a], target.slots[b]);
+        pa.x.total_cmp(&pb.x)
+            .then(pa.y.total_cmp(&pb.y))
+            .then(a.cmp(&b))
+    });
+    let mut slot = vec![target.leader; pos.len()];
+    let others = by_x.iter().copied().filter(|&i| i != leader);
+    for (i, s) in others.zip(slots) {
+        slot[i] = s;
+    }
+    (slot, leader)
 }
 
 /// Convergence tolerances of [`Simulation::in_formation`].
