@@ -339,21 +339,28 @@ fn the_follow_camera_frames_the_whole_sky_of_formations() {
 }
 
 #[test]
-fn a_formation_whose_take_off_falls_short_flies_it_again() {
-    // Seed 4: formation 99's first take-off leaves 2 of its 13 birds short of their slots.
-    let c = config(1000, 4, 2.0);
-    let (a, report) = Pipeline::from_path(example("barnacle_geese_v.json"))
+fn a_take_off_that_never_converges_is_flown_again_then_reported() {
+    // 3 s of flight are too short for any formation to form: every formation tries
+    // TAKEOFF_TRIES take-offs (fresh steady flights and starts), then the run fails naming one.
+    let mut c = config(60, 0, 2.0);
+    c.initiate.max_time = 3.0;
+    let e = Pipeline::from_path(example("barnacle_geese_v.json"))
         .run(&c)
+        .unwrap_err();
+    let msg = e.to_string();
+    assert_eq!(e.exit_code(), 1);
+    assert!(msg.starts_with("formation 0 ("), "{msg}");
+    assert!(
+        msg.contains(&format!("in {} take-offs", formation::skein::TAKEOFF_TRIES)),
+        "{msg}"
+    );
+    // A normal run flies each formation's take-off once or a few times.
+    let (_, report) = Pipeline::from_path(example("barnacle_geese_v.json"))
+        .run(&config(60, 0, 2.0))
         .unwrap();
-    assert!(report.initiate.unwrap().converged);
     let sk = report.skein.unwrap();
-    let retried: Vec<usize> = (0..sk.formations.len())
-        .filter(|&f| sk.formations[f].takeoff_tries > 1)
-        .collect();
-    assert!(!retried.is_empty());
     assert!(sk
         .formations
         .iter()
         .all(|f| (1..=formation::skein::TAKEOFF_TRIES).contains(&f.takeoff_tries)));
-    assert!(min_separation(&a) >= 5.0);
 }
