@@ -21,14 +21,17 @@ cp "$T/frames/frame_00006.png" "$I/usage-initiation.png"
 last=$(ls "$T/frames" | tail -n 3 | head -n 1)
 cp "$T/frames/$last" "$I/usage-steady.png"
 # The ground observer: the flock passes over at 70 % of the film; show it a second before.
-$B render "$T/flock.json" -o "$T/ground/" --camera ground --fps 1 --sun --quiet
+$B render "$T/flock.json" -o "$T/ground/" --camera ground --picture-fps 1 --sun --quiet
 g=$(( (n - 1) * 7 / 10 - 1 ))
 cp "$T/ground/$(printf 'frame_%05d.png' "$g")" "$I/usage-ground.png"
 # One close frame per species (a small flock, so the follow camera is at its closest).
 for sp in goose crane pelican; do
   $B animate "$T/geese.json" --birds 4 --seconds 6 --species "$sp" --seed 3 \
     -o "$T/$sp/" --picture-fps 2 --quiet
-  cp "$T/$sp/frame_00045.png" "$I/species-$sp.png"
+  # Frame 45 (22.5 s) when the flight is that long, else 3 s before its end.
+  f="$T/$sp/frame_00045.png"
+  [ -f "$f" ] || f="$T/$sp/$(ls "$T/$sp" | tail -n 7 | head -n 1)"
+  cp "$f" "$I/species-$sp.png"
 done
 # The README job's GIF, for its size.
 $B animate $E/barnacle_geese_v.json --birds 14 -o "$T/flock.gif" --quiet
@@ -36,6 +39,7 @@ echo "README job GIF: $(stat -c %s "$T/flock.gif") bytes"
 $B plot paths "$T/flock.json" -o "$I/usage-paths.png"
 $B plot xi "$T/flock.json" -o "$I/usage-xi.png"
 $B plot power "$T/flock.json" --key 2 -o "$I/usage-power.png"
+$B plot savings "$T/flock.json" -o "$I/usage-savings.png"
 $B plot wingbeat --species goose -o "$I/usage-wingbeat.png"
 # Large flocks (docs/large-flocks.md): 200 geese at 1280x720, 1000 at 1920x1080, seed 0.
 $B animate $E/barnacle_geese_v.json --birds 200 -o "$T/sky200.json" --quiet

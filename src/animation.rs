@@ -7,6 +7,8 @@ use std::path::Path;
 
 use crate::error::{Error, Result};
 
+pub mod relative;
+pub mod stats;
 pub mod wing;
 
 pub use crate::sniff::ANIMATION_FORMAT;

@@ -191,6 +191,8 @@ pub enum OutputKind {
     Mp4,
     /// `.webm` (VP9 video through the system ffmpeg)
     Webm,
+    /// `.html` (the self-contained page of `report`)
+    Html,
 }
 
 impl OutputKind {
@@ -221,6 +223,7 @@ impl OutputKind {
             Some("mp4") => Some(OutputKind::Mp4),
             Some("webm") => Some(OutputKind::Webm),
             Some("usda") => Some(OutputKind::Usda),
+            Some("html") | Some("htm") => Some(OutputKind::Html),
             _ => None,
         };
         let kind = if s.ends_with('/') || s.ends_with(std::path::MAIN_SEPARATOR) {
@@ -272,6 +275,7 @@ impl OutputKind {
             OutputKind::Directory => "a directory (DIR/)",
             OutputKind::Mp4 => ".mp4",
             OutputKind::Webm => ".webm",
+            OutputKind::Html => ".html",
         }
     }
 }

@@ -21,6 +21,8 @@
 //! ```text
 //! pipeline      pipeline (Config, Pipeline, one function per stage)
 //!                  │
+//! report        report (one HTML page over plot, extract and animation statistics)
+//!                  │
 //! stages        extract (§4) · keyshape (§5, with aero) · initiate (§6) · wingbeat · export · plot
 //!                  │
 //! data types    annotations · extract::params · shape · animation (+ animation::wing) · sniff
@@ -40,6 +42,7 @@
 //! | wingbeats (Wu & Popović) | [`wingbeat`] |
 //! | GIF, PNG, glTF, CSV, JSON | [`export`] |
 //! | charts | [`plot`] |
+//! | the HTML report (parameters, fits, savings, take-off, field studies) | [`report`] |
 //!
 //! Library code never prints or exits; errors are [`Error`] values naming the option path
 //! (`steady.fps`) or the file, frame and bird at fault. The `formation` binary (feature `cli`, on
@@ -65,6 +68,7 @@ pub mod limits;
 pub mod pipeline;
 pub mod plot;
 pub mod progress;
+pub mod report;
 pub mod rng;
 pub mod shape;
 pub mod skein;

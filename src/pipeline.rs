@@ -179,6 +179,9 @@ impl Config {
 pub struct Report {
     /// Model-selection scores of every annotated frame (empty when the input was parameters).
     pub extract: Vec<FrameReport>,
+    /// The formation parameters the steady flight was made from (read or extracted), with
+    /// their summary and warnings.
+    pub params: FormationParams,
     /// Algorithm 1's correspondence, ranges and key-shape statistics.
     pub steady: SteadyReport,
     /// The initiation's statistics (`None` without initiation); for a flock of several
@@ -273,6 +276,7 @@ impl Pipeline {
             anim,
             Report {
                 extract: extract_report,
+                params,
                 steady: steady_report,
                 initiate: initiate_report,
                 skein: None,
@@ -372,6 +376,7 @@ fn flock_run(
         anim,
         Report {
             extract,
+            params: params.clone(),
             steady: first,
             initiate: skein::flock_stats(&report),
             skein: Some(report),

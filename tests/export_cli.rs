@@ -83,7 +83,7 @@ fn fps_and_wingspan_flags_change_the_outputs() {
         &frames,
         "-o",
         s(&json),
-        "--fps",
+        "--picture-fps",
         "10",
         "--size",
         "64x48",
@@ -133,20 +133,20 @@ fn bad_options_and_paths_exit_2_with_one_line_and_no_file() {
             vec!["--size"],
         ),
         (
-            vec!["-o".into(), g.into(), "--fps".into(), "0".into()],
-            vec!["--fps"],
+            vec!["-o".into(), g.into(), "--picture-fps".into(), "0".into()],
+            vec!["--picture-fps"],
         ),
         (
-            vec!["-o".into(), g.into(), "--fps".into(), "NaN".into()],
-            vec!["--fps"],
+            vec!["-o".into(), g.into(), "--picture-fps".into(), "NaN".into()],
+            vec!["--picture-fps"],
         ),
         (
-            vec!["-o".into(), g.into(), "--fps=-5".into()],
-            vec!["--fps"],
+            vec!["-o".into(), g.into(), "--picture-fps=-5".into()],
+            vec!["--picture-fps"],
         ),
         (
-            vec!["-o".into(), g.into(), "--fps".into(), "60".into()],
-            vec!["--fps", "GIF"],
+            vec!["-o".into(), g.into(), "--picture-fps".into(), "60".into()],
+            vec!["--picture-fps", "GIF"],
         ),
         (
             vec!["-o".into(), g.into(), "--wingspan-m".into(), "0".into()],

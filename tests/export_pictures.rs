@@ -328,7 +328,7 @@ fn ffprobe_agrees_with_frame_count_and_rate() {
         s(&webm),
         "--size",
         "320x180",
-        "--fps",
+        "--picture-fps",
         "24",
         "--quiet",
     ]);

@@ -18,6 +18,7 @@ const SWITCHES: &[&str] = &[
     "--keep-unconverged",
     "--no-initiation",
     "--sun",
+    "--strict",
 ];
 
 /// The flags `formation ARGS --help` lists.
@@ -148,7 +149,16 @@ fn commands() -> Vec<Command> {
             cases: cat(vec![
                 read.clone(),
                 fit.clone(),
-                vec![o("OUT/p.txt"), seed.clone()],
+                vec![("--wingspan-m", "0", None), o("OUT/p.txt"), seed.clone()],
+            ]),
+        },
+        Command {
+            name: &["report"],
+            base: strings(&["report", &geese, "-o", "OUT/r.html"]),
+            cases: cat(vec![
+                read.clone(),
+                fit.clone(),
+                vec![("--wingspan-m", "-1", None), o("OUT/r.txt"), seed.clone()],
             ]),
         },
         Command {
@@ -184,6 +194,7 @@ fn commands() -> Vec<Command> {
                 scene.clone(),
                 vec![
                     ("--frames", "0", None),
+                    ("--seconds", "-1", None),
                     ("--report", "OUT/r.txt", None),
                     o("OUT/s.txt"),
                     seed.clone(),
@@ -236,7 +247,7 @@ fn commands() -> Vec<Command> {
                 scene,
                 vec![
                     ("--size", "0x0", None),
-                    ("--fps", "0", None),
+                    ("--picture-fps", "0", None),
                     ("--wingspan-m", "0", None),
                     o("OUT/r.txt"),
                     seed.clone(),
@@ -268,6 +279,11 @@ fn commands() -> Vec<Command> {
                 fit,
                 vec![("--frame", "999", None), o("OUT/s.txt"), seed.clone()],
             ]),
+        },
+        Command {
+            name: &["plot", "savings"],
+            base: strings(&["plot", "savings", &flock, "-o", "OUT/s.png"]),
+            cases: vec![o("OUT/s.txt"), seed.clone()],
         },
         Command {
             name: &["plot", "paths"],

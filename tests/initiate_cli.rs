@@ -49,8 +49,8 @@ fn initiate_writes_an_animation_and_the_paths_chart() {
     assert_eq!(a.stages[1].name, "steady");
     assert_eq!(a.stages[1].end, a.frames.len());
     let text = std::fs::read_to_string(&csv).unwrap();
-    // Exactly SPEC §4.4's columns (the wing phases are in the JSON file).
-    assert!(text.starts_with("frame,t,bird,x,y,z,heading,speed,e,xi\n"));
+    // SPEC §4.4's ten columns first, then the analysis columns (docs/formats.md).
+    assert!(text.starts_with("frame,t,bird,x,y,z,heading,speed,e,xi,stage,"));
     assert_eq!(text.lines().count(), 1 + a.frames.len() * a.birds);
     let png = tmp("paths.png");
     let (code, err) = run(&[

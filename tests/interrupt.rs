@@ -15,6 +15,17 @@ use formation::Animation;
 
 const PREVIOUS: &[u8] = b"previous output: an interrupted run must leave this byte-identical\n";
 
+/// A render slow enough to be interrupted, up to its `-o`.
+const SLOW_RENDER: [&str; 7] = [
+    "render",
+    "--quiet",
+    "--size",
+    "1280x720",
+    "--picture-fps",
+    "50",
+    "-o",
+];
+
 fn workdir(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("formation-interrupt-{}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
@@ -86,9 +97,7 @@ fn interrupt_with(signal: &str, name: &str, output: &str, code: i32, message: &s
     }
     let before = snapshot(&dir);
     let mut child = Command::new(env!("CARGO_BIN_EXE_formation"))
-        .args([
-            "render", "--quiet", "--size", "1280x720", "--fps", "50", "-o",
-        ])
+        .args(SLOW_RENDER)
         .arg(dir.join(output))
         .arg("-o")
         .arg(dir.join("later.csv"))
@@ -180,9 +189,7 @@ fn a_killed_runs_temporary_is_removed_by_the_next_run() {
     let dir = workdir("kill");
     let anim = long_animation(&dir);
     let mut child = Command::new(env!("CARGO_BIN_EXE_formation"))
-        .args([
-            "render", "--quiet", "--size", "1280x720", "--fps", "50", "-o",
-        ])
+        .args(SLOW_RENDER)
         .arg(dir.join("flock.gif"))
         .arg(&anim)
         .stdout(Stdio::null())

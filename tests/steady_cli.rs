@@ -48,8 +48,8 @@ fn writes_json_and_csv_and_plots() {
     assert!(anim.frames.iter().all(|f| f.xi.is_some() && f.e.is_some()));
     let text = std::fs::read_to_string(&csv).unwrap();
     let mut lines = text.lines();
-    // Exactly SPEC §4.4's columns (the wing phases are in the JSON file).
-    assert_eq!(lines.next(), Some("frame,t,bird,x,y,z,heading,speed,e,xi"));
+    // SPEC §4.4's ten columns first, then the analysis columns (docs/formats.md).
+    assert_eq!(lines.next(), Some("frame,t,bird,x,y,z,heading,speed,e,xi,stage,formation,rank,leader,lateral,behind,wing_phase,bank"));
     assert_eq!(lines.count(), 90 * 14);
 
     // Same seed, same bytes; another seed, other bytes.

@@ -180,6 +180,9 @@ pub struct Annotations {
     pub format: Format,
     /// True when the file carried bird ids; false when they were assigned by [`assign_ids`].
     pub ids_given: bool,
+    /// True when pixel y grew upward as read (DLTdv, `read.y_origin` bottom).
+    #[serde(default)]
+    pub y_up: bool,
     /// Frames in file order.
     pub frames: Vec<AnnotatedFrame>,
 }
@@ -331,12 +334,36 @@ fn detect_text(path: &Path, text: &str) -> Result<Format> {
                 "this is a params file written by `formation extract`, not annotations",
             ));
         }
+        if top.format.as_ref().and_then(|f| f.as_str()) == Some(crate::sniff::ANIMATION_FORMAT) {
+            return Err(Error::format(
+                path,
+                "this is an animation file, not annotations: `formation render`, `formation plot` and `formation report` read it",
+            ));
+        }
         if top.shapes.is_some() {
             return Ok(Format::Labelme);
         }
         if top.frames.is_some() {
             native::check_counts(path, t)?;
             return Ok(Format::Native);
+        }
+        // Another of formation's own files: say which command reads it.
+        let kind = crate::sniff::text_kind(t).unwrap_or(crate::sniff::Kind::Unknown);
+        let reader = match kind {
+            crate::sniff::Kind::Shape => {
+                Some("`formation power` and `formation plot power` read it")
+            }
+            crate::sniff::Kind::Target => Some("`formation solve` reads it"),
+            _ => None,
+        };
+        if let Some(reader) = reader {
+            return Err(Error::format(
+                path,
+                format!(
+                    "this is {}, not annotations: {reader}; annotations have \"frames\" (native) or \"shapes\" (Labelme)",
+                    kind.describe()
+                ),
+            ));
         }
         return Err(Error::format(
             path,
@@ -552,6 +579,7 @@ fn finish(path: &Path, raw: RawAnnotations, opts: &ReadOptions) -> Result<Annota
         source,
         format: raw.format,
         ids_given,
+        y_up,
         frames,
     })
 }

@@ -35,8 +35,7 @@ pub struct AnimateArgs {
     #[arg(short = 'o', long = "output", required = true)]
     pub output: Vec<PathBuf>,
     /// Length of the steady flight, seconds (the take-off before it lasts as long as the flock
-    /// needs to form, by default about 7 + 1.1 × birds seconds: 17 s for 9 birds, 22 s for 14,
-    /// 52 s for 41; see --takeoff).
+    /// needs to form, see --takeoff; the summary printed at the end says how long it took).
     #[arg(long, default_value_t = formation::pipeline::DEFAULT_SECONDS, allow_negative_numbers = true)]
     pub seconds: f64,
     /// Skip the take-off: the animation is the steady flight alone.
@@ -122,7 +121,15 @@ pub fn run(args: AnimateArgs, g: Global) -> Result<()> {
     }
     let progress = TermProgress::new(g.quiet);
     let (anim, report) = Pipeline::from_path(&args.input).run_with(&config, &progress)?;
+    let warnings = report
+        .params
+        .summary
+        .as_ref()
+        .map(|s| s.warnings.clone())
+        .unwrap_or_default();
+    super::warn(super::flags::Cmd::Animate, g, &warnings)?;
     super::write_animation(&anim, &args.output, &config.render, g)?;
+    super::summary::animate(g, &anim, &report, &args.output);
     if let (Some(f), false) = (&report.skein, g.quiet) {
         eprintln!("{}", super::steady::flock_summary(f));
     }

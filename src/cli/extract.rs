@@ -47,6 +47,15 @@ pub struct FitArgs {
     pub j_offset: f64,
 }
 
+/// The bird's size in metres (shared by `extract` and `report`).
+#[derive(Debug, Args, Clone)]
+pub struct SizeArgs {
+    /// Wingspan of one bird, metres: the wingtip spacings are also given in metres (default:
+    /// unknown, wingspans only).
+    #[arg(long = "wingspan-m", value_name = "M", allow_hyphen_values = true)]
+    pub wingspan_m: Option<f64>,
+}
+
 impl ReadArgs {
     pub fn options(&self) -> ReadOptions {
         ReadOptions {
@@ -58,7 +67,8 @@ impl ReadArgs {
 }
 
 impl FitArgs {
-    fn options(&self) -> ExtractOptions {
+    /// The library options for these flags.
+    pub fn options(&self) -> ExtractOptions {
         ExtractOptions {
             inlier_threshold: self.threshold,
             max_samples: self.max_samples,
@@ -84,25 +94,34 @@ pub struct ExtractArgs {
     pub read: ReadArgs,
     #[command(flatten)]
     pub fit: FitArgs,
+    #[command(flatten)]
+    pub size: SizeArgs,
 }
 
-/// Reads annotations and extracts, with the seed's `extract` stream.
-fn read_and_extract(
+/// Reads annotations and extracts, with the seed's `extract` stream. The warnings in the
+/// params name `cmd`'s flags.
+pub fn read_and_extract(
     path: &Path,
     read: &ReadArgs,
-    fit: &FitArgs,
+    extract: ExtractOptions,
     g: Global,
+    cmd: super::flags::Cmd,
 ) -> Result<(annotations::Annotations, FormationParams, Vec<FrameReport>)> {
     let config = Config {
         seed: g.seed,
         read: read.options(),
-        extract: fit.options(),
+        extract,
         ..Config::default()
     };
     config.extract.validate()?;
     let ann = annotations::read(path, &config.read)?;
     let progress = super::progress::TermProgress::new(g.quiet);
-    let (params, reports) = extract_stage(&ann, &config, &progress)?;
+    let (mut params, reports) = extract_stage(&ann, &config, &progress)?;
+    if let Some(s) = &mut params.summary {
+        for w in &mut s.warnings {
+            w.message = super::flags::rewrite(cmd, &w.message);
+        }
+    }
     Ok((ann, params, reports))
 }
 
@@ -117,7 +136,18 @@ pub fn run(args: ExtractArgs, g: Global) -> Result<()> {
     if let Some(o) = &args.output {
         OutputKind::from_path(o, &[OutputKind::Json])?;
     }
-    let (ann, params, reports) = read_and_extract(&args.annotations, &args.read, &args.fit, g)?;
+    let extract = ExtractOptions {
+        wingspan_m: args.size.wingspan_m,
+        ..args.fit.options()
+    };
+    let (ann, params, reports) = read_and_extract(
+        &args.annotations,
+        &args.read,
+        extract,
+        g,
+        super::flags::Cmd::Extract,
+    )?;
+    super::warn_params(g, &params)?;
     if let Some(o) = &args.output {
         write_json_atomic(o, &params)?;
     }
@@ -173,7 +203,7 @@ pub fn summary_table(
         }
     );
     s.push_str(
-        " frame birds  kind leader   mu_x sigma_x   mu_y sigma_y  inl  outliers           next best (ΔS)\n",
+        " frame birds  kind leader   mu_x sigma_x   mu_y sigma_y  inl  outliers           next best (ΔS)   apex° (left+right)  depth    WTS\n",
     );
     for (f, r) in p.frames.iter().zip(reports) {
         let next = r
@@ -182,7 +212,7 @@ pub fn summary_table(
             .unwrap_or_else(|| "-".into());
         let _ = writeln!(
             s,
-            "{:>6} {:>5} {:>5} {:>6} {:>6.3} {:>7.3} {:>6.3} {:>7.3} {:>4}  {:<18} {}",
+            "{:>6} {:>5} {:>5} {:>6} {:>6.3} {:>7.3} {:>6.3} {:>7.3} {:>4}  {:<18} {:<14} {:>19} {:>6} {:>6}",
             f.index,
             f.order.len(),
             f.shape.kind(),
@@ -193,18 +223,16 @@ pub fn summary_table(
             f.sigma_y,
             f.inliers.len(),
             id_list(&f.outliers),
-            next
+            next,
+            f.geometry.map(|g| apex_text(&g)).unwrap_or_else(|| "-".into()),
+            f.geometry.map(|g| format!("{:.2}", g.depth)).unwrap_or_else(|| "-".into()),
+            f.geometry
+                .map(|g| format!("{:+.2}", g.wingtip_spacing))
+                .unwrap_or_else(|| "-".into()),
         );
     }
-    let mut counts: Vec<(&str, usize)> = Vec::new();
-    for f in &p.frames {
-        let k = f.shape.kind();
-        match counts.iter_mut().find(|c| c.0 == k) {
-            Some(c) => c.1 += 1,
-            None => counts.push((k, 1)),
-        }
-    }
-    let kinds: Vec<String> = counts
+    let kinds: Vec<String> = p
+        .kind_counts()
         .iter()
         .map(|(k, c)| format!("{k} in {c}/{}", p.frames.len()))
         .collect();
@@ -215,12 +243,67 @@ pub fn summary_table(
         kinds.join(", "),
         n_out
     );
-    match out {
-        Some(o) => {
-            let _ = writeln!(s, "\nwrote {}", o.display());
-        }
-        None => s.push('\n'),
+    s.push('\n');
+    if let Some(sum) = &p.summary {
+        s.push_str(&overall_text(&sum.geometry, sum.wingspan_m.is_some()));
     }
+    s.push_str("angles from the flight axis behind the leader (90° = line abreast); depth = farthest inlier behind the leader; WTS = mean wingtip spacing of lateral neighbours (μ_x − 1), wingspans\n");
+    if let Some(o) = out {
+        let _ = writeln!(s, "wrote {}", o.display());
+    }
+    s
+}
+
+/// `54.1 (27.0+27.1)`, `61.0 (right)` for one arm, `-` for none.
+fn apex_text(g: &formation::extract::geometry::FrameGeometry) -> String {
+    match (g.arm_left_deg, g.arm_right_deg) {
+        (Some(l), Some(r)) => format!("{:.1} ({l:.1}+{r:.1})", l + r),
+        (Some(l), None) => format!("{l:.1} (left)"),
+        (None, Some(r)) => format!("{r:.1} (right)"),
+        (None, None) => "-".into(),
+    }
+}
+
+/// The `overall:` line of the summary table.
+pub fn overall_text(g: &formation::extract::geometry::GeometrySummary, metres: bool) -> String {
+    use formation::extract::geometry::Stat;
+    let st = |s: &Option<Stat>, unit: &str, prec: usize| match s {
+        Some(s) => format!(
+            "{:.prec$}{unit} (median of {} frames, {:.prec$} to {:.prec$})",
+            s.median, s.frames, s.min, s.max
+        ),
+        None => "-".into(),
+    };
+    let mut s = String::from("overall: ");
+    match (&g.apex_deg, &g.arm_left_deg, &g.arm_right_deg) {
+        (Some(_), Some(l), Some(r)) => {
+            let _ = write!(
+                s,
+                "apex angle {}, left arm {:.1}°, right arm {:.1}°; ",
+                st(&g.apex_deg, "°", 1),
+                l.median,
+                r.median
+            );
+        }
+        (_, l, r) => {
+            let _ = write!(
+                s,
+                "no apex (one arm): left arm {}, right arm {}; ",
+                st(l, "°", 1),
+                st(r, "°", 1)
+            );
+        }
+    }
+    let _ = write!(s, "depth {}; ", st(&g.depth, " wingspans", 2));
+    let _ = write!(
+        s,
+        "mean wingtip spacing {}",
+        st(&g.wingtip_spacing, " wingspans", 2)
+    );
+    if metres {
+        let _ = write!(s, " = {}", st(&g.wingtip_spacing_m, " m", 2));
+    }
+    s.push('\n');
     s
 }
 
@@ -251,7 +334,14 @@ pub fn run_plot_shape(args: PlotShapeArgs, g: Global) -> Result<()> {
     let (params, threshold) = if is_params {
         (FormationParams::read(&args.input)?, None)
     } else {
-        let (_, p, _) = read_and_extract(&args.input, &args.read, &args.fit, g)?;
+        let (_, p, _) = read_and_extract(
+            &args.input,
+            &args.read,
+            args.fit.options(),
+            g,
+            super::flags::Cmd::PlotShape,
+        )?;
+        super::warn_params(g, &p)?;
         (p, Some(args.fit.threshold))
     };
     let chart = formation::plot::shape::ShapeChart::from_params(

@@ -33,12 +33,16 @@ pub enum Cmd {
     PlotPaths,
     /// `formation plot wingbeat`.
     PlotWingbeat,
+    /// `formation plot savings`.
+    PlotSavings,
+    /// `formation report`.
+    Report,
 }
 
 use Cmd::*;
 
-const READ: &[Cmd] = &[Extract, PlotShape, Animate];
-const FIT: &[Cmd] = &[Extract, PlotShape];
+const READ: &[Cmd] = &[Extract, PlotShape, Animate, Report];
+const FIT: &[Cmd] = &[Extract, PlotShape, Report];
 const STEADY: &[Cmd] = &[Steady, Animate];
 const INITIATE: &[Cmd] = &[Initiate, Animate];
 const WINGBEAT: &[Cmd] = &[Steady, Initiate, Animate];
@@ -57,6 +61,8 @@ const ALL: &[Cmd] = &[
     PlotShape,
     PlotPaths,
     PlotWingbeat,
+    PlotSavings,
+    Report,
 ];
 
 /// (option path, flag, commands that have the flag). A path may appear several times with
@@ -72,8 +78,9 @@ pub const FLAGS: &[(&str, &str, &[Cmd])] = &[
     ("extract.kind", "--kind", FIT),
     ("extract.max_samples", "--max-samples", FIT),
     ("extract.j_offset", "--j-offset", FIT),
+    ("extract.wingspan_m", "--wingspan-m", &[Extract, Report]),
     ("solve.tolerance", "--tolerance", &[Solve]),
-    ("seconds", "--seconds", &[Animate]),
+    ("seconds", "--seconds", &[Animate, Steady]),
     ("steady.birds", "--birds", STEADY),
     ("steady.frames", "--frames", &[Steady]),
     ("steady.frames", "--seconds", &[Animate]),
@@ -144,8 +151,7 @@ pub const FLAGS: &[(&str, &str, &[Cmd])] = &[
     ("render.width/render.height", "--size", PICTURES),
     ("render.width", "--size", PICTURES),
     ("render.height", "--size", PICTURES),
-    ("render.fps", "--fps", &[Render]),
-    ("render.fps", "--picture-fps", &[Animate]),
+    ("render.fps", "--picture-fps", &[Render, Animate]),
     ("render.wingspan_m", "--wingspan-m", &[Render]),
     ("render.keys", "--keys", SCENE),
     ("render.bird_model", "--bird-model", SCENE),
@@ -258,7 +264,7 @@ mod tests {
         );
         assert_eq!(rewrite_name(Render, "output"), "-o");
         assert_eq!(rewrite(Animate, "render.fps: 3"), "--picture-fps: 3");
-        assert_eq!(rewrite(Render, "render.fps: 3"), "--fps: 3");
+        assert_eq!(rewrite(Render, "render.fps: 3"), "--picture-fps: 3");
         assert_eq!(
             rewrite(Render, "give e.g. render.width/render.height 960x540"),
             "give e.g. --size 960x540"

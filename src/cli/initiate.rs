@@ -276,6 +276,7 @@ pub fn run(args: InitiateArgs, g: Global) -> Result<()> {
         let text = formation::finite::to_json_pretty("statistics", &stats)?;
         super::stdout::println(&text)?;
     }
+    super::summary::initiate(g, &anim, stats.converged, &args.output);
     Ok(())
 }
 

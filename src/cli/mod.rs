@@ -13,9 +13,11 @@ mod plot;
 mod power;
 pub mod progress;
 mod render;
+mod report;
 mod solve;
 mod stdout;
 mod steady;
+pub mod summary;
 mod wingbeat;
 
 /// Animate bird flocks flying in line formations (V, U, J, echelon), after Klotsman & Tal.
@@ -30,6 +32,10 @@ pub struct Cli {
     /// Seed of every random draw; equal seeds and inputs give byte-identical outputs.
     #[arg(long, global = true, default_value_t = formation::pipeline::Config::default().seed)]
     seed: u64,
+    /// Treat warnings about suspicious input (a formation opening forward, an implausible
+    /// scale, too few frames) as errors: exit 2 and write nothing.
+    #[arg(long, global = true)]
+    strict: bool,
 }
 
 /// Options shared by every command.
@@ -39,6 +45,8 @@ pub struct Global {
     pub quiet: bool,
     /// `--seed`.
     pub seed: u64,
+    /// `--strict`.
+    pub strict: bool,
 }
 
 #[derive(Debug, Subcommand)]
@@ -57,8 +65,11 @@ enum Command {
     Animate(Box<animate::AnimateArgs>),
     /// Render or export an animation file (GIF, PNG frames, glTF, CSV, JSON).
     Render(render::RenderArgs),
-    /// Charts: power, xi, shape, paths, wingbeat.
+    /// Charts: power, xi, shape, paths, wingbeat, savings.
     Plot(plot::PlotArgs),
+    /// One self-contained HTML page (inline SVG charts) about annotations, params or an
+    /// animation: parameters per frame with fits, savings per bird, take-off, field comparison.
+    Report(report::ReportArgs),
 }
 
 /// Runs the parsed command line.
@@ -66,6 +77,7 @@ pub fn run(cli: Cli) -> Result<()> {
     let g = Global {
         quiet: cli.quiet,
         seed: cli.seed,
+        strict: cli.strict,
     };
     use flags::Cmd;
     // Every output of the command is committed together at the end, or none of them.
@@ -79,10 +91,50 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Animate(a) => (Cmd::Animate, animate::run(*a, g)),
         Command::Render(a) => (Cmd::Render, render::run(a, g)),
         Command::Plot(a) => (a.cmd(), plot::run(a, g)),
+        Command::Report(a) => (Cmd::Report, report::run(a, g)),
     };
     // Library errors name option paths; the user typed this command's flags.
     result.map_err(|e| flags::name_flags(cmd, e))?;
-    outputs.commit().map_err(|e| flags::name_flags(cmd, e))
+    outputs.commit().map_err(|e| flags::name_flags(cmd, e))?;
+    summary::print_deferred();
+    Ok(())
+}
+
+/// Prints the warnings recorded in `params` (already in the command's flags) and applies
+/// `--strict`.
+pub fn warn_params(g: Global, params: &formation::extract::FormationParams) -> Result<()> {
+    let w = params
+        .summary
+        .as_ref()
+        .map(|s| s.warnings.as_slice())
+        .unwrap_or(&[]);
+    warn(flags::Cmd::Extract, g, w)
+}
+
+/// Prints `warnings` on stderr (`warning: …`, option paths shown as `cmd`'s flags, even with
+/// `--quiet`). With `--strict` the first warning is the error instead (exit 2, one line,
+/// nothing written).
+pub fn warn(cmd: flags::Cmd, g: Global, warnings: &[formation::extract::Warning]) -> Result<()> {
+    if g.strict {
+        if let Some(first) = warnings.first() {
+            let more = match warnings.len() - 1 {
+                0 => String::new(),
+                1 => " (and 1 more warning)".into(),
+                n => format!(" (and {n} more warnings)"),
+            };
+            return Err(formation::Error::parameter(
+                "--strict",
+                format!(
+                    "{}{more}; no output written",
+                    flags::rewrite(cmd, &first.message)
+                ),
+            ));
+        }
+    }
+    for w in warnings {
+        eprintln!("warning: {}", flags::rewrite(cmd, &w.message));
+    }
+    Ok(())
 }
 
 /// On a terminating signal, remove temporary output files before exiting (no partial outputs).

@@ -24,6 +24,27 @@ enum PlotKind {
     Paths(super::initiate::PlotPathsArgs),
     /// Joint angles of one wingbeat over its phase.
     Wingbeat(super::wingbeat::PlotWingbeatArgs),
+    /// Each bird's saving against its rank, and the flock's saving over time through the
+    /// take-off, with the field studies' flock savings for comparison.
+    Savings(SavingsArgs),
+}
+
+/// Arguments of `formation plot savings`.
+#[derive(Debug, Args)]
+pub struct SavingsArgs {
+    /// An animation file.
+    pub input: std::path::PathBuf,
+    /// Output chart (.png or .svg).
+    #[arg(short = 'o', long = "output")]
+    pub output: std::path::PathBuf,
+}
+
+fn run_plot_savings(args: SavingsArgs) -> Result<()> {
+    use formation::io::OutputKind;
+    OutputKind::from_path(&args.output, &[OutputKind::Png, OutputKind::Svg])?;
+    let anim = formation::Animation::read(&args.input)?;
+    let chart = formation::plot::savings::SavingsChart::from_animation(&anim, &args.input)?;
+    formation::plot::save(&chart, &args.output)
 }
 
 impl PlotArgs {
@@ -36,6 +57,7 @@ impl PlotArgs {
             PlotKind::Shape(_) => Cmd::PlotShape,
             PlotKind::Paths(_) => Cmd::PlotPaths,
             PlotKind::Wingbeat(_) => Cmd::PlotWingbeat,
+            PlotKind::Savings(_) => Cmd::PlotSavings,
         }
     }
 }
@@ -48,5 +70,6 @@ pub fn run(args: PlotArgs, g: Global) -> Result<()> {
         PlotKind::Shape(a) => super::extract::run_plot_shape(a, g),
         PlotKind::Paths(a) => super::initiate::run_plot_paths(a, g),
         PlotKind::Wingbeat(a) => super::wingbeat::run_plot_wingbeat(a, g),
+        PlotKind::Savings(a) => run_plot_savings(a),
     }
 }

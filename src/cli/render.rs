@@ -23,6 +23,10 @@ pub struct RenderArgs {
     pub picture: PictureArgs,
     #[command(flatten)]
     pub shot: ShotArgs,
+    /// `--fps` is the animation's own rate, fixed by the file: refused with a pointer to
+    /// `--picture-fps` (one vocabulary across commands, issue 16).
+    #[arg(long = "fps", hide = true, allow_hyphen_values = true)]
+    pub animation_fps: Option<String>,
 }
 
 /// Camera and look of the pictures, shared by `render` and `animate` (defaults from
@@ -73,7 +77,11 @@ pub struct PictureArgs {
     /// Frame rate of the pictures, frames per second (default: the GIF rate, rounded to whole
     /// 1/100 s per frame, for GIF; the animation's own rate for PNG frames and video). JSON, CSV and glTF
     /// keep the animation's frames.
-    #[arg(long, value_name = "FPS", allow_negative_numbers = true)]
+    #[arg(
+        long = "picture-fps",
+        value_name = "FPS",
+        allow_negative_numbers = true
+    )]
     pub fps: Option<f64>,
     /// Bird wingspan in metres for the .glb (and recorded in the .json) (default: the
     /// animation's).
@@ -178,6 +186,14 @@ pub fn parse_size(s: &str) -> std::result::Result<Size, String> {
 
 /// Runs `formation render`.
 pub fn run(args: RenderArgs, g: Global) -> Result<()> {
+    if let Some(v) = &args.animation_fps {
+        return Err(formation::Error::parameter(
+            "--fps",
+            format!(
+                "{v}: --fps is the animation's own frame rate, fixed by the file for `render`; give the rate of the pictures with --picture-fps"
+            ),
+        ));
+    }
     let mut opts = args.picture.options();
     args.shot.apply(&mut opts)?;
     opts.validate()?;

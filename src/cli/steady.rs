@@ -26,9 +26,12 @@ pub struct SteadyArgs {
     /// Number of birds to animate (N ≥ 2).
     #[arg(long)]
     pub birds: usize,
-    /// Number of frames (F ≥ 1).
-    #[arg(long)]
-    pub frames: usize,
+    /// Number of frames (F ≥ 1); or give --seconds.
+    #[arg(long, conflicts_with = "seconds")]
+    pub frames: Option<usize>,
+    /// Length of the steady flight, seconds (frames = seconds × --fps); or give --frames.
+    #[arg(long, allow_negative_numbers = true)]
+    pub seconds: Option<f64>,
     /// Outputs by extension: .json (the animation file), .csv, and also .gif, DIR/, .glb; may be
     /// repeated.
     #[arg(short = 'o', long = "output", required = true)]
@@ -125,11 +128,17 @@ impl SkeinFlags {
 
 /// Runs `formation steady`.
 pub fn run(args: SteadyArgs, g: Global) -> Result<()> {
+    if args.frames.is_none() && args.seconds.is_none() {
+        return Err(Error::parameter(
+            "--frames",
+            "give the length of the steady flight: --frames F or --seconds S",
+        ));
+    }
     let config = Config {
         seed: g.seed,
-        seconds: None,
+        seconds: args.seconds,
         steady: SteadyOptions {
-            frames: args.frames,
+            frames: args.frames.unwrap_or(SteadyOptions::default().frames),
             ..args.steady.options(args.birds)
         },
         wingbeat: args.wingbeat.options()?,
@@ -157,6 +166,7 @@ pub fn run(args: SteadyArgs, g: Global) -> Result<()> {
         }
     }
     let params = read_params(&args.params)?;
+    super::warn_params(g, &params)?;
     let progress = TermProgress::new(g.quiet);
     let (mut anim, outcome) = flock_steady_stage(&params, &config, &progress)?;
     formation::wingbeat::assign_phases(&mut anim, &config.wingbeat)?;
@@ -165,16 +175,24 @@ pub fn run(args: SteadyArgs, g: Global) -> Result<()> {
         write_json_atomic(r, &outcome)?;
     }
     if !g.quiet {
-        match &outcome {
+        let text = match &outcome {
             SteadyOutcome::One(report) => {
                 let k = &report.keys;
-                eprintln!(
-                    "steady: {} key shapes ({} draws, {} redraws, {} damped, {} held, min λ {:.3}), max key residual {:.1e}, max jump {:.2} wingspans",
+                format!(
+                    "{}\nkey shapes: {} ({} draws, {} redraws, {} damped, {} held, min λ {:.3}), max key residual {:.1e}, max jump {:.2} wingspans",
+                    super::summary::animation_text("steady", &anim, Some(&params)),
                     k.keys, k.draws, k.redraws, k.damped, k.held, k.min_damping, k.max_residual, k.max_jump
-                );
+                )
             }
-            SteadyOutcome::Flock(f) => eprintln!("{}", flock_summary(f)),
-        }
+            SteadyOutcome::Flock(f) => format!(
+                "{}\n{}",
+                super::summary::animation_text("steady", &anim, Some(&params)),
+                flock_summary(f)
+            ),
+        };
+        let mut files = args.output.clone();
+        files.extend(args.report.iter().cloned());
+        super::summary::defer(text, &files);
     }
     Ok(())
 }

@@ -411,7 +411,7 @@ pub fn write_outputs(
                 };
                 pictures::write_video(&film, &o.path, codec, threads, progress)?;
             }
-            OutputKind::Png | OutputKind::Svg => {
+            OutputKind::Png | OutputKind::Svg | OutputKind::Html => {
                 return Err(Error::Internal(format!(
                     "{}: not an animation output",
                     o.path.display()

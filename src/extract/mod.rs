@@ -10,8 +10,8 @@
 //! between lateral neighbours.
 //!
 //! **Step 2** (per frame): three families are fitted robustly ([`ransac`]): a line (line /
-//! echelon), a line per side of the leader (V; the leader belongs to both sides), and a parabola
-//! opening backward (U or J). The family is chosen by a GRIC/BIC-like criterion (Torr's geometric
+//! echelon), two arms meeting on the leader's line of flight (V: the apex depth and two slopes,
+//! [`ransac::Vee`]), and a parabola opening backward (U or J). The family is chosen by a GRIC/BIC-like criterion (Torr's geometric
 //! robust information criterion with all models being curves, so only the residual and
 //! parameter-count terms differ):
 //!
@@ -22,26 +22,42 @@
 //!
 //! with r_i = (y_i − curve(x_i)) / √(1 + curve'(x_i)²) the first-order distance of bird i
 //! from the curve (so that image noise on a steep arm is not taken for an outlier), T the inlier threshold (`ExtractOptions::inlier_threshold`,
-//! wingspans), n the birds in the frame and k_M the parameter count (line 2, parabola 3, V 4).
+//! wingspans), n the birds in the frame and k_M the parameter count (line 2, parabola 3, V 3).
 //! A bad point costs at most (T/σ)² = 4, so an outlier cannot pull the choice; a more complex
-//! model must buy its extra parameters with a residual drop of ln n each. The lowest S wins. A
+//! model must buy its extra parameters with a residual drop of ln n each. The lowest S wins;
+//! equal scores (within a relative 1e-6, e.g. three birds, which a V and a parabola both fit
+//! exactly) go to the V, then the line, then the parabola: three birds are a V unless the data
+//! say otherwise (issue 16). The paper is silent on the choice; this criterion is ours.
+//!
+//! After the frames, [`checks`] looks for suspicious input (a formation opening forward, a
+//! heading off by 90°, an implausible scale, few frames, 3-bird frames) and [`geometry`]
+//! measures each frame's apex angle per arm, depth and wingtip spacing; both go into
+//! [`FormationParams::summary`]. A
 //! parabola is a **J** when its vertex x_v = −b/(2a) lies more than `j_offset` half-widths from
 //! the centre of the inliers' lateral extent (one arm clearly longer), else a **U**. Birds with
 //! |r| ≤ T are inliers; μ_y, σ_y are the mean and sample standard deviation of the inliers'
 //! vertical deviations dy = y − curve(x) (the paper's y-deviations).
 
+pub mod checks;
+pub mod geometry;
 pub mod params;
 pub mod ransac;
 
 use rand::Rng;
 use serde::{Deserialize, Serialize};
 
-pub use params::{BirdPosition, FormationParams, FrameParams, LineCoef, ShapeModel, PARAMS_FORMAT};
+pub use checks::{Warning, WarningKind};
+pub use params::{
+    BirdPosition, FormationParams, FrameParams, LineCoef, ParamsSummary, ShapeModel, PARAMS_FORMAT,
+};
 
 use crate::annotations::{AnnotatedFrame, Annotations};
 use crate::error::{Error, Result};
 use crate::progress::Progress;
-use ransac::{Line, Model, Parabola, RansacOptions};
+use ransac::{Line, Model, Parabola, RansacOptions, Vee};
+
+/// Relative gap under which two criterion values count as equal (exact fits of a few birds).
+const TIE: f64 = 1e-6;
 
 pub use crate::shape::ShapeKind;
 
@@ -74,6 +90,8 @@ pub struct ExtractOptions {
     pub j_offset: f64,
     /// Fit only this family (U and J both mean "parabola", labelled as given).
     pub kind: Option<ShapeKind>,
+    /// Wingspan of one bird, metres, when known: the wingtip spacings are also given in metres.
+    pub wingspan_m: Option<f64>,
 }
 
 impl Default for ExtractOptions {
@@ -84,6 +102,7 @@ impl Default for ExtractOptions {
             refine_rounds: 5,
             j_offset: 0.5,
             kind: None,
+            wingspan_m: None,
         }
     }
 }
@@ -115,6 +134,17 @@ impl ExtractOptions {
                 "extract.j_offset",
                 format!("must be between 0 and 1, got {}", self.j_offset),
             ));
+        }
+        if let Some(m) = self.wingspan_m {
+            if !(m.is_finite() && m > 0.0 && m <= crate::limits::MAX_WINGSPAN_M) {
+                return Err(Error::parameter(
+                    "extract.wingspan_m",
+                    format!(
+                        "must be a positive number of metres, at most {}, got {m}",
+                        crate::limits::MAX_WINGSPAN_M
+                    ),
+                ));
+            }
         }
         Ok(())
     }
@@ -201,15 +231,25 @@ pub fn extract_with_report(
         progress.advance(1);
     }
     progress.finish();
-    Ok((
-        FormationParams {
-            format: PARAMS_FORMAT.to_string(),
-            source: ann.source.clone(),
-            birds: ann.bird_count(),
-            frames,
-        },
-        reports,
-    ))
+    for f in &mut frames {
+        f.geometry = Some(geometry::frame_geometry(f, opts.wingspan_m));
+    }
+    let geometry =
+        geometry::summarise(&frames.iter().filter_map(|f| f.geometry).collect::<Vec<_>>());
+    let mut params = FormationParams {
+        format: PARAMS_FORMAT.to_string(),
+        source: ann.source.clone(),
+        birds: ann.bird_count(),
+        frames,
+        summary: None,
+    };
+    let warnings = checks::check(ann, &params, &reports, opts, rng);
+    params.summary = Some(Box::new(ParamsSummary {
+        wingspan_m: opts.wingspan_m,
+        geometry,
+        warnings,
+    }));
+    Ok((params, reports))
 }
 
 /// Slope dy/dx of a fitted curve at x (a V uses the arm of x's side).
@@ -316,6 +356,7 @@ pub fn extract_frame(
             inliers,
             outliers,
             positions,
+            geometry: None,
         },
         FrameReport {
             index: f.index,
@@ -399,30 +440,33 @@ fn choose_model(
         }
     }
     if want(ShapeKind::V) {
-        // A line per side; the leader (at x = 0) belongs to both.
-        let left: Vec<(f64, f64)> = pts.iter().copied().filter(|p| p.0 <= 0.0).collect();
-        let right: Vec<(f64, f64)> = pts.iter().copied().filter(|p| p.0 >= 0.0).collect();
-        if left.len() >= 2 && right.len() >= 2 {
-            let l = ransac::ransac::<Line>(&left, &ro, rng);
-            let r = ransac::ransac::<Line>(&right, &ro, rng);
-            if let (Some((l, _)), Some((r, _))) = (l, r) {
-                let m = ShapeModel::V {
-                    left: LineCoef {
-                        intercept: l.c,
-                        slope: l.s,
-                    },
-                    right: LineCoef {
-                        intercept: r.c,
-                        slope: r.s,
-                    },
-                };
-                cands.push((m, cost_of(&m) / sigma2 + 4.0 * ln_n));
-            }
+        // Two arms meeting at the leader's lateral position (needs a bird on each side).
+        if let Some((v, _)) = ransac::ransac::<Vee>(pts, &ro, rng) {
+            let m = ShapeModel::V {
+                left: LineCoef {
+                    intercept: v.c,
+                    slope: v.sl,
+                },
+                right: LineCoef {
+                    intercept: v.c,
+                    slope: v.sr,
+                },
+            };
+            cands.push((m, cost_of(&m) / sigma2 + 3.0 * ln_n));
         }
     }
+    // Lowest S; among scores equal to rounding (three birds fit a V and a parabola exactly) the
+    // V, then the line, then the parabola.
+    let lowest = cands.iter().map(|c| c.1).fold(f64::INFINITY, f64::min);
+    let preference = |m: &ShapeModel| match m {
+        ShapeModel::V { .. } => 0,
+        ShapeModel::Line { .. } => 1,
+        _ => 2,
+    };
     let best = cands
         .iter()
-        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .filter(|c| c.1 <= lowest + TIE * (1.0 + lowest.abs()))
+        .min_by_key(|c| preference(&c.0))
         .map(|c| c.0)?;
     let scores = cands.iter().map(|(m, s)| (ShapeKind::of(m), *s)).collect();
     Some((best, scores))

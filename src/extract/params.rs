@@ -20,6 +20,23 @@ pub struct FormationParams {
     pub birds: usize,
     /// One entry per annotated frame, in file order.
     pub frames: Vec<FrameParams>,
+    /// The movie's geometry over all frames and the warnings of the extraction (issue 16);
+    /// absent in files written before it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub summary: Option<Box<ParamsSummary>>,
+}
+
+/// What `extract` reports about the whole movie besides the per-frame parameters.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ParamsSummary {
+    /// Wingspan of one bird, metres, when given (the spacings in metres use it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub wingspan_m: Option<f64>,
+    /// Apex angle, arm angles, depth and wingtip spacing over the frames.
+    pub geometry: super::geometry::GeometrySummary,
+    /// Suspicious input found while extracting (empty when none).
+    #[serde(default)]
+    pub warnings: Vec<super::checks::Warning>,
 }
 
 /// §4 steps 1 and 2 for one frame.
@@ -49,6 +66,10 @@ pub struct FrameParams {
     /// deviation from the curve; in `order`.
     #[serde(default)]
     pub positions: Vec<BirdPosition>,
+    /// Apex angle per arm, depth, width and wingtip spacing (issue 16); absent in files
+    /// written before it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub geometry: Option<super::geometry::FrameGeometry>,
 }
 
 /// A marked bird in the formation frame.
@@ -146,6 +167,21 @@ impl ShapeModel {
 }
 
 impl FormationParams {
+    /// How many frames were fitted by each kind (`"v"`, `"line"`, …), most frequent first
+    /// (ties in order of first appearance).
+    pub fn kind_counts(&self) -> Vec<(&'static str, usize)> {
+        let mut counts: Vec<(&'static str, usize)> = Vec::new();
+        for f in &self.frames {
+            let k = f.shape.kind();
+            match counts.iter_mut().find(|c| c.0 == k) {
+                Some(c) => c.1 += 1,
+                None => counts.push((k, 1)),
+            }
+        }
+        counts.sort_by_key(|c| std::cmp::Reverse(c.1));
+        counts
+    }
+
     /// Reads and validates a params file.
     pub fn read(path: &Path) -> Result<FormationParams> {
         let p: FormationParams = crate::io::read_json(path)?;

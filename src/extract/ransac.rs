@@ -37,6 +37,20 @@ pub struct Parabola {
     pub c: f64,
 }
 
+/// Two straight arms meeting at the leader's lateral position (x = 0):
+/// `y = c + sl·x` for x < 0 and `y = c + sr·x` for x ≥ 0, both swept back (`sl ≤ 0 ≤ sr`). Three parameters: the apex's depth
+/// and the two slopes (the apex lies on the leader's line of flight by construction, §4 step 1
+/// puts the leader at x = 0).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Vee {
+    /// `y` at the apex (x = 0), wingspans.
+    pub c: f64,
+    /// Slope dy/dx of the left arm (x < 0); negative for an arm swept back.
+    pub sl: f64,
+    /// Slope dy/dx of the right arm (x ≥ 0); positive for an arm swept back.
+    pub sr: f64,
+}
+
 /// A curve that RANSAC can fit.
 pub trait Model: Copy {
     /// Minimal sample size.
@@ -129,6 +143,55 @@ impl Model for Parabola {
     }
     fn valid(&self) -> bool {
         self.a > 0.0
+    }
+}
+
+impl Model for Vee {
+    const K: usize = 3;
+    fn fit(pts: &[(f64, f64)]) -> Option<Vee> {
+        if pts.len() < 3 {
+            return None;
+        }
+        // Linear least squares on the design row (1, min(x, 0), max(x, 0)); singular when one
+        // side of the leader has no point.
+        let mut ata = nalgebra::Matrix3::<f64>::zeros();
+        let mut aty = nalgebra::Vector3::<f64>::zeros();
+        let scale = pts.iter().map(|p| p.0.abs()).fold(0.0f64, f64::max);
+        if scale <= 1e-9 {
+            return None;
+        }
+        for &(x, y) in pts {
+            let u = x / scale;
+            let row = nalgebra::Vector3::new(1.0, u.min(0.0), u.max(0.0));
+            ata += row * row.transpose();
+            aty += row * y;
+        }
+        let n = pts.len() as f64;
+        if ata.determinant().abs() < 1e-10 * n * n * n {
+            return None;
+        }
+        let sol = ata.lu().solve(&aty)?;
+        let v = Vee {
+            c: sol[0],
+            sl: sol[1] / scale,
+            sr: sol[2] / scale,
+        };
+        (v.c.is_finite() && v.sl.is_finite() && v.sr.is_finite()).then_some(v)
+    }
+    fn y_at(&self, x: f64) -> f64 {
+        self.c + if x < 0.0 { self.sl * x } else { self.sr * x }
+    }
+    fn slope_at(&self, x: f64) -> f64 {
+        if x < 0.0 {
+            self.sl
+        } else {
+            self.sr
+        }
+    }
+    /// Both arms swept back (or flat): an arm reaching forward of the leader's flank is no V
+    /// (it is what a formation opening forward looks like, see `extract::checks`).
+    fn valid(&self) -> bool {
+        self.sl <= 0.0 && self.sr >= 0.0
     }
 }
 
@@ -281,6 +344,16 @@ mod tests {
         for &(x, y) in &[(-2.0, 4.5), (1.0, 1.5), (3.0, 9.5)] {
             assert!((p.y_at(x) - y).abs() < 1e-9);
         }
+    }
+
+    #[test]
+    fn vee_through_three_points_is_exact_and_needs_both_sides() {
+        let pts = [(-0.9, 0.6), (0.0, 0.0), (1.0, 0.5)];
+        let v = Vee::fit(&pts).unwrap();
+        for &(x, y) in &pts {
+            assert!((v.y_at(x) - y).abs() < 1e-9);
+        }
+        assert!(Vee::fit(&[(0.0, 0.0), (1.0, 0.5), (2.0, 1.1)]).is_none());
     }
 
     #[test]

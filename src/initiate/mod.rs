@@ -1627,6 +1627,8 @@ pub fn hand_over(
             k
         })
         .collect();
+    // The steady flight's feasible ξ ranges stay with its key shapes (plot power draws them).
+    out.xi_ranges = steady.xi_ranges.clone();
     out.frames = frames;
     // Closest approach (3-D) in the written initiation frames (after the blend).
     let mut stats = run.stats.clone();

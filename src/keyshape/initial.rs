@@ -342,6 +342,7 @@ mod tests {
             },
             outliers,
             positions: vec![],
+            geometry: None,
         }
     }
 
@@ -473,6 +474,7 @@ mod tests {
             source: String::new(),
             birds: 5,
             frames: vec![f],
+            summary: None,
         };
         let c = correspondence(&p.frames[0], 5).unwrap();
         let s = initial_shapes(&p, &c, &mut seeded(0), &InitialOptions::default());

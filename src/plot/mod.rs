@@ -5,8 +5,11 @@
 use std::path::Path;
 use std::sync::Once;
 
+pub mod field;
+pub mod geometry;
 pub mod paths;
 pub mod power;
+pub mod savings;
 pub mod shape;
 pub mod wingbeat;
 pub mod xi;
@@ -30,6 +33,69 @@ fn register_font() {
         let _ = plotters::style::register_font(FONT_FAMILY, FontStyle::Normal, FONT);
         let _ = plotters::style::register_font(FONT_FAMILY, FontStyle::Bold, FONT);
     });
+}
+
+/// The leader's colour in every chart (not in the birds' colour map).
+pub const LEADER: RGBColor = RGBColor(200, 30, 30);
+
+/// Colour of the bird at `rank` (0 = front) of `n` birds: the viridis map (perceptually
+/// uniform, readable in grey and by colour-blind readers) from dark purple at the front to green
+/// at the back, stopped before its pale yellow end so that every line reads on white.
+pub fn bird_colour(rank: usize, n: usize) -> RGBColor {
+    const V: [(f64, f64, f64); 5] = [
+        (68.0, 1.0, 84.0),
+        (59.0, 82.0, 139.0),
+        (33.0, 145.0, 140.0),
+        (94.0, 201.0, 98.0),
+        (253.0, 231.0, 37.0),
+    ];
+    let s = 0.78 * rank as f64 / (n.max(2) - 1) as f64;
+    let u = s.clamp(0.0, 1.0) * 4.0;
+    let i = (u.floor() as usize).min(3);
+    let f = u - i as f64;
+    let mix = |a: f64, b: f64| (a + (b - a) * f).round() as u8;
+    RGBColor(
+        mix(V[i].0, V[i + 1].0),
+        mix(V[i].1, V[i + 1].1),
+        mix(V[i].2, V[i + 1].2),
+    )
+}
+
+/// Ranks (for the legend) worth a label among `n` birds: the front, the back and a few between.
+pub fn legend_ranks(n: usize) -> Vec<usize> {
+    if n <= 12 {
+        return (0..n).collect();
+    }
+    let mut r: Vec<usize> = (0..5).map(|k| k * (n - 1) / 4).collect();
+    r.dedup();
+    r
+}
+
+/// Start and end of an animation's take-off, seconds (the end is the hand-over frame's time).
+pub fn takeoff_span(anim: &crate::animation::Animation) -> Option<(f64, f64)> {
+    let s = anim.stage("initiation")?;
+    let a = anim.frames.get(s.start)?.t;
+    let b = anim.frames.get(s.end).or(anim.frames.last())?.t;
+    (s.end > s.start).then_some((a, b))
+}
+
+/// What an animation holds, for titles: `take-off and steady flight`, `steady flight only`.
+pub fn stages_title(anim: &crate::animation::Animation) -> String {
+    let names: Vec<&str> = anim
+        .stages
+        .iter()
+        .filter(|s| s.end > s.start)
+        .map(|s| match s.name.as_str() {
+            "initiation" => "take-off",
+            "steady" => "steady flight",
+            other => other,
+        })
+        .collect();
+    match names.as_slice() {
+        [] => "no stages".into(),
+        [one] => format!("{one} only"),
+        many => many.join(" and "),
+    }
 }
 
 /// Error type of a drawing operation on backend `DB`.

@@ -2,8 +2,10 @@
 //! animation file with an `initiation` stage (world frame, wingspans); draws two panels:
 //! the world (x east, y north, equal scales) and the same paths seen from a frame that moves with
 //! the cruise velocity of the steady flight (p − v_c t), where the birds can be seen gathering
-//! into the key shape. Starts are open circles, hand-over positions filled dots, the leader's
-//! path is drawn thicker.
+//! into the key shape. Starts are open circles, hand-over positions filled dots. Birds are
+//! coloured by their rank at the hand-over (the perceptual map of [`super::bird_colour`], front
+//! dark), the leader's path red and thicker, with a legend. A file without a take-off is drawn
+//! whole and says so in its title.
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -21,6 +23,8 @@ pub struct PathsChart {
     pub relative: Vec<Vec<(f64, f64)>>,
     /// Index of the leader (front-most bird at hand-over).
     pub leader: usize,
+    /// Each bird's rank in its formation at the hand-over (colour order).
+    pub rank: Vec<usize>,
     /// Title line.
     pub title: String,
 }
@@ -72,12 +76,21 @@ impl PathsChart {
             })
             .unwrap_or(0);
         let secs = (end - start) as f64 / a.fps;
+        let what = if a.stage("initiation").is_some() {
+            "Take-off".to_string()
+        } else {
+            format!(
+                "No take-off in this file ({}): paths",
+                super::stages_title(a)
+            )
+        };
         Ok(PathsChart {
             world,
             relative,
             leader,
+            rank: a.relative(end - 1).iter().map(|r| r.rank).collect(),
             title: format!(
-                "Initiation of {n} birds: {} frames ({secs:.1} s at {} fps)",
+                "{what} of {n} birds: {} frames ({secs:.1} s at {} fps)",
                 end - start,
                 a.fps
             ),
@@ -122,6 +135,11 @@ fn equal_bounds(paths: &[Vec<(f64, f64)>], w: f64, h: f64) -> ((f64, f64), (f64,
 }
 
 impl PathsChart {
+    fn rank_of(&self, i: usize) -> usize {
+        self.rank.get(i).copied().unwrap_or(i)
+    }
+
+    #[allow(clippy::too_many_arguments)]
     fn panel<DB: DrawingBackend>(
         &self,
         area: &DrawingArea<DB, Shift>,
@@ -129,6 +147,7 @@ impl PathsChart {
         caption: &str,
         x_desc: &str,
         y_desc: &str,
+        legend: bool,
     ) -> DrawResult<DB> {
         let (w, h) = area.dim_in_pixel();
         // Plot area excludes the label areas and margins.
@@ -147,17 +166,46 @@ impl PathsChart {
             .label_style((FONT_FAMILY, 13))
             .light_line_style(RGBColor(235, 235, 235))
             .draw()?;
-        for (i, p) in paths.iter().enumerate() {
-            let color = Palette99::pick(i).to_rgba();
-            let width = if i == self.leader { 3 } else { 1 };
-            chart.draw_series(LineSeries::new(
+        let n = paths.len();
+        let labelled = super::legend_ranks(n);
+        let mut order: Vec<usize> = (0..n).collect();
+        // Back to front, the leader last (on top).
+        order.sort_by_key(|&i| (i == self.leader, std::cmp::Reverse(self.rank_of(i))));
+        for i in order {
+            let p = &paths[i];
+            let rank = self.rank_of(i);
+            let (color, width) = if i == self.leader {
+                (super::LEADER, 3)
+            } else {
+                (super::bird_colour(rank, n), 1)
+            };
+            let s = chart.draw_series(LineSeries::new(
                 p.iter().copied(),
                 color.stroke_width(width),
             ))?;
+            if legend && (i == self.leader || labelled.contains(&rank)) {
+                let style = color.stroke_width(width);
+                let label = if i == self.leader {
+                    format!("leader (bird {i})")
+                } else {
+                    format!("rank {rank} (bird {i})")
+                };
+                s.label(label)
+                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], style));
+            }
             if let (Some(&a), Some(&b)) = (p.first(), p.last()) {
                 chart.draw_series(std::iter::once(Circle::new(a, 4, color.stroke_width(1))))?;
                 chart.draw_series(std::iter::once(Circle::new(b, 4, color.filled())))?;
             }
+        }
+        if legend {
+            chart
+                .configure_series_labels()
+                .background_style(WHITE.mix(0.85))
+                .border_style(BLACK)
+                .label_font((FONT_FAMILY, 12))
+                .position(SeriesLabelPosition::UpperLeft)
+                .draw()?;
         }
         Ok(())
     }
@@ -178,6 +226,7 @@ impl Chart for PathsChart {
             "world (top view)",
             "east, wingspans",
             "north, wingspans",
+            false,
         )?;
         self.panel(
             &right,
@@ -185,6 +234,7 @@ impl Chart for PathsChart {
             "moving with the cruise velocity (○ start, ● hand-over)",
             "east − v_x t, wingspans",
             "north − v_y t, wingspans",
+            true,
         )?;
         Ok(())
     }

@@ -49,7 +49,7 @@ pub enum PowerOf {
 }
 
 /// The file name of `origin`, for titles.
-fn file_name(origin: &Path) -> String {
+pub(crate) fn file_name(origin: &Path) -> String {
     origin
         .file_name()
         .map(|s| s.to_string_lossy().into_owned())
@@ -192,7 +192,7 @@ impl Chart for PowerChart {
             .light_line_style(WHITE.mix(0.0))
             .draw()?;
         let bar = RGBColor(70, 120, 180);
-        let lead = RGBColor(220, 120, 40);
+        let lead = super::LEADER;
         let half = 0.25;
         chart
             .draw_series(
@@ -206,7 +206,7 @@ impl Chart for PowerChart {
                     }),
             )?
             .label(if self.leader.is_some() {
-                "bird (orange: leader)"
+                "bird (red: leader)"
             } else {
                 "bird"
             })

@@ -1,7 +1,8 @@
 //! `formation plot xi`: the relative power reduction ξ_i of every bird over time (seconds) in an
-//! animation, one line per bird coloured from the leftmost (blue) to the rightmost bird (red), with
-//! the key-shape instants as dashed vertical lines. Gaps in a series (frames where ξ is undefined)
-//! are left blank.
+//! animation, one line per bird coloured by its rank in its formation (the perceptual map of
+//! [`super::bird_colour`], front dark), the leader in red and thicker, the take-off shaded, the
+//! key-shape instants as dashed vertical lines. Exactly the ξ the file records (the CSV's `xi`
+//! column) is drawn: frames without it are gaps, never recomputed.
 
 use plotters::coord::Shift;
 use plotters::element::DashedPathElement;
@@ -10,7 +11,6 @@ use plotters::prelude::*;
 use std::path::Path;
 
 use super::{Chart, DrawResult, FONT_FAMILY};
-use crate::aero::power_reduction;
 use crate::animation::Animation;
 use crate::error::{Error, Result};
 
@@ -23,10 +23,14 @@ pub struct XiChart {
     pub t: Vec<f64>,
     /// Per bird, ξ at each time (`NaN` where undefined).
     pub xi: Vec<Vec<f64>>,
-    /// Lateral position of each bird, wingspans (colour order; legend for few birds).
-    pub lateral: Vec<f64>,
+    /// Rank of each bird in its formation (colour order), 0 = front.
+    pub rank: Vec<usize>,
+    /// The formations' leaders.
+    pub leaders: Vec<usize>,
     /// Times of the key shapes, seconds.
     pub key_times: Vec<f64>,
+    /// Start and end of the take-off, seconds, when the file has one.
+    pub takeoff: Option<(f64, f64)>,
 }
 
 impl XiChart {
@@ -38,17 +42,10 @@ impl XiChart {
         let mut xi = vec![Vec::with_capacity(anim.frames.len()); n];
         let mut any = false;
         for fr in &anim.frames {
-            let values = match &fr.xi {
-                Some(v) => Some(v.clone()),
-                None => {
-                    let back: Vec<f64> = fr.y.iter().map(|v| -v).collect();
-                    power_reduction(&fr.x, &back).ok().map(|p| p.xi)
-                }
-            };
-            any |= values.is_some();
+            any |= fr.xi.is_some();
             for (i, series) in xi.iter_mut().enumerate() {
                 series.push(
-                    values
+                    fr.xi
                         .as_ref()
                         .and_then(|v| v.get(i).copied())
                         .unwrap_or(f64::NAN),
@@ -58,51 +55,51 @@ impl XiChart {
         if !any {
             return Err(Error::format(
                 origin,
-                "no frame has a defined ξ (every frame has two birds wing to wing)",
+                "no frame records ξ (`xi`); write the file with `formation steady` or `formation animate`",
             ));
         }
-        let lateral = anim
-            .key_shapes
-            .first()
-            .map(|k| k.birds.iter().map(|b| b.x).collect())
-            .or_else(|| anim.frames.first().map(|f| f.x.clone()))
-            .unwrap_or_default();
-        let name = origin
-            .file_name()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_default();
+        // Ranks at the first steady frame (the formation the flock flies), else the last frame.
+        let k = anim
+            .stage("steady")
+            .filter(|s| s.end > s.start)
+            .map_or(anim.frames.len() - 1, |s| s.start);
+        let rank = anim.relative(k).iter().map(|r| r.rank).collect();
+        let takeoff = super::takeoff_span(anim);
+        let name = super::power::file_name(origin);
         Ok(XiChart {
-            title: format!("{name}: ξ of {n} birds over time"),
+            title: format!(
+                "{name}: ξ of {n} birds over time ({})",
+                super::stages_title(anim)
+            ),
             t: anim.frames.iter().map(|f| f.t).collect(),
             xi,
-            lateral,
+            rank,
+            leaders: anim.leaders(),
             key_times: anim
                 .key_shapes
                 .iter()
                 .filter_map(|k| anim.frames.get(k.frame).map(|f| f.t))
                 .collect(),
+            takeoff,
         })
     }
-}
-
-/// Blue → cyan → green → orange → red by hue, `s` in [0, 1].
-fn ramp(s: f64) -> HSLColor {
-    let s = s.clamp(0.0, 1.0);
-    HSLColor((240.0 - 240.0 * s) / 360.0, 0.8, 0.42)
 }
 
 impl Chart for XiChart {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult<DB> {
         let t0 = self.t.first().copied().unwrap_or(0.0);
         let t1 = self.t.last().copied().unwrap_or(1.0).max(t0 + 1e-6);
+        // The axis spans the steady flight's ξ (after the take-off): while the birds are still
+        // scattered E is near 0 and ξ = e/E is huge; those spikes are cut at the top.
+        let after = self.takeoff.map_or(f64::NEG_INFINITY, |(_, b)| b);
         let top = self
             .xi
             .iter()
-            .flatten()
-            .copied()
-            .filter(|v| v.is_finite())
+            .flat_map(|s| s.iter().zip(&self.t))
+            .filter(|(v, &t)| v.is_finite() && t >= after)
+            .map(|(v, _)| *v)
             .fold(0.0, f64::max);
-        let top = if top > 0.0 { top * 1.1 } else { 1.0 };
+        let top = if top > 0.0 { top * 1.25 } else { 1.0 };
         let mut chart = ChartBuilder::on(root)
             .caption(&self.title, (FONT_FAMILY, 22))
             .margin(16)
@@ -111,11 +108,23 @@ impl Chart for XiChart {
             .build_cartesian_2d(t0..t1, 0.0..top)?;
         chart
             .configure_mesh()
-            .x_desc("time (s)   ·   colour: lateral position, leftmost blue → rightmost red   ·   dashed: key shapes")
+            .x_desc("time (s)   ·   colour: rank in the formation, front dark → back green; red: leader   ·   dashed: key shapes")
             .y_desc("relative power reduction ξ")
             .label_style((FONT_FAMILY, 14))
             .light_line_style(WHITE.mix(0.0))
             .draw()?;
+        if let Some((a, b)) = self.takeoff {
+            let c = RGBColor(150, 150, 150);
+            chart
+                .draw_series(std::iter::once(Rectangle::new(
+                    [(a, 0.0), (b, top)],
+                    c.mix(0.15).filled(),
+                )))?
+                .label(format!("take-off ({:.1} s)", b - a))
+                .legend(move |(x, y)| {
+                    Rectangle::new([(x, y - 5), (x + 14, y + 5)], c.mix(0.4).filled())
+                });
+        }
         let grey = RGBColor(170, 170, 170);
         for &k in &self.key_times {
             chart.draw_series(std::iter::once(DashedPathElement::new(
@@ -126,14 +135,18 @@ impl Chart for XiChart {
             )))?;
         }
         let mut order: Vec<usize> = (0..self.xi.len()).collect();
-        order.sort_by(|&a, &b| {
-            let xa = self.lateral.get(a).copied().unwrap_or(0.0);
-            let xb = self.lateral.get(b).copied().unwrap_or(0.0);
-            xa.total_cmp(&xb)
-        });
-        let n = order.len().max(2) - 1;
-        for (rank, &i) in order.iter().enumerate() {
-            let color = ramp(rank as f64 / n as f64);
+        // Back to front, so that the leader and the front birds are drawn on top.
+        order.sort_by_key(|&i| std::cmp::Reverse(self.rank.get(i).copied().unwrap_or(0)));
+        let n = order.len();
+        let labelled = super::legend_ranks(n);
+        for &i in &order {
+            let rank = self.rank.get(i).copied().unwrap_or(0);
+            let leader = self.leaders.contains(&i);
+            let (color, width) = if leader {
+                (super::LEADER, 3)
+            } else {
+                (super::bird_colour(rank, n), 2)
+            };
             let series = &self.xi[i];
             // Split into runs of finite values.
             let mut runs: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
@@ -146,17 +159,21 @@ impl Chart for XiChart {
                     runs.push(Vec::new());
                 }
             }
-            let style = ShapeStyle::from(&color).stroke_width(2);
+            let style = ShapeStyle::from(&color).stroke_width(width);
             for (j, run) in runs.into_iter().filter(|r| !r.is_empty()).enumerate() {
                 let s = chart.draw_series(LineSeries::new(run, style))?;
-                if j == 0 && self.xi.len() <= 12 {
-                    let x = self.lateral.get(i).copied().unwrap_or(0.0);
-                    s.label(format!("bird {i} (x = {x:.2})"))
+                if j == 0 && (leader || labelled.contains(&rank)) {
+                    let label = if leader {
+                        format!("leader (bird {i})")
+                    } else {
+                        format!("rank {rank} (bird {i})")
+                    };
+                    s.label(label)
                         .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], style));
                 }
             }
         }
-        if self.xi.len() <= 12 {
+        {
             chart
                 .configure_series_labels()
                 .background_style(WHITE.mix(0.85))

@@ -109,6 +109,7 @@ pub fn movie(
                 .collect(),
             outliers: outliers.iter().map(|(r, _)| *r).collect(),
             positions,
+            geometry: None,
         });
     }
     FormationParams {
@@ -116,6 +117,7 @@ pub fn movie(
         source: format!("synthetic {kind:?} movie, {n_hat} birds, seed {seed}"),
         birds: n_hat,
         frames: out,
+        summary: None,
     }
 }
 

@@ -1,0 +1,76 @@
+//! `formation report INPUT -o report.html` (issue 16): reads annotations (extracted on the
+//! fly), a params file or an animation, and writes the library's self-contained page
+//! ([`formation::report`]) atomically.
+
+use std::path::PathBuf;
+
+use clap::Args;
+use formation::extract::{ExtractOptions, FormationParams};
+use formation::io::{write_bytes_atomic, OutputKind};
+use formation::report::{report, Subject};
+use formation::sniff::Kind;
+use formation::{Animation, Result};
+
+use super::extract::{FitArgs, ReadArgs, SizeArgs};
+use super::Global;
+
+/// Arguments of `formation report`.
+#[derive(Debug, Args)]
+pub struct ReportArgs {
+    /// Annotations (any format), a params file written by `formation extract`, or an animation
+    /// file.
+    pub input: PathBuf,
+    /// Output page (.html).
+    #[arg(short = 'o', long = "output")]
+    pub output: PathBuf,
+    #[command(flatten)]
+    pub read: ReadArgs,
+    #[command(flatten)]
+    pub fit: FitArgs,
+    #[command(flatten)]
+    pub size: SizeArgs,
+}
+
+/// Runs `formation report`.
+pub fn run(args: ReportArgs, g: Global) -> Result<()> {
+    OutputKind::for_flag("-o", &args.output, &[OutputKind::Html])?;
+    let extract = ExtractOptions {
+        wingspan_m: args.size.wingspan_m,
+        ..args.fit.options()
+    };
+    extract.validate()?;
+    formation::io::check_output_dir("-o", &args.output)?;
+    let kind = if args.input.is_dir() {
+        Kind::Labelme
+    } else {
+        let text = formation::io::read_text(&args.input)?;
+        serde_json::from_str::<serde_json::Value>(&text)
+            .map(|v| formation::sniff::json_kind(&v))
+            .unwrap_or(Kind::Unknown)
+    };
+    let (params, animation, threshold): (Option<FormationParams>, Option<Animation>, _) = match kind
+    {
+        Kind::Animation => (None, Some(Animation::read(&args.input)?), None),
+        Kind::Params => (Some(super::steady::read_params(&args.input)?), None, None),
+        _ => {
+            let (_, p, _) = super::extract::read_and_extract(
+                &args.input,
+                &args.read,
+                extract,
+                g,
+                super::flags::Cmd::Report,
+            )?;
+            (Some(p), None, Some(extract.inlier_threshold))
+        }
+    };
+    if let Some(p) = &params {
+        super::warn_params(g, p)?;
+    }
+    let page = report(&Subject {
+        origin: &args.input,
+        params: params.as_ref(),
+        threshold,
+        animation: animation.as_ref(),
+    })?;
+    write_bytes_atomic(&args.output, page.as_bytes())
+}

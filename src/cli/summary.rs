@@ -1,0 +1,143 @@
+//! The one-paragraph summary that `animate`, `steady` and `initiate` print on stderr after
+//! their outputs are committed (issue 16): the shape learnt, the formations, the take-off time,
+//! the flock's saving and the files written with their sizes. `--quiet` hides it.
+
+use std::path::PathBuf;
+use std::sync::Mutex;
+
+use formation::animation::Animation;
+use formation::extract::FormationParams;
+
+/// Lines to print once every output is committed (their sizes are known then).
+static DEFERRED: Mutex<Vec<(String, Vec<PathBuf>)>> = Mutex::new(Vec::new());
+
+/// Prints `text` and the sizes of `outputs` after the command's outputs are committed.
+pub fn defer(text: String, outputs: &[PathBuf]) {
+    if let Ok(mut d) = DEFERRED.lock() {
+        d.push((text, outputs.to_vec()));
+    }
+}
+
+/// Prints what [`defer`] queued (called once the outputs exist).
+pub fn print_deferred() {
+    let items = DEFERRED
+        .lock()
+        .map(|mut d| std::mem::take(&mut *d))
+        .unwrap_or_default();
+    for (text, outputs) in items {
+        let files: Vec<String> = outputs
+            .iter()
+            .map(|p| format!("{} ({})", p.display(), human_size(&size_of(p))))
+            .collect();
+        if files.is_empty() {
+            eprintln!("{text}");
+        } else {
+            eprintln!("{text}\nwrote {}", files.join(", "));
+        }
+    }
+}
+
+/// Bytes of a file, or of every file in a directory (PNG frames).
+fn size_of(p: &std::path::Path) -> u64 {
+    match std::fs::metadata(p) {
+        Ok(m) if m.is_dir() => std::fs::read_dir(p)
+            .map(|rd| {
+                rd.filter_map(|e| e.ok())
+                    .filter_map(|e| e.metadata().ok())
+                    .map(|m| m.len())
+                    .sum()
+            })
+            .unwrap_or(0),
+        Ok(m) => m.len(),
+        Err(_) => 0,
+    }
+}
+
+/// `7.3 MB`, `12 kB`, `512 B`.
+pub fn human_size(bytes: &u64) -> String {
+    let b = *bytes as f64;
+    if b >= 1e6 {
+        format!("{:.1} MB", b / 1e6)
+    } else if b >= 1e3 {
+        format!("{:.0} kB", b / 1e3)
+    } else {
+        format!("{bytes} B")
+    }
+}
+
+/// The kinds fitted over the frames of `p`: `V in 20/20 frames`.
+pub fn kinds_text(p: &FormationParams) -> String {
+    let parts: Vec<String> = p
+        .kind_counts()
+        .iter()
+        .map(|(k, c)| format!("{} in {c}/{}", k.to_uppercase(), p.frames.len()))
+        .collect();
+    format!("{} frames", parts.join(", "))
+}
+
+/// The summary of an animation: `what` names the command.
+pub fn animation_text(what: &str, anim: &Animation, params: Option<&FormationParams>) -> String {
+    let s = formation::animation::stats::AnimationStats::of(anim);
+    let mut parts = vec![format!("{what}: {} birds", anim.birds)];
+    if let Some(p) = params {
+        parts.push(format!(
+            "shape {} (learnt from {})",
+            dominant(p),
+            kinds_text(p)
+        ));
+    }
+    parts.push(format!(
+        "{} formation{}",
+        s.formations,
+        if s.formations == 1 { "" } else { "s" }
+    ));
+    if let Some(t) = s.takeoff_s {
+        parts.push(format!("take-off {t:.1} s"));
+    }
+    if let Some(t) = s.steady_s {
+        parts.push(format!("steady flight {t:.1} s"));
+    }
+    if let Some(e) = s.steady_saving {
+        parts.push(format!(
+            "flock saving {:.1} % of induced power in steady flight (field studies: 14–36 %)",
+            100.0 * e
+        ));
+    }
+    parts.join(", ")
+}
+
+/// The most frequent kind of `p`, upper case.
+pub fn dominant(p: &FormationParams) -> String {
+    p.kind_counts()
+        .first()
+        .map_or("?".into(), |(k, _)| k.to_uppercase())
+}
+
+/// `initiate`'s summary (one call from its command, so that its file stays its own).
+pub fn initiate(g: super::Global, anim: &Animation, converged: bool, outputs: &[PathBuf]) {
+    if g.quiet {
+        return;
+    }
+    let mut text = animation_text("initiate", anim, None);
+    if !converged {
+        text.push_str(" (the take-off did not converge)");
+    }
+    defer(text, outputs);
+}
+
+/// `animate`'s summary.
+pub fn animate(
+    g: super::Global,
+    anim: &Animation,
+    report: &formation::pipeline::Report,
+    outputs: &[PathBuf],
+) {
+    if g.quiet {
+        return;
+    }
+    let mut text = animation_text("animate", anim, Some(&report.params));
+    if report.initiate.as_ref().is_some_and(|s| !s.converged) {
+        text.push_str(" (the take-off did not converge)");
+    }
+    defer(text, outputs);
+}
