@@ -407,6 +407,11 @@ fn steady_of(
 /// from fresh random starts.
 pub const TAKEOFF_TRIES: usize = 4;
 
+/// Closest two birds of a formation should come during its take-off, wingspans: a converged
+/// take-off that brought two birds closer is flown again like one that did not converge (and
+/// kept only if no try does better).
+pub const MIN_TAKEOFF_DISTANCE: f64 = 0.3;
+
 /// Formation `f`'s take-off into the first key shape of its steady flight `steady` (not yet
 /// handed over), from its own start drawn around the origin; the number of tries it took, and
 /// the formation's new steady flight if it was drawn afresh. A take-off that does not converge
@@ -425,6 +430,7 @@ fn takeoff_run(
 ) -> Result<(InitiationRun, usize, Option<(Animation, FormationReport)>)> {
     let n = steady.birds;
     let mut last = None;
+    let mut close: Option<(InitiationRun, usize, Option<(Animation, FormationReport)>)> = None;
     let mut fresh: Option<(Animation, FormationReport)> = None;
     for t in 0..TAKEOFF_TRIES {
         if t > 0 {
@@ -445,10 +451,25 @@ fn takeoff_run(
         };
         let run = initiate::simulate(&target, steady.fps, &cruise, opts, &mut rng, &Silent)
             .map_err(|e| in_formation(e, f, n))?;
-        if run.stats.converged {
+        if run.stats.converged && run.stats.min_distance >= MIN_TAKEOFF_DISTANCE {
             return Ok((run, t + 1, fresh));
         }
+        if run.stats.converged {
+            // Converged, but two birds came closer than wanted: keep the best such run in case
+            // no try does better.
+            let better = match &close {
+                None => true,
+                Some((r, _, _)) => run.stats.min_distance > r.stats.min_distance,
+            };
+            if better {
+                close = Some((run, t + 1, fresh.clone()));
+            }
+            continue;
+        }
         last = Some(run.stats);
+    }
+    if let Some(c) = close {
+        return Ok(c);
     }
     let stats = last.expect("at least one try");
     Err(Error::NotConverged(format!(
