@@ -1,7 +1,9 @@
 //! The main job end to end: what `formation animate examples_data/barnacle_geese_v.json
 //! --birds 14 -o flock.gif` does (read and extract the 9-goose annotations, 20 s of steady flight
 //! at 30 fps for 14 birds, the take-off before it, wingbeats, the 960×540 GIF), and the same
-//! without the GIF (the simulation alone). Results: docs/performance.md.
+//! without the GIF (the simulation alone). Issue 13: a flock of 1000 geese (about 111 formations)
+//! taking off and flying 20 s of steady flight, written as JSON and CSV, and 10 000 geese in
+//! steady flight only (20 s, the animation in memory). Results: docs/performance.md.
 
 use std::path::{Path, PathBuf};
 
@@ -16,11 +18,22 @@ fn simulate() -> Animation {
 }
 
 fn simulate_on(path: Option<PathBuf>) -> Animation {
+    flock_on(14, true, path)
+}
+
+/// `birds` geese from the 9-goose example, 20 s of steady flight, with or without the take-off.
+fn flock(birds: usize, takeoff: bool) -> Animation {
+    flock_on(birds, takeoff, None)
+}
+
+/// [`flock`] along a path, if given.
+fn flock_on(birds: usize, takeoff: bool, path: Option<PathBuf>) -> Animation {
     let input = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples_data/barnacle_geese_v.json");
     let mut config = Config::default();
-    config.steady.birds = 14;
+    config.steady.birds = birds;
     config.seconds = Some(20.0);
     config.course.path = path;
+    config.initiation = takeoff;
     Pipeline::from_path(input).run(&config).unwrap().0
 }
 
@@ -86,6 +99,16 @@ fn bench(c: &mut Criterion) {
             )
             .unwrap()
         })
+    });
+    let files: Vec<PathBuf> = vec![dir.join("flock.json"), dir.join("flock.csv")];
+    g.bench_function("geese_1000_birds_takeoff_20s_json_csv", |b| {
+        b.iter(|| {
+            let anim = flock(1000, true);
+            write_outputs(&anim, &files, &RenderOptions::default(), &Silent).unwrap()
+        })
+    });
+    g.bench_function("geese_10000_birds_steady_20s", |b| {
+        b.iter(|| flock(10_000, false))
     });
     g.finish();
     let _ = std::fs::remove_dir_all(&dir);

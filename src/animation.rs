@@ -86,6 +86,10 @@ pub struct FormationRecord {
     /// Feasible ξ range of each of this formation's birds (order of `birds`), when known.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub xi_ranges: Option<Vec<[f64; 2]>>,
+    /// First frame of this formation's steady flight (the frame its take-off hands over at),
+    /// when known.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub steady_start: Option<usize>,
 }
 
 /// A named range of frames.
@@ -429,6 +433,27 @@ impl Animation {
                         ));
                     }
                 }
+                if fm.steady_start.is_some_and(|s| s >= self.frames.len()) {
+                    return Err(Error::format(
+                        origin,
+                        format!(
+                            "formations[{k}].steady_start: beyond the {} frames",
+                            self.frames.len()
+                        ),
+                    ));
+                }
+                for (s, ks) in fm.key_shapes.iter().enumerate() {
+                    if ks.frame >= self.frames.len() {
+                        return Err(Error::format(
+                            origin,
+                            format!(
+                                "formations[{k}].key_shapes[{s}].frame: {} is beyond the {} frames",
+                                ks.frame,
+                                self.frames.len()
+                            ),
+                        ));
+                    }
+                }
                 if let Some(r) = &fm.xi_ranges {
                     if r.len() != fm.birds.len() {
                         return Err(Error::format(
@@ -470,6 +495,52 @@ impl Animation {
             }
         }
         of
+    }
+
+    /// Number of formations (1 for a flock of one formation).
+    pub fn formation_count(&self) -> usize {
+        self.formations.as_ref().map_or(1, |f| f.len().max(1))
+    }
+
+    /// Formation `k` alone, as an animation of one formation: its birds (in the order of its
+    /// record), its key shapes and ranges, every frame and stage. Formation 0 of a flock of one
+    /// formation is the animation itself. `None` when there is no formation `k`.
+    pub fn formation(&self, k: usize) -> Option<Animation> {
+        let Some(fs) = &self.formations else {
+            return (k == 0).then(|| self.clone());
+        };
+        let fm = fs.get(k)?;
+        let pick = |v: &Vec<f64>| -> Vec<f64> {
+            fm.birds
+                .iter()
+                .map(|&b| v.get(b).copied().unwrap_or(0.0))
+                .collect()
+        };
+        let pick_opt = |v: &Option<Vec<f64>>| v.as_ref().map(pick);
+        let mut a = Animation::new(self.seed, self.fps, self.wingspan_m, fm.birds.len());
+        a.species = self.species.clone();
+        a.wingbeat = self.wingbeat.clone();
+        a.stages = self.stages.clone();
+        a.key_shapes = fm.key_shapes.clone();
+        a.xi_ranges = fm.xi_ranges.clone();
+        a.frames = self
+            .frames
+            .iter()
+            .map(|f| Frame {
+                t: f.t,
+                x: pick(&f.x),
+                y: pick(&f.y),
+                z: pick(&f.z),
+                heading: pick(&f.heading),
+                speed: pick(&f.speed),
+                bank: pick_opt(&f.bank),
+                pitch: pick_opt(&f.pitch),
+                e: pick_opt(&f.e),
+                xi: pick_opt(&f.xi),
+                wing_phase: pick_opt(&f.wing_phase),
+            })
+            .collect();
+        Some(a)
     }
 
     /// Each formation's leader (one entry for a flock of one formation): the recorded leader, or

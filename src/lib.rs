@@ -73,6 +73,7 @@ pub mod progress;
 pub mod report;
 pub mod rng;
 pub mod shape;
+pub mod skein;
 pub mod sniff;
 pub mod wingbeat;
 

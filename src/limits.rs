@@ -11,7 +11,8 @@
 /// Most birds in an animation (`steady.birds`, `birds` of an animation file).
 pub const MAX_BIRDS: usize = 100_000;
 
-/// Most birds in one formation's steady flight (`steady.birds`). Algorithm 1 is
+/// Most birds in one formation's steady flight (`steady.birds` of a flock of one formation, and
+/// each formation of a larger flock, see [`crate::skein`]). Algorithm 1 is
 /// quadratic in a formation's birds (every pair interacts): measured on the shared 2-core machine,
 /// 1000 birds take 1.7 s and 2000 birds 6.3 s for one key shape, so 5000 birds take about 40 s
 /// and the 100 000 that [`MAX_BIRDS`] allows would have taken hours.

@@ -34,6 +34,7 @@ use crate::initiate::{self, InitiateOptions, InitiateStats};
 use crate::keyshape::{steady_flight_report, SteadyOptions, SteadyReport};
 use crate::progress::{Progress, Silent};
 use crate::rng::{stream, Stream};
+use crate::skein::{self, FlockOptions, SkeinOptions, SkeinReport};
 use crate::wingbeat::{self, WingbeatOptions};
 
 /// Default length of the steady flight, seconds ([`Config::seconds`]).
@@ -64,6 +65,8 @@ pub struct Config {
     pub wingbeat: WingbeatOptions,
     /// The course: the path the flock follows, turn and bank limits (issue 19).
     pub course: CourseOptions,
+    /// Large flocks as several formations (skeins): how many, how big, how far apart.
+    pub skein: SkeinOptions,
     /// Pictures and exports (used by [`crate::export::write_outputs`], not by [`Pipeline::run`]).
     pub render: RenderOptions,
 }
@@ -80,6 +83,7 @@ impl Default for Config {
             initiate: InitiateOptions::default(),
             wingbeat: WingbeatOptions::default(),
             course: CourseOptions::default(),
+            skein: SkeinOptions::default(),
             render: RenderOptions::default(),
         }
     }
@@ -116,14 +120,34 @@ impl Config {
         Ok(frames as usize)
     }
 
-    /// The steady-flight options with the derived fields set.
+    /// The steady-flight options with the derived fields set. A flock that may fly as several
+    /// formations is checked with its largest possible formation (the flock as a whole only
+    /// against [`crate::limits::MAX_BIRDS`] and the bird-frame limit).
     pub fn steady_options(&self) -> Result<SteadyOptions> {
         let steady = SteadyOptions {
             frames: self.frames()?,
             seed: self.seed,
             ..self.steady.clone()
         };
-        steady.validate()?;
+        let n = steady.birds;
+        if self.skein.formations == Some(1) || n <= crate::limits::MAX_FORMATION_BIRDS {
+            steady.validate()?;
+        } else {
+            if n > crate::limits::MAX_BIRDS {
+                return Err(Error::parameter(
+                    "steady.birds",
+                    format!("{n}: at most {} birds", crate::limits::MAX_BIRDS),
+                ));
+            }
+            crate::limits::check_animation_size("steady.frames", n, steady.frames)?;
+            SteadyOptions {
+                birds: crate::limits::MAX_FORMATION_BIRDS,
+                frames: 1,
+                ..steady.clone()
+            }
+            .validate()?;
+        }
+        self.skein.validate(n)?;
         Ok(steady)
     }
 
@@ -134,7 +158,11 @@ impl Config {
             ..self.initiate.clone()
         };
         o.validate()?;
-        initiate::check_size(self.steady.birds, 0, o.max_steps)?;
+        // The memory bound of the take-off's frames matters only when it is flown (a large
+        // flock's steady flight alone may hold more birds than a take-off of max_steps could).
+        if self.initiation {
+            initiate::check_size(self.steady.birds, 0, o.max_steps)?;
+        }
         Ok(o)
     }
 
@@ -167,10 +195,14 @@ pub struct Report {
     pub params: FormationParams,
     /// Algorithm 1's correspondence, ranges and key-shape statistics.
     pub steady: SteadyReport,
-    /// The initiation's statistics (`None` without initiation).
+    /// The initiation's statistics (`None` without initiation); for a flock of several
+    /// formations the whole flock's (see [`skein::flock_stats`]).
     pub initiate: Option<InitiateStats>,
     /// What the course step did (turns widened, laps of a loop, warnings to show).
     pub course: CourseReport,
+    /// Each formation's reports and the arrangement, when the flock flew as several formations
+    /// (then `steady` is formation 0's).
+    pub skein: Option<SkeinReport>,
 }
 
 /// What a pipeline starts from.
@@ -237,6 +269,19 @@ impl Pipeline {
         config.validate()?;
         let path = config.course.load(config.steady.wingspan_m)?;
         let (params, extract_report) = self.params(config, progress)?;
+        let sizes = config
+            .skein
+            .sizes(config.steady.birds, params.birds, config.seed)?;
+        if sizes.len() > 1 {
+            return flock_run(
+                &params,
+                &sizes,
+                extract_report,
+                config,
+                path.as_ref(),
+                progress,
+            );
+        }
         let (steady, steady_report) = steady_stage(&params, config, progress)?;
         let (mut anim, initiate_report) = if config.initiation {
             initiate::check_steady(&steady, self.origin())?;
@@ -258,6 +303,7 @@ impl Pipeline {
                 steady: steady_report,
                 initiate: initiate_report,
                 course,
+                skein: None,
             },
         ))
     }
@@ -351,8 +397,94 @@ pub fn course_stage(
     crate::course::apply(anim, path, &config.course, flight)
 }
 
+/// The whole run of a flock of several formations of `sizes` birds: steady flights, take-offs
+/// (when `config.initiation`), arrangement, savings and wingbeats.
+fn flock_run(
+    params: &FormationParams,
+    sizes: &[usize],
+    extract: Vec<FrameReport>,
+    config: &Config,
+    path: Option<&PathPoints>,
+    progress: &dyn Progress,
+) -> Result<(Animation, Report)> {
+    let steady = config.steady_options()?;
+    let initiate = config
+        .initiation
+        .then(|| takeoff_config(config, path)?.initiate_options())
+        .transpose()?;
+    let (mut anim, report) = skein::fly(
+        params,
+        sizes,
+        &FlockOptions {
+            steady: &steady,
+            initiate: initiate.as_ref(),
+            skein: &config.skein,
+            seed: config.seed,
+        },
+        progress,
+    )?;
+    let course = course_stage(&mut anim, path, config)?;
+    wingbeat::assign_phases(&mut anim, &config.wingbeat)?;
+    let first = report
+        .formations
+        .first()
+        .and_then(|f| f.steady.clone())
+        .ok_or_else(|| Error::Internal("a flock without formations".into()))?;
+    Ok((
+        anim,
+        Report {
+            extract,
+            params: params.clone(),
+            steady: first,
+            initiate: skein::flock_stats(&report),
+            course,
+            skein: Some(report),
+        },
+    ))
+}
+
+/// The steady flight of `params` for the config: one formation ([`steady_stage`]) or, for a
+/// large flock, several ([`skein::fly`] without take-off); the report is then the flock's.
+pub fn flock_steady_stage(
+    params: &FormationParams,
+    config: &Config,
+    progress: &dyn Progress,
+) -> Result<(Animation, SteadyOutcome)> {
+    let sizes = config
+        .skein
+        .sizes(config.steady.birds, params.birds, config.seed)?;
+    if sizes.len() == 1 {
+        let (a, r) = steady_stage(params, config, progress)?;
+        return Ok((a, SteadyOutcome::One(Box::new(r))));
+    }
+    let steady = config.steady_options()?;
+    let (a, r) = skein::fly(
+        params,
+        &sizes,
+        &FlockOptions {
+            steady: &steady,
+            initiate: None,
+            skein: &config.skein,
+            seed: config.seed,
+        },
+        progress,
+    )?;
+    Ok((a, SteadyOutcome::Flock(Box::new(r))))
+}
+
+/// The report of [`flock_steady_stage`].
+#[derive(Debug, Clone, Serialize)]
+#[serde(untagged)]
+pub enum SteadyOutcome {
+    /// One formation: Algorithm 1's report.
+    One(Box<SteadyReport>),
+    /// Several formations: each one's report and the arrangement.
+    Flock(Box<SkeinReport>),
+}
+
 /// §6 initiation into the first key shape of `steady` with the config's `initiate` section and
-/// the seed's `initiate` stream. The flock size is the steady flight's.
+/// the seed's `initiate` stream. The flock size is the steady flight's. A steady flight of
+/// several formations takes off formation by formation ([`skein::initiate_flock`]).
 pub fn initiate_stage(
     steady: &Animation,
     config: &Config,
@@ -364,6 +496,21 @@ pub fn initiate_stage(
     };
     opts.validate()?;
     initiate::check_size(steady.birds, 0, opts.max_steps)?;
+    if steady.formations.is_some() {
+        let (anim, report) = skein::initiate_flock(
+            steady,
+            &FlockOptions {
+                steady: &config.steady,
+                initiate: Some(&opts),
+                skein: &config.skein,
+                seed: config.seed,
+            },
+            progress,
+        )?;
+        let stats = skein::flock_stats(&report)
+            .ok_or_else(|| Error::Internal("a take-off without statistics".into()))?;
+        return Ok((anim, stats));
+    }
     initiate::initiate(
         steady,
         &opts,

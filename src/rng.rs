@@ -25,6 +25,8 @@ pub enum Stream {
     Initiate,
     /// Wingbeats: per-bird frequencies, amplitudes and initial phases.
     Wingbeat,
+    /// Flocks of several formations (skeins): formation sizes, arrangement, drift.
+    Skein,
 }
 
 impl Stream {
@@ -36,6 +38,7 @@ impl Stream {
             Stream::Steady => "steady",
             Stream::Initiate => "initiate",
             Stream::Wingbeat => "wingbeat",
+            Stream::Skein => "skein",
         }
     }
 }
@@ -70,6 +73,13 @@ pub fn stream(seed: u64, stage: impl StreamLabel) -> FlockRng {
     FlockRng::seed_from_u64(seed ^ h.rotate_left(17))
 }
 
+/// The generator of formation `k` of a flock of several formations for `stage` (label
+/// `"{stage}/formation/{k}"`): every formation draws its own numbers, so one formation's draws do
+/// not shift another's.
+pub fn formation_stream(seed: u64, stage: Stream, k: usize) -> FlockRng {
+    stream(seed, format!("{}/formation/{k}", stage.label()).as_str())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -82,6 +92,7 @@ mod tests {
             Stream::Steady,
             Stream::Initiate,
             Stream::Wingbeat,
+            Stream::Skein,
         ] {
             let a: u64 = stream(42, s).random();
             let b: u64 = stream(42, s.label()).random();
@@ -90,5 +101,8 @@ mod tests {
         let e: u64 = stream(42, Stream::Extract).random();
         let s: u64 = stream(42, Stream::Steady).random();
         assert_ne!(e, s);
+        let a: u64 = formation_stream(42, Stream::Steady, 0).random();
+        let b: u64 = formation_stream(42, Stream::Steady, 1).random();
+        assert!(a != b && a != s);
     }
 }

@@ -61,11 +61,15 @@ fn animate(birds: usize, d: &Path) -> Animation {
 /// As [`animate`], with `seconds` of steady flight after the take-off.
 fn animate_for(birds: usize, d: &Path, seconds: &str) -> Animation {
     let json = d.join(format!("flock{birds}_{seconds}.json"));
+    // One formation of all birds: a larger flock would fly as several formations (issue 13),
+    // which the follow camera frames whole (tests/skeins.rs).
     let out = formation(&[
         "animate",
         GEESE,
         "--birds",
         &birds.to_string(),
+        "--formations",
+        "1",
         "--seconds",
         seconds,
         "-o",

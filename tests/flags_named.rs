@@ -91,6 +91,9 @@ fn commands() -> Vec<Command> {
         ("--c2", "3", None),
         ("--wingspan-m", "0", None),
         ("--max-jump", "0", None),
+        ("--formations", "0", None),
+        ("--formation-size", "1", None),
+        ("--clearance", "-1", None),
     ];
     let course: Vec<(&str, &str, Option<String>)> = vec![
         ("--path", "OUT/no-path.json", Some("no-path.json".into())),
@@ -267,6 +270,7 @@ fn commands() -> Vec<Command> {
                 ("--key", "5", None),
                 ("--frame", "100000", None),
                 ("--metric", "watts", None),
+                ("--formation", "5", None),
                 o("OUT/p.txt"),
                 seed.clone(),
             ],
@@ -274,7 +278,7 @@ fn commands() -> Vec<Command> {
         Command {
             name: &["plot", "xi"],
             base: strings(&["plot", "xi", &flock, "-o", "OUT/x.png"]),
-            cases: vec![o("OUT/x.txt"), seed.clone()],
+            cases: vec![("--formation", "5", None), o("OUT/x.txt"), seed.clone()],
         },
         Command {
             name: &["plot", "shape"],
@@ -293,7 +297,7 @@ fn commands() -> Vec<Command> {
         Command {
             name: &["plot", "paths"],
             base: strings(&["plot", "paths", &flock, "-o", "OUT/p.png"]),
-            cases: vec![o("OUT/p.txt"), seed.clone()],
+            cases: vec![("--formation", "5", None), o("OUT/p.txt"), seed.clone()],
         },
         Command {
             name: &["plot", "wingbeat"],

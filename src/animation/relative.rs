@@ -105,6 +105,7 @@ mod tests {
             leader: 0,
             key_shapes: vec![],
             xi_ranges: None,
+            steady_start: None,
         }]);
         a
     }
@@ -129,12 +130,14 @@ mod tests {
                 leader: 0,
                 key_shapes: vec![],
                 xi_ranges: None,
+                steady_start: None,
             },
             FormationRecord {
                 birds: vec![1],
                 leader: 1,
                 key_shapes: vec![],
                 xi_ranges: None,
+                steady_start: None,
             },
         ]);
         let r = a.relative(0);

@@ -97,6 +97,9 @@ pub const FLAGS: &[(&str, &str, &[Cmd])] = &[
     ("course.path", "--path", SCENE_COURSE),
     ("course.units", "--path-units", SCENE_COURSE),
     ("course.cruise_altitude", "--cruise-altitude", STEADY),
+    ("skein.formations", "--formations", STEADY),
+    ("skein.formation_size", "--formation-size", STEADY),
+    ("skein.clearance", "--clearance", STEADY),
     ("initiate.max_steps", "--max-steps", INITIATE),
     ("initiate.max_time", "--max-seconds", INITIATE),
     ("initiate.perception.mode", "--perception", INITIATE),
@@ -164,6 +167,11 @@ pub const FLAGS: &[(&str, &str, &[Cmd])] = &[
     ("render.gif_tolerance", "--gif-tolerance", PICTURES),
     // Chart selections (`plot::power::PowerOf`, `plot::shape::ShapeChart::from_params`).
     ("plot.key", "--key", &[PlotPower]),
+    (
+        "plot.formation",
+        "--formation",
+        &[PlotPower, PlotXi, PlotPaths],
+    ),
     ("plot.frame", "--frame", &[PlotPower, PlotShape]),
 ];
 

@@ -253,14 +253,26 @@ pub fn run(args: InitiateArgs, g: Global) -> Result<()> {
     let wing = args.wingbeat.options()?;
     formation::export::plan_outputs(&args.output)?;
     let steady = Animation::read(&args.steady)?;
-    initiate::check_steady(&steady, &args.steady)?;
+    if steady.formations.is_none() {
+        initiate::check_steady(&steady, &args.steady)?;
+    }
     let mut opts = args.initiate.options(g.seed, steady.birds)?;
     // Issue 19: the take-off climbs to the path's first point, then the course step maps the
     // whole flight onto the path.
     let course = super::course::course_config(&args.path, &steady, &args.steady, &mut opts)?;
     let mut rng = formation::rng::stream(g.seed, "initiate");
     let progress = TermProgress::new(g.quiet);
-    let (mut anim, stats) = initiate::initiate(&steady, &opts, &mut rng, &progress)?;
+    let (mut anim, stats) = if steady.formations.is_some() {
+        // A flock of several formations takes off formation by formation (issue 13).
+        let config = formation::pipeline::Config {
+            seed: g.seed,
+            initiate: opts,
+            ..Default::default()
+        };
+        formation::pipeline::initiate_stage(&steady, &config, &progress)?
+    } else {
+        initiate::initiate(&steady, &opts, &mut rng, &progress)?
+    };
     // Savings (e, ξ) in the take-off frames too.
     formation::aero::fill_frame_savings(&mut anim, &Default::default());
     let report = formation::pipeline::course_stage(&mut anim, course.1.as_ref(), &course.0)?;
@@ -283,13 +295,18 @@ pub struct PlotPathsArgs {
     /// Output chart (.png or .svg).
     #[arg(short = 'o', long = "output")]
     pub output: PathBuf,
+    #[command(flatten)]
+    pub formation: super::steady::FormationArg,
 }
 
 /// Runs `formation plot paths`.
 pub fn run_plot_paths(args: PlotPathsArgs, _g: Global) -> Result<()> {
     OutputKind::from_path(&args.output, &[OutputKind::Png, OutputKind::Svg])?;
-    let a = Animation::read(&args.input)?;
-    let chart = formation::plot::paths::PathsChart::from_animation(&a)
+    let (a, which) = args
+        .formation
+        .pick(Animation::read(&args.input)?, &args.input)?;
+    let mut chart = formation::plot::paths::PathsChart::from_animation(&a)
         .map_err(|e| Error::format(&args.input, e.to_string()))?;
+    chart.title.push_str(which.as_deref().unwrap_or(""));
     formation::plot::save(&chart, &args.output)
 }

@@ -8,10 +8,11 @@ use formation::animation::Animation;
 use formation::extract::params::FormationParams;
 use formation::io::{write_json_atomic, OutputKind};
 use formation::keyshape::SteadyOptions;
-use formation::pipeline::{steady_stage, Config};
+use formation::pipeline::{flock_steady_stage, Config, SteadyOutcome};
 use formation::plot::power::{PowerChart, PowerMetric, PowerOf};
 use formation::plot::xi::XiChart;
 use formation::shape::Shape;
+use formation::skein::SkeinOptions;
 use formation::{Error, Result};
 
 use super::progress::TermProgress;
@@ -47,6 +48,8 @@ pub struct SteadyArgs {
         default_value_t = 0.0
     )]
     pub cruise_altitude: f64,
+    #[command(flatten)]
+    pub skein: SkeinFlags,
     #[command(flatten)]
     pub wingbeat: super::wingbeat::WingbeatFlags,
     #[command(flatten)]
@@ -111,6 +114,34 @@ impl SteadyFlags {
     }
 }
 
+/// Flags of flocks of several formations, shared by `steady` and `animate` (the `skein` section
+/// of the library's `Config`).
+#[derive(Debug, Clone, Args)]
+pub struct SkeinFlags {
+    /// Number of formations (skeins) the flock flies as (default: formations of about the
+    /// footage's size; one formation up to twice its birds). 1 = one formation of all birds.
+    #[arg(long, value_name = "K")]
+    pub formations: Option<usize>,
+    /// Typical number of birds of a formation instead of the footage's (at least 2).
+    #[arg(long = "formation-size", value_name = "M")]
+    pub formation_size: Option<usize>,
+    /// Smallest distance between birds of different formations, wingspans.
+    #[arg(long, default_value_t = SkeinOptions::default().clearance, allow_negative_numbers = true)]
+    pub clearance: f64,
+}
+
+impl SkeinFlags {
+    /// The library options.
+    pub fn options(&self) -> SkeinOptions {
+        SkeinOptions {
+            formations: self.formations,
+            formation_size: self.formation_size,
+            clearance: self.clearance,
+            ..SkeinOptions::default()
+        }
+    }
+}
+
 /// Runs `formation steady`.
 pub fn run(args: SteadyArgs, g: Global) -> Result<()> {
     if args.frames.is_none() && args.seconds.is_none() {
@@ -132,6 +163,7 @@ pub fn run(args: SteadyArgs, g: Global) -> Result<()> {
             cruise_altitude: Some(args.cruise_altitude),
             ..args.path.options()
         },
+        skein: args.skein.options(),
         ..Config::default()
     };
     config.steady_options()?;
@@ -159,26 +191,49 @@ pub fn run(args: SteadyArgs, g: Global) -> Result<()> {
     let params = read_params(&args.params)?;
     super::warn_params(g, &params)?;
     let progress = TermProgress::new(g.quiet);
-    let (mut anim, report) = steady_stage(&params, &config, &progress)?;
+    let (mut anim, outcome) = flock_steady_stage(&params, &config, &progress)?;
     let course = formation::pipeline::course_stage(&mut anim, path.as_ref(), &config)?;
     super::course::warn(super::flags::Cmd::Steady, g, &course)?;
     formation::wingbeat::assign_phases(&mut anim, &config.wingbeat)?;
     super::write_animation(&anim, &args.output, &args.scene.options(), g)?;
     if let Some(r) = &args.report {
-        write_json_atomic(r, &report)?;
+        write_json_atomic(r, &outcome)?;
     }
     if !g.quiet {
-        let k = &report.keys;
-        let text = format!(
-            "{}\nkey shapes: {} ({} draws, {} redraws, {} damped, {} held, {} kept the previous lateral positions, min λ {:.3}), max key residual {:.1e}, max jump {:.2} wingspans",
-            super::summary::animation_text("steady", &anim, Some(&params)),
-            k.keys, k.draws, k.redraws, k.damped, k.held, k.lateral_held, k.min_damping, k.max_residual, k.max_jump
-        );
+        let text = match &outcome {
+            SteadyOutcome::One(report) => {
+                let k = &report.keys;
+                format!(
+                    "{}\nkey shapes: {} ({} draws, {} redraws, {} damped, {} held, {} kept the previous lateral positions, min λ {:.3}), max key residual {:.1e}, max jump {:.2} wingspans",
+                    super::summary::animation_text("steady", &anim, Some(&params)),
+                    k.keys, k.draws, k.redraws, k.damped, k.held, k.lateral_held, k.min_damping, k.max_residual, k.max_jump
+                )
+            }
+            SteadyOutcome::Flock(f) => format!(
+                "{}\n{}",
+                super::summary::animation_text("steady", &anim, Some(&params)),
+                flock_summary(f)
+            ),
+        };
         let mut files = args.output.clone();
         files.extend(args.report.iter().cloned());
         super::summary::defer(text, &files);
     }
     Ok(())
+}
+
+/// One line about a flock of several formations: how many, their sizes, lanes, separation.
+pub fn flock_summary(f: &formation::skein::SkeinReport) -> String {
+    let lo = f.sizes.iter().min().copied().unwrap_or(0);
+    let hi = f.sizes.iter().max().copied().unwrap_or(0);
+    format!(
+        "flock: {} birds in {} formations of {lo} to {hi} birds, {} lanes; birds of different formations at least {:.1} wingspans apart (clearance {})",
+        f.sizes.iter().sum::<usize>(),
+        f.sizes.len(),
+        f.lanes,
+        f.min_separation,
+        f.clearance
+    )
 }
 
 /// Reads a params file, telling other `formation` files apart before serde's field errors.
@@ -224,6 +279,40 @@ pub struct PlotPowerArgs {
     /// Quantity to plot.
     #[arg(long, value_enum, default_value_t = MetricArg::Xi)]
     pub metric: MetricArg,
+    #[command(flatten)]
+    pub formation: FormationArg,
+}
+
+/// `--formation K` of the charts of one formation.
+#[derive(Debug, Clone, Args)]
+pub struct FormationArg {
+    /// Formation of a flock of several formations to chart (index into the file's formations;
+    /// default 0).
+    #[arg(long, value_name = "K")]
+    pub formation: Option<usize>,
+}
+
+impl FormationArg {
+    /// The formation asked for of `anim` (read from `origin`) as an animation of its own, and
+    /// the words a chart's title adds (`None` for a flock of one formation).
+    pub fn pick(&self, anim: Animation, origin: &Path) -> Result<(Animation, Option<String>)> {
+        let count = anim.formation_count();
+        let k = self.formation.unwrap_or(0);
+        if anim.formations.is_none() && k == 0 {
+            return Ok((anim, None));
+        }
+        let one = anim.formation(k).ok_or_else(|| {
+            Error::parameter(
+                "plot.formation",
+                format!(
+                    "{k}: {} has {count} formation(s) (0..{})",
+                    origin.display(),
+                    count - 1
+                ),
+            )
+        })?;
+        Ok((one, Some(format!(", formation {k} of {count}"))))
+    }
 }
 
 /// Runs `formation plot power`.
@@ -236,13 +325,26 @@ pub fn run_plot_power(args: PlotPowerArgs, _g: Global) -> Result<()> {
     let value: serde_json::Value = formation::io::read_json(&args.input)?;
     let is_animation = formation::sniff::json_kind(&value) == formation::sniff::Kind::Animation;
     let chart = if is_animation {
-        let anim = Animation::read(&args.input)?;
+        let (anim, which) = args
+            .formation
+            .pick(Animation::read(&args.input)?, &args.input)?;
         let of = match (args.frame, args.key) {
             (Some(k), _) => PowerOf::Frame(k),
             (None, k) => PowerOf::Key(k.unwrap_or(0)),
         };
-        PowerChart::from_animation(&anim, &args.input, of, metric)?
+        let mut chart = PowerChart::from_animation(&anim, &args.input, of, metric)?;
+        chart.title.push_str(which.as_deref().unwrap_or(""));
+        chart
     } else {
+        if args.formation.formation.is_some() {
+            return Err(Error::parameter(
+                "plot.formation",
+                format!(
+                    "{} is a shape file, which has no formations",
+                    args.input.display()
+                ),
+            ));
+        }
         if args.key.is_some() || args.frame.is_some() {
             return Err(Error::parameter(
                 "--key/--frame",
@@ -270,12 +372,17 @@ pub struct PlotXiArgs {
     /// Output chart (.png or .svg).
     #[arg(short = 'o', long = "output")]
     pub output: PathBuf,
+    #[command(flatten)]
+    pub formation: FormationArg,
 }
 
 /// Runs `formation plot xi`.
 pub fn run_plot_xi(args: PlotXiArgs, _g: Global) -> Result<()> {
     OutputKind::from_path(&args.output, &[OutputKind::Png, OutputKind::Svg])?;
-    let anim = Animation::read(&args.input)?;
-    let chart = XiChart::from_animation(&anim, &args.input)?;
+    let (anim, which) = args
+        .formation
+        .pick(Animation::read(&args.input)?, &args.input)?;
+    let mut chart = XiChart::from_animation(&anim, &args.input)?;
+    chart.title.push_str(which.as_deref().unwrap_or(""));
     formation::plot::save(&chart, &args.output)
 }

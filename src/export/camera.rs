@@ -4,7 +4,10 @@
 //!   moves smoothly. Birds are never drawn smaller than [`CameraParams::min_bird_px`] (pixels
 //!   per wingspan, default 12): when the whole flock would need a smaller scale to fit, the
 //!   camera zooms in on the leading birds (those nearest the front along the flock's heading)
-//!   and lets the trailing ones leave the picture.
+//!   and lets the trailing ones leave the picture. A flock of several formations (skeins) is
+//!   framed whole down to [`FLOCK_MIN_BIRD_PX`] (if the minimum asked for is larger), so that
+//!   every formation is in the picture; only a flock that would be drawn smaller still is cut to
+//!   its leading formations.
 //! - **ground**: a fixed observer standing under the flock's course, looking up at
 //!   [`GroundParams::elevation_deg`] towards the oncoming flock with a perspective lens; the
 //!   flock approaches low over the horizon, grows and passes over the top of the picture.
@@ -34,6 +37,22 @@
 
 use super::sample::BirdState;
 use crate::error::{Error, Result};
+
+/// Smallest on-screen wingspan, pixels, down to which the follow camera shows the whole of a
+/// flock of several formations: at 3 px a bird is a distinct mark and the birds of a line
+/// formation (0.6–1 wingspans apart) still draw its lines.
+pub const FLOCK_MIN_BIRD_PX: f64 = 3.0;
+
+/// The smallest bird size the follow camera keeps for a flock of `formations` formations when
+/// `min_bird_px` is asked for: `min_bird_px` for one formation, at most [`FLOCK_MIN_BIRD_PX`]
+/// for several.
+pub fn min_bird_px_for(min_bird_px: f64, formations: usize) -> f64 {
+    if formations > 1 {
+        min_bird_px.min(FLOCK_MIN_BIRD_PX)
+    } else {
+        min_bird_px
+    }
+}
 
 /// Which camera draws the pictures.
 #[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]

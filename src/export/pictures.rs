@@ -94,7 +94,7 @@ impl Film {
             .unwrap_or_default();
         let params = CameraParams {
             kind: opts.camera,
-            min_bird_px: opts.min_bird_px,
+            min_bird_px: camera::min_bird_px_for(opts.min_bird_px, anim.formation_count()),
             bird_radius: super::silhouette::radius(species),
             ..CameraParams::default()
         };
