@@ -563,3 +563,33 @@ fn the_camera_follows_a_flock_turning_at_any_heading() {
         assert!(inside >= 7, "picture {k}: {inside} birds in the picture");
     }
 }
+
+#[test]
+fn a_sky_of_formations_is_centred_on_the_path() {
+    // 60 geese from the 9-goose example fly as several formations; the path is the course of the
+    // leader nearest the middle of the flock, so formations fly on both sides of it.
+    let dir = scratch("paths_skein");
+    let path = write_path(
+        &dir,
+        "north.json",
+        &[[40.0, 0.0, 20.0], [40.0, 2000.0, 20.0]],
+    );
+    let mut c = config(60, 10.0, Some(path));
+    c.initiation = false;
+    let (a, _) = Pipeline::from_path(support::example("barnacle_geese_v.json"))
+        .run(&c)
+        .unwrap();
+    let leaders = a.leaders();
+    assert!(leaders.len() > 2, "{} formations", leaders.len());
+    let f = &a.frames[0];
+    let east = leaders.iter().filter(|&&l| f.x[l] > 40.5).count();
+    let west = leaders.iter().filter(|&&l| f.x[l] < 39.5).count();
+    assert!(
+        east.abs_diff(west) <= 1,
+        "{east} formations east of the path, {west} west"
+    );
+    assert!(
+        leaders.iter().any(|&l| (f.x[l] - 40.0).abs() < 1e-6),
+        "one leader flies on the path"
+    );
+}

@@ -27,7 +27,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use crate::animation::{Animation, PathRecord};
+use crate::animation::{Animation, Frame, PathRecord};
 use crate::error::{Error, Result};
 
 pub use file::{PathPoints, PathUnits};
@@ -227,6 +227,29 @@ pub fn takeoff_altitude(points: &PathPoints, origin: &Path) -> Result<f64> {
     Ok(z)
 }
 
+/// The bird whose track the path is: the leader of a flock of one formation; for a flock of
+/// several formations the leader nearest the middle of the flock across the course (the median
+/// of the leaders' lateral positions at the start of the steady flight), so that the path runs
+/// through the middle of the sky of formations rather than along its edge.
+fn reference_leader(leaders: &[usize], f: &Frame) -> usize {
+    let mut xs: Vec<f64> = leaders
+        .iter()
+        .filter(|&&l| l < f.x.len())
+        .map(|&l| f.x[l])
+        .collect();
+    if xs.is_empty() {
+        return 0;
+    }
+    xs.sort_by(f64::total_cmp);
+    let mid = xs[xs.len() / 2];
+    leaders
+        .iter()
+        .copied()
+        .filter(|&l| l < f.x.len())
+        .min_by(|&a, &b| (f.x[a] - mid).abs().total_cmp(&(f.x[b] - mid).abs()))
+        .unwrap_or(0)
+}
+
 /// Maps `anim` (course frame) onto its course: positions, headings, speeds, banks and pitches.
 /// `points` is the loaded path (or `None`), `flight` what the earlier stages did.
 pub fn apply(
@@ -264,12 +287,12 @@ pub fn apply(
     };
     let origin = opts.path.clone().unwrap_or_else(|| PathBuf::from("path"));
     let n = anim.birds;
-    let leader = anim.leaders().first().copied().unwrap_or(0);
     let steady = anim
         .stage("steady")
         .map(|s| s.start..s.end)
         .unwrap_or(0..anim.frames.len());
     let f_ref = &anim.frames[steady.start.min(anim.frames.len() - 1)];
+    let leader = reference_leader(&anim.leaders(), f_ref);
     let x_ref = f_ref.x[leader];
     let f0 = &anim.frames[0];
     let s0 = if flight.takeoff_altitude.is_some() {
