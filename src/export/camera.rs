@@ -290,6 +290,10 @@ pub struct CameraParams {
     pub ground: GroundParams,
     /// Largest distance from a bird's origin to any part of it, wingspans.
     pub bird_radius: f64,
+    /// The frames are one cycle of a loop (the frame after the last is the first): the follow
+    /// camera's smoothing wraps around, so its framing has no jump from the last frame to the
+    /// first.
+    pub cyclic: bool,
 }
 
 impl Default for CameraParams {
@@ -302,6 +306,7 @@ impl Default for CameraParams {
             smoothing_s: 0.8,
             ground: GroundParams::default(),
             bird_radius: super::rig::BIRD_RADIUS,
+            cyclic: false,
         }
     }
 }
@@ -315,6 +320,21 @@ fn gaussian(sigma: f64, half: usize) -> Vec<f64> {
         .collect();
     let s: f64 = w.iter().sum();
     w.into_iter().map(|v| v / s).collect()
+}
+
+/// Gaussian smoothing of one cycle of a periodic sequence (`v(n + k) = v(k)`).
+fn smooth_cyclic(v: &[f64], kernel: &[f64]) -> Vec<f64> {
+    let n = v.len() as isize;
+    let half = (kernel.len() / 2) as isize;
+    (0..n)
+        .map(|i| {
+            kernel
+                .iter()
+                .enumerate()
+                .map(|(k, w)| w * v[(i + k as isize - half).rem_euclid(n) as usize])
+                .sum()
+        })
+        .collect()
 }
 
 /// Gaussian smoothing with odd reflection at the ends (`v(−k) = 2 v(0) − v(k)`).
@@ -436,8 +456,11 @@ fn follow(
             lead_centre(s, hw / s_min - r, hh / s_min - r)
         })
         .unzip();
-    let cx = smooth_odd(&raw_x, &kernel);
-    let cy = smooth_odd(&raw_y, &kernel);
+    // A loop wraps around when it is longer than the smoothing window.
+    let cyclic = p.cyclic && n > 2 * half + 1;
+    let smooth = if cyclic { smooth_cyclic } else { smooth_odd };
+    let cx = smooth(&raw_x, &kernel);
+    let cy = smooth(&raw_y, &kernel);
     let log_need: Vec<f64> = (0..n)
         .map(|i| {
             let mut s = s_max;
@@ -451,6 +474,11 @@ fn follow(
         .collect();
     let eroded: Vec<f64> = (0..n)
         .map(|i| {
+            if cyclic {
+                return (0..=2 * half)
+                    .map(|k| log_need[(i + n + k - half) % n])
+                    .fold(f64::MAX, f64::min);
+            }
             let lo = i.saturating_sub(half);
             let hi = (i + half).min(n - 1);
             log_need[lo..=hi].iter().cloned().fold(f64::MAX, f64::min)
@@ -462,9 +490,17 @@ fn follow(
             let mut wsum = 0.0;
             for (k, wk) in kernel.iter().enumerate() {
                 let j = i as isize + k as isize - half as isize;
-                // Clamping at the ends keeps every term a minimum over a window containing i.
-                let j = j.clamp(0, n as isize - 1) as usize;
-                let j = if j.abs_diff(i) > half { i } else { j };
+                let j = if cyclic {
+                    j.rem_euclid(n as isize) as usize
+                } else {
+                    // Clamping at the ends keeps every term a minimum over a window containing i.
+                    let j = j.clamp(0, n as isize - 1) as usize;
+                    if j.abs_diff(i) > half {
+                        i
+                    } else {
+                        j
+                    }
+                };
                 acc += wk * eroded[j];
                 wsum += wk;
             }
@@ -569,6 +605,60 @@ mod tests {
         assert!(CameraKind::Fixed([0.0, 0.0, 0.0, 5.0]).validate().is_err());
         assert!(CameraKind::parse("orbit", None).is_err());
         assert!(parse_view("1,2,3").is_err());
+    }
+
+    #[test]
+    fn a_loop_on_a_circle_is_framed_without_a_jump_at_the_wrap() {
+        // One lap of a circle of radius 60 wingspans in 200 frames, a flock that breathes in
+        // width: the smoothed views of a cycle must wrap like any other step.
+        let n = 200;
+        let states: Vec<Vec<BirdState>> = (0..n)
+            .map(|k| {
+                let a = 2.0 * std::f64::consts::PI * k as f64 / n as f64;
+                let spread = 3.0 + 2.0 * (3.0 * a).sin();
+                (0..5)
+                    .map(|b| BirdState {
+                        x: 60.0 * a.cos() + b as f64 * spread,
+                        y: 60.0 * a.sin() - b as f64,
+                        ..Default::default()
+                    })
+                    .collect()
+            })
+            .collect();
+        let step = |v: &[View], i: usize, j: usize| {
+            let (
+                View::Top {
+                    cx: ax,
+                    cy: ay,
+                    scale: sa,
+                },
+                View::Top {
+                    cx: bx,
+                    cy: by,
+                    scale: sb,
+                },
+            ) = (v[i], v[j])
+            else {
+                panic!("top views expected")
+            };
+            (ax - bx).hypot(ay - by) + (sa.ln() - sb.ln()).abs()
+        };
+        for cyclic in [false, true] {
+            let p = CameraParams {
+                cyclic,
+                ..fit_all()
+            };
+            let v = track(&states, 25.0, 320, 180, &p);
+            let inner = (1..n).map(|k| step(&v, k - 1, k)).fold(0.0, f64::max);
+            let wrap = step(&v, n - 1, 0);
+            if cyclic {
+                assert!(wrap <= 1.05 * inner, "wrap {wrap} > largest step {inner}");
+            } else {
+                // Without wrapping, the ends are smoothed one-sidedly: here the wrap is 15 %
+                // larger than any step inside (the case tells the two apart).
+                assert!(wrap > 1.1 * inner, "wrap {wrap}, largest step {inner}");
+            }
+        }
     }
 
     #[test]

@@ -96,6 +96,7 @@ impl Film {
             kind: opts.camera,
             min_bird_px: camera::min_bird_px_for(opts.min_bird_px, anim.formation_count()),
             bird_radius: super::silhouette::radius(species),
+            cyclic: anim.looped,
             ..CameraParams::default()
         };
         let views = camera::track(&states, fps, width, height, &params);
