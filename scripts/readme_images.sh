@@ -43,10 +43,10 @@ $B plot savings "$T/flock.json" -o "$I/usage-savings.png"
 $B plot wingbeat --species goose -o "$I/usage-wingbeat.png"
 # Large flocks (docs/large-flocks.md): 200 geese at 1280x720, 1000 at 1920x1080, seed 0.
 $B animate $E/barnacle_geese_v.json --birds 200 -o "$T/sky200.json" --quiet
-$B render "$T/sky200.json" -o "$T/sky200/" --size 1280x720 --fps 1 --quiet
+$B render "$T/sky200.json" -o "$T/sky200/" --size 1280x720 --picture-fps 1 --quiet
 cp "$T/sky200/frame_00025.png" "$I/skeins-200.png"
 $B animate $E/barnacle_geese_v.json --birds 1000 -o "$T/sky1000.json" --quiet
-$B render "$T/sky1000.json" -o "$T/sky1000/" --size 1920x1080 --fps 1 --quiet
+$B render "$T/sky1000.json" -o "$T/sky1000/" --size 1920x1080 --picture-fps 1 --quiet
 cp "$T/sky1000/frame_00028.png" "$I/skeins-1000.png"
 cp "$T/sky1000/frame_00005.png" "$I/skeins-1000-takeoff.png"
 echo "pictures written to $I"
