@@ -63,6 +63,9 @@ pub struct Film {
     pub species: Species,
     backdrop: Backdrop,
     gif_tolerance: i32,
+    /// One cycle of a loop: the GIF's last frame is written exactly (no tolerance), so that the
+    /// step back to the first frame (always drawn whole) is a true step.
+    looped: bool,
 }
 
 impl Film {
@@ -114,6 +117,7 @@ impl Film {
             species,
             backdrop: Backdrop::new(width, height, &style, opts.background, anim.seed),
             gif_tolerance: opts.gif_tolerance.round().clamp(0.0, 255.0) as i32,
+            looped: anim.looped,
         }
     }
 
@@ -331,6 +335,7 @@ fn delta_step(
     lookup: &mut Lookup,
     palette: &Palette,
     tolerance: i32,
+    catch_up: bool,
 ) {
     for (((s, p), o), q) in shown
         .iter_mut()
@@ -339,8 +344,9 @@ fn delta_step(
         .zip(prev.chunks_exact(4))
     {
         // Same true colour as in the previous frame: what is shown was within the tolerance of
-        // it then (or set to it), so it still is.
-        if !first && p == q {
+        // it then (or set to it), so it still is, unless the tolerance is lower now (the end of
+        // a loop catching up with what earlier frames held back: every pixel is checked).
+        if !first && !catch_up && p == q {
             *o = TRANSPARENT;
             continue;
         }
@@ -369,12 +375,29 @@ fn delta_step(
     }
 }
 
+/// Seconds over which the GIF of a loop lowers its tolerance to 0 before the last frame.
+const LOOP_CATCH_UP_S: f64 = 2.0;
+
+/// The differencing tolerance of frame `k` of `total`: `base`, except over the last `ramp`
+/// frames of a loop, where it falls linearly to 0 at the last frame, so that what the tolerance
+/// held back (soft clouds lagging by a few grey levels) is caught up gradually and the last
+/// frame, shown exactly, leads into the first (always drawn whole) like any other step.
+fn loop_tolerance(base: i32, looped: bool, k: usize, total: usize, ramp: usize) -> i32 {
+    let left = total.saturating_sub(k + 1);
+    if !looped || left >= ramp {
+        return base;
+    }
+    (base as f64 * left as f64 / ramp as f64).floor() as i32
+}
+
 /// Writes an animated, looping GIF of `film` to `path` (atomically).
 pub fn write_gif(film: &Film, path: &Path, threads: usize, progress: &dyn Progress) -> Result<()> {
     let (w, h) = (film.width, film.height);
     let delay = (100.0 / film.fps).round().max(1.0) as u16;
     let palette = film.palette();
     let tolerance = film.gif_tolerance;
+    let (looped, frames_total) = (film.looped, film.len());
+    let ramp = (LOOP_CATCH_UP_S * film.fps).round().max(1.0) as usize;
     let mut file = AtomicFile::create(path)?;
     let io_err = |e: gif::EncodingError| match e {
         gif::EncodingError::Io(e) => Error::io(path, e),
@@ -435,6 +458,13 @@ pub fn write_gif(film: &Film, path: &Path, threads: usize, progress: &dyn Progre
                             let hi = lo + s.len();
                             for (k, o) in mine.into_iter().take(count).enumerate() {
                                 let prev = if k == 0 { last } else { &drawn[k - 1] };
+                                let tol = loop_tolerance(
+                                    tolerance,
+                                    looped,
+                                    start + k,
+                                    frames_total,
+                                    ramp,
+                                );
                                 delta_step(
                                     s,
                                     start + k == 0,
@@ -443,7 +473,8 @@ pub fn write_gif(film: &Film, path: &Path, threads: usize, progress: &dyn Progre
                                     o,
                                     lookup,
                                     palette,
-                                    tolerance,
+                                    tol,
+                                    tol < tolerance,
                                 );
                             }
                         });
@@ -714,6 +745,58 @@ pub fn write_video(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_loop_lowers_the_gif_tolerance_to_zero_at_its_last_frame() {
+        // 100 frames, a ramp of 10: the base up to frame 89, then falling to 0 at frame 99.
+        let t: Vec<i32> = (0..100)
+            .map(|k| loop_tolerance(12, true, k, 100, 10))
+            .collect();
+        assert!(t[..90].iter().all(|&v| v == 12));
+        assert!(t[90..].windows(2).all(|w| w[1] <= w[0]));
+        assert_eq!(t[99], 0);
+        assert!(t[95] > 0 && t[95] < 12);
+        // Not a loop: the base everywhere.
+        assert!((0..100).all(|k| loop_tolerance(12, false, k, 100, 10) == 12));
+    }
+
+    #[test]
+    fn a_frame_written_exactly_catches_up_with_held_back_pixels() {
+        // One grey pixel shown as palette colour 0 (black) while its true colour has been white
+        // for two frames: the tolerant step keeps it (same true colour as before), the
+        // catching-up step at tolerance 0 sends it.
+        let mut colours = vec![[0u8, 0, 0]; 256];
+        colours[1] = [255, 255, 255];
+        let palette = Palette { colours };
+        let mut lookup = Lookup::new(&palette);
+        let white = [255u8, 255, 255, 255];
+        let mut out = [TRANSPARENT];
+        let mut shown = [0u8];
+        delta_step(
+            &mut shown,
+            false,
+            &white,
+            &white,
+            &mut out,
+            &mut lookup,
+            &palette,
+            255,
+            false,
+        );
+        assert_eq!((shown[0], out[0]), (0, TRANSPARENT));
+        delta_step(
+            &mut shown,
+            false,
+            &white,
+            &white,
+            &mut out,
+            &mut lookup,
+            &palette,
+            0,
+            true,
+        );
+        assert_eq!((shown[0], out[0]), (1, 1));
+    }
 
     #[test]
     fn frame_delta_keeps_only_the_changed_box() {
