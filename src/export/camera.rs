@@ -322,41 +322,28 @@ fn gaussian(sigma: f64, half: usize) -> Vec<f64> {
     w.into_iter().map(|v| v / s).collect()
 }
 
-/// Gaussian smoothing of one cycle of a periodic sequence (`v(n + k) = v(k)`).
-fn smooth_cyclic(v: &[f64], kernel: &[f64]) -> Vec<f64> {
+/// Gaussian smoothing of `v`: with `cyclic`, one cycle of a periodic sequence
+/// (`v(n + k) = v(k)`); otherwise with odd reflection at the ends (`v(−k) = 2 v(0) − v(k)`).
+fn smooth(v: &[f64], kernel: &[f64], cyclic: bool) -> Vec<f64> {
     let n = v.len() as isize;
     let half = (kernel.len() / 2) as isize;
+    let at = |j: isize| {
+        if cyclic {
+            v[j.rem_euclid(n) as usize]
+        } else if j < 0 {
+            2.0 * v[0] - v[(-j).min(n - 1) as usize]
+        } else if j >= n {
+            2.0 * v[(n - 1) as usize] - v[(2 * (n - 1) - j).max(0) as usize]
+        } else {
+            v[j as usize]
+        }
+    };
     (0..n)
         .map(|i| {
             kernel
                 .iter()
                 .enumerate()
-                .map(|(k, w)| w * v[(i + k as isize - half).rem_euclid(n) as usize])
-                .sum()
-        })
-        .collect()
-}
-
-/// Gaussian smoothing with odd reflection at the ends (`v(−k) = 2 v(0) − v(k)`).
-fn smooth_odd(v: &[f64], kernel: &[f64]) -> Vec<f64> {
-    let n = v.len() as isize;
-    let half = (kernel.len() / 2) as isize;
-    (0..n)
-        .map(|i| {
-            kernel
-                .iter()
-                .enumerate()
-                .map(|(k, w)| {
-                    let j = i + k as isize - half;
-                    let val = if j < 0 {
-                        2.0 * v[0] - v[(-j).min(n - 1) as usize]
-                    } else if j >= n {
-                        2.0 * v[(n - 1) as usize] - v[(2 * (n - 1) - j).max(0) as usize]
-                    } else {
-                        v[j as usize]
-                    };
-                    w * val
-                })
+                .map(|(k, w)| w * at(i + k as isize - half))
                 .sum()
         })
         .collect()
@@ -458,9 +445,17 @@ fn follow(
         .unzip();
     // A loop wraps around when it is longer than the smoothing window.
     let cyclic = p.cyclic && n > 2 * half + 1;
-    let smooth = if cyclic { smooth_cyclic } else { smooth_odd };
-    let cx = smooth(&raw_x, &kernel);
-    let cy = smooth(&raw_y, &kernel);
+    let cx = smooth(&raw_x, &kernel, cyclic);
+    let cy = smooth(&raw_y, &kernel, cyclic);
+    // The frame `d` frames from `i`: around the loop, or clamped to the ends (a clamped window
+    // still contains `i`, so a minimum over it is still a bound for frame `i`).
+    let near = |i: usize, d: isize| {
+        if cyclic {
+            (i as isize + d).rem_euclid(n as isize) as usize
+        } else {
+            (i as isize + d).clamp(0, n as isize - 1) as usize
+        }
+    };
     let log_need: Vec<f64> = (0..n)
         .map(|i| {
             let mut s = s_max;
@@ -474,14 +469,9 @@ fn follow(
         .collect();
     let eroded: Vec<f64> = (0..n)
         .map(|i| {
-            if cyclic {
-                return (0..=2 * half)
-                    .map(|k| log_need[(i + n + k - half) % n])
-                    .fold(f64::MAX, f64::min);
-            }
-            let lo = i.saturating_sub(half);
-            let hi = (i + half).min(n - 1);
-            log_need[lo..=hi].iter().cloned().fold(f64::MAX, f64::min)
+            (-(half as isize)..=half as isize)
+                .map(|d| log_need[near(i, d)])
+                .fold(f64::MAX, f64::min)
         })
         .collect();
     (0..n)
@@ -489,18 +479,7 @@ fn follow(
             let mut acc = 0.0;
             let mut wsum = 0.0;
             for (k, wk) in kernel.iter().enumerate() {
-                let j = i as isize + k as isize - half as isize;
-                let j = if cyclic {
-                    j.rem_euclid(n as isize) as usize
-                } else {
-                    // Clamping at the ends keeps every term a minimum over a window containing i.
-                    let j = j.clamp(0, n as isize - 1) as usize;
-                    if j.abs_diff(i) > half {
-                        i
-                    } else {
-                        j
-                    }
-                };
+                let j = near(i, k as isize - half as isize);
                 acc += wk * eroded[j];
                 wsum += wk;
             }
@@ -553,7 +532,7 @@ mod tests {
     #[test]
     fn odd_reflection_keeps_linear_motion_unbiased() {
         let v: Vec<f64> = (0..50).map(|k| 3.0 * k as f64 + 1.0).collect();
-        let s = smooth_odd(&v, &gaussian(4.0, 10));
+        let s = smooth(&v, &gaussian(4.0, 10), false);
         for (a, b) in v.iter().zip(&s) {
             assert!((a - b).abs() < 1e-9);
         }
