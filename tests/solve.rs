@@ -56,6 +56,10 @@ proptest! {
     /// perturbed guess (same fore-aft order) → the same ξ (and the same shape).
     #[test]
     fn round_trip((x, y, guess) in v_strategy()) {
+        // The noise can bring two overlapping neighbours of the guess closer fore and aft than
+        // the collision distance; the solver rightly refuses such a start (Error::Collision),
+        // so it is no valid input here.
+        prop_assume!(power_reduction(&x, &guess).is_ok());
         let xi = power_reduction(&x, &y).unwrap().xi;
         let rep = solve(&x, &xi, Some(&guess), &SolveOptions::default()).unwrap();
         prop_assert!(rep.converged, "residual {}", rep.residual);
