@@ -13,7 +13,9 @@ const VICTIM: &[u8] = b"a file the user cares about: no run of formation may cha
 
 mod support;
 
-use support::{assert_refused, bin, bin_path, repo_file, run_in, scratch, stderr};
+use support::{
+    assert_refused, assert_usage_error_in, bin, bin_path, repo_file, run_in, scratch, stderr,
+};
 
 /// Runs `formation ARGS` through `sh -c` with a memory cap (`ulimit -v`, KiB) and an optional
 /// file-size cap (`ulimit -f`, blocks), in `dir`.
@@ -61,8 +63,12 @@ fn writing_commands() -> Vec<(&'static str, Vec<String>, Vec<&'static str>)> {
     let params = repo_file("tests/data/steady_v9_params.json")
         .display()
         .to_string();
-    let anim = repo_file("tests/data/flock_small.json").display().to_string();
-    let shape = repo_file("examples_data/v9_shape.json").display().to_string();
+    let anim = repo_file("tests/data/flock_small.json")
+        .display()
+        .to_string();
+    let shape = repo_file("examples_data/v9_shape.json")
+        .display()
+        .to_string();
     let target = repo_file("examples_data/equal_savings_target.json")
         .display()
         .to_string();
@@ -198,7 +204,9 @@ fn planted_links_are_never_followed() {
 #[test]
 fn a_failed_multi_output_run_keeps_none_of_its_outputs() {
     let dir = scratch("atomic-set");
-    let anim = repo_file("tests/data/flock_small.json").display().to_string();
+    let anim = repo_file("tests/data/flock_small.json")
+        .display()
+        .to_string();
     std::fs::write(dir.join("a.csv"), VICTIM).unwrap();
     // 200 blocks: more than the CSV needs, far less than the GIF.
     let (o, _) = run_capped(
@@ -251,7 +259,9 @@ fn report_outputs_are_checked_with_the_others() {
         assert!(names(&dir).is_empty(), "{report}: {:?}", names(&dir));
     }
     // `-o a.json -o ./a.json` is one file given twice.
-    let anim = repo_file("tests/data/flock_small.json").display().to_string();
+    let anim = repo_file("tests/data/flock_small.json")
+        .display()
+        .to_string();
     let o = run_in(&dir, &["render", &anim, "-o", "a.json", "-o", "./a.json"]);
     assert_refused(&o, "given twice", "-o twice");
     std::fs::remove_dir_all(&dir).unwrap();
@@ -262,7 +272,9 @@ fn printing_commands() -> Vec<(&'static str, Vec<String>)> {
     let ex = repo_file("examples_data/barnacle_geese_v.json")
         .display()
         .to_string();
-    let shape = repo_file("examples_data/v9_shape.json").display().to_string();
+    let shape = repo_file("examples_data/v9_shape.json")
+        .display()
+        .to_string();
     let steady = repo_file("tests/data/initiate_steady_v9.json")
         .display()
         .to_string();
@@ -351,7 +363,9 @@ fn the_longest_legal_output_names_work() {
     let ex = repo_file("examples_data/barnacle_geese_v.json")
         .display()
         .to_string();
-    let anim = repo_file("tests/data/flock_small.json").display().to_string();
+    let anim = repo_file("tests/data/flock_small.json")
+        .display()
+        .to_string();
     let json = format!("{}.json", "p".repeat(250));
     let gif = format!("{}.gif", "g".repeat(251));
     let frames = format!("{}/", "f".repeat(255));
@@ -607,7 +621,9 @@ fn many_csv_frames_are_refused_by_the_frame_limit() {
 fn the_format_follows_the_name() {
     let dir = scratch("dir-named-gif");
     std::fs::create_dir(dir.join("x.gif")).unwrap();
-    let anim = repo_file("tests/data/flock_small.json").display().to_string();
+    let anim = repo_file("tests/data/flock_small.json")
+        .display()
+        .to_string();
     let o = run_in(&dir, &["render", &anim, "-o", "x.gif"]);
     assert_refused(&o, "-o: x.gif: is an existing directory", "x.gif dir");
     assert!(names(&dir.join("x.gif")).is_empty());
@@ -625,9 +641,8 @@ fn messages_quote_file_content_safely() {
     )
     .unwrap();
     let o = run_in(&dir, &["extract", "esc.csv", "-o", "p.json"]);
+    assert_usage_error_in("control characters in a CSV header", &o, &["esc.csv"]);
     let e = stderr(&o);
-    assert_eq!(o.status.code(), Some(2), "{e}");
-    assert_eq!(e.lines().count(), 1, "{e}");
     assert!(!e.contains('\u{1b}') && !e.contains('\u{7}'), "{e:?}");
 
     let long = format!("frame,bird,x,y\n0,0,{},2\n", "9".repeat(10_000_000));
@@ -641,7 +656,9 @@ fn messages_quote_file_content_safely() {
         &dir,
         &[
             "render",
-            &repo_file("tests/data/flock_small.json").display().to_string(),
+            &repo_file("tests/data/flock_small.json")
+                .display()
+                .to_string(),
             "-o",
             "a.gif",
             "--wingspan-px",
@@ -691,7 +708,9 @@ fn a_wide_dltdv_header_is_refused_at_once() {
 #[test]
 fn the_flag_or_file_at_fault_is_named() {
     let dir = scratch("named");
-    let anim = repo_file("tests/data/flock_small.json").display().to_string();
+    let anim = repo_file("tests/data/flock_small.json")
+        .display()
+        .to_string();
     let o = run_in(&dir, &["power", &anim]);
     assert_refused(
         &o,

@@ -46,7 +46,11 @@ fn initiate_writes_an_animation_and_the_paths_chart() {
 fn same_seed_gives_byte_identical_files() {
     let dir = scratch("initiate-same-seed");
     let steady = data("initiate_steady_v9.json");
-    let (a, b, c) = (dir.join("s1.json"), dir.join("s2.json"), dir.join("s3.json"));
+    let (a, b, c) = (
+        dir.join("s1.json"),
+        dir.join("s2.json"),
+        dir.join("s3.json"),
+    );
     for (p, seed) in [(&a, "4"), (&b, "4"), (&c, "5")] {
         let (code, _, err) = run_full(&[
             "initiate",

@@ -112,13 +112,12 @@ pub fn assert_refused(out: &Output, needle: &str, what: &str) {
 
 /// [`assert_usage_error`], with `what` (the case: its arguments, say) in every failure message.
 pub fn assert_usage_error_in(what: &str, out: &Output, needles: &[&str]) {
-    let err = stderr(out);
-    assert_eq!(
-        out.status.code(),
-        Some(2),
-        "{what}: exit {:?}, stderr: {err}",
-        out.status
-    );
+    assert_usage_text(what, code(out), &stderr(out), needles);
+}
+
+/// [`assert_usage_error_in`] for a run already reduced to its exit `code` and stderr `err`.
+pub fn assert_usage_text(what: &str, code: i32, err: &str, needles: &[&str]) {
+    assert_eq!(code, 2, "{what}: exit {code}, stderr: {err}");
     assert_eq!(
         err.trim_end().lines().count(),
         1,
