@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 use formation::annotations::{self, Heading, ReadOptions, YOrigin};
-use formation::extract::{self, ExtractOptions, FormationParams, FrameReport, ShapeKind};
+use formation::extract::{ExtractOptions, FormationParams, FrameReport, ShapeKind};
 use formation::io::{write_json_atomic, OutputKind};
 use formation::pipeline::{extract_stage, Config};
 use formation::{Error, Result};
@@ -327,12 +327,8 @@ pub struct PlotShapeArgs {
 /// Runs `formation plot shape`.
 pub fn run_plot_shape(args: PlotShapeArgs, g: Global) -> Result<()> {
     OutputKind::from_path(&args.output, &[OutputKind::Png, OutputKind::Svg])?;
-    let is_params = !args.input.is_dir()
-        && formation::io::read_text(&args.input)
-            .map(|t| extract::is_params_file(&t))
-            .unwrap_or(false);
-    let (params, threshold) = if is_params {
-        (FormationParams::read(&args.input)?, None)
+    let (params, threshold) = if let Some(p) = FormationParams::read_if_params(&args.input)? {
+        (p, None)
     } else {
         let (_, p, _) = read_and_extract(
             &args.input,

@@ -40,18 +40,11 @@ pub fn run(args: ReportArgs, g: Global) -> Result<()> {
     };
     extract.validate()?;
     formation::io::check_output_dir("-o", &args.output)?;
-    let kind = if args.input.is_dir() {
-        Kind::Labelme
-    } else {
-        let text = formation::io::read_text(&args.input)?;
-        serde_json::from_str::<serde_json::Value>(&text)
-            .map(|v| formation::sniff::json_kind(&v))
-            .unwrap_or(Kind::Unknown)
-    };
+    let kind = formation::sniff::path_kind(&args.input)?;
     let (params, animation, threshold): (Option<FormationParams>, Option<Animation>, _) = match kind
     {
         Kind::Animation => (None, Some(Animation::read(&args.input)?), None),
-        Kind::Params => (Some(super::steady::read_params(&args.input)?), None, None),
+        Kind::Params => (Some(FormationParams::read(&args.input)?), None, None),
         _ => {
             let (_, p, _) = super::extract::read_and_extract(
                 &args.input,

@@ -68,6 +68,15 @@ pub enum CameraKind {
 }
 
 impl CameraKind {
+    /// The camera's name, as [`CameraKind::parse`] reads it: `follow`, `ground` or `fixed`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            CameraKind::Follow => "follow",
+            CameraKind::Ground => "ground",
+            CameraKind::Fixed(_) => "fixed",
+        }
+    }
+
     /// Parses `follow`, `ground` or `fixed` (`fixed` takes its rectangle from `view`).
     pub fn parse(name: &str, view: Option<[f64; 4]>) -> Result<CameraKind> {
         match (name, view) {

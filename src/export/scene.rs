@@ -66,6 +66,17 @@ impl Background {
     }
 }
 
+/// `sky`, `none` or `#rrggbb`, as [`Background::parse`] reads it.
+impl std::fmt::Display for Background {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Background::Sky => write!(f, "sky"),
+            Background::None => write!(f, "none"),
+            Background::Colour([r, g, b]) => write!(f, "#{r:02x}{g:02x}{b:02x}"),
+        }
+    }
+}
+
 /// Colours and look of the picture.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Style {

@@ -98,6 +98,32 @@ pub fn stages_title(anim: &crate::animation::Animation) -> String {
     }
 }
 
+/// Formation `k` (default 0) of a flock of several formations, as an animation of its own, and
+/// the words a chart's title adds for it (`None` for an animation of one formation). Errors
+/// name `plot.formation` and the file `origin` the animation was read from.
+pub fn one_formation(
+    anim: crate::animation::Animation,
+    k: Option<usize>,
+    origin: &Path,
+) -> Result<(crate::animation::Animation, Option<String>)> {
+    let count = anim.formation_count();
+    let k = k.unwrap_or(0);
+    if anim.formations.is_none() && k == 0 {
+        return Ok((anim, None));
+    }
+    let one = anim.formation(k).ok_or_else(|| {
+        Error::parameter(
+            "plot.formation",
+            format!(
+                "{k}: {} has {count} formation(s) (0..{})",
+                origin.display(),
+                count - 1
+            ),
+        )
+    })?;
+    Ok((one, Some(format!(", formation {k} of {count}"))))
+}
+
 /// Error type of a drawing operation on backend `DB`.
 pub type DrawResult<DB> =
     std::result::Result<(), DrawingAreaErrorKind<<DB as DrawingBackend>::ErrorType>>;

@@ -134,6 +134,39 @@ impl PowerChart {
         })
     }
 
+    /// The chart of the file at `path`: a shape file (SPEC §4.3), or formation `formation` of an
+    /// animation file and its key shape or frame `of` (default: key shape 0), told apart by
+    /// content ([`crate::sniff`]). Errors name `plot.formation`, `plot.key` or `plot.frame`.
+    pub fn from_file(
+        path: &Path,
+        formation: Option<usize>,
+        of: Option<PowerOf>,
+        metric: PowerMetric,
+    ) -> Result<PowerChart> {
+        if crate::sniff::path_kind(path)? == crate::sniff::Kind::Animation {
+            let (anim, which) = super::one_formation(Animation::read(path)?, formation, path)?;
+            let of = of.unwrap_or(PowerOf::Key(0));
+            let mut chart = PowerChart::from_animation(&anim, path, of, metric)?;
+            chart.title.push_str(which.as_deref().unwrap_or(""));
+            return Ok(chart);
+        }
+        let refuse = |option: &str, what: &str| {
+            Err(Error::parameter(
+                option,
+                format!("{} is a shape file, which has no {what}", path.display()),
+            ))
+        };
+        if formation.is_some() {
+            return refuse("plot.formation", "formations");
+        }
+        if of.is_some() {
+            return refuse("plot.key/plot.frame", "key shapes or frames");
+        }
+        let shape: Shape = crate::io::read_json(path)?;
+        shape.validate(path, 2)?;
+        PowerChart::from_shape(&shape, path, metric)
+    }
+
     /// The chart of a shape file's shape (already validated), read from `origin`.
     pub fn from_shape(shape: &Shape, origin: &Path, metric: PowerMetric) -> Result<PowerChart> {
         let name = file_name(origin);
