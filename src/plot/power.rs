@@ -44,7 +44,8 @@ pub struct PowerChart {
 pub enum PowerOf {
     /// Key shape `k` (index into `key_shapes`), with the feasible ranges.
     Key(usize),
-    /// Frame `k`, in the formation frame of a flock heading +y.
+    /// Frame `k`, in the formation frame of its leader (any heading): bars at the birds'
+    /// offsets to the right of the leader's heading.
     Frame(usize),
 }
 
@@ -80,16 +81,19 @@ impl PowerChart {
                         ),
                     )
                 })?;
+                // The formation frame of SPEC §2 at this frame, whatever the heading: lateral
+                // offsets to the right of the leader's heading, distances behind it along it.
+                let rel = anim.relative(k);
+                let lateral: Vec<f64> = rel.iter().map(|r| r.lateral).collect();
                 let (e, xi) = match (&fr.e, &fr.xi) {
                     (Some(e), Some(xi)) => (e.clone(), xi.clone()),
                     _ => {
-                        // World → formation frame for a flock heading +y: y behind = −north.
-                        let back: Vec<f64> = fr.y.iter().map(|v| -v).collect();
-                        let p = power_reduction(&fr.x, &back)?;
+                        let behind: Vec<f64> = rel.iter().map(|r| r.behind).collect();
+                        let p = power_reduction(&lateral, &behind)?;
                         (p.e, p.xi)
                     }
                 };
-                (fr.x.clone(), e, xi, format!("frame {k}"))
+                (lateral, e, xi, format!("frame {k}"))
             }
             PowerOf::Key(k) => {
                 let ks = anim.key_shapes.get(k).ok_or_else(|| {
