@@ -128,6 +128,49 @@ pub fn one_formation(
 pub type DrawResult<DB> =
     std::result::Result<(), DrawingAreaErrorKind<<DB as DrawingBackend>::ErrorType>>;
 
+/// Draws the grid and the axis descriptions every chart shares (light grey minor lines, tick
+/// labels of `label_size` points).
+pub fn draw_mesh<DB, X, Y>(
+    chart: &mut ChartContext<'_, DB, Cartesian2d<X, Y>>,
+    x_desc: &str,
+    y_desc: &str,
+    label_size: u32,
+) -> DrawResult<DB>
+where
+    DB: DrawingBackend,
+    X: Ranged + plotters::coord::ranged1d::ValueFormatter<X::ValueType>,
+    Y: Ranged + plotters::coord::ranged1d::ValueFormatter<Y::ValueType>,
+{
+    chart
+        .configure_mesh()
+        .x_desc(x_desc)
+        .y_desc(y_desc)
+        .label_style((FONT_FAMILY, label_size))
+        .light_line_style(RGBColor(235, 235, 235))
+        .draw()
+}
+
+/// Draws the legend box every chart shares (white, black border, labels of `label_size`
+/// points) at `position`.
+pub fn draw_legend<'a, DB, X, Y>(
+    chart: &mut ChartContext<'a, DB, Cartesian2d<X, Y>>,
+    label_size: u32,
+    position: SeriesLabelPosition,
+) -> DrawResult<DB>
+where
+    DB: DrawingBackend + 'a,
+    X: Ranged,
+    Y: Ranged,
+{
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font((FONT_FAMILY, label_size))
+        .position(position)
+        .draw()
+}
+
 /// A chart that can draw itself on any plotters backend.
 pub trait Chart {
     /// Default size in pixels (width, height).

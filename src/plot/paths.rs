@@ -167,13 +167,7 @@ impl PathsChart {
             .x_label_area_size(40)
             .y_label_area_size(50)
             .build_cartesian_2d(x0..x1, y0..y1)?;
-        chart
-            .configure_mesh()
-            .x_desc(x_desc)
-            .y_desc(y_desc)
-            .label_style((FONT_FAMILY, 13))
-            .light_line_style(RGBColor(235, 235, 235))
-            .draw()?;
+        super::draw_mesh(&mut chart, x_desc, y_desc, 13)?;
         let n = paths.len();
         let labelled = super::legend_ranks(n);
         let mut order: Vec<usize> = (0..n).collect();
@@ -207,13 +201,7 @@ impl PathsChart {
             }
         }
         if legend {
-            chart
-                .configure_series_labels()
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .label_font((FONT_FAMILY, 12))
-                .position(SeriesLabelPosition::UpperLeft)
-                .draw()?;
+            super::draw_legend(&mut chart, 12, SeriesLabelPosition::UpperLeft)?;
         }
         Ok(())
     }

@@ -268,13 +268,7 @@ impl Chart for PowerChart {
                 )?;
             }
         }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font((FONT_FAMILY, 14))
-            .position(SeriesLabelPosition::UpperRight)
-            .draw()?;
+        super::draw_legend(&mut chart, 14, SeriesLabelPosition::UpperRight)?;
         Ok(())
     }
 }
