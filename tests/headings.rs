@@ -344,61 +344,46 @@ fn the_cameras_frame_the_flock_at_any_heading() {
     ] {
         let a = fly(&path, 30.0);
         let name = path.file_name().unwrap().to_string_lossy().into_owned();
-        // Follow, fitting the whole flock: every bird in every picture.
-        let opts = RenderOptions {
-            width: w as u32,
-            height: h as u32,
-            min_bird_px: 0.0,
-            ..RenderOptions::default()
+        // The pictures (5 a second) of `camera`, birds never under `min_bird_px` pixels a
+        // wingspan; each picture's birds in pixels.
+        let pictures = |camera: CameraKind, min_bird_px: f64| -> Vec<Vec<(f64, f64)>> {
+            let opts = RenderOptions {
+                width: w as u32,
+                height: h as u32,
+                camera,
+                min_bird_px,
+                ..RenderOptions::default()
+            };
+            let film = Film::with_options(&a, 5.0, &opts);
+            film.states
+                .iter()
+                .zip(&film.views)
+                .map(|(st, view)| {
+                    st.iter()
+                        .filter_map(|b| view.project([b.x, b.y, b.z], w, h))
+                        .map(|(x, y, _)| (x, y))
+                        .collect()
+                })
+                .collect()
         };
-        let film = Film::with_options(&a, 5.0, &opts);
-        for (k, (st, view)) in film.states.iter().zip(&film.views).enumerate() {
-            for (i, b) in st.iter().enumerate() {
-                let (x, y, _) = view.project([b.x, b.y, b.z], w, h).unwrap();
-                assert!(
-                    inside((x, y)),
-                    "{name}: follow picture {k}: bird {i} at ({x:.0}, {y:.0})"
-                );
+        // Follow, fitting the whole flock: every bird in every picture.
+        for (k, birds) in pictures(CameraKind::Follow, 0.0).iter().enumerate() {
+            assert_eq!(birds.len(), a.birds);
+            for (i, &p) in birds.iter().enumerate() {
+                assert!(inside(p), "{name}: follow picture {k}: bird {i} at {p:?}");
             }
         }
         // Follow at the default minimum size: the leader always in the picture.
-        let film = Film::with_options(
-            &a,
-            5.0,
-            &RenderOptions {
-                width: w as u32,
-                height: h as u32,
-                ..RenderOptions::default()
-            },
-        );
         let lead = a.leaders()[0];
-        for (k, (st, view)) in film.states.iter().zip(&film.views).enumerate() {
-            let b = &st[lead];
-            let (x, y, _) = view.project([b.x, b.y, b.z], w, h).unwrap();
-            assert!(
-                inside((x, y)),
-                "{name}: picture {k}: the leader at ({x:.0}, {y:.0})"
-            );
+        let min = RenderOptions::default().min_bird_px;
+        for (k, birds) in pictures(CameraKind::Follow, min).iter().enumerate() {
+            let p = birds[lead];
+            assert!(inside(p), "{name}: picture {k}: the leader at {p:?}");
         }
         // Ground: the observer under the course sees the flock pass over, whatever its heading.
-        let film = Film::with_options(
-            &a,
-            5.0,
-            &RenderOptions {
-                width: w as u32,
-                height: h as u32,
-                camera: CameraKind::Ground,
-                ..RenderOptions::default()
-            },
-        );
-        let most = (0..film.states.len())
-            .map(|k| {
-                film.states[k]
-                    .iter()
-                    .filter_map(|b| film.views[k].project([b.x, b.y, b.z], w, h))
-                    .filter(|&(x, y, _)| inside((x, y)))
-                    .count()
-            })
+        let most = pictures(CameraKind::Ground, min)
+            .iter()
+            .map(|birds| birds.iter().filter(|&&p| inside(p)).count())
             .max()
             .unwrap();
         assert!(

@@ -91,11 +91,29 @@ pub struct ExtractArgs {
     #[arg(long)]
     pub json: bool,
     #[command(flatten)]
+    pub extraction: ExtractionArgs,
+}
+
+/// Reading, fitting and the bird's size: every flag of §4 extraction (shared by `extract` and
+/// `report`).
+#[derive(Debug, Args, Clone)]
+pub struct ExtractionArgs {
+    #[command(flatten)]
     pub read: ReadArgs,
     #[command(flatten)]
     pub fit: FitArgs,
     #[command(flatten)]
     pub size: SizeArgs,
+}
+
+impl ExtractionArgs {
+    /// The extraction options for these flags.
+    pub fn options(&self) -> ExtractOptions {
+        ExtractOptions {
+            wingspan_m: self.size.wingspan_m,
+            ..self.fit.options()
+        }
+    }
 }
 
 /// Reads annotations and extracts, with the seed's `extract` stream. The warnings in the
@@ -136,14 +154,10 @@ pub fn run(args: ExtractArgs, g: Global) -> Result<()> {
     if let Some(o) = &args.output {
         OutputKind::from_path(o, &[OutputKind::Json])?;
     }
-    let extract = ExtractOptions {
-        wingspan_m: args.size.wingspan_m,
-        ..args.fit.options()
-    };
     let (ann, params, reports) = read_and_extract(
         &args.annotations,
-        &args.read,
-        extract,
+        &args.extraction.read,
+        args.extraction.options(),
         g,
         super::flags::Cmd::Extract,
     )?;

@@ -5,13 +5,13 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use formation::extract::{ExtractOptions, FormationParams};
+use formation::extract::FormationParams;
 use formation::io::{write_bytes_atomic, OutputKind};
 use formation::report::{report, Subject};
 use formation::sniff::Kind;
 use formation::{Animation, Result};
 
-use super::extract::{FitArgs, ReadArgs, SizeArgs};
+use super::extract::ExtractionArgs;
 use super::Global;
 
 /// Arguments of `formation report`.
@@ -24,20 +24,13 @@ pub struct ReportArgs {
     #[arg(short = 'o', long = "output")]
     pub output: PathBuf,
     #[command(flatten)]
-    pub read: ReadArgs,
-    #[command(flatten)]
-    pub fit: FitArgs,
-    #[command(flatten)]
-    pub size: SizeArgs,
+    pub extraction: ExtractionArgs,
 }
 
 /// Runs `formation report`.
 pub fn run(args: ReportArgs, g: Global) -> Result<()> {
     OutputKind::for_flag("-o", &args.output, &[OutputKind::Html])?;
-    let extract = ExtractOptions {
-        wingspan_m: args.size.wingspan_m,
-        ..args.fit.options()
-    };
+    let extract = args.extraction.options();
     extract.validate()?;
     formation::io::check_output_dir("-o", &args.output)?;
     let kind = formation::sniff::path_kind(&args.input)?;
@@ -48,7 +41,7 @@ pub fn run(args: ReportArgs, g: Global) -> Result<()> {
         _ => {
             let (_, p, _) = super::extract::read_and_extract(
                 &args.input,
-                &args.read,
+                &args.extraction.read,
                 extract,
                 g,
                 super::flags::Cmd::Report,
