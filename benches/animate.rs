@@ -93,14 +93,25 @@ fn bench(c: &mut Criterion) {
         config.steady.birds = 14;
         config.course.path = Some(path.clone());
         let straight = simulate();
-        g.bench_function("geese_14_birds_20s_course_step", |b| {
-            b.iter(|| {
-                let points = config.course.load(config.steady.wingspan_m).unwrap();
-                let mut a = straight.clone();
-                formation::pipeline::course_stage(&mut a, points.as_ref(), &config).unwrap();
-                a
-            })
-        });
+        // The same step without the path (pitch and banks only, as every flight has): the
+        // difference of the two is what following the path costs.
+        let mut unbanked = straight.clone();
+        for f in &mut unbanked.frames {
+            f.bank = None;
+        }
+        for (name, config) in [
+            ("geese_14_birds_20s_course_step", config.clone()),
+            ("geese_14_birds_20s_course_step_without_path", Config::default()),
+        ] {
+            g.bench_function(name, |b| {
+                b.iter(|| {
+                    let points = config.course.load(config.steady.wingspan_m).unwrap();
+                    let mut a = unbanked.clone();
+                    formation::pipeline::course_stage(&mut a, points.as_ref(), &config).unwrap();
+                    a
+                })
+            });
+        }
     }
     let gif: PathBuf = dir.join("flock.gif");
     let anim = simulate();
