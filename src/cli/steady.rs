@@ -227,6 +227,24 @@ pub enum MetricArg {
     E,
 }
 
+impl From<PowerMetric> for MetricArg {
+    fn from(m: PowerMetric) -> MetricArg {
+        match m {
+            PowerMetric::Xi => MetricArg::Xi,
+            PowerMetric::E => MetricArg::E,
+        }
+    }
+}
+
+impl From<MetricArg> for PowerMetric {
+    fn from(m: MetricArg) -> PowerMetric {
+        match m {
+            MetricArg::Xi => PowerMetric::Xi,
+            MetricArg::E => PowerMetric::E,
+        }
+    }
+}
+
 /// Arguments of `formation plot power`.
 #[derive(Debug, Args)]
 pub struct PlotPowerArgs {
@@ -242,7 +260,7 @@ pub struct PlotPowerArgs {
     #[arg(long)]
     pub frame: Option<usize>,
     /// Quantity to plot.
-    #[arg(long, value_enum, default_value_t = MetricArg::Xi)]
+    #[arg(long, value_enum, default_value_t = MetricArg::from(PowerMetric::default()))]
     pub metric: MetricArg,
     #[command(flatten)]
     pub formation: FormationArg,
@@ -268,10 +286,7 @@ impl FormationArg {
 /// Runs `formation plot power`.
 pub fn run_plot_power(args: PlotPowerArgs, _g: Global) -> Result<()> {
     OutputKind::from_path(&args.output, &[OutputKind::Png, OutputKind::Svg])?;
-    let metric = match args.metric {
-        MetricArg::Xi => PowerMetric::Xi,
-        MetricArg::E => PowerMetric::E,
-    };
+    let metric = PowerMetric::from(args.metric);
     let of = match (args.frame, args.key) {
         (Some(k), _) => Some(PowerOf::Frame(k)),
         (None, k) => k.map(PowerOf::Key),

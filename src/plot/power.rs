@@ -14,9 +14,10 @@ use crate::error::{Error, Result};
 use crate::shape::Shape;
 
 /// Which quantity the bars show.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum PowerMetric {
     /// Relative power reduction ξ_i = e_i / E.
+    #[default]
     Xi,
     /// Power reduction e_i (Hummel's model without the drag ratio).
     E,
