@@ -4,7 +4,7 @@
 
 use formation::export::{sample, write_outputs, RenderOptions};
 use formation::extract::params::FormationParams;
-use formation::keyshape::{steady_flight, SteadyOptions};
+use formation::keyshape::{steady_flight, KeyOptions, SteadyOptions};
 use formation::progress::Silent;
 use formation::rng::stream;
 use formation::Animation;
@@ -21,7 +21,10 @@ fn tiny_steady(p: &FormationParams) -> formation::Result<Animation> {
     let opts = SteadyOptions {
         birds: 6,
         frames: 4,
-        key_every_s: 0.05,
+        keys: KeyOptions {
+            key_every_s: 0.05,
+            ..KeyOptions::default()
+        },
         ..SteadyOptions::default()
     };
     steady_flight(p, &opts, &mut stream(0, "steady"), &Silent)
