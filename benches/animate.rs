@@ -101,7 +101,10 @@ fn bench(c: &mut Criterion) {
         }
         for (name, config) in [
             ("geese_14_birds_20s_course_step", config.clone()),
-            ("geese_14_birds_20s_course_step_without_path", Config::default()),
+            (
+                "geese_14_birds_20s_course_step_without_path",
+                Config::default(),
+            ),
         ] {
             g.bench_function(name, |b| {
                 b.iter(|| {

@@ -206,16 +206,15 @@ fn assert_same_charts(north: &Animation, a: &Animation, h: f64, what: &str) {
 fn the_charts_show_the_same_flight_at_any_heading() {
     let dir = scratch("headings-charts");
     let north = fly(&straight(&dir, 0.0), 6.0);
-    for deg in [90.0, 225.0] {
+    for deg in [90.0f64, 225.0] {
         let a = fly(&straight(&dir, deg), 6.0);
         // The run really flies that way: the leader's heading in the steady flight.
         let k = frames_to_chart(&a)[0];
         let l = a.leaders()[0];
-        let dh =
-            (a.frames[k].heading[l] - north.frames[k].heading[l] - f64::from(deg).to_radians())
-                .rem_euclid(2.0 * PI);
+        let dh = (a.frames[k].heading[l] - north.frames[k].heading[l] - deg.to_radians())
+            .rem_euclid(2.0 * PI);
         assert!(dh.min(2.0 * PI - dh) < 1e-9, "{deg}°: heading off by {dh}");
-        assert_same_charts(&north, &a, f64::from(deg).to_radians(), &format!("{deg}°"));
+        assert_same_charts(&north, &a, deg.to_radians(), &format!("{deg}°"));
     }
 }
 
@@ -399,8 +398,8 @@ fn the_hand_over_is_the_same_step_at_any_heading() {
     let north = fly(&straight(&dir, 0.0), 4.0);
     let e = north.stage("initiation").unwrap().end;
     assert!(e > 1 && e < north.frames.len());
-    for deg in [90.0, 225.0] {
-        let h = f64::from(deg).to_radians();
+    for deg in [90.0f64, 225.0] {
+        let h = deg.to_radians();
         let a = fly(&straight(&dir, deg), 4.0);
         assert_eq!(
             a.stage("initiation").unwrap().end,
