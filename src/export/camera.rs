@@ -530,6 +530,19 @@ fn lead_centre(s: &[BirdState], ax: f64, ay: f64) -> (f64, f64) {
 mod tests {
     use super::*;
 
+    #[test]
+    fn camera_names_read_back() {
+        let view = [0.0, 0.0, 10.0, 5.0];
+        for c in [
+            CameraKind::Follow,
+            CameraKind::Ground,
+            CameraKind::Fixed(view),
+        ] {
+            let v = matches!(c, CameraKind::Fixed(_)).then_some(view);
+            assert_eq!(CameraKind::parse(c.name(), v).unwrap(), c);
+        }
+    }
+
     fn fit_all() -> CameraParams {
         CameraParams {
             min_bird_px: 0.0,

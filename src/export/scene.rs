@@ -546,6 +546,18 @@ mod tests {
     use super::*;
 
     #[test]
+    fn backgrounds_read_back_what_they_write() {
+        for b in [
+            Background::Sky,
+            Background::None,
+            Background::Colour([0x87, 0xce, 0x0b]),
+        ] {
+            assert_eq!(Background::parse(&b.to_string()).unwrap(), b);
+        }
+        assert_eq!(Background::Colour([1, 2, 255]).to_string(), "#0102ff");
+    }
+
+    #[test]
     fn sky_gradient_runs_from_top_to_bottom_colour() {
         let st = Style::default();
         let top = st.sky(0.0);
