@@ -123,7 +123,9 @@ fn not_utf8(path: &Path, offset: usize) -> Error {
 }
 
 /// Parses JSON text into `T`, turning serde's message into one line naming the file, line and column.
+/// A leading byte-order mark (written by some Windows editors) is skipped.
 pub fn parse_json<T: DeserializeOwned>(path: &Path, text: &str) -> Result<T> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     if text.trim().is_empty() {
         return Err(Error::format(path, "file is empty, expected JSON"));
     }
