@@ -86,13 +86,13 @@ pub const FLAGS: &[(&str, &str, &[Cmd])] = &[
     ("steady.frames", "--frames", &[Steady]),
     ("steady.frames", "--seconds", &[Animate]),
     ("steady.fps", "--fps", STEADY),
-    ("steady.key_every_s", "--key-every", STEADY),
+    ("steady.keys.key_every_s", "--key-every", STEADY),
     ("steady.speed", "--speed", STEADY),
-    ("steady.epsilon", "--epsilon", STEADY),
-    ("steady.c1", "--c1", STEADY),
-    ("steady.c2", "--c2", STEADY),
+    ("steady.keys.epsilon", "--epsilon", STEADY),
+    ("steady.keys.c1", "--c1", STEADY),
+    ("steady.keys.c2", "--c2", STEADY),
     ("steady.wingspan_m", "--wingspan-m", STEADY),
-    ("steady.max_jump", "--max-jump", STEADY),
+    ("steady.keys.max_jump", "--max-jump", STEADY),
     ("steady.loop", "--loop", STEADY),
     ("course.path", "--path", SCENE_COURSE),
     ("course.units", "--path-units", SCENE_COURSE),
@@ -176,7 +176,7 @@ pub const FLAGS: &[(&str, &str, &[Cmd])] = &[
 ];
 
 /// `text` with every option path that `cmd` has a flag for replaced by the flag. A path is
-/// replaced only as a whole word (`steady.c1` is not found in `steady.c10`); longer paths first,
+/// replaced only as a whole word (`steady.keys.c1` is not found in `steady.keys.c10`); longer paths first,
 /// so that `render.width/render.height` becomes one `--size`. Paths without a dot (`seconds`,
 /// `output`) are ordinary words in running text, so they are replaced only in an error's name
 /// ([`rewrite_name`]).
@@ -276,9 +276,10 @@ mod tests {
         );
         // Only whole paths, and only those the command has.
         assert_eq!(
-            rewrite(Steady, "steady.c10 xsteady.c1"),
-            "steady.c10 xsteady.c1"
+            rewrite(Steady, "steady.keys.c10 xsteady.keys.c1"),
+            "steady.keys.c10 xsteady.keys.c1"
         );
+        assert_eq!(rewrite(Steady, "steady.keys.c1: 2"), "--c1: 2");
         assert_eq!(rewrite(Extract, "steady.fps"), "steady.fps");
         assert_eq!(
             rewrite(Initiate, "initiate.min_speed/initiate.max_speed: x"),

@@ -7,7 +7,7 @@ use clap::{Args, ValueEnum};
 use formation::animation::Animation;
 use formation::extract::params::FormationParams;
 use formation::io::{write_json_atomic, OutputKind};
-use formation::keyshape::SteadyOptions;
+use formation::keyshape::{KeyOptions, SteadyOptions};
 use formation::pipeline::{flock_steady_stage, Config, SteadyOutcome};
 use formation::plot::power::{PowerChart, PowerMetric, PowerOf};
 use formation::plot::xi::XiChart;
@@ -67,25 +67,25 @@ pub struct SteadyFlags {
     #[arg(long, default_value_t = SteadyOptions::default().fps, allow_negative_numbers = true)]
     pub fps: f64,
     /// Time between key shapes, seconds.
-    #[arg(long = "key-every", default_value_t = SteadyOptions::default().key_every_s, allow_negative_numbers = true)]
+    #[arg(long = "key-every", default_value_t = KeyOptions::default().key_every_s, allow_negative_numbers = true)]
     pub key_every: f64,
     /// Cruise speed of the flock, wingspans per second.
     #[arg(long, default_value_t = SteadyOptions::default().speed, allow_negative_numbers = true)]
     pub speed: f64,
     /// ε of eq. (2): widening of each bird's ξ range, in [0, 0.5].
-    #[arg(long, default_value_t = SteadyOptions::default().epsilon, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = KeyOptions::default().epsilon, allow_negative_numbers = true)]
     pub epsilon: f64,
     /// C1 of eq. (2): smallest step ratio of ξ between key shapes, in [0.5, 1].
-    #[arg(long, default_value_t = SteadyOptions::default().c1, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = KeyOptions::default().c1, allow_negative_numbers = true)]
     pub c1: f64,
     /// C2 of eq. (2): largest step ratio of ξ between key shapes, in [1, 2].
-    #[arg(long, default_value_t = SteadyOptions::default().c2, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = KeyOptions::default().c2, allow_negative_numbers = true)]
     pub c2: f64,
     /// Wingspan of one bird, metres (recorded in the animation; used by the .glb export).
     #[arg(long = "wingspan-m", default_value_t = SteadyOptions::default().wingspan_m, allow_negative_numbers = true)]
     pub wingspan_m: f64,
     /// Largest move of a bird between consecutive key shapes, wingspans.
-    #[arg(long = "max-jump", default_value_t = SteadyOptions::default().max_jump, allow_negative_numbers = true)]
+    #[arg(long = "max-jump", default_value_t = KeyOptions::default().max_jump, allow_negative_numbers = true)]
     pub max_jump: f64,
     /// A seamless cycle: the last key shape is the first and the wingbeats make whole cycles, so
     /// the GIF, the glTF clip or a game's background flock loops without a jump (in the flock's
@@ -101,13 +101,16 @@ impl SteadyFlags {
         SteadyOptions {
             birds,
             fps: self.fps,
-            key_every_s: self.key_every,
             speed: self.speed,
-            epsilon: self.epsilon,
-            c1: self.c1,
-            c2: self.c2,
             wingspan_m: self.wingspan_m,
-            max_jump: self.max_jump,
+            keys: KeyOptions {
+                epsilon: self.epsilon,
+                c1: self.c1,
+                c2: self.c2,
+                key_every_s: self.key_every,
+                max_jump: self.max_jump,
+                ..KeyOptions::default()
+            },
             looped: self.looped,
             ..SteadyOptions::default()
         }
