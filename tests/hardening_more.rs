@@ -5,35 +5,17 @@
 //! that do are there. Memory is bounded with `ulimit -v` as in `tests/hardening.rs`.
 #![cfg(unix)]
 
-use std::path::{Path, PathBuf};
+mod support;
+
+use std::path::Path;
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
-fn bin() -> &'static str {
-    env!("CARGO_BIN_EXE_formation")
-}
+use support::{assert_refused, bin_path, run_in, scratch, stderr};
 
+/// A file of the repository as an argument.
 fn data(rel: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join(rel)
-        .display()
-        .to_string()
-}
-
-/// A fresh scratch directory for one test.
-fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("formation-harden3-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn run_in(dir: &Path, args: &[&str]) -> Output {
-    Command::new(bin())
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .unwrap()
+    support::repo_file(rel).display().to_string()
 }
 
 /// Runs `formation --quiet ARGS` in `dir` through `sh -c` with `ulimit -v mem_kib` and `redirect`
@@ -45,7 +27,7 @@ fn run_sh(dir: &Path, mem_kib: u64, redirect: &str, args: &[&str]) -> (Output, D
         .current_dir(dir)
         .arg("-c")
         .arg(script)
-        .arg(bin())
+        .arg(bin_path())
         .args(args)
         .stdin(Stdio::null())
         .output()
@@ -53,24 +35,10 @@ fn run_sh(dir: &Path, mem_kib: u64, redirect: &str, args: &[&str]) -> (Output, D
     (out, start.elapsed())
 }
 
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-/// Asserts a clean refusal: exit 2, one line starting with `error: ` that contains `needle`.
-fn assert_refused(o: &Output, needle: &str, what: &str) {
-    let e = stderr(o);
-    assert_eq!(o.status.code(), Some(2), "{what}: exit {:?}: {e}", o.status);
-    assert_eq!(e.lines().count(), 1, "{what}: not one line: {e}");
-    assert!(e.starts_with("error: "), "{what}: {e}");
-    assert!(e.contains(needle), "{what}: expected `{needle}` in {e}");
-}
-
 fn steady_with_path(dir: &Path, path: &str, out: &str) -> Output {
     run_in(
         dir,
         &[
-            "--quiet",
             "steady",
             &data("tests/data/steady_v9_params.json"),
             "--birds",
@@ -137,13 +105,19 @@ fn huge_path_files_stop_at_the_point_limit_in_bounded_memory() {
     json += "]}";
     std::fs::write(dir.join("many.json"), json).unwrap();
     std::fs::write(dir.join("many.csv"), "0,0,10\n0,1,10\n".repeat(2_000_000)).unwrap();
-    let long_point = format!("{{\"points\": [[0,0,0],[{}]]}}", vec!["1"; 10_000_000].join(","));
+    let long_point = format!(
+        "{{\"points\": [[0,0,0],[{}]]}}",
+        vec!["1"; 10_000_000].join(",")
+    );
     std::fs::write(dir.join("long_point.json"), long_point).unwrap();
     let params = data("tests/data/steady_v9_params.json");
     for (file, needle) in [
         ("many.json", "points: more than 100000 points"),
         ("many.csv", "line 100001: more than 100000 points"),
-        ("long_point.json", "points[1]: 10000000 numbers, expected [x, y, z]"),
+        (
+            "long_point.json",
+            "points[1]: 10000000 numbers, expected [x, y, z]",
+        ),
     ] {
         // The text itself (up to 28 MB here) plus the kept points (2.4 MB) and the binary; the
         // JSON used to take 113 MB resident here, the CSV its 4·10⁶ points (96 MB) and more.
@@ -152,7 +126,16 @@ fn huge_path_files_stop_at_the_point_limit_in_bounded_memory() {
             100_000,
             "",
             &[
-                "steady", &params, "--birds", "9", "--seconds", "5", "--path", file, "-o", "a.json",
+                "steady",
+                &params,
+                "--birds",
+                "9",
+                "--seconds",
+                "5",
+                "--path",
+                file,
+                "-o",
+                "a.json",
             ],
         );
         assert_refused(&o, needle, file);
@@ -178,7 +161,6 @@ fn closed_paths_too_small_for_the_flock_are_refused_naming_the_path() {
     let o = run_in(
         &dir,
         &[
-            "--quiet",
             "steady",
             &params,
             "--birds",
@@ -195,14 +177,27 @@ fn closed_paths_too_small_for_the_flock_are_refused_naming_the_path() {
             "a.json",
         ],
     );
-    assert_refused(&o, "square.csv: the closed path is 1261 wingspans around", "sky");
+    assert_refused(
+        &o,
+        "square.csv: the closed path is 1261 wingspans around",
+        "sky",
+    );
     assert!(stderr(&o).contains("too small for the flock"));
     // The same square is wide enough for one V: it flies, every number finite.
     let o = run_in(
         &dir,
         &[
-            "--quiet", "steady", &params, "--birds", "9", "--seconds", "130", "--loop", "--path",
-            "square.csv", "-o", "b.json",
+            "steady",
+            &params,
+            "--birds",
+            "9",
+            "--seconds",
+            "130",
+            "--loop",
+            "--path",
+            "square.csv",
+            "-o",
+            "b.json",
         ],
     );
     assert!(o.status.success(), "{}", stderr(&o));
@@ -224,8 +219,26 @@ fn a_full_or_closed_stderr_loses_no_output() {
     let ex = data("examples_data/barnacle_geese_v.json");
     let runs: Vec<Vec<&str>> = vec![
         // A summary, and warnings (a turn widened, the flight past the path's end) before it.
-        vec!["steady", &params, "--birds", "9", "--seconds", "5", "--path", "u.csv"],
-        vec!["steady", &params, "--birds", "40", "--formations", "2", "--seconds", "3"],
+        vec![
+            "steady",
+            &params,
+            "--birds",
+            "9",
+            "--seconds",
+            "5",
+            "--path",
+            "u.csv",
+        ],
+        vec![
+            "steady",
+            &params,
+            "--birds",
+            "40",
+            "--formations",
+            "2",
+            "--seconds",
+            "3",
+        ],
         // A take-off longer than the flock can stretch: a warning, then the summary.
         vec!["initiate", &steady, "--takeoff", "100"],
         vec!["animate", &ex, "--birds", "9", "--seconds", "3"],
@@ -245,7 +258,7 @@ fn a_full_or_closed_stderr_loses_no_output() {
                 .current_dir(&dir)
                 .arg("-c")
                 .arg(script)
-                .arg(bin())
+                .arg(bin_path())
                 .args(&a)
                 .output()
                 .unwrap();
@@ -277,7 +290,6 @@ fn warnings_are_one_safe_line() {
     let o = run_in(
         &dir,
         &[
-            "--quiet",
             "initiate",
             &data("tests/data/initiate_steady_v9.json"),
             "--takeoff",
@@ -311,7 +323,11 @@ fn start_positions_far_away_are_refused_at_once() {
         "",
         &["initiate", &steady, "--start", "far.json", "-o", "a.json"],
     );
-    assert_refused(&o, "far.json: x[8]: 1e12 wingspans; a start position must be within ±1e7 wingspans", "far");
+    assert_refused(
+        &o,
+        "far.json: x[8]: 1e12 wingspans; a start position must be within ±1e7 wingspans",
+        "far",
+    );
     assert!(took < Duration::from_secs(10), "took {took:?}");
     // Within the bound the take-off runs (and reports not converging, exit 1, as documented).
     std::fs::write(
@@ -321,7 +337,7 @@ fn start_positions_far_away_are_refused_at_once() {
     .unwrap();
     let o = run_in(
         &dir,
-        &["--quiet", "initiate", &steady, "--start", "near.json", "-o", "a.json"],
+        &["initiate", &steady, "--start", "near.json", "-o", "a.json"],
     );
     assert!(o.status.success(), "{}", stderr(&o));
     std::fs::remove_dir_all(&dir).unwrap();
@@ -338,7 +354,6 @@ fn report_of_a_sky_of_many_formations_is_not_quadratic() {
     let o = run_in(
         &dir,
         &[
-            "--quiet",
             "steady",
             &data("tests/data/steady_v9_params.json"),
             "--birds",
@@ -374,9 +389,13 @@ fn every_animation_file_written_can_be_read_back() {
     };
     make("three.json", 3_000_000_000);
     make("five.json", 5_000_000_000);
-    let o = run_in(&dir, &["--quiet", "render", "three.json", "-o", "a.csv"]);
-    assert_refused(&o, "three.json: binary data (a NUL byte at offset 0)", "3 GB");
-    let o = run_in(&dir, &["--quiet", "render", "five.json", "-o", "a.csv"]);
+    let o = run_in(&dir, &["render", "three.json", "-o", "a.csv"]);
+    assert_refused(
+        &o,
+        "three.json: binary data (a NUL byte at offset 0)",
+        "3 GB",
+    );
+    let o = run_in(&dir, &["render", "five.json", "-o", "a.csv"]);
     assert_refused(&o, "more than the 4294967296 byte limit", "5 GB");
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -43,7 +43,10 @@ pub const MAX_DIAGNOSTIC_CHARS: usize = 2000;
 pub fn diagnostic(text: &str) {
     let mut safe = String::with_capacity(text.len() + 1);
     for line in text.lines() {
-        safe.push_str(&formation::error::one_line_within(line, MAX_DIAGNOSTIC_CHARS));
+        safe.push_str(&formation::error::one_line_within(
+            line,
+            MAX_DIAGNOSTIC_CHARS,
+        ));
         safe.push('\n');
     }
     write_stderr(&safe);

@@ -27,7 +27,13 @@ pub fn print_deferred() {
     for (text, outputs) in items {
         let files: Vec<String> = outputs
             .iter()
-            .map(|p| format!("{} ({})", super::stdout::file_name(p), human_size(&size_of(p))))
+            .map(|p| {
+                format!(
+                    "{} ({})",
+                    super::stdout::file_name(p),
+                    human_size(&size_of(p))
+                )
+            })
             .collect();
         if files.is_empty() {
             super::stdout::diagnostic(&text);

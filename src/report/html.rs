@@ -381,9 +381,11 @@ fn bird_tables(page: &mut Page, birds: &[BirdStats]) {
     let side = |b: &BirdStats| (b.formation, b.lateral >= 0.0);
     arm.sort_by(|&i, &j| {
         let (a, b) = (&birds[i], &birds[j]);
-        side(a)
-            .cmp(&side(b))
-            .then((a.behind, a.bird).partial_cmp(&(b.behind, b.bird)).unwrap_or(std::cmp::Ordering::Equal))
+        side(a).cmp(&side(b)).then(
+            (a.behind, a.bird)
+                .partial_cmp(&(b.behind, b.bird))
+                .unwrap_or(std::cmp::Ordering::Equal),
+        )
     });
     let mut place = vec![0usize; birds.len()];
     for (w, &i) in arm.iter().enumerate() {
