@@ -137,8 +137,8 @@ pub fn target(data: &[u8]) {
     let _ = formation::keyshape::solve(&target.x, &target.xi, target.y.as_deref(), &opts);
 }
 
-/// Two small steady flights (5 birds, 2 s at 10 fps; one plain, one looped) flown once, that the
-/// `path` target maps onto each accepted path.
+/// Two small steady flights (5 birds, 2 s at 10 fps, a key every second; one plain, one looped)
+/// flown once, that the `path` target maps onto each accepted path (and `bird_model` exports).
 fn path_flights() -> &'static [formation::Animation; 2] {
     use formation::extract::params::FormationParams;
     static FLIGHTS: std::sync::OnceLock<[formation::Animation; 2]> = std::sync::OnceLock::new();
@@ -154,6 +154,8 @@ fn path_flights() -> &'static [formation::Animation; 2] {
             config.steady.birds = 5;
             config.steady.frames = 20;
             config.steady.fps = 10.0;
+            // A loop needs at least one key interval.
+            config.steady.keys.key_every_s = 1.0;
             config.steady.looped = looped;
             steady_stage(&p, &config, &Silent).expect("steady").0
         };

@@ -322,14 +322,20 @@ pub fn apply(
     let before = pts.clone();
     let (pts, ds, tight) =
         spline::widen(pts, ds, points.closed, 1.0 / r_min, spline::SAMPLE_SPACING);
-    let course = Course::from_samples(pts, ds, points.closed);
-    if !(course.length() > 0.0 && course.length().is_finite()) {
-        return Err(Error::format(
+    let cannot = || {
+        Error::format(
             &origin,
             format!(
                 "the path cannot be widened to the flock's smallest turn radius of {r_min:.0} wingspans ({why}); draw it with wider turns"
             ),
-        ));
+        )
+    };
+    if pts.len() < 2 {
+        return Err(cannot());
+    }
+    let course = Course::from_samples(pts, ds, points.closed);
+    if !(course.length() > 0.0 && course.length().is_finite()) {
+        return Err(cannot());
     }
     report.length = course.length();
     for t in &tight {

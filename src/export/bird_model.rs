@@ -471,7 +471,14 @@ impl Reader<'_> {
         let mut bind: [Option<Mat4>; 7] = [None; 7];
         for (slot, n) in skin.joints.iter().enumerate() {
             if let Some(j) = ours(n.value()) {
-                bind[j] = Some(ibm[slot].inverse());
+                let m = ibm[slot].inverse();
+                if !m.is_finite() {
+                    return Err(self.err(format!(
+                        "skin: the inverse bind matrix of joint {slot} ({}) cannot be inverted",
+                        JOINTS[j]
+                    )));
+                }
+                bind[j] = Some(m);
             }
         }
         let required = [bird::BODY, 3, 4, 5, 6];
@@ -619,6 +626,18 @@ impl Reader<'_> {
                 skel.bind_pos[j] = t;
                 skel.bind_rot[j] = r.normalize();
             }
+        }
+        // Finite inputs can still give a degenerate placement (a joint's matrix that overflows
+        // f32, a bind rotation of a singular matrix): refuse it here, not as an internal error
+        // of the glTF writer or a NaN in the USD text (found by fuzzing, issue 17).
+        let finite = mesh.positions.iter().all(|v| v.is_finite())
+            && mesh.normals.iter().all(|v| v.is_finite())
+            && skel.bind_pos.iter().all(|v| v.is_finite())
+            && skel.bind_rot.iter().all(|q| q.is_finite());
+        if !finite {
+            return Err(self.err(
+                "its transforms are degenerate (a matrix that cannot be inverted or overflows 32-bit floats); fix the model's joints and nodes",
+            ));
         }
         // A static model keeps the species' skeleton: `body` at the centre, so bank turns the
         // model about the centre of its bounding box.
