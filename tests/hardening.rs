@@ -244,8 +244,8 @@ fn report_outputs_are_checked_with_the_others() {
         "steady", &params, "--birds", "9", "--frames", "30", "-o", "a.json",
     ];
     for (report, needle) in [
-        ("a.json", "--report: a.json: is also given to -o"),
-        ("./a.json", "--report: ./a.json: is also given to -o"),
+        ("a.json", "--report: a.json: is also an output"),
+        ("./a.json", "--report: ./a.json: is also an output"),
         (
             "nodir/r.json",
             "--report: nodir/r.json: directory nodir does not exist",
