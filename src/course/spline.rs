@@ -25,6 +25,10 @@ pub const SAMPLE_SPACING: f64 = 0.25;
 /// Largest number of samples of a course.
 pub const MAX_SAMPLES: usize = 400_000;
 
+/// Most sample updates of [`widen`]'s smoothing (about a second): what is not widened by then
+/// stays as far as it got.
+pub const WIDEN_WORK: usize = 200_000_000;
+
 /// The course at one place.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CourseAt {
@@ -248,8 +252,15 @@ pub fn widen(
     // cannot be flown (see `course::check_loop_size`) and would shrink to nothing (a thin spike
     // did, and the stretch below grew without bound: a hang found by fuzzing, issue 17).
     let shortest_loop = 2.0 * PI / max_turn;
+    // At most 400 rounds, and at most WIDEN_WORK sample updates in all: a path that turns back
+    // onto itself along a long leg is never widened and took 35 s (found by fuzzing, issue 17).
+    let mut work = 0usize;
     for _round in 0..400 {
         let n = q.len();
+        work += 20 * n;
+        if work > WIDEN_WORK {
+            break;
+        }
         if !(dq > 0.0 && dq.is_finite()) || (closed && dq * ((n - 1) as f64) < shortest_loop) {
             return (Vec::new(), dq, tight);
         }
