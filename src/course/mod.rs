@@ -618,7 +618,10 @@ mod tests {
         for k in -2000..=2000 {
             let t = k as f64 * 1.3e-5;
             let (a, b) = (atan_small(t), t.atan());
-            assert!((a - b).abs() <= 2.0 * f64::EPSILON * b.abs(), "{t}: {a} {b}");
+            assert!(
+                (a - b).abs() <= 2.0 * f64::EPSILON * b.abs(),
+                "{t}: {a} {b}"
+            );
         }
     }
 }

@@ -397,7 +397,11 @@ impl Course {
         if !self.closed && (s < 0.0 || s > len) {
             let (i, over) = if s < 0.0 { (0, s) } else { (n - 1, s - len) };
             let Knot {
-                p, t, heading, climb, ..
+                p,
+                t,
+                heading,
+                climb,
+                ..
             } = k[i];
             return CourseAt {
                 p: [p[0] + over * t[0], p[1] + over * t[1], p[2] + over * t[2]],
@@ -421,8 +425,7 @@ impl Course {
             u3 - u2,
         );
         let l = self.ds;
-        let hermite =
-            |d: usize| h00 * a.p[d] + h10 * l * a.t[d] + h01 * b.p[d] + h11 * l * b.t[d];
+        let hermite = |d: usize| h00 * a.p[d] + h10 * l * a.t[d] + h01 * b.p[d] + h11 * l * b.t[d];
         let p = [hermite(0), hermite(1), hermite(2)];
         let li = |va: f64, vb: f64| va + u * (vb - va);
         // The unit horizontal tangent, interpolated and renormalised (no trigonometry per call).
