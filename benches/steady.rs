@@ -3,7 +3,7 @@
 //! Results: docs/performance.md.
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use formation::keyshape::{steady_flight_report, SteadyOptions};
+use formation::keyshape::{steady_flight_report, KeyOptions, SteadyOptions};
 use formation::progress::Silent;
 use formation::rng::seeded;
 use std::sync::Once;
@@ -16,7 +16,10 @@ fn opts(birds: usize, keys: usize) -> SteadyOptions {
         birds,
         frames: keys,
         fps: 1.0,
-        key_every_s: 1.0,
+        keys: KeyOptions {
+            key_every_s: 1.0,
+            ..KeyOptions::default()
+        },
         ..SteadyOptions::default()
     }
 }

@@ -2,19 +2,18 @@
 //! kept as regression tests. Each runs the same code as its fuzz target and must end in a clean
 //! error (or success), quickly and without a large allocation.
 
-use std::path::Path;
-
 use formation::export::{sample, write_outputs, RenderOptions};
 use formation::extract::params::FormationParams;
-use formation::keyshape::{steady_flight, SteadyOptions};
+use formation::keyshape::{steady_flight, KeyOptions, SteadyOptions};
 use formation::progress::Silent;
 use formation::rng::stream;
 use formation::Animation;
 
+mod support;
+
+/// A fuzz finding of `tests/data/fuzz/`.
 fn data(name: &str) -> std::path::PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/data/fuzz")
-        .join(name)
+    support::data("fuzz").join(name)
 }
 
 /// The `params` target's steady flight: 6 birds, 4 frames, a key shape every 0.05 s.
@@ -22,7 +21,10 @@ fn tiny_steady(p: &FormationParams) -> formation::Result<Animation> {
     let opts = SteadyOptions {
         birds: 6,
         frames: 4,
-        key_every_s: 0.05,
+        keys: KeyOptions {
+            key_every_s: 0.05,
+            ..KeyOptions::default()
+        },
         ..SteadyOptions::default()
     };
     steady_flight(p, &opts, &mut stream(0, "steady"), &Silent)
@@ -56,8 +58,7 @@ fn an_animation_lasting_years_is_refused_without_allocating() {
     let a = Animation::read(&path).unwrap();
     sample::check_times(&a, &path).unwrap();
     assert!(sample::output_count(&a, 25.0) > 1_000_000_000);
-    let dir = std::env::temp_dir().join(format!("formation-fuzz-reg-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = support::scratch("fuzz-years");
     let e = write_outputs(
         &a,
         &[dir.join("a.gif"), dir.join("frames/")],

@@ -6,7 +6,9 @@ mod steady_support;
 
 use formation::aero::power_reduction;
 use formation::extract::params::FormationParams;
-use formation::keyshape::{steady_flight, steady_flight_report, SteadyOptions, SteadyReport};
+use formation::keyshape::{
+    steady_flight, steady_flight_report, KeyOptions, SteadyOptions, SteadyReport,
+};
 use formation::progress::Silent;
 use formation::rng::seeded;
 use formation::Animation;
@@ -80,8 +82,8 @@ fn check(anim: &Animation, rep: &SteadyReport, opts: &SteadyOptions) {
     // Motion relative to the flock (formation-frame y = leader's north − bird's north) is smooth:
     // bounded step per frame and bounded change of step.
     let spacing = (rep.key_frames[1] - rep.key_frames[0]) as f64;
-    let step_bound = 3.0 * opts.max_jump / spacing + 1e-9;
-    let accel_bound = 20.0 * opts.max_jump / (spacing * spacing) + 1e-9;
+    let step_bound = 3.0 * opts.keys.max_jump / spacing + 1e-9;
+    let accel_bound = 20.0 * opts.keys.max_jump / (spacing * spacing) + 1e-9;
     let rel = |f: usize| -> Vec<f64> {
         let fr = &anim.frames[f];
         let lead_n = fr.y[rep.leader];
@@ -124,7 +126,7 @@ fn check(anim: &Animation, rep: &SteadyReport, opts: &SteadyOptions) {
                 xf >= lo - 1e-9 && xf <= hi + 1e-9,
                 "frame {f} bird {i}: x {xf} outside [{lo}, {hi}]"
             );
-            assert!(hi - lo <= opts.max_jump + 1e-9);
+            assert!(hi - lo <= opts.keys.max_jump + 1e-9);
         }
     }
     // Speeds are continuous too (C¹ interpolation: no velocity kink at key frames).
@@ -144,7 +146,10 @@ fn case(params: &FormationParams, birds: usize) {
         birds,
         frames: 181,
         fps: 30.0,
-        key_every_s: 1.0,
+        keys: KeyOptions {
+            key_every_s: 1.0,
+            ..KeyOptions::default()
+        },
         ..SteadyOptions::default()
     };
     let (anim, rep) = steady_flight_report(params, &opts, &mut seeded(7), &Silent).unwrap();
@@ -268,7 +273,10 @@ fn odd_movies_still_give_valid_flights() {
     let opts = SteadyOptions {
         birds: 2,
         frames: 121,
-        key_every_s: 1.0,
+        keys: KeyOptions {
+            key_every_s: 1.0,
+            ..KeyOptions::default()
+        },
         ..SteadyOptions::default()
     };
     let err = steady_flight_report(&tiny, &opts, &mut seeded(2), &Silent).unwrap_err();
@@ -286,7 +294,10 @@ fn odd_movies_still_give_valid_flights() {
             let opts = SteadyOptions {
                 birds,
                 frames: 121,
-                key_every_s: 1.0,
+                keys: KeyOptions {
+                    key_every_s: 1.0,
+                    ..KeyOptions::default()
+                },
                 ..SteadyOptions::default()
             };
             let (anim, rep) = steady_flight_report(p, &opts, &mut seeded(2), &Silent).unwrap();

@@ -62,7 +62,7 @@ pub fn params(data: &[u8]) {
     };
     config.steady.birds = 6;
     config.steady.frames = 4;
-    config.steady.key_every_s = 0.05;
+    config.steady.keys.key_every_s = 0.05;
     let _ = steady_stage(&p, &config, &Silent);
 }
 

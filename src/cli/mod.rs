@@ -189,9 +189,3 @@ pub fn write_animation(
 ) -> Result<()> {
     formation::export::write_outputs(anim, outputs, opts, &progress::TermProgress::new(g.quiet))
 }
-
-/// The error for a command that is not built yet.
-#[allow(dead_code)]
-pub fn not_yet(what: &str) -> formation::Error {
-    formation::Error::Internal(format!("`{what}` is not implemented yet"))
-}

@@ -14,6 +14,7 @@
 
 use rand::Rng;
 use rand_distr::{Distribution, Normal};
+use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
 use crate::extract::params::{FormationParams, FrameParams, ShapeModel};
@@ -32,19 +33,21 @@ pub struct Correspondence {
     pub dropped: Vec<usize>,
 }
 
-/// Options of step 1.
-#[derive(Debug, Clone)]
+/// Options of step 1 (the `steady.initial` section of [`crate::pipeline::Config`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct InitialOptions {
-    /// The one physical bound on a lateral gap drawn from the footage's N(μ_x, σ_x), wingspans:
-    /// a gap at or below it (about a body's width: birds nearly in line astern, body behind body)
-    /// is redrawn. Overlapping wingtips (gaps under π/4) are kept: real geese fly there, and the
-    /// model covers them; wings side by side are excluded later, fore and aft, by the collision
-    /// rule (`aero::AeroOptions::collision_chord`).
+    /// The one physical bound on a lateral gap drawn from the footage's N(μ_x, σ_x), wingspans,
+    /// in [0, 1): a gap at or below it (about a body's width: birds nearly in line astern, body
+    /// behind body) is redrawn. Overlapping wingtips (gaps under π/4) are kept: real geese fly
+    /// there, and the model covers them; wings side by side are excluded later, fore and aft, by
+    /// the collision rule (`aero::AeroOptions::collision_chord`).
     pub min_gap: f64,
-    /// Redraws of one gap before it is clamped to `min_gap` (or the mean, if larger).
+    /// Redraws of one gap (or deviation) before it is clamped to `min_gap` (or the mean, if
+    /// larger), count.
     pub max_gap_draws: usize,
-    /// Every follower stays at least this far behind the leader, wingspans: the leader is the
-    /// front-most bird by definition (§4), so a Gaussian deviation that would put a follower
+    /// Every follower stays at least this far behind the leader, wingspans (≥ 0): the leader is
+    /// the front-most bird by definition (§4), so a Gaussian deviation that would put a follower
     /// abreast of or ahead of it is redrawn (and, after `max_gap_draws` tries or for a carried
     /// outlier deviation, clamped).
     pub lead_margin: f64,
@@ -57,6 +60,28 @@ impl Default for InitialOptions {
             max_gap_draws: 64,
             lead_margin: 0.05,
         }
+    }
+}
+
+impl InitialOptions {
+    /// Checks every option; the error names the option path (`steady.initial.min_gap`).
+    pub fn validate(&self) -> Result<()> {
+        if !(self.min_gap.is_finite() && self.min_gap >= 0.0 && self.min_gap < 1.0) {
+            return Err(Error::parameter(
+                "steady.initial.min_gap",
+                format!("{}: must be a number of wingspans in [0, 1)", self.min_gap),
+            ));
+        }
+        if !(self.lead_margin.is_finite() && (0.0..=1.0).contains(&self.lead_margin)) {
+            return Err(Error::parameter(
+                "steady.initial.lead_margin",
+                format!(
+                    "{}: must be a number of wingspans in [0, 1]",
+                    self.lead_margin
+                ),
+            ));
+        }
+        Ok(())
     }
 }
 

@@ -20,33 +20,40 @@
 //! solution is the previous key shape at λ = 0, so the reachable set always contains a fallback.
 
 use rand::Rng;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
 use crate::keyshape::ranges::XiRanges;
 use crate::keyshape::solve::{solve, SolveOptions};
 
-/// Options of step 3.
-#[derive(Debug, Clone)]
+/// Options of step 3 (the `steady.keys` section of [`crate::pipeline::Config`]): eq. (2)'s
+/// draws, the key interval, and what a key shape must satisfy to be accepted.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct KeyOptions {
-    /// ε of eq. (2): widening of [p_i, P_i] (paper: 0 ≤ ε ≤ 0.2).
+    /// ε of eq. (2): widening of [p_i, P_i], dimensionless, in [0, 0.5] (paper: 0 ≤ ε ≤ 0.2).
     pub epsilon: f64,
-    /// C₁ of eq. (2): smallest ratio ξ̂_{i,k} / ξ̂_{i,k−1} (paper: 0.75–0.9).
+    /// C₁ of eq. (2): smallest ratio ξ̂_{i,k} / ξ̂_{i,k−1}, dimensionless, in [0.5, 1]
+    /// (paper: 0.75–0.9).
     pub c1: f64,
-    /// C₂ of eq. (2): largest ratio ξ̂_{i,k} / ξ̂_{i,k−1} (paper: 1.1–1.25).
+    /// C₂ of eq. (2): largest ratio ξ̂_{i,k} / ξ̂_{i,k−1}, dimensionless, in [1, 2]
+    /// (paper: 1.1–1.25).
     pub c2: f64,
-    /// A key shape is solved when ‖ξ − ξ̂‖₂ is at most this.
-    pub accept_residual: f64,
-    /// Draws of ξ̂ per key before damping.
-    pub max_draws: usize,
-    /// Damping steps (λ shrinks each time) before the previous key shape is held.
-    pub max_damping: usize,
-    /// Largest longitudinal move of any bird between consecutive key shapes, wingspans.
+    /// Time between key shapes, seconds (keys are spread evenly over the flight, about this far
+    /// apart).
+    pub key_every_s: f64,
+    /// Largest move of any bird between consecutive key shapes, wingspans.
     pub max_jump: f64,
-    /// No bird may be further behind the leader than this, wingspans.
-    pub max_depth: f64,
-    /// Options of the Levenberg–Marquardt solve.
-    pub solve: SolveOptions,
+    /// Draws of ξ̂ per key before damping, count.
+    pub max_draws: usize,
+    /// Halvings of the damping factor λ before the previous key shape is held, count.
+    pub max_damping: usize,
+    /// A key shape is solved when ‖ξ − ξ̂‖₂ is at most this, dimensionless (the solve's own
+    /// tolerance is a thousandth of it).
+    pub accept_residual: f64,
+    /// Depth limit of key shapes: no bird further behind the leader than this factor times the
+    /// deepest initial shape plus one wingspan, dimensionless (≥ 1).
+    pub max_depth_factor: f64,
 }
 
 impl Default for KeyOptions {
@@ -55,12 +62,75 @@ impl Default for KeyOptions {
             epsilon: 0.1,
             c1: 0.85,
             c2: 1.15,
-            accept_residual: 1e-6,
+            key_every_s: 3.0,
+            max_jump: 0.5,
             max_draws: 3,
             max_damping: 12,
-            max_jump: 0.5,
-            max_depth: f64::INFINITY,
-            solve: SolveOptions::default(),
+            accept_residual: 1e-6,
+            max_depth_factor: 1.5,
+        }
+    }
+}
+
+impl KeyOptions {
+    /// Checks every option; the error names the option path (`steady.keys.epsilon`).
+    pub fn validate(&self) -> Result<()> {
+        let p = |name: &str, msg: String| Err(Error::parameter(name, msg));
+        if !(self.epsilon.is_finite() && (0.0..=0.5).contains(&self.epsilon)) {
+            return p(
+                "steady.keys.epsilon",
+                format!(
+                    "{}: must be in [0, 0.5] (the paper uses 0 to 0.2)",
+                    self.epsilon
+                ),
+            );
+        }
+        if !(self.c1.is_finite() && (0.5..=1.0).contains(&self.c1)) {
+            return p(
+                "steady.keys.c1",
+                format!(
+                    "{}: must be in [0.5, 1] (the paper uses 0.75 to 0.9)",
+                    self.c1
+                ),
+            );
+        }
+        if !(self.c2.is_finite() && (1.0..=2.0).contains(&self.c2)) {
+            return p(
+                "steady.keys.c2",
+                format!(
+                    "{}: must be in [1, 2] (the paper uses 1.1 to 1.25)",
+                    self.c2
+                ),
+            );
+        }
+        if !(self.key_every_s.is_finite() && self.key_every_s > 0.0) {
+            return p(
+                "steady.keys.key_every_s",
+                format!("{}: must be a positive number of seconds", self.key_every_s),
+            );
+        }
+        if !(self.max_jump.is_finite() && self.max_jump > 0.0) {
+            return p(
+                "steady.keys.max_jump",
+                "must be a positive number of wingspans".into(),
+            );
+        }
+        if !(self.accept_residual.is_finite() && self.accept_residual > 0.0) {
+            return p("steady.keys.accept_residual", "must be positive".into());
+        }
+        if !(self.max_depth_factor.is_finite() && self.max_depth_factor >= 1.0) {
+            return p("steady.keys.max_depth_factor", "must be at least 1".into());
+        }
+        Ok(())
+    }
+
+    /// The Levenberg–Marquardt solve's options: tolerance a thousandth of `accept_residual`
+    /// (at least 10⁻¹²), the given aerodynamic model.
+    pub fn solve_options(&self, aero: &crate::aero::AeroOptions) -> SolveOptions {
+        SolveOptions {
+            tolerance: (self.accept_residual * 1e-3).max(1e-12),
+            aero: *aero,
+            ..SolveOptions::default()
         }
     }
 }
@@ -240,20 +310,26 @@ enum Attempt {
     Rejected,
 }
 
-/// Solves for `target` from `prev`, checks the result; counts into `stats`.
+/// Solves for `target` from `start` at the lateral positions `ctx.x`, checks the result against
+/// `prev` and `ctx`'s structure and options; counts into `stats`.
 fn attempt(
-    x: &[f64],
+    ctx: &KeyContext,
     prev: &KeyShape,
     start: &[f64],
     target: &[f64],
-    structure: &Structure,
-    opts: &KeyOptions,
     stats: &mut KeyStats,
 ) -> Result<Attempt> {
+    let KeyContext {
+        x,
+        structure,
+        opts,
+        solve: solve_opts,
+        ..
+    } = *ctx;
     stats.solves += 1;
     // A predicted start may put two birds wing to wing; the solve starts from them separated.
-    let start = crate::keyshape::steady::separate(x, start, &opts.solve.aero);
-    let report = match solve(x, target, Some(&start), &opts.solve) {
+    let start = crate::keyshape::steady::separate(x, start, &solve_opts.aero);
+    let report = match solve(x, target, Some(&start), solve_opts) {
         Ok(r) => r,
         Err(Error::Unreachable(_) | Error::Collision { .. } | Error::NotConverged(_)) => {
             stats.solve_errors += 1;
@@ -302,6 +378,8 @@ pub struct KeyContext<'a> {
     pub structure: &'a Structure,
     /// Step-3 options.
     pub opts: &'a KeyOptions,
+    /// The solve's options (from [`KeyOptions::solve_options`]).
+    pub solve: &'a SolveOptions,
     /// E of every key shape (Munk: fixed by `x`).
     pub total: f64,
 }
@@ -392,6 +470,7 @@ pub fn next_key(
         feasible,
         structure,
         opts,
+        solve: solve_opts,
         total,
     } = *ctx;
     // The lateral positions drifted since the previous key: its fore-aft placement at the new
@@ -400,8 +479,7 @@ pub fn next_key(
     let prev = if prev.x.as_slice() == x {
         prev
     } else {
-        let xi: Vec<f64> = opts
-            .solve
+        let xi: Vec<f64> = solve_opts
             .aero
             .power_lenient(x, &prev.y)
             .iter()
@@ -425,7 +503,7 @@ pub fn next_key(
         };
         &moved
     };
-    let predictor = Predictor::new(x, prev, structure.leader, total, &opts.solve.aero);
+    let predictor = Predictor::new(x, prev, structure.leader, total, &solve_opts.aero);
     let promising = |y: &[f64]| structure.accepts(y) && max_jump(&prev.y, y) <= opts.max_jump;
     let mut tried: Vec<Vec<f64>> = Vec::new();
     let mut draws = 0;
@@ -452,9 +530,7 @@ pub fn next_key(
             }
             None => prev.y.clone(),
         };
-        if let Attempt::Accepted(y, xi, residual) =
-            attempt(x, prev, &start, &target, structure, opts, stats)?
-        {
+        if let Attempt::Accepted(y, xi, residual) = attempt(ctx, prev, &start, &target, stats)? {
             return Ok(KeyShape {
                 x: x.to_vec(),
                 y,
@@ -484,8 +560,7 @@ pub fn next_key(
                 Some(_) => continue,
                 None => prev.y.clone(),
             };
-            if let Attempt::Accepted(y, xi, residual) =
-                attempt(x, prev, &start, &target, structure, opts, stats)?
+            if let Attempt::Accepted(y, xi, residual) = attempt(ctx, prev, &start, &target, stats)?
             {
                 stats.damped += 1;
                 return Ok(KeyShape {

@@ -1,12 +1,18 @@
 //! §5 steps 1–4: initial shapes, power ranges, the Levenberg–Marquardt key-shape solve, and the
 //! interpolation into a steady flight.
 
+pub mod heights;
 pub mod initial;
 pub mod interpolate;
 pub mod keys;
+pub mod lateral;
 pub mod ranges;
 pub mod solve;
 pub mod steady;
 
+pub use heights::HeightOptions;
+pub use initial::InitialOptions;
+pub use keys::KeyOptions;
+pub use lateral::LateralOptions;
 pub use solve::{solve, SolveOptions, SolveReport};
 pub use steady::{steady_flight, steady_flight_report, SteadyOptions, SteadyReport};

@@ -26,6 +26,7 @@ use crate::aero::AeroOptions;
 use crate::animation::{Animation, Frame, KeyBird, KeyShapeRecord, Stage};
 use crate::error::{Error, Result};
 use crate::extract::params::FormationParams;
+use crate::keyshape::heights::{heights, HeightOptions};
 use crate::keyshape::initial::{
     correspondence, curve_y, initial_shapes, lateral_gaps, positions_from_gaps, side_scales,
     Correspondence, InitialOptions,
@@ -34,58 +35,37 @@ use crate::keyshape::interpolate::Track;
 use crate::keyshape::keys::{
     key_shapes, KeyContext, KeyOptions, KeyPlan, KeyShape, KeyStats, Structure,
 };
+use crate::keyshape::lateral::{lateral_plan, LateralOptions};
 use crate::keyshape::ranges::{power_at, xi_ranges, XiRanges};
-use crate::keyshape::solve::SolveOptions;
 use crate::progress::Progress;
 
-/// Options of the steady flight (the `steady` section of [`crate::pipeline::Config`]).
+/// Options of the steady flight (the `steady` section of [`crate::pipeline::Config`]). Each
+/// step's options are their own section (`steady.keys`, `steady.initial`, …), defined once.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct SteadyOptions {
-    /// N, birds to animate (≥ 2).
+    /// N, birds to animate, count (≥ 2).
     pub birds: usize,
-    /// F, frames to produce (≥ 1).
+    /// F, frames to produce, count (≥ 1).
     pub frames: usize,
-    /// Frames per second.
+    /// Frames per second, in [1, 1000].
     pub fps: f64,
-    /// Time between key shapes, seconds (keys are spread evenly over the flight, about this far apart).
-    pub key_every_s: f64,
-    /// Cruise speed of the flock along +y, wingspans per second.
+    /// Cruise speed of the flock along +y, wingspans per second, in (0, 1000].
     pub speed: f64,
-    /// ε of eq. (2): widening of each bird's range of ξ (paper: 0–0.2).
-    pub epsilon: f64,
-    /// C₁ of eq. (2): smallest step ratio of ξ̂ between keys (paper: 0.75–0.9).
-    pub c1: f64,
-    /// C₂ of eq. (2): largest step ratio of ξ̂ between keys (paper: 1.1–1.25).
-    pub c2: f64,
-    /// Wingspan of one bird, metres (recorded in the file for exports).
+    /// Wingspan of one bird, metres, in (0, 100] (recorded in the file for exports).
     pub wingspan_m: f64,
     /// Seed recorded in the animation file (the generator itself is passed in).
     pub seed: u64,
-    /// Largest move of a bird between consecutive key shapes, wingspans.
-    pub max_jump: f64,
-    /// Draws of ξ̂ per key before damping.
-    pub max_draws: usize,
-    /// Halvings of the damping factor λ before the previous key is held.
-    pub max_damping: usize,
-    /// Largest accepted ‖ξ − ξ̂‖₂ of a key shape.
-    pub accept_residual: f64,
-    /// Lateral gaps drawn at or below this are redrawn (the one physical bound, see
-    /// [`InitialOptions::min_gap`]), wingspans.
-    pub min_gap: f64,
-    /// Depth limit of key shapes: this factor times the deepest initial shape, plus one wingspan.
-    pub max_depth_factor: f64,
+    /// Step 3: eq. (2)'s draws, the key interval and the acceptance of key shapes.
+    pub keys: KeyOptions,
+    /// Step 1: the lateral gaps' physical bound and the initial shapes' redraws.
+    pub initial: InitialOptions,
+    /// The lateral positions' slow drift between key shapes (issue 19).
+    pub lateral: LateralOptions,
+    /// Small per-bird altitude differences (issue 19).
+    pub heights: HeightOptions,
     /// The aerodynamic model's vortex core and collision distance.
     pub aero: AeroOptions,
-    /// Standard deviation of each lateral gap's slow drift around its drawn value, from key
-    /// shape to key shape, wingspans (0: lateral positions fixed for the whole flight).
-    pub lateral_drift: f64,
-    /// Standard deviation of the birds' heights about the leader's, wingspans (a stereo-filmed
-    /// V of white-fronted geese: 0.14).
-    pub height_spread: f64,
-    /// Root-mean-square height difference of lateral neighbours, wingspans (the same V: 0.06);
-    /// at most `height_spread` · √2.
-    pub height_neighbour: f64,
     /// A seamless cycle: the last key shape is the first, placed one frame after the last
     /// frame, so the frame after the last is the first again (in the flock's moving frame).
     #[serde(rename = "loop")]
@@ -98,30 +78,21 @@ impl Default for SteadyOptions {
             birds: 9,
             frames: 300,
             fps: 30.0,
-            key_every_s: 3.0,
             speed: 10.0,
-            epsilon: 0.1,
-            c1: 0.85,
-            c2: 1.15,
             wingspan_m: 1.5,
             seed: 0,
-            max_jump: 0.5,
-            max_draws: 3,
-            max_damping: 12,
-            accept_residual: 1e-6,
-            min_gap: 0.1,
+            keys: KeyOptions::default(),
+            initial: InitialOptions::default(),
+            lateral: LateralOptions::default(),
+            heights: HeightOptions::default(),
             aero: AeroOptions::default(),
-            max_depth_factor: 1.5,
-            lateral_drift: 0.03,
-            height_spread: 0.14,
-            height_neighbour: 0.06,
             looped: false,
         }
     }
 }
 
 impl SteadyOptions {
-    /// Checks every option; the error names the option path (`steady.fps`).
+    /// Checks every option; the error names the option path (`steady.fps`, `steady.keys.c1`).
     pub fn validate(&self) -> Result<()> {
         let p = |name: &str, msg: String| Error::parameter(name, msg);
         if self.birds < 2 {
@@ -157,43 +128,10 @@ impl SteadyOptions {
                 format!("{}: must be in [1, 1000] frames per second", self.fps),
             ));
         }
-        if !(self.key_every_s.is_finite() && self.key_every_s > 0.0) {
-            return Err(p(
-                "steady.key_every_s",
-                format!("{}: must be a positive number of seconds", self.key_every_s),
-            ));
-        }
         if !(self.speed.is_finite() && self.speed > 0.0 && self.speed <= 1000.0) {
             return Err(p(
                 "steady.speed",
                 format!("{}: must be in (0, 1000] wingspans per second", self.speed),
-            ));
-        }
-        if !(self.epsilon.is_finite() && (0.0..=0.5).contains(&self.epsilon)) {
-            return Err(p(
-                "steady.epsilon",
-                format!(
-                    "{}: must be in [0, 0.5] (the paper uses 0 to 0.2)",
-                    self.epsilon
-                ),
-            ));
-        }
-        if !(self.c1.is_finite() && (0.5..=1.0).contains(&self.c1)) {
-            return Err(p(
-                "steady.c1",
-                format!(
-                    "{}: must be in [0.5, 1] (the paper uses 0.75 to 0.9)",
-                    self.c1
-                ),
-            ));
-        }
-        if !(self.c2.is_finite() && (1.0..=2.0).contains(&self.c2)) {
-            return Err(p(
-                "steady.c2",
-                format!(
-                    "{}: must be in [1, 2] (the paper uses 1.1 to 1.25)",
-                    self.c2
-                ),
             ));
         }
         if !(self.wingspan_m.is_finite() && self.wingspan_m > 0.0 && self.wingspan_m <= 100.0) {
@@ -202,56 +140,18 @@ impl SteadyOptions {
                 format!("{}: must be in (0, 100] metres", self.wingspan_m),
             ));
         }
-        if !(self.max_jump.is_finite() && self.max_jump > 0.0) {
-            return Err(p(
-                "steady.max_jump",
-                "must be a positive number of wingspans".into(),
-            ));
-        }
-        if !(self.accept_residual.is_finite() && self.accept_residual > 0.0) {
-            return Err(p("steady.accept_residual", "must be positive".into()));
-        }
-        if !(self.min_gap.is_finite() && self.min_gap >= 0.0 && self.min_gap < 1.0) {
-            return Err(p(
-                "steady.min_gap",
-                "must be a number of wingspans in [0, 1)".into(),
-            ));
-        }
+        self.keys.validate()?;
+        self.initial.validate()?;
+        self.lateral.validate()?;
+        self.heights.validate()?;
         self.aero.validate()?;
-        if !(self.max_depth_factor.is_finite() && self.max_depth_factor >= 1.0) {
-            return Err(p("steady.max_depth_factor", "must be at least 1".into()));
-        }
-        if !(self.lateral_drift >= 0.0 && self.lateral_drift <= 1.0) {
-            return Err(p(
-                "steady.lateral_drift",
-                format!("{}: must be in [0, 1] wingspans", self.lateral_drift),
-            ));
-        }
-        if !(self.height_spread >= 0.0 && self.height_spread <= 10.0) {
-            return Err(p(
-                "steady.height_spread",
-                format!("{}: must be in [0, 10] wingspans", self.height_spread),
-            ));
-        }
-        if !(self.height_neighbour >= 0.0
-            && self.height_neighbour <= self.height_spread * std::f64::consts::SQRT_2 + 1e-12)
-        {
-            return Err(p(
-                "steady.height_neighbour",
-                format!(
-                    "{}: must be in [0, √2 · steady.height_spread = {:.3}] wingspans",
-                    self.height_neighbour,
-                    self.height_spread * std::f64::consts::SQRT_2
-                ),
-            ));
-        }
         let seconds = self.frames as f64 / self.fps;
-        if self.looped && seconds < self.key_every_s {
+        if self.looped && seconds < self.keys.key_every_s {
             return Err(p(
                 "steady.loop",
                 format!(
-                    "a loop of {seconds:.2} s is shorter than one key interval (steady.key_every_s = {} s); make the flight longer or the key interval shorter",
-                    self.key_every_s
+                    "a loop of {seconds:.2} s is shorter than one key interval (steady.keys.key_every_s = {} s); make the flight longer or the key interval shorter",
+                    self.keys.key_every_s
                 ),
             ));
         }
@@ -265,7 +165,7 @@ impl SteadyOptions {
         if f <= 1 {
             return vec![0];
         }
-        let spacing = (self.key_every_s * self.fps).round().max(1.0);
+        let spacing = (self.keys.key_every_s * self.fps).round().max(1.0);
         let k = (((f - 1) as f64 / spacing).round() as usize).max(1) + 1;
         (0..k)
             .map(|i| ((i as f64) * ((f - 1) as f64) / ((k - 1) as f64)).round() as usize)
@@ -354,101 +254,6 @@ pub fn separate(x: &[f64], y: &[f64], aero: &AeroOptions) -> Vec<f64> {
     y
 }
 
-/// Correlation of a lateral gap's drift, and of the height field, from one key shape to the next.
-const KEY_CORRELATION: f64 = 0.7;
-
-/// Lateral positions of every key shape (the first the drawn `x` from `gaps`): each gap drifts
-/// around its drawn value as an AR(1) process from key to key (standard deviation
-/// `lateral_drift`, correlation [`KEY_CORRELATION`]), never at or below `min_gap`, no bird moving
-/// more than `max_jump` between keys; a loop's drift tapers to 0 at its last key (= the first).
-fn lateral_plan(
-    gaps: &[f64],
-    leader: usize,
-    keys: usize,
-    opts: &SteadyOptions,
-    rng: &mut impl Rng,
-) -> Vec<Vec<f64>> {
-    use rand_distr::{Distribution, StandardNormal};
-    let rho = KEY_CORRELATION;
-    let mut dev = vec![0.0; gaps.len()];
-    let mut prev = positions_from_gaps(gaps, leader);
-    let mut out = vec![prev.clone()];
-    for k in 1..keys {
-        for d in dev.iter_mut() {
-            let z: f64 = StandardNormal.sample(rng);
-            *d = rho * *d + (1.0 - rho * rho).sqrt() * opts.lateral_drift * z;
-        }
-        let taper = if opts.looped {
-            1.0 - (k as f64 / (keys - 1).max(1) as f64).powi(2)
-        } else {
-            1.0
-        };
-        let g: Vec<f64> = gaps
-            .iter()
-            .zip(&dev)
-            .map(|(&g, &d)| (g + taper * d).max((opts.min_gap + 0.02).min(g)))
-            .collect();
-        let mut xk = positions_from_gaps(&g, leader);
-        let jump = crate::keyshape::keys::max_jump(&prev, &xk);
-        if jump > opts.max_jump {
-            let f = opts.max_jump / jump;
-            for (a, b) in xk.iter_mut().zip(&prev) {
-                *a = b + f * (*a - b);
-            }
-        }
-        prev = xk.clone();
-        out.push(xk);
-    }
-    out
-}
-
-/// Heights of every bird at every key shape, wingspans, the leader at 0: a random walk along
-/// the lateral order (step `height_neighbour`) plus a tilt across the flock that brings the
-/// expected spread to `height_spread` (one arm a little higher than the other, as in the
-/// footage), both evolving from key to key as AR(1) processes (correlation [`KEY_CORRELATION`]).
-/// A loop's last key repeats the first. Drawn from the seed's `steady.height` stream.
-fn heights(n: usize, x: &[f64], leader: usize, keys: usize, opts: &SteadyOptions) -> Vec<Vec<f64>> {
-    use rand_distr::{Distribution, StandardNormal};
-    let mut rng = crate::rng::stream(opts.seed, "steady.height");
-    let rho = KEY_CORRELATION;
-    let nf = n as f64;
-    let walk_var = opts.height_neighbour.powi(2) * (nf * nf - 1.0) / (6.0 * nf);
-    let mean_x = x.iter().sum::<f64>() / nf;
-    let var_x = x.iter().map(|v| (v - mean_x).powi(2)).sum::<f64>() / nf;
-    let tilt_sd = if var_x > 1e-12 {
-        ((opts.height_spread.powi(2) - walk_var).max(0.0) / var_x).sqrt()
-    } else {
-        0.0
-    };
-    let draw = |rng: &mut crate::rng::FlockRng| -> Vec<f64> {
-        let tilt: f64 = StandardNormal.sample(rng);
-        let mut h = Vec::with_capacity(n);
-        let mut walk = 0.0;
-        for &xi in x {
-            let z: f64 = StandardNormal.sample(rng);
-            walk += opts.height_neighbour * z;
-            h.push(walk + tilt_sd * tilt * (xi - mean_x));
-        }
-        h
-    };
-    let mut field = draw(&mut rng);
-    let mut out = Vec::with_capacity(keys);
-    for k in 0..keys {
-        if k > 0 {
-            let fresh = draw(&mut rng);
-            for (f, g) in field.iter_mut().zip(fresh) {
-                *f = rho * *f + (1.0 - rho * rho).sqrt() * g;
-            }
-        }
-        let lead = field[leader];
-        out.push(field.iter().map(|h| h - lead).collect::<Vec<f64>>());
-    }
-    if opts.looped && keys > 1 {
-        out[keys - 1] = out[0].clone();
-    }
-    out
-}
-
 /// The steady flight of Algorithm 1 as an animation (one `steady` stage covering all frames).
 pub fn steady_flight(
     params: &FormationParams,
@@ -472,10 +277,7 @@ pub fn steady_flight_report(
         .first()
         .ok_or_else(|| Error::parameter("params", "no frames"))?;
     let n = opts.birds;
-    let init_opts = InitialOptions {
-        min_gap: opts.min_gap,
-        ..InitialOptions::default()
-    };
+    let init_opts = &opts.initial;
 
     // Step 1.
     let corr: Correspondence = correspondence(first, n)?;
@@ -488,10 +290,10 @@ pub fn steady_flight_report(
     let sigma_bar =
         params.frames.iter().map(|f| f.sigma_x).sum::<f64>() / params.frames.len() as f64;
     let u: f64 = rng.random();
-    let mean_gap = (lo_mu + u * (hi_mu - lo_mu)).max(opts.min_gap);
-    let gaps = lateral_gaps(rng, mean_gap, sigma_bar, n - 1, &init_opts);
+    let mean_gap = (lo_mu + u * (hi_mu - lo_mu)).max(init_opts.min_gap);
+    let gaps = lateral_gaps(rng, mean_gap, sigma_bar, n - 1, init_opts);
     let x = positions_from_gaps(&gaps, corr.leader);
-    let shapes = initial_shapes(params, &corr, rng, &init_opts);
+    let shapes = initial_shapes(params, &corr, rng, init_opts);
 
     // Step 2, at the key shapes' lateral positions.
     // At the key shapes' lateral positions a movie frame's placement can put two birds wing to
@@ -503,7 +305,7 @@ pub fn steady_flight_report(
         .collect();
     let values = power_at(&x, &shapes, aero)?;
     let ranges = xi_ranges(&values)?;
-    let feasible = ranges.widened(opts.epsilon);
+    let feasible = ranges.widened(opts.keys.epsilon);
     let total = aero.munk_total(&x)?;
     if !(total > 0.0) {
         return Err(Error::parameter(
@@ -517,7 +319,7 @@ pub fn steady_flight_report(
         .iter()
         .map(|s| s.ys().iter().copied().fold(0.0, f64::max))
         .fold(0.0, f64::max);
-    let max_depth = opts.max_depth_factor * deepest + 1.0;
+    let max_depth = opts.keys.max_depth_factor * deepest + 1.0;
     let loose = Structure {
         leader: corr.leader,
         monotone_pairs: vec![],
@@ -563,28 +365,15 @@ pub fn steady_flight_report(
 
     // Step 3.
     let key_frames = opts.key_frames();
-    let key_opts = KeyOptions {
-        epsilon: opts.epsilon,
-        c1: opts.c1,
-        c2: opts.c2,
-        accept_residual: opts.accept_residual,
-        max_draws: opts.max_draws,
-        max_damping: opts.max_damping,
-        max_jump: opts.max_jump,
-        max_depth,
-        solve: SolveOptions {
-            tolerance: (opts.accept_residual * 1e-3).max(1e-12),
-            aero: opts.aero,
-            ..SolveOptions::default()
-        },
-    };
+    let solve_opts = opts.keys.solve_options(&opts.aero);
     let nk = key_frames.len();
     progress.start("steady: key shapes", nk as u64);
     let ctx = KeyContext {
         x: &x,
         feasible: &feasible,
         structure: &structure,
-        opts: &key_opts,
+        opts: &opts.keys,
+        solve: &solve_opts,
         total,
     };
     let mut lateral = Vec::with_capacity(nk);
@@ -731,7 +520,10 @@ mod tests {
         let o = SteadyOptions {
             frames: 301,
             fps: 30.0,
-            key_every_s: 3.0,
+            keys: KeyOptions {
+                key_every_s: 3.0,
+                ..KeyOptions::default()
+            },
             ..SteadyOptions::default()
         };
         assert_eq!(o.key_frames(), vec![0, 100, 200, 300]);
@@ -742,10 +534,72 @@ mod tests {
         assert_eq!(o.key_frames(), vec![0]);
         let o = SteadyOptions {
             frames: 5,
-            key_every_s: 0.001,
+            keys: KeyOptions {
+                key_every_s: 0.001,
+                ..KeyOptions::default()
+            },
             ..SteadyOptions::default()
         };
         assert_eq!(o.key_frames(), vec![0, 1, 2, 3, 4]);
+    }
+
+    #[test]
+    fn options_nest_and_round_trip_through_json() {
+        let o: SteadyOptions = serde_json::from_str(
+            r#"{"birds": 12, "keys": {"epsilon": 0.2}, "lateral": {"drift": 0.05}, "loop": true}"#,
+        )
+        .unwrap();
+        assert_eq!(o.birds, 12);
+        assert_eq!(o.keys.epsilon, 0.2);
+        assert_eq!(
+            o.keys.c1,
+            KeyOptions::default().c1,
+            "unset fields keep defaults"
+        );
+        assert_eq!(o.lateral.drift, 0.05);
+        assert!(o.looped);
+        let back: SteadyOptions =
+            serde_json::from_str(&serde_json::to_string(&o).unwrap()).unwrap();
+        assert_eq!(back, o);
+        // An option is defined once: the old flat names are unknown fields.
+        assert!(serde_json::from_str::<SteadyOptions>(r#"{"epsilon": 0.2}"#).is_err());
+        assert!(serde_json::from_str::<SteadyOptions>(r#"{"keys": {"min_gap": 0.2}}"#).is_err());
+        let bad = SteadyOptions {
+            initial: InitialOptions {
+                min_gap: 1.5,
+                ..InitialOptions::default()
+            },
+            ..SteadyOptions::default()
+        };
+        assert!(bad
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .starts_with("steady.initial.min_gap"));
+        let bad = SteadyOptions {
+            lateral: LateralOptions {
+                drift: -1.0,
+                ..LateralOptions::default()
+            },
+            ..SteadyOptions::default()
+        };
+        assert!(bad
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .starts_with("steady.lateral.drift"));
+        let bad = SteadyOptions {
+            heights: HeightOptions {
+                neighbour: 1.0,
+                ..HeightOptions::default()
+            },
+            ..SteadyOptions::default()
+        };
+        assert!(bad
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .starts_with("steady.heights.neighbour"));
     }
 
     #[test]
@@ -760,24 +614,33 @@ mod tests {
                 ..SteadyOptions::default()
             },
             SteadyOptions {
-                epsilon: 0.9,
+                keys: KeyOptions {
+                    epsilon: 0.9,
+                    ..KeyOptions::default()
+                },
                 ..SteadyOptions::default()
             },
             SteadyOptions {
-                c1: 1.2,
+                keys: KeyOptions {
+                    c1: 1.2,
+                    ..KeyOptions::default()
+                },
                 ..SteadyOptions::default()
             },
             SteadyOptions {
-                c2: 0.9,
+                keys: KeyOptions {
+                    c2: 0.9,
+                    ..KeyOptions::default()
+                },
                 ..SteadyOptions::default()
             },
         ];
         let flags = [
             "steady.birds",
             "steady.frames",
-            "steady.epsilon",
-            "steady.c1",
-            "steady.c2",
+            "steady.keys.epsilon",
+            "steady.keys.c1",
+            "steady.keys.c2",
         ];
         for (o, f) in bad.iter().zip(flags) {
             let e = o.validate().unwrap_err().to_string();
