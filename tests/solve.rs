@@ -147,7 +147,7 @@ fn large_flocks_at_real_spacing_round_trip() {
 
 /// From `SolveOptions::interpolate_from` birds the iteration runs on interpolated far sums and
 /// its result is checked with the exact ones: the same shape as the all-exact iteration (to
-/// 10⁻⁶ wingspans), an exact residual within the tolerance, from a perturbed start at real
+/// 10⁻⁸ of the depth), an exact residual within the tolerance, from a perturbed start at real
 /// spacing; with the correction rounds forced (a crude interpolation, order 3) it still converges.
 #[test]
 fn interpolated_iterations_are_checked_exactly() {
