@@ -54,6 +54,10 @@ pub struct KeyOptions {
     /// Depth limit of key shapes: no bird further behind the leader than this factor times the
     /// deepest initial shape plus one wingspan, dimensionless (≥ 1).
     pub max_depth_factor: f64,
+    /// Widening of the band of the median longitudinal distance to the nearest bird ahead that
+    /// the initial shapes span, inside which every key shape's must stay (the footage's
+    /// spacing, issue 12), fraction in [0, 1].
+    pub spacing_margin: f64,
 }
 
 impl Default for KeyOptions {
@@ -68,6 +72,7 @@ impl Default for KeyOptions {
             max_damping: 12,
             accept_residual: 1e-6,
             max_depth_factor: 1.5,
+            spacing_margin: 0.0,
         }
     }
 }
@@ -120,6 +125,12 @@ impl KeyOptions {
         }
         if !(self.max_depth_factor.is_finite() && self.max_depth_factor >= 1.0) {
             return p("steady.keys.max_depth_factor", "must be at least 1".into());
+        }
+        if !(self.spacing_margin.is_finite() && (0.0..=1.0).contains(&self.spacing_margin)) {
+            return p(
+                "steady.keys.spacing_margin",
+                format!("{}: must be in [0, 1]", self.spacing_margin),
+            );
         }
         Ok(())
     }
@@ -206,6 +217,10 @@ pub struct Structure {
     /// An outer bird may come this far ahead of its inner neighbour before the arm counts as
     /// broken, wingspans (near-ties, e.g. around a J's vertex, would otherwise block every move).
     pub monotone_tolerance: f64,
+    /// The band [lo, hi] of the median longitudinal distance to the nearest bird ahead
+    /// ([`crate::keyshape::spacing`]), wingspans: the footage's spacing, as the initial shapes
+    /// span it. `None`: not checked.
+    pub spacing: Option<(f64, f64)>,
 }
 
 impl Structure {
@@ -233,11 +248,13 @@ impl Structure {
             monotone_pairs: pairs,
             max_depth,
             monotone_tolerance: 0.1,
+            spacing: None,
         }
     }
 
-    /// True when `y` keeps the leader front-most, the depth limit and the arms' monotone steps.
-    pub fn accepts(&self, y: &[f64]) -> bool {
+    /// True when the depths `y` at lateral positions `x` keep the leader front-most, the depth
+    /// limit, the arms' monotone steps and the spacing band.
+    pub fn accepts(&self, x: &[f64], y: &[f64]) -> bool {
         let Some(&yl) = y.get(self.leader) else {
             return false;
         };
@@ -250,7 +267,13 @@ impl Structure {
             .monotone_pairs
             .iter()
             .all(|&(inner, outer)| y[outer] >= y[inner] - self.monotone_tolerance);
-        ok_leader && ok_depth && ok_arms
+        ok_leader
+            && ok_depth
+            && ok_arms
+            && self.spacing.map_or(true, |(lo, hi)| {
+                let m = crate::keyshape::spacing::spacing([(x, y)]).1;
+                m >= lo && m <= hi
+            })
     }
 }
 
@@ -348,7 +371,7 @@ fn attempt(
     // Leader at 0 (the solver puts the front-most bird there; re-anchor on ours).
     let yl = report.y[structure.leader];
     let y: Vec<f64> = report.y.iter().map(|v| v - yl).collect();
-    if !structure.accepts(&y) {
+    if !structure.accepts(x, &y) {
         stats.rejected_structure += 1;
         return Ok(Attempt::Rejected);
     }
@@ -504,7 +527,7 @@ pub fn next_key(
         &moved
     };
     let predictor = Predictor::new(x, prev, structure.leader, total, &solve_opts.aero);
-    let promising = |y: &[f64]| structure.accepts(y) && max_jump(&prev.y, y) <= opts.max_jump;
+    let promising = |y: &[f64]| structure.accepts(x, y) && max_jump(&prev.y, y) <= opts.max_jump;
     let mut tried: Vec<Vec<f64>> = Vec::new();
     let mut draws = 0;
     for _ in 0..opts.max_draws.max(1) {
@@ -684,18 +707,28 @@ mod tests {
     fn structure_keeps_leader_and_arms() {
         let x = [-2.0, -1.0, 0.0, 1.0, 2.0];
         let y = [1.4, 0.7, 0.0, 0.7, 1.4];
-        let s = Structure::of(&x, &y, 2, 5.0);
+        let mut s = Structure::of(&x, &y, 2, 5.0);
         assert_eq!(s.monotone_pairs.len(), 4);
-        assert!(s.accepts(&y));
+        assert!(s.accepts(&x, &y));
         assert!(
-            !s.accepts(&[1.4, 0.7, 0.0, -0.1, 1.4]),
+            !s.accepts(&x, &[1.4, 0.7, 0.0, -0.1, 1.4]),
             "bird ahead of leader"
         );
-        assert!(!s.accepts(&[0.5, 0.7, 0.0, 0.7, 1.4]), "arm not monotone");
         assert!(
-            s.accepts(&[0.65, 0.7, 0.0, 0.7, 1.4]),
+            !s.accepts(&x, &[0.5, 0.7, 0.0, 0.7, 1.4]),
+            "arm not monotone"
+        );
+        assert!(
+            s.accepts(&x, &[0.65, 0.7, 0.0, 0.7, 1.4]),
             "within the tolerance"
         );
-        assert!(!s.accepts(&[1.4, 0.7, 0.0, 0.7, 6.0]), "too deep");
+        assert!(!s.accepts(&x, &[1.4, 0.7, 0.0, 0.7, 6.0]), "too deep");
+        // The spacing band: median step to the nearest bird ahead 0.7 here.
+        s.spacing = Some((0.6, 0.8));
+        assert!(s.accepts(&x, &y));
+        assert!(
+            !s.accepts(&x, &[2.0, 1.0, 0.0, 1.0, 2.0]),
+            "steps of 1 outside the band"
+        );
     }
 }
