@@ -499,33 +499,35 @@ pub fn next_key(
     // The lateral positions drifted since the previous key: its fore-aft placement at the new
     // positions is the reference of eq. (2) (and the fallback at λ = 0, reachable by design).
     let moved;
+    let mut hull = XiRanges {
+        min: vec![],
+        max: vec![],
+    };
     let prev = if prev.x.as_slice() == x {
         prev
     } else {
+        // A pair brought wing to wing by the drift: the bird behind drops back (as in step 1).
+        let y = crate::keyshape::steady::separate(x, &prev.y, &solve_opts.aero);
         let xi: Vec<f64> = solve_opts
             .aero
-            .power_lenient(x, &prev.y)
+            .power_lenient(x, &y)
             .iter()
             .map(|e| e / total)
             .collect();
-        // The reference of eq. (2) inside the feasible ranges (renormalised, as a draw is), so
-        // that every target, damped or not, stays in them.
-        let mut reference = xi.clone();
-        for _ in 0..100 {
-            if feasible.excess(&reference) <= 1e-13 {
-                break;
-            }
-            feasible.clip(&mut reference);
-            renormalise(&mut reference);
-        }
+        // The reference of eq. (2) is this placement as it is (ξ̂ at λ = 0, which the previous
+        // y solves exactly); the ranges at the new positions are extended to it, so that the
+        // damped targets between it and a draw inside the ranges stay in them.
+        hull = feasible.including(&xi);
         moved = KeyShape {
             x: x.to_vec(),
-            xi_target: reference,
+            y,
+            xi_target: xi.clone(),
             xi,
             ..prev.clone()
         };
         &moved
     };
+    let feasible = if hull.is_empty() { feasible } else { &hull };
     let predictor = Predictor::new(x, prev, structure.leader, total, &solve_opts.aero);
     let promising = |y: &[f64]| structure.accepts(x, y) && max_jump(&prev.y, y) <= opts.max_jump;
     let mut tried: Vec<Vec<f64>> = Vec::new();
@@ -606,23 +608,51 @@ pub fn next_key(
     })
 }
 
-/// The lateral positions of every key and E there (Munk), and whether the keys return to the
-/// first one (a loop: each draw is pulled toward the first key's ξ̂, more so near the end).
+/// One key's lateral positions and what depends on them.
+#[derive(Debug, Clone)]
+pub struct LateralKey {
+    /// Lateral positions, wingspans.
+    pub x: Vec<f64>,
+    /// E there (Munk), dimensionless.
+    pub total: f64,
+    /// Feasible ranges of ξ there (the initial shapes' ξ at these positions, widened by ε).
+    pub feasible: XiRanges,
+}
+
+/// The lateral positions of every key (with E and the feasible ranges there), and whether the
+/// keys return to the first one (a loop: each draw is pulled toward the first key's ξ̂, more so
+/// near the end).
 #[derive(Debug, Clone, Default)]
 pub struct KeyPlan {
-    /// Per key after the first: lateral positions (wingspans) and E there; empty: `ctx.x`.
-    pub lateral: Vec<(Vec<f64>, f64)>,
+    /// Per key (the first included): its lateral positions; empty: `ctx.x` for every key.
+    pub lateral: Vec<LateralKey>,
     /// Pull the draws back toward the first key (a loop).
     pub home: bool,
 }
 
+/// `ctx` at the lateral positions of `l` (`None`: as it is).
+fn context_at<'b>(ctx: &KeyContext<'b>, l: Option<&'b LateralKey>) -> KeyContext<'b> {
+    match l {
+        Some(l) => KeyContext {
+            x: &l.x,
+            total: l.total,
+            feasible: &l.feasible,
+            ..*ctx
+        },
+        None => *ctx,
+    }
+}
+
 /// `count` key shapes starting from `first` (already solved), each from the one before, key k
-/// at the lateral positions `plan.lateral[k]`.
+/// at the lateral positions `plan.lateral[k]`. When no shape fits a key's drifted positions
+/// (every damped target failed), that key keeps the previous key's positions
+/// (`KeyStats::lateral_held`).
 pub fn key_shapes(
     ctx: &KeyContext,
     plan: &KeyPlan,
     first: KeyShape,
     count: usize,
+    lateral_at: &dyn Fn(&[f64]) -> Option<LateralKey>,
     rng: &mut impl Rng,
     mut on_key: impl FnMut(),
 ) -> Result<(Vec<KeyShape>, KeyStats)> {
@@ -634,39 +664,45 @@ pub fn key_shapes(
     let mut keys = Vec::with_capacity(count);
     keys.push(first);
     on_key();
+    // The positions the previous key has (`None`: `ctx.x`).
+    let mut current: Option<LateralKey> = plan.lateral.first().cloned();
     while keys.len() < count {
         let prev = keys
             .last()
             .ok_or_else(|| Error::Internal("no key".into()))?;
         let at = keys.len();
-        let ctx_k = match plan.lateral.get(at) {
-            Some((x, total)) => KeyContext {
-                x,
-                total: *total,
-                ..*ctx
-            },
-            None => *ctx,
-        };
+        let mut here = plan.lateral.get(at).cloned().or_else(|| current.clone());
+        // After a key that kept older positions, the plan can be more than `max_jump` away:
+        // this key goes that far toward it.
+        if let Some(l) = &here {
+            let jump = max_jump(&prev.x, &l.x);
+            if jump > ctx.opts.max_jump {
+                let f = ctx.opts.max_jump / jump;
+                let x: Vec<f64> = prev
+                    .x
+                    .iter()
+                    .zip(&l.x)
+                    .map(|(a, b)| a + f * (b - a))
+                    .collect();
+                here = lateral_at(&x).or_else(|| current.clone());
+            }
+        }
         let w = (at as f64 / count.max(2) as f64).powi(2);
         let home = plan.home.then(|| (keys[0].xi_target.as_slice(), w));
-        let mut k = next_key(&ctx_k, prev, home, rng, &mut stats)?;
+        let mut k = next_key(&context_at(ctx, here.as_ref()), prev, home, rng, &mut stats)?;
         if k.damping == 0.0 && k.x != prev.x {
             // No shape at the drifted lateral positions: this key keeps the previous ones.
             stats.held -= 1;
             stats.lateral_held += 1;
-            let ctx_prev = KeyContext {
-                x: &prev.x,
-                total: if prev.x.as_slice() == ctx.x {
-                    ctx.total
-                } else {
-                    plan.lateral
-                        .iter()
-                        .find(|(x, _)| *x == prev.x)
-                        .map_or(ctx.total, |(_, t)| *t)
-                },
-                ..*ctx
-            };
-            k = next_key(&ctx_prev, prev, home, rng, &mut stats)?;
+            k = next_key(
+                &context_at(ctx, current.as_ref()),
+                prev,
+                home,
+                rng,
+                &mut stats,
+            )?;
+        } else {
+            current = here;
         }
         stats.min_damping = stats.min_damping.min(k.damping);
         stats.max_residual = stats.max_residual.max(k.residual);

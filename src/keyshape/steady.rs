@@ -33,7 +33,7 @@ use crate::keyshape::initial::{
 };
 use crate::keyshape::interpolate::Track;
 use crate::keyshape::keys::{
-    key_shapes, KeyContext, KeyOptions, KeyPlan, KeyShape, KeyStats, Structure,
+    key_shapes, KeyContext, KeyOptions, KeyPlan, KeyShape, KeyStats, LateralKey, Structure,
 };
 use crate::keyshape::lateral::{lateral_plan, LateralOptions};
 use crate::keyshape::ranges::{power_at, xi_ranges, XiRanges};
@@ -209,6 +209,9 @@ pub struct SteadyReport {
     /// Band of every key shape's median longitudinal distance to the nearest bird ahead,
     /// wingspans.
     pub spacing_band: Option<(f64, f64)>,
+    /// Standard deviation of the lateral gaps' drift between key shapes, wingspans (the
+    /// footage's unless `steady.lateral.drift` is set).
+    pub lateral_drift: f64,
     /// Frames where some bird's ξ leaves its feasible range.
     pub frames_outside_range: usize,
     /// Largest amount by which a frame's ξ leaves the feasible range.
@@ -262,6 +265,19 @@ pub fn separate(x: &[f64], y: &[f64], aero: &AeroOptions) -> Vec<f64> {
         }
     }
     y
+}
+
+/// The shapes' depths with every collision at lateral positions `x` resolved by [`separate`]
+/// (each shape keeps its own lateral positions).
+fn separated_at(
+    x: &[f64],
+    shapes: &[crate::shape::Shape],
+    aero: &AeroOptions,
+) -> Vec<crate::shape::Shape> {
+    shapes
+        .iter()
+        .map(|s| crate::shape::Shape::from_xy(&s.xs(), &separate(x, &s.ys(), aero)))
+        .collect()
 }
 
 /// Largest factor (and smallest, its inverse) [`depth_scale`] applies to the U and J curves.
@@ -350,17 +366,13 @@ pub fn steady_flight_report(
     // At the key shapes' lateral positions a movie frame's placement can put two birds wing to
     // wing; the bird behind is moved back to the collision distance (what a real bird does).
     let aero = &opts.aero;
-    let at_key_x = |shapes: Vec<crate::shape::Shape>| -> Vec<crate::shape::Shape> {
-        shapes
-            .iter()
-            .map(|s| crate::shape::Shape::from_xy(&s.xs(), &separate(&x, &s.ys(), aero)))
-            .collect()
-    };
+    let at_key_x = |shapes: Vec<crate::shape::Shape>| separated_at(&x, &shapes, aero);
     let footage = spacing::footage_spacing(params);
     let depth_scale = depth_scale(params, &corr, &x, footage, init_opts, rng, &at_key_x);
     let (sl, sr) = side_scales(params, &corr);
     let scales = (sl * depth_scale, sr * depth_scale);
-    let shapes = at_key_x(initial_shapes_scaled(params, &corr, scales, rng, init_opts));
+    let raw_shapes = initial_shapes_scaled(params, &corr, scales, rng, init_opts);
+    let shapes = at_key_x(raw_shapes.clone());
 
     // Step 2, at the key shapes' lateral positions.
     let values = power_at(&x, &shapes, aero)?;
@@ -456,24 +468,63 @@ pub fn steady_flight_report(
     };
     let mut lateral = Vec::with_capacity(nk);
     let mut lat_rng = crate::rng::stream(opts.seed, "steady.lateral");
-    for xk in lateral_plan(&gaps, corr.leader, nk, opts, &mut lat_rng) {
-        // A drift that leaves the flock no saving in total keeps the drawn positions.
-        match aero.munk_total(&xk) {
-            Ok(t) if t > 0.0 => lateral.push((xk, t)),
-            _ => lateral.push((x.clone(), total)),
-        }
+    let drawn = LateralKey {
+        x: x.clone(),
+        total,
+        feasible: feasible.clone(),
+    };
+    let drift = opts.lateral.drift_for(params);
+    // Each key's feasible ranges are the initial shapes' ξ at its own lateral positions (as
+    // step 2 does at the drawn ones). A drift that leaves the flock no saving in total, or at
+    // which every initial shape collides, is not taken.
+    let lateral_at = |xk: &[f64]| -> Option<LateralKey> {
+        let t = aero.munk_total(xk).ok().filter(|t| *t > 0.0)?;
+        let values = power_at(xk, &separated_at(xk, &raw_shapes, aero), aero).ok()?;
+        Some(LateralKey {
+            x: xk.to_vec(),
+            total: t,
+            feasible: xi_ranges(&values).ok()?.widened(opts.keys.epsilon),
+        })
+    };
+    for xk in lateral_plan(&gaps, corr.leader, nk, drift, opts, &mut lat_rng) {
+        lateral.push(if xk == x {
+            drawn.clone()
+        } else {
+            lateral_at(&xk).unwrap_or_else(|| drawn.clone())
+        });
     }
     let plan = KeyPlan {
         lateral,
         home: opts.looped,
     };
     let solved = if opts.looped { nk - 1 } else { nk };
-    let (mut keys, key_stats) = key_shapes(&ctx, &plan, key0, solved, rng, || progress.advance(1))?;
+    let (mut keys, key_stats) = key_shapes(&ctx, &plan, key0, solved, &lateral_at, rng, || {
+        progress.advance(1)
+    })?;
     if opts.looped {
         keys.push(keys[0].clone());
         progress.advance(1);
     }
     progress.finish();
+    // The published ranges: every key's own, extended (as its draws were) to the previous key's
+    // placement at its lateral positions.
+    let mut feasible = feasible;
+    for (k, key) in keys.iter().enumerate().skip(1) {
+        if let Some(l) = plan.lateral.iter().find(|l| l.x == key.x) {
+            feasible = feasible.union(&l.feasible);
+        } else if let Some(l) = lateral_at(&key.x) {
+            feasible = feasible.union(&l.feasible);
+        }
+        if key.x != keys[k - 1].x {
+            let t = aero.munk_total(&key.x).unwrap_or(total);
+            let reference: Vec<f64> = aero
+                .power_lenient(&key.x, &keys[k - 1].y)
+                .iter()
+                .map(|e| e / t)
+                .collect();
+            feasible = feasible.including(&reference);
+        }
+    }
     let heights = heights(n, &x, corr.leader, nk, opts);
 
     // Step 4.
@@ -586,6 +637,7 @@ pub fn steady_flight_report(
         footage_spacing: footage,
         depth_scale,
         spacing_band,
+        lateral_drift: drift,
         frames_outside_range,
         max_frame_excess,
     };
@@ -637,7 +689,7 @@ mod tests {
             KeyOptions::default().c1,
             "unset fields keep defaults"
         );
-        assert_eq!(o.lateral.drift, 0.05);
+        assert_eq!(o.lateral.drift, Some(0.05));
         assert!(o.looped);
         let back: SteadyOptions =
             serde_json::from_str(&serde_json::to_string(&o).unwrap()).unwrap();
@@ -659,7 +711,7 @@ mod tests {
             .starts_with("steady.initial.min_gap"));
         let bad = SteadyOptions {
             lateral: LateralOptions {
-                drift: -1.0,
+                drift: Some(-1.0),
                 ..LateralOptions::default()
             },
             ..SteadyOptions::default()
