@@ -7,6 +7,9 @@
 
 use std::path::{Path, PathBuf};
 
+use std::hint::black_box;
+use std::time::{Duration, Instant};
+
 use criterion::{criterion_group, criterion_main, Criterion};
 use formation::export::{write_outputs, RenderOptions};
 use formation::pipeline::{Config, Pipeline};
@@ -37,21 +40,11 @@ fn flock_on(birds: usize, takeoff: bool, path: Option<PathBuf>) -> Animation {
     Pipeline::from_path(input).run(&config).unwrap().0
 }
 
-/// Issue 19's test path: 200 wingspans north, a 90° right turn of radius 150, 300 east
-/// climbing 20 wingspans (the take-off joins it at its first point, at the default cruise
-/// altitude of 10 wingspans, so both runs fly the same take-off).
-fn turn_path(dir: &Path) -> PathBuf {
-    let mut pts: Vec<[f64; 3]> = (0..5).map(|k| [0.0, 50.0 * k as f64, 10.0]).collect();
-    for k in 1..=12 {
-        let a = std::f64::consts::PI * (1.0 - k as f64 / 24.0);
-        pts.push([150.0 + 150.0 * a.cos(), 200.0 + 150.0 * a.sin(), 10.0]);
-    }
-    for k in 1..=6 {
-        pts.push([150.0 + 50.0 * k as f64, 350.0, 10.0 + 20.0 * k as f64 / 6.0]);
-    }
-    let p = dir.join("turn.json");
-    std::fs::write(&p, format!("{{\"points\": {pts:?}}}")).unwrap();
-    p
+/// Issue 19's test path, `tests/data/path_turn_climb.json`: 200 wingspans north, a 90° right
+/// turn of radius 150, 300 east climbing 20 wingspans (the take-off joins it at its first point,
+/// at the default cruise altitude of 10 wingspans, so both runs fly the same take-off).
+fn turn_path() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/path_turn_climb.json")
 }
 
 fn bench(c: &mut Criterion) {
@@ -60,10 +53,39 @@ fn bench(c: &mut Criterion) {
     g.bench_function("geese_14_birds_20s_simulation", |b| b.iter(simulate));
     let dir = std::env::temp_dir().join(format!("formation-bench-animate-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let path = turn_path(&dir);
+    let path = turn_path();
     g.bench_function("geese_14_birds_20s_simulation_on_a_path", |b| {
         b.iter(|| simulate_on(Some(path.clone())))
     });
+    // Paired: straight and path runs alternate within every sample, so that the load of the
+    // shared machine hits both alike; the ratio of their summed times is printed at the end.
+    let sums = std::cell::Cell::new((Duration::ZERO, Duration::ZERO, 0u32));
+    g.bench_function("geese_14_birds_20s_straight_then_path_paired", |b| {
+        b.iter_custom(|iters| {
+            let mut total = Duration::ZERO;
+            for _ in 0..iters {
+                let t = Instant::now();
+                black_box(simulate());
+                let straight = t.elapsed();
+                let t = Instant::now();
+                black_box(simulate_on(Some(path.clone())));
+                let on_path = t.elapsed();
+                let (s, p, n) = sums.get();
+                sums.set((s + straight, p + on_path, n + 1));
+                total += straight + on_path;
+            }
+            total
+        })
+    });
+    let (s, p, n) = sums.get();
+    if n > 0 {
+        eprintln!(
+            "paired ({n} runs each): straight {:.2} ms, on the path {:.2} ms per run: path following adds {:+.1} %",
+            s.as_secs_f64() * 1e3 / n as f64,
+            p.as_secs_f64() * 1e3 / n as f64,
+            100.0 * (p.as_secs_f64() / s.as_secs_f64() - 1.0)
+        );
+    }
     // The course step alone (reading the path, the spline, the mapping, banks and pitches) on
     // the course-frame flight of the first benchmark.
     {
@@ -71,14 +93,28 @@ fn bench(c: &mut Criterion) {
         config.steady.birds = 14;
         config.course.path = Some(path.clone());
         let straight = simulate();
-        g.bench_function("geese_14_birds_20s_course_step", |b| {
-            b.iter(|| {
-                let points = config.course.load(config.steady.wingspan_m).unwrap();
-                let mut a = straight.clone();
-                formation::pipeline::course_stage(&mut a, points.as_ref(), &config).unwrap();
-                a
-            })
-        });
+        // The same step without the path (pitch and banks only, as every flight has): the
+        // difference of the two is what following the path costs.
+        let mut unbanked = straight.clone();
+        for f in &mut unbanked.frames {
+            f.bank = None;
+        }
+        for (name, config) in [
+            ("geese_14_birds_20s_course_step", config.clone()),
+            (
+                "geese_14_birds_20s_course_step_without_path",
+                Config::default(),
+            ),
+        ] {
+            g.bench_function(name, |b| {
+                b.iter(|| {
+                    let points = config.course.load(config.steady.wingspan_m).unwrap();
+                    let mut a = unbanked.clone();
+                    formation::pipeline::course_stage(&mut a, points.as_ref(), &config).unwrap();
+                    a
+                })
+            });
+        }
     }
     let gif: PathBuf = dir.join("flock.gif");
     let anim = simulate();

@@ -11,10 +11,12 @@ use serde::Serialize;
 
 use crate::error::{Error, Result};
 
-/// Upper bound on the size of any input file we read fully into memory, bytes: 2 GiB, enough for
-/// the largest animation file `formation` writes (10⁷ bird-frames of pretty JSON, about 2 GB; see
-/// [`crate::limits::MAX_BIRD_FRAMES`]).
-pub const MAX_INPUT_BYTES: u64 = 2 * 1024 * 1024 * 1024;
+/// Upper bound on the size of any input file we read fully into memory, bytes: 4 GiB, enough for
+/// the largest animation file `formation` writes (10⁷ bird-frames of pretty JSON: 1.97 GB for
+/// 100 birds × 100 000 frames, 2.9 GB for 100 000 birds × 100 frames of a wide sky of
+/// formations, whose coordinates have more digits; see [`crate::limits::MAX_BIRD_FRAMES`]). It
+/// was 2 GiB, which refused the latter (issue 17).
+pub const MAX_INPUT_BYTES: u64 = 4 * 1024 * 1024 * 1024;
 
 /// Opens an input for reading, refusing directories and regular files over the size limit up
 /// front. Devices, FIFOs and process substitutions (`<(…)`) are read too, through a bounded
@@ -123,7 +125,9 @@ fn not_utf8(path: &Path, offset: usize) -> Error {
 }
 
 /// Parses JSON text into `T`, turning serde's message into one line naming the file, line and column.
+/// A leading byte-order mark (written by some Windows editors) is skipped.
 pub fn parse_json<T: DeserializeOwned>(path: &Path, text: &str) -> Result<T> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     if text.trim().is_empty() {
         return Err(Error::format(path, "file is empty, expected JSON"));
     }
@@ -414,7 +418,7 @@ fn new_temporary<T>(
     dir: &Path,
     create: impl FnOnce(&Path) -> std::io::Result<(T, PathBuf)>,
 ) -> std::io::Result<(T, PathBuf)> {
-    let (value, path, first_use) = with_registry(|r| {
+    let (value, path, first_use) = with_registry(|r| -> std::io::Result<_> {
         let (value, path) = create(dir)?;
         r.open.push(path.clone());
         let first_use = r.cleaned_dirs.insert(dir.to_path_buf());
@@ -526,7 +530,7 @@ fn discard_queued(registry: &mut Registry, pending: &[Pending]) {
 /// Hands a finished temporary to the open [`OutputBatch`], or moves it into place at once when
 /// there is none.
 fn finish(tmp: PathBuf, target: PathBuf) -> Result<()> {
-    lock_registry_then(|r| {
+    with_registry(|r| {
         let p = Pending { tmp, target };
         match r.batch.as_mut() {
             Some(queue) => {
@@ -653,7 +657,7 @@ impl Drop for AtomicFile {
 
 /// Removes an unfinished temporary and forgets it.
 fn discard(tmp: &Path) {
-    let _ = with_registry(|r| {
+    let _ = with_registry(|r| -> std::io::Result<()> {
         remove_any(tmp);
         r.forget(std::iter::once(tmp));
         Ok(())
@@ -747,7 +751,7 @@ pub struct OutputBatch {
 impl OutputBatch {
     /// Opens the batch. Fails if one is already open (batches do not nest).
     pub fn begin() -> Result<OutputBatch> {
-        with_registry(|r| {
+        with_registry(|r| -> std::io::Result<_> {
             if r.batch.is_some() {
                 return Ok(false);
             }
@@ -767,7 +771,7 @@ impl OutputBatch {
     /// Moves every queued output into place, all or none.
     pub fn commit(mut self) -> Result<()> {
         self.committed = true;
-        lock_registry_then(|r| {
+        with_registry(|r| {
             let pending = r.batch.take().unwrap_or_default();
             commit_all(r, pending)
         })
@@ -777,7 +781,7 @@ impl OutputBatch {
 impl Drop for OutputBatch {
     fn drop(&mut self) {
         if !self.committed {
-            let _ = with_registry(|r| {
+            let _ = with_registry(|r| -> std::io::Result<()> {
                 let pending = r.batch.take().unwrap_or_default();
                 discard_queued(r, &pending);
                 Ok(())
@@ -807,13 +811,11 @@ impl Registry {
 
 static REGISTRY: std::sync::Mutex<Option<Registry>> = std::sync::Mutex::new(None);
 
-fn lock_registry_then<R>(f: impl FnOnce(&mut Registry) -> R) -> R {
+/// Runs `f` on the registry of open temporaries, locked (a poisoned lock is taken over: the
+/// registry is a list of paths, consistent after any panic).
+fn with_registry<R>(f: impl FnOnce(&mut Registry) -> R) -> R {
     let mut guard = REGISTRY.lock().unwrap_or_else(|p| p.into_inner());
     f(guard.get_or_insert_with(Registry::default))
-}
-
-fn with_registry<R>(f: impl FnOnce(&mut Registry) -> std::io::Result<R>) -> std::io::Result<R> {
-    lock_registry_then(f)
 }
 
 /// Removes every temporary file or directory still open (called on a terminating signal, right

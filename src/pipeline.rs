@@ -151,6 +151,27 @@ impl Config {
         Ok(steady)
     }
 
+    /// Birds of the largest formation that takes off, which sets the take-off's length and
+    /// memory bound: the flock; with several formations (`skein.formations`, or
+    /// `skein.formation_size`), the largest one's size; 2 without a take-off (its options are
+    /// still checked, but no take-off frames are needed).
+    pub fn takeoff_birds(&self) -> usize {
+        let birds = self.steady.birds;
+        if !self.initiation {
+            return 2;
+        }
+        let k = match (self.skein.formations, self.skein.formation_size) {
+            (Some(k), _) => k,
+            (None, Some(m)) => skein::formation_count(birds, m, None, Some(m)),
+            (None, None) => 1,
+        };
+        if k > 1 && 2 * k <= birds {
+            skein::sizes::size_bounds(birds, k).1
+        } else {
+            birds
+        }
+    }
+
     /// The initiation options with the seed set.
     pub fn initiate_options(&self) -> Result<InitiateOptions> {
         let o = InitiateOptions {
@@ -321,13 +342,8 @@ impl Pipeline {
             }
             Input::Annotations(a) => extract_stage(a, config, progress),
             Input::Path(path) => {
-                if !path.is_dir() {
-                    let text = crate::io::read_text(path)?;
-                    if extract::is_params_file(&text) {
-                        let p: FormationParams = crate::io::parse_json(path, &text)?;
-                        p.validate(path)?;
-                        return Ok((p, Vec::new()));
-                    }
+                if let Some(p) = FormationParams::read_if_params(path)? {
+                    return Ok((p, Vec::new()));
                 }
                 let ann = crate::annotations::read(path, &config.read)?;
                 extract_stage(&ann, config, progress)
@@ -374,6 +390,41 @@ pub fn takeoff_config(config: &Config, path: Option<&PathPoints>) -> Result<Conf
         c.initiate.cruise_altitude = crate::course::takeoff_altitude(p, &origin)?;
     }
     Ok(c)
+}
+
+/// The config and the loaded path of a take-off flown on its own onto `course`'s path, ahead of
+/// the steady flight `steady` (read from `origin`), as `formation initiate` does: the course step
+/// needs the steady flight's cruise speed and wingspan, and the take-off climbs to the path's
+/// first point (set in `initiate.cruise_altitude`, and in the config). A steady flight already
+/// on a path is refused.
+pub fn takeoff_course(
+    course: CourseOptions,
+    steady: &Animation,
+    origin: &Path,
+    initiate: &mut InitiateOptions,
+) -> Result<(Config, Option<PathPoints>)> {
+    let mut config = Config {
+        course,
+        ..Config::default()
+    };
+    config.steady.wingspan_m = steady.wingspan_m;
+    let leader = steady.leaders().first().copied().unwrap_or(0);
+    if let Some(f) = steady.frames.first() {
+        config.steady.speed = f.speed.get(leader).copied().unwrap_or(config.steady.speed);
+    }
+    if steady.path.is_some() && config.course.path.is_some() {
+        return Err(Error::format(
+            origin,
+            "path: this steady flight already follows a path; give the take-off the steady flight made without one, and the path here",
+        ));
+    }
+    let path = config.course.load(steady.wingspan_m)?;
+    if let Some(p) = &path {
+        let file = config.course.path.clone().unwrap_or_default();
+        initiate.cruise_altitude = crate::course::takeoff_altitude(p, &file)?;
+    }
+    config.initiate.cruise_altitude = initiate.cruise_altitude;
+    Ok((config, path))
 }
 
 /// The course step (issue 19): maps `anim`, made in the course frame by the stages before, onto

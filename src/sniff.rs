@@ -76,6 +76,23 @@ pub fn text_kind(text: &str) -> Option<Kind> {
     serde_json::from_str::<Value>(t).ok().map(|v| json_kind(&v))
 }
 
+/// What the file or directory at `path` holds: a directory is Labelme annotations (a JSON file
+/// per frame), a file is judged by [`text_kind`] ([`Kind::Unknown`] for text that is not JSON,
+/// e.g. CSV annotations).
+pub fn path_kind(path: &std::path::Path) -> crate::error::Result<Kind> {
+    if path.is_dir() {
+        return Ok(Kind::Labelme);
+    }
+    let text = crate::io::read_text(path)?;
+    Ok(text_kind(&text).unwrap_or(Kind::Unknown))
+}
+
+/// Whether `text` is a params file (`"format": "formation-params/1"`); cheap for annotations,
+/// which never carry the tag.
+pub fn is_params(text: &str) -> bool {
+    text.contains(PARAMS_FORMAT) && text_kind(text) == Some(Kind::Params)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -98,5 +115,16 @@ mod tests {
         assert_eq!(k(r#"{"frames": []}"#), Some(Kind::NativeAnnotations));
         assert_eq!(k("frame,bird,x,y\n"), None);
         assert_eq!(k("{ truncated"), None);
+    }
+
+    #[test]
+    fn params_files_are_told_from_annotations() {
+        assert!(is_params(
+            r#"{"format": "formation-params/1", "frames": []}"#
+        ));
+        assert!(!is_params(
+            r#"{"frames": [], "source": "formation-params/1"}"#
+        ));
+        assert!(!is_params("frame,x,y\n"));
     }
 }

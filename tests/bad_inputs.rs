@@ -8,10 +8,13 @@
 //! initiate, render, plot power|xi|shape|paths|wingbeat and animate, including the size limits
 //! of `formation::limits` (10⁶ birds, 10⁷ frames, a 10-GB GIF).
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::path::PathBuf;
 
 use serde::Deserialize;
+
+mod support;
+
+use support::{data, run_in, scratch};
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -27,7 +30,7 @@ struct Case {
 }
 
 fn bad_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/bad")
+    data("bad")
 }
 
 fn cases() -> Vec<Case> {
@@ -73,7 +76,7 @@ fn manifest_covers_every_command_and_every_file() {
 
 #[test]
 fn every_bad_input_fails_cleanly_and_writes_nothing() {
-    let base = std::env::temp_dir().join(format!("formation-bad-{}", std::process::id()));
+    let base = scratch("bad-inputs");
     let mut failures = Vec::new();
     for (k, case) in cases().iter().enumerate() {
         let out = base.join(format!("case{k}"));
@@ -84,12 +87,8 @@ fn every_bad_input_fails_cleanly_and_writes_nothing() {
             .iter()
             .map(|a| a.replace("$OUT", &out_s))
             .collect();
-        let r = Command::new(env!("CARGO_BIN_EXE_formation"))
-            .arg("--quiet")
-            .args(&args)
-            .current_dir(bad_dir())
-            .output()
-            .unwrap();
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let r = run_in(&bad_dir(), &args);
         let stderr = String::from_utf8_lossy(&r.stderr);
         let first = stderr.lines().next().unwrap_or("").replace(&out_s, "$OUT");
         let left: Vec<String> = std::fs::read_dir(&out)

@@ -2,7 +2,7 @@
 //! wingspan by its bounding box and bound to `body`; a skinned model following the joint
 //! convention gets the wingbeat; bad files are refused with exit code 2 and the reason.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use formation::export::bird_model::{self, MAX_VERTICES};
 use formation::export::gltf::{glb_bytes, glb_bytes_with, SceneOptions};
@@ -11,12 +11,9 @@ use formation::wingbeat::{assign_phases, Species, WingbeatOptions};
 use formation::Animation;
 use serde_json::{json, Value};
 
-fn tmpdir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("formation-birdmodel-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+mod support;
+
+use support::scratch;
 
 fn flock() -> Animation {
     let p = SyntheticParams {
@@ -96,7 +93,7 @@ fn parse(bytes: &[u8]) -> Value {
 
 #[test]
 fn a_static_model_is_scaled_to_the_wingspan_and_bound_to_the_body() {
-    let d = tmpdir("static");
+    let d = scratch("static");
     let path = d.join("bird.glb");
     std::fs::write(&path, static_bird(40)).unwrap();
     let asset = bird_model::load(&path, Species::Goose).unwrap();
@@ -130,7 +127,7 @@ fn a_static_model_is_scaled_to_the_wingspan_and_bound_to_the_body() {
 
 #[test]
 fn a_skinned_model_with_the_convention_flaps_like_the_built_in_bird() {
-    let d = tmpdir("skinned");
+    let d = scratch("skinned");
     let anim = flock();
     let path = d.join("ours.glb");
     std::fs::write(&path, glb_bytes(&anim, 1.5).unwrap()).unwrap();
@@ -170,7 +167,7 @@ fn refused(path: &Path, needle: &str) {
 
 #[test]
 fn bad_models_are_refused_with_the_reason() {
-    let d = tmpdir("bad");
+    let d = scratch("bad");
     let p = d.join("x.glb");
     std::fs::write(&p, b"{\"asset\": {\"version\": \"2.0\"}}").unwrap();
     refused(&p, "not a binary .glb");

@@ -8,12 +8,9 @@ use formation::export::{plan_outputs, write_outputs, Film, RenderOptions};
 use formation::progress::Silent;
 use formation::Animation;
 
-fn tmpdir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("formation-export-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+mod support;
+
+use support::scratch;
 
 /// A short synthetic flock: 14 birds converging into a V, then cruising.
 fn flock(seconds: f64, fps: f64) -> Animation {
@@ -37,7 +34,7 @@ fn small() -> RenderOptions {
 #[test]
 fn every_output_opens_in_an_independent_reader() {
     let anim = flock(3.0, 20.0);
-    let d = tmpdir("all");
+    let d = scratch("all");
     let outs: Vec<PathBuf> = ["a.gif", "frames/", "a.glb", "a.csv", "a.json"]
         .iter()
         .map(|n| d.join(n))
@@ -147,7 +144,7 @@ fn every_output_opens_in_an_independent_reader() {
 
 #[test]
 fn equal_inputs_give_byte_identical_outputs_whatever_the_thread_count() {
-    let d = tmpdir("det");
+    let d = scratch("det");
     let names = ["a.gif", "a.glb", "a.csv", "a.json"];
     for (run, threads) in [(0, 1), (1, 3)] {
         let anim = flock(2.0, 20.0);
@@ -226,7 +223,7 @@ fn the_drawn_birds_are_inside_the_picture_and_dark_against_the_sky() {
 
 #[test]
 fn bad_outputs_are_rejected_before_any_work() {
-    let d = tmpdir("bad");
+    let d = scratch("bad");
     let anim = flock(1.0, 10.0);
     let good = d.join("ok.csv");
     for bad in [
@@ -300,7 +297,7 @@ fn regenerate_fixture() {
         ..SyntheticParams::default()
     };
     let anim = synthetic_flock(&mut formation::rng::seeded(1), &p);
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/flock_small.json");
+    let path = support::data("flock_small.json");
     formation::io::write_json_atomic(&path, &anim).unwrap();
 }
 
@@ -344,7 +341,7 @@ fn gif_frames_decode_to_the_drawn_pictures_within_the_tolerance() {
     // or within the tolerance of its true colour. With tolerance 0 it is exactly the former.
     let anim = flock(2.0, 20.0);
     for tol in [0.0, 10.0] {
-        let d = tmpdir(&format!("exact{tol}"));
+        let d = scratch(&format!("exact{tol}"));
         let gif = d.join("a.gif");
         let opts = RenderOptions {
             gif_tolerance: tol,

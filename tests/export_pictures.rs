@@ -3,55 +3,21 @@
 //! checked by ffprobe, and the one-line refusals of bad camera, background, view and video
 //! requests.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::path::Path;
+use std::process::Command;
 
 use formation::export::{Background, CameraKind, Film, RenderOptions};
 use formation::Animation;
+
+mod support;
+
+use support::{assert_usage_error, bin, run as formation, s, scratch as tmpdir};
 
 const GEESE: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
     "/examples_data/barnacle_geese_v.json"
 );
 const FIXTURE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/flock_small.json");
-
-fn formation(args: &[&str]) -> Output {
-    formation_env(args, &[])
-}
-
-fn formation_env(args: &[&str], env: &[(&str, &str)]) -> Output {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_formation"));
-    c.args(args);
-    for (k, v) in env {
-        c.env(k, v);
-    }
-    c.output().expect("run formation")
-}
-
-fn tmpdir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("formation-pic-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
-
-/// Exit 2, exactly one line on stderr containing every `needle`.
-fn assert_usage_error(out: &Output, needles: &[&str]) {
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "stderr: {err}");
-    assert_eq!(
-        err.trim_end().lines().count(),
-        1,
-        "one line expected: {err}"
-    );
-    for n in needles {
-        assert!(err.contains(n), "{err:?} should mention {n:?}");
-    }
-}
 
 /// A real animation (extraction, steady flight, take-off) of `birds` geese.
 fn animate(birds: usize, d: &Path) -> Animation {
@@ -267,10 +233,11 @@ fn bad_camera_background_view_and_video_requests_exit_2_with_one_line() {
     assert_usage_error(&out, &["--min-bird-px"]);
     // Video without ffmpeg: how to install it, and no file.
     let mp4 = d.join("a.mp4");
-    let out = formation_env(
-        &["render", FIXTURE, "-o", s(&mp4)],
-        &[("FORMATION_FFMPEG", "/nonexistent/ffmpeg")],
-    );
+    let out = bin()
+        .args(["render", FIXTURE, "-o", s(&mp4)])
+        .env("FORMATION_FFMPEG", "/nonexistent/ffmpeg")
+        .output()
+        .unwrap();
     assert_usage_error(&out, &["a.mp4", "apt-get install ffmpeg"]);
     assert!(!mp4.exists() && !gif.exists());
     let out = formation(&["render", FIXTURE, "-o", s(&mp4), "--size", "321x180"]);

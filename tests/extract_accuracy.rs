@@ -12,6 +12,10 @@ use formation::annotations::{read, Heading, ReadOptions, YOrigin};
 use formation::extract::{extract, ExtractOptions, FormationParams, ShapeKind};
 use formation::rng::stream;
 
+mod support;
+
+use support::scratch;
+
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Fmt {
     NativeNoIds,
@@ -30,16 +34,6 @@ const FORMATS: [Fmt; 6] = [
     Fmt::Dltdv,
     Fmt::LabelmeDir,
 ];
-
-fn tmpdir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!(
-        "formation-extract-acc-{}-{name}",
-        std::process::id()
-    ));
-    let _ = fs::remove_dir_all(&d);
-    fs::create_dir_all(&d).unwrap();
-    d
-}
 
 /// Writes the flock in `fmt` under `dir`; returns the path to read and the read options a user
 /// would give for a format that cannot carry heading or scale.
@@ -184,7 +178,7 @@ fn run_kind(kind: ShapeKind) -> Vec<(Fmt, Tally)> {
             let spec = spec(kind, sc);
             let mut rng = stream(sc as u64 * 31 + kind as u64, "flock");
             let flock = generate(&spec, &mut rng);
-            let dir = tmpdir(&format!("{}-{fi}-{i}", kind.name()));
+            let dir = scratch(&format!("{}-{fi}-{i}", kind.name()));
             let (path, opts) = write(&flock, fmt, &dir, sc as u64);
             let ann = read(&path, &opts).unwrap_or_else(|e| panic!("{fmt:?} {spec:?}: {e}"));
             let mut rng = stream(7, "extract");
@@ -264,7 +258,7 @@ fn dltdv_with_a_nan_bird_reads_the_others() {
         ..SynthSpec::default()
     };
     let flock = generate(&spec, &mut stream(1, "nan"));
-    let dir = tmpdir("nan");
+    let dir = scratch("nan");
     let p = dir.join("dlt.csv");
     fs::write(&p, flock.dltdv_csv(1080.0, &[(2, 4), (3, 4)])).unwrap();
     let opts = ReadOptions {
@@ -304,7 +298,7 @@ fn ids_are_recovered_when_birds_are_shuffled_and_one_is_missing() {
     let mut flock = generate(&spec, &mut stream(3, "ids"));
     // Bird 5 is not marked in frame 4.
     flock.frames[4].birds.retain(|b| b.id != 5);
-    let dir = tmpdir("ids");
+    let dir = scratch("ids");
     let p = dir.join("a.json");
     fs::write(&p, flock.native_json("t", false, &mut stream(3, "shuffle"))).unwrap();
     let ann = read(&p, &ReadOptions::default()).unwrap();
@@ -331,7 +325,7 @@ fn same_seed_same_params_and_exhaustive_fits_do_not_depend_on_it() {
         ..SynthSpec::default()
     };
     let flock = generate(&spec, &mut stream(5, "seed"));
-    let dir = tmpdir("seed");
+    let dir = scratch("seed");
     let p = dir.join("a.json");
     fs::write(&p, flock.native_json("t", true, &mut stream(5, "w"))).unwrap();
     let ann = read(&p, &ReadOptions::default()).unwrap();
@@ -368,7 +362,7 @@ fn params_do_not_depend_on_heading_or_scale() {
         outliers: 2,
         ..SynthSpec::default()
     };
-    let dir = tmpdir("invariance");
+    let dir = scratch("invariance");
     let mut results = Vec::new();
     for (heading, scale) in [(0.0, 40.0), (123.0, 17.0), (270.0, 95.0)] {
         let spec = SynthSpec {

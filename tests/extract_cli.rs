@@ -5,7 +5,7 @@
 
 mod support;
 
-use support::{examples_dir as examples, run, scratch as tmpdir};
+use support::{assert_usage_error_in, examples_dir as examples, run, scratch as tmpdir};
 
 use std::fs;
 use std::path::Path;
@@ -25,21 +25,10 @@ fn bad(name: &str, content: &str, extra: &[&str], needles: &[&str]) {
     ];
     args.extend_from_slice(extra);
     let o = run(&args);
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{name}: exit code; stderr: {err}");
-    assert_eq!(
-        err.trim_end().lines().count(),
-        1,
-        "{name}: one line, got: {err}"
-    );
-    assert!(err.contains(name), "{name}: message names the file: {err}");
-    for n in needles {
-        assert!(
-            err.contains(n),
-            "{name}: message should contain `{n}`: {err}"
-        );
-    }
-    assert!(!err.contains("panicked"), "{name}: {err}");
+    // The message names the file, and says what is wrong with it.
+    let mut all = vec![name];
+    all.extend_from_slice(needles);
+    assert_usage_error_in(name, &o, &all);
     assert!(!out.exists(), "{name}: no output after a failure");
     // Only the input is left: no temporary files either.
     assert_eq!(
@@ -208,10 +197,11 @@ fn labelme_directory_without_points() {
         "--wingspan-px",
         "20",
     ]);
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{err}");
-    assert_eq!(err.trim_end().lines().count(), 1);
-    assert!(err.contains("frames") && err.contains("point"), "{err}");
+    assert_usage_error_in(
+        "a labelme directory without points",
+        &o,
+        &["frames", "point"],
+    );
     assert!(!out.exists());
     // And an empty directory.
     let empty = dir.join("none");

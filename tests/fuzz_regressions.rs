@@ -2,8 +2,6 @@
 //! kept as regression tests. Each runs the same code as its fuzz target and must end in a clean
 //! error (or success), quickly and without a large allocation.
 
-use std::path::Path;
-
 use formation::export::{sample, write_outputs, RenderOptions};
 use formation::extract::params::FormationParams;
 use formation::keyshape::{steady_flight, KeyOptions, SteadyOptions};
@@ -11,10 +9,11 @@ use formation::progress::Silent;
 use formation::rng::stream;
 use formation::Animation;
 
+mod support;
+
+/// A fuzz finding of `tests/data/fuzz/`.
 fn data(name: &str) -> std::path::PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/data/fuzz")
-        .join(name)
+    support::data("fuzz").join(name)
 }
 
 /// The `params` target's steady flight: 6 birds, 4 frames, a key shape every 0.05 s.
@@ -59,8 +58,7 @@ fn an_animation_lasting_years_is_refused_without_allocating() {
     let a = Animation::read(&path).unwrap();
     sample::check_times(&a, &path).unwrap();
     assert!(sample::output_count(&a, 25.0) > 1_000_000_000);
-    let dir = std::env::temp_dir().join(format!("formation-fuzz-reg-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = support::scratch("fuzz-years");
     let e = write_outputs(
         &a,
         &[dir.join("a.gif"), dir.join("frames/")],
@@ -72,4 +70,78 @@ fn an_animation_lasting_years_is_refused_without_allocating() {
     assert!(e.to_string().contains("frames at"), "{e}");
     assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 0);
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The small steady flight of the `path` target: 5 birds, 2 s at 10 fps, a key every second.
+fn path_flight() -> Animation {
+    let p: FormationParams = formation::io::parse_json(
+        &support::data("steady_v9_params.json"),
+        &std::fs::read_to_string(support::data("steady_v9_params.json")).unwrap(),
+    )
+    .unwrap();
+    let opts = SteadyOptions {
+        birds: 5,
+        frames: 20,
+        fps: 10.0,
+        keys: KeyOptions {
+            key_every_s: 1.0,
+            ..KeyOptions::default()
+        },
+        ..SteadyOptions::default()
+    };
+    steady_flight(&p, &opts, &mut stream(0, "steady"), &Silent).unwrap()
+}
+
+/// An open path that turns back onto its own leg 28 000 wingspans long (`[30000, 0, 10]` then
+/// back to the start): widening smoothed it for all 400 rounds, 13 s in the fuzzer's build (4 s
+/// in release; a 49 000-wingspan leg at `--speed 1` took 35 s). The smoothing's work is bounded
+/// now; the path still flies, with the widening warning.
+#[test]
+fn a_path_turning_back_onto_a_long_leg_is_widened_in_bounded_time() {
+    use formation::course::file;
+    let path = data("path-slow-232ab045.json");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let points = file::parse_str(&path, &text, None, 1.5).unwrap();
+    let mut anim = path_flight();
+    let mut config = formation::pipeline::Config::default();
+    config.course.path = Some(path.clone());
+    let start = std::time::Instant::now();
+    let report = formation::pipeline::course_stage(&mut anim, Some(&points), &config).unwrap();
+    assert!(!report.widened.is_empty());
+    assert!(start.elapsed() < std::time::Duration::from_secs(10));
+}
+
+/// A closed path shaped as a thin spike (`(0,0) → (11,0) → (10,13) → (0,500) → (0,0)`, CRLF and a
+/// form feed from the fuzzer): long enough around for the flock's turns, but widening it shrank
+/// it towards nothing, and the stretch smoothed around each tight sample grew without bound (a
+/// hang in `course::spline::widen`). Now the collapse is detected and the path refused.
+#[test]
+fn a_closed_spike_path_is_refused_not_widened_forever() {
+    use formation::course::file;
+    let path = data("path-timeout-f1861c65.csv");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let points = file::parse_str(&path, &text, None, 1.5).unwrap();
+    assert!(points.closed);
+    let mut anim = path_flight();
+    let mut config = formation::pipeline::Config::default();
+    config.course.path = Some(path.clone());
+    let start = std::time::Instant::now();
+    let e = formation::pipeline::course_stage(&mut anim, Some(&points), &config).unwrap_err();
+    assert_eq!(e.exit_code(), 2);
+    assert!(e.to_string().contains("cannot be widened"), "{e}");
+    assert!(start.elapsed() < std::time::Duration::from_secs(10));
+}
+
+/// A bird model (a formation `.glb` with bytes changed by the fuzzer) whose inverse bind matrix
+/// of `body` is singular: its inverse was NaN, so the `.glb` export failed with "internal error"
+/// (exit 1) and the `.usda` text held NaN. Now the model is refused naming the joint.
+#[test]
+fn a_bird_model_with_a_singular_bind_matrix_is_refused() {
+    let path = data("bird_model-nan-5da5f56a.glb");
+    let bytes = std::fs::read(&path).unwrap();
+    let e =
+        formation::export::bird_model::parse(&path, &bytes, formation::wingbeat::Species::Goose)
+            .unwrap_err();
+    assert_eq!(e.exit_code(), 2);
+    assert!(e.to_string().contains("cannot be inverted"), "{e}");
 }

@@ -17,7 +17,7 @@ mod support;
 
 use std::collections::BTreeMap;
 
-use support::{bin, example_arg, s, scratch, sha256_hex};
+use support::{bin, example_arg, repo_file, s, scratch, sha256_hex};
 
 const DIGESTS: &str = "tests/data/golden.sha256";
 
@@ -115,7 +115,7 @@ fn leak(s: String) -> &'static str {
 }
 
 fn recorded() -> BTreeMap<String, String> {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(DIGESTS);
+    let path = repo_file(DIGESTS);
     let text = std::fs::read_to_string(&path).unwrap_or_default();
     text.lines()
         .filter(|l| !l.trim().is_empty() && !l.starts_with('#'))
@@ -153,7 +153,7 @@ fn outputs_match_the_recorded_digests() {
         for (name, hash) in &got {
             text.push_str(&format!("{hash}  {name}\n"));
         }
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(DIGESTS);
+        let path = repo_file(DIGESTS);
         std::fs::write(path, text).unwrap();
         return;
     }

@@ -1,40 +1,17 @@
 //! `formation initiate` and `formation plot paths` through the binary: outputs, exit codes,
 //! one-line messages, nothing written on failure, byte-identical reruns.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+mod support;
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_formation"))
-}
-
-fn data(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/data")
-        .join(name)
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("formation-initiate-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
-}
-
-/// Runs the binary; returns exit code and stderr.
-fn run(args: &[&str]) -> (i32, String) {
-    let out = bin().args(args).output().unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+use support::{assert_usage_error_in, data, run, run_full, scratch};
 
 #[test]
 fn initiate_writes_an_animation_and_the_paths_chart() {
+    let dir = scratch("initiate-writes");
     let steady = data("initiate_steady_v9.json");
-    let out = tmp("init9.json");
-    let csv = tmp("init9.csv");
-    let (code, err) = run(&[
+    let out = dir.join("init9.json");
+    let csv = dir.join("init9.csv");
+    let (code, _, err) = run_full(&[
         "initiate",
         steady.to_str().unwrap(),
         "-o",
@@ -52,8 +29,8 @@ fn initiate_writes_an_animation_and_the_paths_chart() {
     // SPEC §4.4's ten columns first, then the analysis columns (docs/formats.md).
     assert!(text.starts_with("frame,t,bird,x,y,z,heading,speed,e,xi,stage,"));
     assert_eq!(text.lines().count(), 1 + a.frames.len() * a.birds);
-    let png = tmp("paths.png");
-    let (code, err) = run(&[
+    let png = dir.join("paths.png");
+    let (code, _, err) = run_full(&[
         "plot",
         "paths",
         out.to_str().unwrap(),
@@ -67,10 +44,15 @@ fn initiate_writes_an_animation_and_the_paths_chart() {
 
 #[test]
 fn same_seed_gives_byte_identical_files() {
+    let dir = scratch("initiate-same-seed");
     let steady = data("initiate_steady_v9.json");
-    let (a, b, c) = (tmp("s1.json"), tmp("s2.json"), tmp("s3.json"));
+    let (a, b, c) = (
+        dir.join("s1.json"),
+        dir.join("s2.json"),
+        dir.join("s3.json"),
+    );
     for (p, seed) in [(&a, "4"), (&b, "4"), (&c, "5")] {
-        let (code, err) = run(&[
+        let (code, _, err) = run_full(&[
             "initiate",
             steady.to_str().unwrap(),
             "-o",
@@ -87,9 +69,10 @@ fn same_seed_gives_byte_identical_files() {
 #[test]
 fn bad_input_is_exit_2_with_one_line() {
     let steady = data("initiate_steady_v9.json");
+    let dir = scratch("initiate-bad-input");
     let s = steady.to_str().unwrap();
     let no_ks = data("initiate_steady_no_keyshape.json");
-    let out = tmp("bad.json");
+    let out = dir.join("bad.json");
     let o = out.to_str().unwrap();
     let cases: Vec<(Vec<&str>, &str)> = vec![
         (
@@ -189,20 +172,18 @@ fn bad_input_is_exit_2_with_one_line() {
         ),
     ];
     for (args, needle) in cases {
-        let (code, err) = run(&args);
-        assert_eq!(code, 2, "{args:?}: {err}");
-        assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
-        assert!(err.contains(needle), "{args:?}: {err}");
+        assert_usage_error_in(&format!("{args:?}"), &run(&args), &[needle]);
         assert!(!out.exists(), "{args:?} wrote a file");
     }
 }
 
 #[test]
 fn no_convergence_is_exit_1_and_writes_nothing() {
+    let dir = scratch("initiate-no-convergence");
     let steady = data("initiate_steady_v9.json");
-    let out = tmp("nc.json");
+    let out = dir.join("nc.json");
     std::fs::write(&out, b"previous").unwrap();
-    let (code, err) = run(&[
+    let (code, _, err) = run_full(&[
         "initiate",
         steady.to_str().unwrap(),
         "-o",
@@ -214,8 +195,8 @@ fn no_convergence_is_exit_1_and_writes_nothing() {
     assert_eq!(err.trim_end().lines().count(), 1, "{err}");
     assert!(err.contains("did not converge"), "{err}");
     assert_eq!(std::fs::read(&out).unwrap(), b"previous");
-    let fresh = tmp("nc-fresh.json");
-    let (code, _) = run(&[
+    let fresh = dir.join("nc-fresh.json");
+    let (code, _, _) = run_full(&[
         "initiate",
         steady.to_str().unwrap(),
         "-o",

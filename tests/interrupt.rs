@@ -13,6 +13,10 @@ use std::time::{Duration, Instant};
 
 use formation::Animation;
 
+mod support;
+
+use support::{bin, data, scratch};
+
 const PREVIOUS: &[u8] = b"previous output: an interrupted run must leave this byte-identical\n";
 
 /// A render slow enough to be interrupted, up to its `-o`.
@@ -26,16 +30,9 @@ const SLOW_RENDER: [&str; 7] = [
     "-o",
 ];
 
-fn workdir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("formation-interrupt-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
 /// A long animation: `tests/data/flock_small.json` (50 frames, 1.6 s) slowed down 40 times.
 fn long_animation(dir: &Path) -> PathBuf {
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/flock_small.json");
+    let src = data("flock_small.json");
     let mut a = Animation::read(&src).unwrap();
     for f in &mut a.frames {
         f.t *= 40.0;
@@ -85,7 +82,7 @@ fn interrupt(signal: &str, name: &str, output: &str) {
 
 /// [`interrupt`] for any catchable signal, with its expected exit code and message.
 fn interrupt_with(signal: &str, name: &str, output: &str, code: i32, message: &str) {
-    let dir = workdir(name);
+    let dir = scratch(name);
     let anim = long_animation(&dir);
     // Existing outputs that must survive: the file itself, or a frames directory of ours.
     if output.ends_with('/') {
@@ -96,7 +93,7 @@ fn interrupt_with(signal: &str, name: &str, output: &str, code: i32, message: &s
         std::fs::write(dir.join(output), PREVIOUS).unwrap();
     }
     let before = snapshot(&dir);
-    let mut child = Command::new(env!("CARGO_BIN_EXE_formation"))
+    let mut child = bin()
         .args(SLOW_RENDER)
         .arg(dir.join(output))
         .arg("-o")
@@ -186,9 +183,9 @@ fn other_catchable_signals_clean_up_too() {
 /// directory recognises it as a dead run's and removes it.
 #[test]
 fn a_killed_runs_temporary_is_removed_by_the_next_run() {
-    let dir = workdir("kill");
+    let dir = scratch("kill");
     let anim = long_animation(&dir);
-    let mut child = Command::new(env!("CARGO_BIN_EXE_formation"))
+    let mut child = bin()
         .args(SLOW_RENDER)
         .arg(dir.join("flock.gif"))
         .arg(&anim)
@@ -205,8 +202,8 @@ fn a_killed_runs_temporary_is_removed_by_the_next_run() {
     child.kill().unwrap();
     child.wait().unwrap();
     assert!(has_temporary(&dir), "SIGKILL should leave the temporary");
-    let small = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/flock_small.json");
-    let ok = Command::new(env!("CARGO_BIN_EXE_formation"))
+    let small = data("flock_small.json");
+    let ok = bin()
         .args(["render", "--quiet", "-o"])
         .arg(dir.join("small.csv"))
         .arg(&small)
@@ -227,7 +224,7 @@ fn a_killed_runs_temporary_is_removed_by_the_next_run() {
 /// file stays byte-identical and no temporary is left.
 #[test]
 fn failed_write_leaves_no_temporary_and_keeps_the_target() {
-    let dir = workdir("failed");
+    let dir = scratch("failed");
     let target = dir.join("out.json");
     std::fs::write(&target, PREVIOUS).unwrap();
     #[derive(serde::Serialize)]

@@ -469,8 +469,7 @@ fn bad_paths_are_refused_with_the_file_and_the_point() {
     std::fs::write(&ok, r#"{"points": [[0, 0, 5], [0, 10, 5]]}"#).unwrap();
     let flags = ["--frames", "200", "--path", s(&ok), "--path-units", "feet"];
     let out = steady(&flags, &dir.join("x.json"));
-    assert_eq!(out.status.code(), Some(2));
-    assert!(support::stderr(&out).contains("unknown units"));
+    assert_usage_error(&out, &["unknown units"]);
     // A loop shorter than one key interval.
     let out = steady(&["--frames", "60", "--loop"], &dir.join("y.json"));
     assert_usage_error(

@@ -4,7 +4,7 @@
 //! and every number in every output file must be finite (no `null` smuggled into JSON, no
 //! `NaN`/`inf` in CSV). Few small cases, so that it takes seconds under `cargo test --release`.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use formation::annotations::synth::{generate, SynthSpec};
 use formation::annotations::{parse_str, ReadOptions};
@@ -16,15 +16,9 @@ use formation::rng::seeded;
 use formation::{Animation, Error};
 use proptest::prelude::*;
 
-fn workdir(case: u64) -> PathBuf {
-    let d = std::env::temp_dir().join(format!(
-        "formation-pipeline-props-{}-{case}",
-        std::process::id()
-    ));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+mod support;
+
+use support::scratch;
 
 /// Every number of a JSON document is finite and nothing is `null` (serde_json writes a
 /// non-finite `f64` as `null`).
@@ -149,7 +143,7 @@ proptest! {
         let flock = generate(&spec, &mut seeded(seed));
         let text = flock.native_json("property test", seed % 2 == 0, &mut seeded(seed ^ 1));
         let ann = parse_str(Path::new("movie.json"), &text, &ReadOptions::default()).unwrap();
-        let dir = workdir(seed);
+        let dir = scratch(&format!("pipeline-props-{seed}"));
 
         // The stages one by one, as `formation animate` runs them (each stage's result is
         // checked on its own).

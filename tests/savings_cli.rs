@@ -2,17 +2,16 @@
 //! as numbers in every frame of the JSON animation and every row of the CSV, the take-off
 //! included.
 
-use std::path::Path;
-use std::process::Command;
+mod support;
+
+use support::{bin, example, scratch};
 
 #[test]
 fn every_frame_and_csv_row_carries_numeric_e_and_xi() {
-    let dir = std::env::temp_dir().join(format!("formation-savings-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    let input = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples_data/barnacle_geese_v.json");
+    let dir = scratch("savings");
+    let input = example("barnacle_geese_v.json");
     let (csv, json) = (dir.join("flock.csv"), dir.join("flock.json"));
-    let out = Command::new(env!("CARGO_BIN_EXE_formation"))
+    let out = bin()
         .args([
             "animate",
             input.to_str().unwrap(),

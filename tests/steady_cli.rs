@@ -3,20 +3,15 @@
 
 mod support;
 
-use support::{assert_usage_error, data, run};
+use support::{assert_usage_error, data, example, run, scratch};
 
-use std::path::{Path, PathBuf};
-
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("formation-steady-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d.join(name)
-}
+use std::path::Path;
 
 #[test]
 fn writes_json_and_csv_and_plots() {
+    let dir = scratch("writes_json_and_csv_and_plots");
     let params = data("steady_v9_params.json");
-    let (json, csv) = (tmp("a.json"), tmp("a.csv"));
+    let (json, csv) = (dir.join("a.json"), dir.join("a.csv"));
     let out = run(&[
         "steady",
         params.to_str().unwrap(),
@@ -53,8 +48,8 @@ fn writes_json_and_csv_and_plots() {
     assert_eq!(lines.count(), 90 * 14);
 
     // Same seed, same bytes; another seed, other bytes.
-    let json2 = tmp("b.json");
-    let json3 = tmp("c.json");
+    let json2 = dir.join("b.json");
+    let json3 = dir.join("c.json");
     for (p, seed) in [(&json2, "0"), (&json3, "5")] {
         let out = run(&[
             "steady",
@@ -83,7 +78,7 @@ fn writes_json_and_csv_and_plots() {
     );
 
     // Charts.
-    let png = tmp("power.png");
+    let png = dir.join("power.png");
     let out = run(&[
         "plot",
         "power",
@@ -99,7 +94,7 @@ fn writes_json_and_csv_and_plots() {
         String::from_utf8_lossy(&out.stderr)
     );
     assert!(std::fs::read(&png).unwrap().starts_with(b"\x89PNG"));
-    let svg = tmp("power.svg");
+    let svg = dir.join("power.svg");
     let out = run(&[
         "plot",
         "power",
@@ -116,7 +111,7 @@ fn writes_json_and_csv_and_plots() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let xi = tmp("xi.png");
+    let xi = dir.join("xi.png");
     let out = run(&[
         "plot",
         "xi",
@@ -145,9 +140,10 @@ fn writes_json_and_csv_and_plots() {
 
 #[test]
 fn bad_input_is_one_line_exit_2_and_leaves_no_file() {
+    let dir = scratch("bad_input_is_one_line_exit_2_and_leaves_no_file");
     let params = data("steady_v9_params.json");
     let p = params.to_str().unwrap();
-    let o = tmp("bad.json");
+    let o = dir.join("bad.json");
     let os = o.to_str().unwrap();
     let cases: &[(&[&str], &str)] = &[
         (&["--birds", "0", "--frames", "10"], "--birds"),
@@ -187,14 +183,14 @@ fn bad_input_is_one_line_exit_2_and_leaves_no_file() {
         assert!(!o.exists());
     }
     // A params file of the wrong format: an animation, a shape, broken JSON, a missing file.
-    let shape = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples_data/v9_shape.json");
-    let broken = tmp("broken.json");
+    let shape = example("v9_shape.json");
+    let broken = dir.join("broken.json");
     std::fs::write(
         &broken,
         "{\"format\": \"formation-params/1\", \"frames\": [",
     )
     .unwrap();
-    let wrong = tmp("wrong.json");
+    let wrong = dir.join("wrong.json");
     std::fs::write(&wrong, "{\"format\": \"formation-animation/1\"}").unwrap();
     for (f, needle) in [
         (shape.as_path(), "v9_shape.json"),
@@ -223,7 +219,7 @@ fn bad_input_is_one_line_exit_2_and_leaves_no_file() {
         "--frames",
         "10",
         "-o",
-        tmp("x.txt").to_str().unwrap(),
+        dir.join("x.txt").to_str().unwrap(),
     ]);
     assert_usage_error(&out, &["-o"]);
 }

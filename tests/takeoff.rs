@@ -498,9 +498,10 @@ fn takeoff_8_and_20_seconds_are_met_and_the_default_is_short() {
 /// Issue 18: ground take-offs into a V at real spacing (0.7 wingspans across, wingtips
 /// overlapping) converge in at least 99 % of 100 seeds for 9, 14, 41 and 100 birds and in all of
 /// 10 seeds for 300, within the issue's durations (median ≤ 12 s for 9–14, ≤ 30 s for 100, every
-/// 300-bird run ≤ 45 s), no bird straying more than 30 wingspans (up to 100 birds), closest
-/// approach ≥ 0.3 wingspans (3-D) up to 41 birds. Measured (docs/initiation.md): 100/100 each;
-/// closest 0.31/0.31/0.31/0.17, 300 birds 0.29; strays 14/16/21/30, 300 birds 49.
+/// 300-bird run ≤ 45 s), no bird straying more than 30 wingspans beyond the formed flock, closest
+/// approach ≥ 0.3 wingspans (3-D) in every decision and written frame. Measured
+/// (docs/initiation.md): 100/100 each, 10/10; closest 0.417/0.382/0.393/0.375, 300 birds 0.320;
+/// strays 11.0/11.6/14.3/20.9, 300 birds 28.9.
 #[test]
 fn convergence_over_seeds_and_flock_sizes() {
     let opts = InitiateOptions::default();
@@ -534,17 +535,93 @@ fn convergence_over_seeds_and_flock_sizes() {
         if n == 300 {
             assert!(secs.iter().all(|&s| s <= 45.0), "300 birds: {secs:?}");
         }
-        // The issue's 0.3 wingspans holds up to 41 birds; 100 birds came 0.17 close in one of 100
-        // seeds and 300 birds 0.29 (open in issue 18, docs/initiation.md).
-        let floor = if n <= 41 { 0.3 } else { 0.15 };
-        assert!(closest >= floor, "{n} birds: closest approach {closest:.3}");
-        // Strays: at most 30 wingspans up to 100 birds; 300 birds reach 49 (open).
-        let stray_max = if n <= 100 { 31.0 } else { 55.0 };
+        assert!(closest >= 0.3, "{n} birds: closest approach {closest:.3}");
         assert!(
-            stray <= stray_max,
+            stray <= 30.0,
             "{n} birds: a bird strayed {stray:.1} wingspans"
         );
     }
+}
+
+/// The paper's airborne start (`--start air`: scattered, any heading) converges in at least 99 %
+/// of the runs for 9, 14, 41 and 100 birds (100 seeds) and 300 birds (10 seeds). Strays and the
+/// closest approach of the air start are not yet within issue 18's 30 and 0.3 wingspans
+/// (docs/initiation.md, Limitations): they are reported, not asserted.
+#[test]
+fn air_start_converges_over_seeds_and_flock_sizes() {
+    let opts = InitiateOptions {
+        start: Start::Random(Default::default()),
+        ..Default::default()
+    };
+    let (many, few) = if cfg!(debug_assertions) {
+        (2, 1)
+    } else {
+        (100, 10)
+    };
+    for (n, seeds) in [
+        (9usize, many),
+        (14, many),
+        (41, many),
+        (100, many),
+        (300, few),
+    ] {
+        let mut ok = 0u64;
+        for seed in 0..seeds {
+            let s = run_stats_shape(n, 0.7, 0.35, seed, &opts);
+            assert!(s.max_turn_accel <= opts.max_turn_accel * (1.0 + 1e-9));
+            assert!(s.max_accel <= opts.max_accel * (1.0 + 1e-9));
+            ok += u64::from(s.converged);
+        }
+        assert!(
+            ok * 100 >= 99 * seeds,
+            "{n} birds from the air: {ok}/{seeds} converged"
+        );
+    }
+}
+
+/// `--takeoff 8` is met within 25 % up to 41 birds at real spacing (median of 11 seeds); for 100
+/// birds, which cannot take off that fast, the take-off plan warns with the shortest duration it
+/// can reach, and that duration is what the take-off lasts (within 25 %).
+#[test]
+fn takeoff_8_for_larger_flocks_is_met_or_warned_about() {
+    let seeds = if cfg!(debug_assertions) { 1 } else { 11 };
+    for n in [41usize, 100] {
+        let opts = InitiateOptions {
+            takeoff: Some(8.0),
+            ..Default::default()
+        };
+        let mut secs: Vec<f64> = (0..seeds)
+            .map(|seed| {
+                let s = run_stats_shape(n, 0.7, 0.35, seed, &opts);
+                assert!(s.converged, "{n} birds, seed {seed}");
+                s.seconds
+            })
+            .collect();
+        secs.sort_by(f64::total_cmp);
+        let med = secs[secs.len() / 2];
+        let warning = initiate::TakeoffPlan::warning(n, &opts);
+        if n <= 41 {
+            assert!(warning.is_none(), "{warning:?}");
+            assert!((med - 8.0).abs() <= 2.0, "{n} birds: median {med:.1} s");
+        } else {
+            let w = warning.expect("100 birds cannot take off in 8 s: a warning");
+            let shortest = initiate::TakeoffPlan::shortest_seconds(n);
+            assert!(
+                w.contains("initiate.takeoff") && w.contains(&format!("{shortest:.0} s")),
+                "{w}"
+            );
+            assert!(
+                (med - shortest).abs() <= 0.25 * shortest,
+                "{n} birds: median {med:.1} s, warned {shortest:.1}"
+            );
+        }
+    }
+    // Within reach: no warning.
+    let opts = InitiateOptions {
+        takeoff: Some(10.0),
+        ..Default::default()
+    };
+    assert!(initiate::TakeoffPlan::warning(14, &opts).is_none());
 }
 
 #[test]
@@ -604,5 +681,121 @@ fn closest() {
             }
         }
         println!("seed {seed}: {:.3} at {:.2} s: {}", best.0, best.1, best.2);
+    }
+}
+
+/// Two birds of one take-off in the formation frame (x right, y behind the leader, wingspans):
+/// `N=100 SEED=44 A=60 B=70 FROM=6 TO=10 cargo test --release --test takeoff pair -- --ignored
+/// --nocapture`.
+#[test]
+#[ignore]
+fn pair() {
+    let n = env_u("N").unwrap_or(100) as usize;
+    let seed = env_u("SEED").unwrap_or(44);
+    let (a, b) = (
+        env_u("A").unwrap_or(60) as usize,
+        env_u("B").unwrap_or(70) as usize,
+    );
+    let from = env_u("FROM").unwrap_or(0) as f64;
+    let to = env_u("TO").unwrap_or(20) as f64;
+    let mut opts = InitiateOptions::default();
+    if std::env::var("AIR").is_ok() {
+        opts.start = Start::Random(Default::default());
+    }
+    let (gap, back) = env_shape();
+    let t = shape_target(n, gap, back);
+    let (mut sim, _) =
+        initiate::start_simulation(&t, &Cruise::new(0.0, 10.0), &opts, &mut rng::seeded(seed))
+            .unwrap();
+    let mut next = from;
+    while sim.time < to {
+        sim.step();
+        if sim.time + 1e-9 < next {
+            continue;
+        }
+        next += 0.1;
+        let f = &sim.flock;
+        let l = f.pos[f.leader];
+        let sp = sim.slot_positions();
+        let row = |i: usize| {
+            let r = f.pos[i] - l;
+            let s = sp[f.slot[i].unwrap()] - l;
+            format!(
+                "{i}:{:?} x{:6.2} y{:6.2} sx{:6.2} sy{:6.2} z{:5.2} v{:5.2} h{:5.0} w{:5.0}",
+                f.phase[i],
+                r.x,
+                -r.y,
+                s.x,
+                -s.y,
+                f.z[i],
+                f.speed[i],
+                f.heading[i].to_degrees(),
+                f.turn_rate[i].to_degrees()
+            )
+        };
+        let d = ((f.pos[a] - f.pos[b]).length_squared() + (f.z[a] - f.z[b]).powi(2)).sqrt();
+        println!("t{:5.2} d{d:.2} | {} | {}", sim.time, row(a), row(b));
+    }
+}
+
+/// The bird farthest from every slot, each half second once all are airborne: `N=300 SEED=0
+/// cargo test --release --test takeoff strays -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn strays() {
+    let n = env_u("N").unwrap_or(300) as usize;
+    let seed = env_u("SEED").unwrap_or(0);
+    let mut opts = InitiateOptions::default();
+    if std::env::var("AIR").is_ok() {
+        opts.start = Start::Random(Default::default());
+    }
+    let (gap, back) = env_shape();
+    let t = shape_target(n, gap, back);
+    let (mut sim, plan) =
+        initiate::start_simulation(&t, &Cruise::new(0.0, 10.0), &opts, &mut rng::seeded(seed))
+            .unwrap();
+    println!("{plan:?}");
+    let f = &sim.flock;
+    let l0 = f.pos[f.leader];
+    println!("leader start x{:.1} y{:.1}", l0.x, l0.y);
+    let mut next = 0.0;
+    while sim.time < 30.0 {
+        sim.step();
+        if sim.time + 1e-9 < next {
+            continue;
+        }
+        next += 0.5;
+        let f = &sim.flock;
+        let l = f.pos[f.leader];
+        let sp = sim.slot_positions();
+        let (d, i) = (0..n)
+            .map(|i| {
+                let d = sp
+                    .iter()
+                    .map(|s| (*s - f.pos[i]).length())
+                    .fold(f64::INFINITY, f64::min);
+                (d, i)
+            })
+            .fold((0.0, 0), |a, b| if b.0 > a.0 { b } else { a });
+        let r = f.pos[i] - l;
+        let s = sp[f.slot[i].unwrap()] - l;
+        let start = f.pos[i] - l0;
+        println!(
+            "t{:5.2} air {} stray {d:5.1} bird {i} {:?} x{:6.1} y{:6.1} slot x{:6.1} y{:6.1} z{:4.1} v{:4.1} h{:4.0} depart {:.2} | lead v{:.1} y{:.1}",
+            sim.time,
+            sim.all_airborne(),
+            f.phase[i],
+            r.x,
+            -r.y,
+            s.x,
+            -s.y,
+            f.z[i],
+            f.speed[i],
+            f.heading[i].to_degrees(),
+            f.depart[i],
+            f.speed[f.leader],
+            (l - l0).y
+        );
+        let _ = start;
     }
 }

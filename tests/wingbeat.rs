@@ -4,7 +4,7 @@
 
 mod support;
 
-use support::bin;
+use support::{bin, scratch};
 
 use std::f64::consts::{PI, TAU};
 
@@ -437,8 +437,7 @@ fn options_parse_and_reject_unknown_names() {
 
 #[test]
 fn plot_wingbeat_writes_png_and_svg() {
-    let dir = std::env::temp_dir().join(format!("formation-wingbeat-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = scratch("plot-wingbeat");
     for (species, name) in [("goose", "g.png"), ("pelican", "p.svg")] {
         let out = dir.join(name);
         let st = bin()

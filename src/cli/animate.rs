@@ -84,26 +84,9 @@ pub fn run(args: AnimateArgs, g: Global) -> Result<()> {
     };
     // In the order the stages run: the steady flight's options are checked first.
     config.steady_options()?;
-    // Without the take-off its flags are still checked, but not its memory bound for the
-    // flock's size (10 000 birds of steady flight need no take-off frames). A flock of several
-    // formations takes off formation by formation: the take-off's length (and the --takeoff
-    // warning) is its largest formation's, when the flags say how large; the whole flock's
-    // memory bound is checked by `config.validate()` below.
-    let takeoff_birds = if args.no_initiation {
-        2
-    } else {
-        let sk = args.skein.options();
-        let k = match (sk.formations, sk.formation_size) {
-            (Some(k), _) => k,
-            (None, Some(m)) => formation::skein::formation_count(args.birds, m, None, Some(m)),
-            (None, None) => 1,
-        };
-        if k > 1 && 2 * k <= args.birds {
-            formation::skein::sizes::size_bounds(args.birds, k).1
-        } else {
-            args.birds
-        }
-    };
+    // The take-off's length (and the --takeoff warning) is its largest formation's; the whole
+    // flock's memory bound is checked by `config.validate()` below.
+    let takeoff_birds = config.takeoff_birds();
     config.initiate = args.initiate.options(g.seed, takeoff_birds)?;
     config.course = args.path.options();
     if args.no_initiation {
@@ -139,7 +122,7 @@ pub fn run(args: AnimateArgs, g: Global) -> Result<()> {
     super::write_animation(&anim, &args.output, &config.render, g)?;
     super::summary::animate(g, &anim, &report, &args.output);
     if let (Some(f), false) = (&report.skein, g.quiet) {
-        eprintln!("{}", super::steady::flock_summary(f));
+        super::stdout::diagnostic(&super::steady::flock_summary(f));
     }
     Ok(())
 }

@@ -59,26 +59,5 @@ pub fn course_config(
     formation::pipeline::Config,
     Option<formation::course::PathPoints>,
 )> {
-    let mut config = formation::pipeline::Config {
-        course: flags.options(),
-        ..formation::pipeline::Config::default()
-    };
-    config.steady.wingspan_m = steady.wingspan_m;
-    let leader = steady.leaders().first().copied().unwrap_or(0);
-    if let Some(f) = steady.frames.first() {
-        config.steady.speed = f.speed.get(leader).copied().unwrap_or(config.steady.speed);
-    }
-    if steady.path.is_some() && flags.path.is_some() {
-        return Err(formation::Error::format(
-            origin,
-            "path: this steady flight already follows a path; give initiate the steady flight written without --path, and the path here",
-        ));
-    }
-    let path = config.course.load(steady.wingspan_m)?;
-    if let Some(p) = &path {
-        let file = flags.path.clone().unwrap_or_default();
-        opts.cruise_altitude = formation::course::takeoff_altitude(p, &file)?;
-    }
-    config.initiate.cruise_altitude = opts.cruise_altitude;
-    Ok((config, path))
+    formation::pipeline::takeoff_course(flags.options(), steady, origin, opts)
 }

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 use formation::annotations::{self, Heading, ReadOptions, YOrigin};
-use formation::extract::{self, ExtractOptions, FormationParams, FrameReport, ShapeKind};
+use formation::extract::{ExtractOptions, FormationParams, FrameReport, ShapeKind};
 use formation::io::{write_json_atomic, OutputKind};
 use formation::pipeline::{extract_stage, Config};
 use formation::{Error, Result};
@@ -91,11 +91,29 @@ pub struct ExtractArgs {
     #[arg(long)]
     pub json: bool,
     #[command(flatten)]
+    pub extraction: ExtractionArgs,
+}
+
+/// Reading, fitting and the bird's size: every flag of §4 extraction (shared by `extract` and
+/// `report`).
+#[derive(Debug, Args, Clone)]
+pub struct ExtractionArgs {
+    #[command(flatten)]
     pub read: ReadArgs,
     #[command(flatten)]
     pub fit: FitArgs,
     #[command(flatten)]
     pub size: SizeArgs,
+}
+
+impl ExtractionArgs {
+    /// The extraction options for these flags.
+    pub fn options(&self) -> ExtractOptions {
+        ExtractOptions {
+            wingspan_m: self.size.wingspan_m,
+            ..self.fit.options()
+        }
+    }
 }
 
 /// Reads annotations and extracts, with the seed's `extract` stream. The warnings in the
@@ -136,14 +154,10 @@ pub fn run(args: ExtractArgs, g: Global) -> Result<()> {
     if let Some(o) = &args.output {
         OutputKind::from_path(o, &[OutputKind::Json])?;
     }
-    let extract = ExtractOptions {
-        wingspan_m: args.size.wingspan_m,
-        ..args.fit.options()
-    };
     let (ann, params, reports) = read_and_extract(
         &args.annotations,
-        &args.read,
-        extract,
+        &args.extraction.read,
+        args.extraction.options(),
         g,
         super::flags::Cmd::Extract,
     )?;
@@ -327,12 +341,8 @@ pub struct PlotShapeArgs {
 /// Runs `formation plot shape`.
 pub fn run_plot_shape(args: PlotShapeArgs, g: Global) -> Result<()> {
     OutputKind::from_path(&args.output, &[OutputKind::Png, OutputKind::Svg])?;
-    let is_params = !args.input.is_dir()
-        && formation::io::read_text(&args.input)
-            .map(|t| extract::is_params_file(&t))
-            .unwrap_or(false);
-    let (params, threshold) = if is_params {
-        (FormationParams::read(&args.input)?, None)
+    let (params, threshold) = if let Some(p) = FormationParams::read_if_params(&args.input)? {
+        (p, None)
     } else {
         let (_, p, _) = read_and_extract(
             &args.input,

@@ -49,29 +49,16 @@ const WINGBEAT: &[Cmd] = &[Steady, Initiate, Animate];
 const PICTURES: &[Cmd] = &[Render, Animate];
 const SCENE_COURSE: &[Cmd] = &[Steady, Initiate, Animate];
 const SCENE: &[Cmd] = &[Steady, Initiate, Animate, Render];
-const ALL: &[Cmd] = &[
-    Extract,
-    Power,
-    Solve,
-    Steady,
-    Initiate,
-    Animate,
-    Render,
-    PlotPower,
-    PlotXi,
-    PlotShape,
-    PlotPaths,
-    PlotWingbeat,
-    PlotSavings,
-    Report,
-];
+/// Every command: an empty list in [`FLAGS`].
+const EVERY: &[Cmd] = &[];
 
-/// (option path, flag, commands that have the flag). A path may appear several times with
+/// (option path, flag, commands that have the flag; [`EVERY`] for all). A path may appear several times with
 /// different flags for different commands (`steady.frames` is `--frames` of `steady` but
 /// `--seconds` of `animate`, which derives the frame count from the length).
 pub const FLAGS: &[(&str, &str, &[Cmd])] = &[
     // The output files (`export::write_outputs`' `outputs`, `io::OutputKind`).
-    ("output", "-o", ALL),
+    ("output", "-o", EVERY),
+    ("report", "--report", &[Steady]),
     ("read.heading", "--heading", READ),
     ("read.wingspan_px", "--wingspan-px", READ),
     ("read.y_origin", "--y-origin", READ),
@@ -167,6 +154,7 @@ pub const FLAGS: &[(&str, &str, &[Cmd])] = &[
     ("render.gif_tolerance", "--gif-tolerance", PICTURES),
     // Chart selections (`plot::power::PowerOf`, `plot::shape::ShapeChart::from_params`).
     ("plot.key", "--key", &[PlotPower]),
+    ("plot.key/plot.frame", "--key/--frame", &[PlotPower]),
     (
         "plot.formation",
         "--formation",
@@ -188,17 +176,22 @@ pub fn rewrite(cmd: Cmd, text: &str) -> String {
 pub fn rewrite_name(cmd: Cmd, name: &str) -> String {
     match FLAGS
         .iter()
-        .find(|(p, _, cmds)| *p == name && cmds.contains(&cmd))
+        .find(|(p, _, cmds)| *p == name && applies(cmds, cmd))
     {
         Some((_, f, _)) => f.to_string(),
         None => replace_paths(cmd, name, true),
     }
 }
 
+/// Whether a row of [`FLAGS`] for `cmds` is a flag of `cmd`.
+fn applies(cmds: &[Cmd], cmd: Cmd) -> bool {
+    cmds.is_empty() || cmds.contains(&cmd)
+}
+
 fn replace_paths(cmd: Cmd, text: &str, dotted_only: bool) -> String {
     let mut paths: Vec<(&str, &str)> = FLAGS
         .iter()
-        .filter(|(p, _, cmds)| cmds.contains(&cmd) && (!dotted_only || p.contains('.')))
+        .filter(|(p, _, cmds)| applies(cmds, cmd) && (!dotted_only || p.contains('.')))
         .map(|(p, f, _)| (*p, *f))
         .collect();
     paths.sort_by_key(|(p, _)| std::cmp::Reverse(p.len()));

@@ -80,8 +80,8 @@ pub struct InitiateFlags {
     #[arg(long, allow_negative_numbers = true, default_value_t = d().max_time)]
     pub max_seconds: f64,
     /// Take-off duration, seconds: the birds start closer or farther apart and drive harder or
-    /// softer to form in about this time (a range of about 0.7 to 2 times the flock's natural
-    /// one is reachable; outside it a warning) [default: the natural one, which grows with the
+    /// softer to form in about this time (down to about 7.8 + 0.042 N s for N birds and up to
+    /// about twice the natural one; outside that a warning with the duration it will have) [default: the natural one, which grows with the
     /// flock size; `--json` reports it as planned_seconds].
     #[arg(long, allow_negative_numbers = true)]
     pub takeoff: Option<f64>,
@@ -242,7 +242,7 @@ impl InitiateFlags {
         o.validate()?;
         initiate::check_size(birds, 0, o.max_steps)?;
         if let Some(w) = TakeoffPlan::warning(birds, &o) {
-            eprintln!("warning: {}", super::flags::rewrite(Cmd::Initiate, &w));
+            super::stdout::warning(&super::flags::rewrite(Cmd::Initiate, &w));
         }
         Ok(o)
     }

@@ -35,7 +35,7 @@ pub struct RenderArgs {
 pub struct ShotArgs {
     /// Camera: follow (top-down, frames the flock), ground (an observer looking up as the flock
     /// passes over) or fixed (the --view rectangle).
-    #[arg(long, value_name = "NAME", default_value = "follow")]
+    #[arg(long, value_name = "NAME", default_value_t = RenderOptions::default().camera.name().to_string())]
     pub camera: String,
     /// World rectangle of --camera fixed: x0,y0,x1,y1 in wingspans (x east, y north).
     #[arg(long, value_name = "X0,Y0,X1,Y1", allow_hyphen_values = true, value_parser = formation::export::camera::parse_view)]
@@ -45,7 +45,7 @@ pub struct ShotArgs {
     #[arg(long, value_name = "PX", default_value_t = RenderOptions::default().min_bird_px, allow_negative_numbers = true)]
     pub min_bird_px: f64,
     /// Background: sky (gradient and clouds), none (transparent PNG frames) or a colour #rrggbb.
-    #[arg(long, value_name = "BG", default_value = "sky")]
+    #[arg(long, value_name = "BG", default_value_t = RenderOptions::default().background.to_string())]
     pub background: String,
     /// Add a sun glow to the sky.
     #[arg(long)]

@@ -5,13 +5,13 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use formation::extract::{ExtractOptions, FormationParams};
+use formation::extract::FormationParams;
 use formation::io::{write_bytes_atomic, OutputKind};
 use formation::report::{report, Subject};
 use formation::sniff::Kind;
 use formation::{Animation, Result};
 
-use super::extract::{FitArgs, ReadArgs, SizeArgs};
+use super::extract::ExtractionArgs;
 use super::Global;
 
 /// Arguments of `formation report`.
@@ -24,38 +24,24 @@ pub struct ReportArgs {
     #[arg(short = 'o', long = "output")]
     pub output: PathBuf,
     #[command(flatten)]
-    pub read: ReadArgs,
-    #[command(flatten)]
-    pub fit: FitArgs,
-    #[command(flatten)]
-    pub size: SizeArgs,
+    pub extraction: ExtractionArgs,
 }
 
 /// Runs `formation report`.
 pub fn run(args: ReportArgs, g: Global) -> Result<()> {
     OutputKind::for_flag("-o", &args.output, &[OutputKind::Html])?;
-    let extract = ExtractOptions {
-        wingspan_m: args.size.wingspan_m,
-        ..args.fit.options()
-    };
+    let extract = args.extraction.options();
     extract.validate()?;
     formation::io::check_output_dir("-o", &args.output)?;
-    let kind = if args.input.is_dir() {
-        Kind::Labelme
-    } else {
-        let text = formation::io::read_text(&args.input)?;
-        serde_json::from_str::<serde_json::Value>(&text)
-            .map(|v| formation::sniff::json_kind(&v))
-            .unwrap_or(Kind::Unknown)
-    };
+    let kind = formation::sniff::path_kind(&args.input)?;
     let (params, animation, threshold): (Option<FormationParams>, Option<Animation>, _) = match kind
     {
         Kind::Animation => (None, Some(Animation::read(&args.input)?), None),
-        Kind::Params => (Some(super::steady::read_params(&args.input)?), None, None),
+        Kind::Params => (Some(FormationParams::read(&args.input)?), None, None),
         _ => {
             let (_, p, _) = super::extract::read_and_extract(
                 &args.input,
-                &args.read,
+                &args.extraction.read,
                 extract,
                 g,
                 super::flags::Cmd::Report,

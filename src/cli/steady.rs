@@ -11,7 +11,6 @@ use formation::keyshape::{KeyOptions, SteadyOptions};
 use formation::pipeline::{flock_steady_stage, Config, SteadyOutcome};
 use formation::plot::power::{PowerChart, PowerMetric, PowerOf};
 use formation::plot::xi::XiChart;
-use formation::shape::Shape;
 use formation::skein::SkeinOptions;
 use formation::{Error, Result};
 
@@ -40,14 +39,11 @@ pub struct SteadyArgs {
     pub steady: SteadyFlags,
     #[command(flatten)]
     pub path: super::course::PathFlags,
-    /// Height of the flight above the ground without a path, wingspans (0 keeps the file ready
-    /// for `formation initiate`, which climbs to its own --cruise-altitude and adds this).
-    #[arg(
-        long = "cruise-altitude",
-        allow_negative_numbers = true,
-        default_value_t = 0.0
-    )]
-    pub cruise_altitude: f64,
+    /// Height of the flight above the ground without a path, wingspans (without it the flight
+    /// keeps the course frame's height, ready for `formation initiate`, which climbs to its own
+    /// --cruise-altitude and adds this).
+    #[arg(long = "cruise-altitude", allow_negative_numbers = true)]
+    pub cruise_altitude: Option<f64>,
     #[command(flatten)]
     pub skein: SkeinFlags,
     #[command(flatten)]
@@ -163,7 +159,7 @@ pub fn run(args: SteadyArgs, g: Global) -> Result<()> {
         wingbeat: args.wingbeat.options()?,
         initiation: false,
         course: formation::course::CourseOptions {
-            cruise_altitude: Some(args.cruise_altitude),
+            cruise_altitude: args.cruise_altitude,
             ..args.path.options()
         },
         skein: args.skein.options(),
@@ -174,24 +170,10 @@ pub fn run(args: SteadyArgs, g: Global) -> Result<()> {
     config.course.validate()?;
     let plan = formation::export::plan_outputs(&args.output)?;
     if let Some(r) = &args.report {
-        OutputKind::for_flag("--report", r, &[OutputKind::Json])?;
-        formation::io::check_output_dir("--report", r)?;
-        let id = formation::io::output_identity(r);
-        if plan
-            .iter()
-            .any(|o| formation::io::output_identity(&o.path) == id)
-        {
-            return Err(formation::Error::parameter(
-                "--report",
-                format!(
-                    "{}: is also given to -o; the report needs a file of its own",
-                    r.display()
-                ),
-            ));
-        }
+        formation::export::plan_report(r, &plan)?;
     }
     let path = config.course.load(config.steady.wingspan_m)?;
-    let params = read_params(&args.params)?;
+    let params = FormationParams::read(&args.params)?;
     super::warn_params(g, &params)?;
     let progress = TermProgress::new(g.quiet);
     let (mut anim, outcome) = flock_steady_stage(&params, &config, &progress)?;
@@ -239,23 +221,6 @@ pub fn flock_summary(f: &formation::skein::SkeinReport) -> String {
     )
 }
 
-/// Reads a params file, telling other `formation` files apart before serde's field errors.
-pub fn read_params(path: &Path) -> Result<FormationParams> {
-    let value: serde_json::Value = formation::io::read_json(path)?;
-    let kind = formation::sniff::json_kind(&value);
-    if kind != formation::sniff::Kind::Params {
-        return Err(Error::format(
-            path,
-            format!(
-                "not a formation params file ({}, expected \"format\": \"{}\"); write one with `formation extract ANNOTATIONS -o params.json`",
-                kind.describe(),
-                formation::extract::params::PARAMS_FORMAT
-            ),
-        ));
-    }
-    FormationParams::read(path)
-}
-
 /// What `plot power` shows.
 #[derive(Debug, Clone, Copy, ValueEnum)]
 pub enum MetricArg {
@@ -263,6 +228,24 @@ pub enum MetricArg {
     Xi,
     /// Power reduction e_i.
     E,
+}
+
+impl From<PowerMetric> for MetricArg {
+    fn from(m: PowerMetric) -> MetricArg {
+        match m {
+            PowerMetric::Xi => MetricArg::Xi,
+            PowerMetric::E => MetricArg::E,
+        }
+    }
+}
+
+impl From<MetricArg> for PowerMetric {
+    fn from(m: MetricArg) -> PowerMetric {
+        match m {
+            MetricArg::Xi => PowerMetric::Xi,
+            MetricArg::E => PowerMetric::E,
+        }
+    }
 }
 
 /// Arguments of `formation plot power`.
@@ -280,7 +263,7 @@ pub struct PlotPowerArgs {
     #[arg(long)]
     pub frame: Option<usize>,
     /// Quantity to plot.
-    #[arg(long, value_enum, default_value_t = MetricArg::Xi)]
+    #[arg(long, value_enum, default_value_t = MetricArg::from(PowerMetric::default()))]
     pub metric: MetricArg,
     #[command(flatten)]
     pub formation: FormationArg,
@@ -299,71 +282,19 @@ impl FormationArg {
     /// The formation asked for of `anim` (read from `origin`) as an animation of its own, and
     /// the words a chart's title adds (`None` for a flock of one formation).
     pub fn pick(&self, anim: Animation, origin: &Path) -> Result<(Animation, Option<String>)> {
-        let count = anim.formation_count();
-        let k = self.formation.unwrap_or(0);
-        if anim.formations.is_none() && k == 0 {
-            return Ok((anim, None));
-        }
-        let one = anim.formation(k).ok_or_else(|| {
-            Error::parameter(
-                "plot.formation",
-                format!(
-                    "{k}: {} has {count} formation(s) (0..{})",
-                    origin.display(),
-                    count - 1
-                ),
-            )
-        })?;
-        Ok((one, Some(format!(", formation {k} of {count}"))))
+        formation::plot::one_formation(anim, self.formation, origin)
     }
 }
 
 /// Runs `formation plot power`.
 pub fn run_plot_power(args: PlotPowerArgs, _g: Global) -> Result<()> {
     OutputKind::from_path(&args.output, &[OutputKind::Png, OutputKind::Svg])?;
-    let metric = match args.metric {
-        MetricArg::Xi => PowerMetric::Xi,
-        MetricArg::E => PowerMetric::E,
+    let metric = PowerMetric::from(args.metric);
+    let of = match (args.frame, args.key) {
+        (Some(k), _) => Some(PowerOf::Frame(k)),
+        (None, k) => k.map(PowerOf::Key),
     };
-    let value: serde_json::Value = formation::io::read_json(&args.input)?;
-    let is_animation = formation::sniff::json_kind(&value) == formation::sniff::Kind::Animation;
-    let chart = if is_animation {
-        let (anim, which) = args
-            .formation
-            .pick(Animation::read(&args.input)?, &args.input)?;
-        let of = match (args.frame, args.key) {
-            (Some(k), _) => PowerOf::Frame(k),
-            (None, k) => PowerOf::Key(k.unwrap_or(0)),
-        };
-        let mut chart = PowerChart::from_animation(&anim, &args.input, of, metric)?;
-        chart.title.push_str(which.as_deref().unwrap_or(""));
-        chart
-    } else {
-        if args.formation.formation.is_some() {
-            return Err(Error::parameter(
-                "plot.formation",
-                format!(
-                    "{} is a shape file, which has no formations",
-                    args.input.display()
-                ),
-            ));
-        }
-        if args.key.is_some() || args.frame.is_some() {
-            return Err(Error::parameter(
-                "--key/--frame",
-                format!(
-                    "{} is a shape file, which has no key shapes or frames",
-                    args.input.display()
-                ),
-            ));
-        }
-        let shape: Shape = formation::io::parse_json(
-            &args.input,
-            &serde_json::to_string(&value).map_err(|e| Error::Internal(e.to_string()))?,
-        )?;
-        shape.validate(&args.input, 2)?;
-        PowerChart::from_shape(&shape, &args.input, metric)?
-    };
+    let chart = PowerChart::from_file(&args.input, args.formation.formation, of, metric)?;
     formation::plot::save(&chart, &args.output)
 }
 

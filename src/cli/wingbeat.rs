@@ -43,7 +43,7 @@ pub struct WingbeatFlags {
     /// Gliding: `off` (continuous flapping), `bouts` (flap-gliding) or `always`.
     #[arg(long, default_value_t = WingbeatOptions::default().glide.to_string(), value_name = "off|bouts|always")]
     pub glide: String,
-    /// Scale of the per-bird and per-wingbeat variation: 0 = identical birds, 1 = default.
+    /// Scale of the per-bird and per-wingbeat variation: 0 = identical birds, 1 = the species' own.
     #[arg(long = "wing-variation", default_value_t = WingbeatOptions::default().variation, allow_negative_numbers = true)]
     pub variation: f64,
 }

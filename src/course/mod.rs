@@ -315,11 +315,28 @@ pub fn apply(
     check_backwards(points, depth, &origin)?;
     let (r_min, why) = min_radius(d_lo, d_hi, flight.speed, g, opts);
     let dense = spline::spline_points(&points.points, points.closed);
+    if points.closed {
+        check_loop_size(&dense, r_min, &origin)?;
+    }
     let (pts, ds) = spline::resample(&dense, spline::SAMPLE_SPACING);
     let before = pts.clone();
     let (pts, ds, tight) =
         spline::widen(pts, ds, points.closed, 1.0 / r_min, spline::SAMPLE_SPACING);
+    let cannot = || {
+        Error::format(
+            &origin,
+            format!(
+                "the path cannot be widened to the flock's smallest turn radius of {r_min:.0} wingspans ({why}); draw it with wider turns"
+            ),
+        )
+    };
+    if pts.len() < 2 {
+        return Err(cannot());
+    }
     let course = Course::from_samples(pts, ds, points.closed);
+    if !(course.length() > 0.0 && course.length().is_finite()) {
+        return Err(cannot());
+    }
     report.length = course.length();
     for t in &tight {
         let p = before[t.sample.min(before.len() - 1)];
@@ -436,6 +453,27 @@ pub fn apply(
         widened: !report.widened.is_empty(),
     });
     Ok(report)
+}
+
+/// Refuses a closed path too small for the flock's turns: seen from above, a closed curve whose
+/// turns have radii of at least `r_min` is at least 2π `r_min` long (its heading turns through at
+/// least a full turn, Fenchel's theorem), so widening a shorter one to `r_min` would shrink it
+/// to nothing. `dense` is the spline through the path.
+fn check_loop_size(dense: &[[f64; 3]], r_min: f64, origin: &Path) -> Result<()> {
+    let around: f64 = dense
+        .windows(2)
+        .map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]))
+        .sum();
+    let needed = 2.0 * std::f64::consts::PI * r_min;
+    if around < needed {
+        return Err(Error::format(
+            origin,
+            format!(
+                "the closed path is {around:.0} wingspans around (seen from above), too small for the flock: its turns need a radius of at least {r_min:.0} wingspans, so a closed path at least {needed:.0} wingspans around; draw it larger, or slow the flock"
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// Refuses a path that turns back on itself (more than 90° at a control point) with a segment

@@ -25,6 +25,10 @@ pub const SAMPLE_SPACING: f64 = 0.25;
 /// Largest number of samples of a course.
 pub const MAX_SAMPLES: usize = 400_000;
 
+/// Most sample updates of [`widen`]'s smoothing (about a second): what is not widened by then
+/// stays as far as it got.
+pub const WIDEN_WORK: usize = 200_000_000;
+
 /// The course at one place.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CourseAt {
@@ -203,7 +207,9 @@ pub struct Tight {
 /// Widens every turn tighter than `max_turn` (radians per wingspan) by local smoothing of the
 /// horizontal course (Laplacian steps on the offending stretch and its surroundings, end points
 /// of an open path fixed), on a polyline of a spacing fitting the needed radius; returns the
-/// widened polyline (even spacing `spacing`), and the too-tight places found before.
+/// widened polyline (even spacing `spacing`), and the too-tight places found before. The
+/// polyline is empty when a closed path shrank below a full turn at the needed radius: it
+/// cannot be widened.
 pub fn widen(
     pts: Vec<[f64; 3]>,
     ds: f64,
@@ -242,27 +248,74 @@ pub fn widen(
     let coarse = (0.1 / max_turn).max(spacing);
     let (mut q, mut dq) = resample(&pts, coarse);
     let target = 0.92 * max_turn;
+    // Smoothing shrinks a closed curve; one shorter than a full turn at the needed radius
+    // cannot be flown (see `course::check_loop_size`) and would shrink to nothing (a thin spike
+    // did, and the stretch below grew without bound: a hang found by fuzzing, issue 17).
+    let shortest_loop = 2.0 * PI / max_turn;
+    // At most 400 rounds, and at most WIDEN_WORK sample updates in all: a path that turns back
+    // onto itself along a long leg is never widened and took 35 s (found by fuzzing, issue 17).
+    let mut work = 0usize;
     for _round in 0..400 {
-        let k = curvature(&q, dq, closed);
         let n = q.len();
+        work += 20 * n;
+        if work > WIDEN_WORK {
+            break;
+        }
+        if !(dq > 0.0 && dq.is_finite()) || (closed && dq * ((n - 1) as f64) < shortest_loop) {
+            return (Vec::new(), dq, tight);
+        }
+        let k = curvature(&q, dq, closed);
         let bad: Vec<usize> = (0..n).filter(|&i| k[i].abs() > target).collect();
         if bad.is_empty() {
             break;
         }
-        // Smooth around every offending sample, over a stretch of the needed quarter turn.
-        let reach = ((0.5 * PI / max_turn) / dq).ceil() as isize + 2;
+        // Smooth around every offending sample, over a stretch of the needed quarter turn (at
+        // most the whole curve), marked through a running count so the cost is linear.
+        let reach = (((0.5 * PI / max_turn) / dq).ceil() as usize + 2).min(n);
         let mut mark = vec![false; n];
-        for &b in &bad {
-            for o in -reach..=reach {
-                let j = b as isize + o;
-                let j = if closed {
-                    j.rem_euclid(n as isize - 1) as usize
-                } else if j <= 0 || j as usize >= n - 1 {
+        if closed {
+            let m = n - 1;
+            let mut delta = vec![0i64; m + 1];
+            for &b in &bad {
+                let (lo, hi) = (b as i64 - reach as i64, b as i64 + reach as i64);
+                if hi - lo + 1 >= m as i64 {
+                    delta[0] += 1;
+                    delta[m] -= 1;
                     continue;
+                }
+                let (lo, hi) = (
+                    lo.rem_euclid(m as i64) as usize,
+                    hi.rem_euclid(m as i64) as usize,
+                );
+                if lo <= hi {
+                    delta[lo] += 1;
+                    delta[hi + 1] -= 1;
                 } else {
-                    j as usize
-                };
-                mark[j] = true;
+                    delta[lo] += 1;
+                    delta[m] -= 1;
+                    delta[0] += 1;
+                    delta[hi + 1] -= 1;
+                }
+            }
+            let mut run = 0i64;
+            for j in 0..m {
+                run += delta[j];
+                mark[j] = run > 0;
+            }
+        } else {
+            let mut delta = vec![0i64; n + 1];
+            for &b in &bad {
+                let lo = b.saturating_sub(reach).max(1);
+                let hi = (b + reach).min(n.saturating_sub(2));
+                if lo <= hi {
+                    delta[lo] += 1;
+                    delta[hi + 1] -= 1;
+                }
+            }
+            let mut run = 0i64;
+            for j in 0..n {
+                run += delta[j];
+                mark[j] = run > 0;
             }
         }
         for _ in 0..20 {
@@ -288,6 +341,9 @@ pub fn widen(
         let (r, d) = resample(&q, coarse);
         q = r;
         dq = d;
+    }
+    if closed && dq * ((q.len() - 1) as f64) < shortest_loop {
+        return (Vec::new(), dq, tight);
     }
     let dense = spline_points(&q[..if closed { q.len() - 1 } else { q.len() }], closed);
     let (out, d) = resample(&dense, spacing);

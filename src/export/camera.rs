@@ -68,6 +68,15 @@ pub enum CameraKind {
 }
 
 impl CameraKind {
+    /// The camera's name, as [`CameraKind::parse`] reads it: `follow`, `ground` or `fixed`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            CameraKind::Follow => "follow",
+            CameraKind::Ground => "ground",
+            CameraKind::Fixed(_) => "fixed",
+        }
+    }
+
     /// Parses `follow`, `ground` or `fixed` (`fixed` takes its rectangle from `view`).
     pub fn parse(name: &str, view: Option<[f64; 4]>) -> Result<CameraKind> {
         match (name, view) {
@@ -520,6 +529,19 @@ fn lead_centre(s: &[BirdState], ax: f64, ay: f64) -> (f64, f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn camera_names_read_back() {
+        let view = [0.0, 0.0, 10.0, 5.0];
+        for c in [
+            CameraKind::Follow,
+            CameraKind::Ground,
+            CameraKind::Fixed(view),
+        ] {
+            let v = matches!(c, CameraKind::Fixed(_)).then_some(view);
+            assert_eq!(CameraKind::parse(c.name(), v).unwrap(), c);
+        }
+    }
 
     fn fit_all() -> CameraParams {
         CameraParams {

@@ -259,6 +259,27 @@ pub fn plan_outputs(outputs: &[PathBuf]) -> Result<Vec<Output>> {
     Ok(plan)
 }
 
+/// Checks the JSON file a run's report goes to (named `report` in errors): a `.json` name in an
+/// existing directory, and not one of the run's outputs (`plan`, from [`plan_outputs`]).
+pub fn plan_report(report: &Path, plan: &[Output]) -> Result<()> {
+    OutputKind::for_flag("report", report, &[OutputKind::Json])?;
+    crate::io::check_output_dir("report", report)?;
+    let id = crate::io::output_identity(report);
+    if plan
+        .iter()
+        .any(|o| crate::io::output_identity(&o.path) == id)
+    {
+        return Err(Error::parameter(
+            "report",
+            format!(
+                "{}: is also an output; the report needs a file of its own",
+                report.display()
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// Frame rate used for a picture output of `kind`.
 fn picture_fps(anim: &Animation, kind: OutputKind, opts: &RenderOptions) -> f64 {
     match (kind, opts.fps) {

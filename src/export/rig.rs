@@ -181,20 +181,8 @@ pub fn top_view(pose: &WingPose) -> Vec<Vec<[f32; 2]>> {
     out
 }
 
-/// Signed area of a closed polygon (shoelace), positive when counter-clockwise.
-pub fn signed_area(p: &[[f32; 2]]) -> f32 {
-    let n = p.len();
-    let mut a = 0.0;
-    for i in 0..n {
-        let [x0, y0] = p[i];
-        let [x1, y1] = p[(i + 1) % n];
-        a += x0 * y1 - x1 * y0;
-    }
-    0.5 * a
-}
-
 fn ccw(mut p: Vec<[f32; 2]>) -> Vec<[f32; 2]> {
-    if signed_area(&p) < 0.0 {
+    if super::raster::signed_area(&p) < 0.0 {
         p.reverse();
     }
     p

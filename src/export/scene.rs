@@ -66,6 +66,17 @@ impl Background {
     }
 }
 
+/// `sky`, `none` or `#rrggbb`, as [`Background::parse`] reads it.
+impl std::fmt::Display for Background {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Background::Sky => write!(f, "sky"),
+            Background::None => write!(f, "none"),
+            Background::Colour([r, g, b]) => write!(f, "#{r:02x}{g:02x}{b:02x}"),
+        }
+    }
+}
+
 /// Colours and look of the picture.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Style {
@@ -533,6 +544,18 @@ pub fn draw_birds(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn backgrounds_read_back_what_they_write() {
+        for b in [
+            Background::Sky,
+            Background::None,
+            Background::Colour([0x87, 0xce, 0x0b]),
+        ] {
+            assert_eq!(Background::parse(&b.to_string()).unwrap(), b);
+        }
+        assert_eq!(Background::Colour([1, 2, 255]).to_string(), "#0102ff");
+    }
 
     #[test]
     fn sky_gradient_runs_from_top_to_bottom_colour() {

@@ -171,13 +171,6 @@ impl FrameReport {
     }
 }
 
-/// Tells a params file (`"format": "formation-params/1"`) from annotations, by content.
-pub fn is_params_file(text: &str) -> bool {
-    // Cheap first: most inputs are annotations, which never carry the tag.
-    text.contains(PARAMS_FORMAT)
-        && crate::sniff::text_kind(text) == Some(crate::sniff::Kind::Params)
-}
-
 /// Formation parameters from `path`, whatever it holds: a params file written by `extract` is
 /// read and validated; anything else is read as annotations (with `read`) and extracted (with
 /// `opts` and `rng`). This is what `formation animate INPUT` needs.
@@ -187,13 +180,8 @@ pub fn params_from_path(
     opts: &ExtractOptions,
     rng: &mut impl Rng,
 ) -> Result<FormationParams> {
-    if !path.is_dir() {
-        let text = crate::io::read_text(path)?;
-        if is_params_file(&text) {
-            let p: FormationParams = crate::io::parse_json(path, &text)?;
-            p.validate(path)?;
-            return Ok(p);
-        }
+    if let Some(p) = FormationParams::read_if_params(path)? {
+        return Ok(p);
     }
     let ann = crate::annotations::read(path, read)?;
     extract(&ann, opts, rng)
@@ -475,17 +463,6 @@ fn choose_model(
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn params_file_is_recognised() {
-        assert!(is_params_file(
-            r#"{"format": "formation-params/1", "frames": []}"#
-        ));
-        assert!(!is_params_file(
-            r#"{"frames": [], "source": "formation-params/1"}"#
-        ));
-        assert!(!is_params_file("frame,x,y\n"));
-    }
 
     #[test]
     fn kinds_parse() {

@@ -182,9 +182,40 @@ impl FormationParams {
         counts
     }
 
-    /// Reads and validates a params file.
+    /// Reads and validates a params file. Another of formation's files (an animation, a shape,
+    /// annotations) is named for what it is ([`crate::sniff`]) before any field error.
     pub fn read(path: &Path) -> Result<FormationParams> {
-        let p: FormationParams = crate::io::read_json(path)?;
+        let text = crate::io::read_text(path)?;
+        FormationParams::parse(path, &text)
+    }
+
+    /// The params file at `path` when it is one (told apart by content, [`crate::sniff`]),
+    /// read and validated; `None` for a directory or any other file (annotations, say).
+    pub fn read_if_params(path: &Path) -> Result<Option<FormationParams>> {
+        if path.is_dir() {
+            return Ok(None);
+        }
+        let text = crate::io::read_text(path)?;
+        if !crate::sniff::is_params(&text) {
+            return Ok(None);
+        }
+        FormationParams::parse(path, &text).map(Some)
+    }
+
+    /// [`FormationParams::read`] of a text already read from `path`.
+    fn parse(path: &Path, text: &str) -> Result<FormationParams> {
+        let value: serde_json::Value = crate::io::parse_json(path, text)?;
+        let kind = crate::sniff::json_kind(&value);
+        if kind != crate::sniff::Kind::Params {
+            return Err(Error::format(
+                path,
+                format!(
+                    "not a formation params file ({}, expected \"format\": \"{PARAMS_FORMAT}\"); write one with `formation extract ANNOTATIONS -o params.json`",
+                    kind.describe(),
+                ),
+            ));
+        }
+        let p: FormationParams = crate::io::parse_json(path, text)?;
         p.validate(path)?;
         Ok(p)
     }

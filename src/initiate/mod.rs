@@ -53,6 +53,14 @@ pub const MAX_STEPS_LIMIT: usize = 1_000_000;
 /// Largest accepted width or depth of the random start region, wingspans.
 pub const MAX_START_EXTENT: f64 = 1e6;
 
+/// Width over depth of the automatic take-off area (before [`GROUND_MAX_DEPTH`] makes it wider).
+pub const GROUND_ASPECT: f64 = 3.0;
+
+/// Largest depth of the automatic take-off area, wingspans: a deeper one leaves the birds at its
+/// back (whose slots are near the apex of the V) more than 30 wingspans from every slot when the
+/// last of them lifts off.
+pub const GROUND_MAX_DEPTH: f64 = 22.0;
+
 /// Gravity, metres per second squared.
 pub const GRAVITY_M_S2: f64 = 9.81;
 
@@ -214,7 +222,7 @@ impl Default for InitiateOptions {
             takeoff: None,
             separation_distance: 10.0,
             lookahead: 4.0,
-            avoid_distance: 0.6,
+            avoid_distance: 0.3,
             avoid_range: 6.0,
             avoid_horizon: 2.0,
             lost_speed_factor: 0.9,
@@ -225,7 +233,7 @@ impl Default for InitiateOptions {
             linear_zone: 0.25,
             catchup_distance: 1.5,
             gap_speed: true,
-            gather_speed: 0.6,
+            gather_speed: 0.5,
             assign_slots: true,
             approach_distance: 5.0,
             approach_time: 1.2,
@@ -316,11 +324,11 @@ impl TakeoffPlan {
     pub const MAX_DRIVE: f64 = 1.6;
 
     /// The natural take-off of `n` birds from the ground at the default options, seconds:
-    /// measured medians (docs/initiation.md) about 10.5 s for 9–14 birds, 12.5 s for 41, 18.5 s
-    /// for 100, 37 s for 300 (the lift-off and climb to 10 wingspans take about 8 s; the rest
+    /// measured medians (docs/initiation.md) about 9.5 s for 9–14 birds, 10.7 s for 41, 12.7 s
+    /// for 100, 23 s for 300 (the lift-off and climb to 10 wingspans take about 7 s; the rest
     /// grows with the width of the V).
     pub fn natural_seconds(n: usize) -> f64 {
-        9.5 + 0.09 * n.max(1) as f64
+        9.0 + 0.045 * n.max(1) as f64
     }
 
     /// The automatic take-off duration of `n` birds, seconds: the natural one.
@@ -328,16 +336,32 @@ impl TakeoffPlan {
         Self::natural_seconds(n)
     }
 
-    /// A warning when the take-off duration of `opts` is outside what the drive can reach for
-    /// `n` birds (about 0.75 to 2 times the natural duration), naming `initiate.takeoff`.
+    /// The shortest take-off of `n` birds from the ground at the strongest drive, seconds:
+    /// measured medians 8.3 s for 9 birds, 8.5 for 14, 8.9 for 41, 11.1 for 100, 20.5 for 300
+    /// (docs/initiation.md). The run, lift-off and climb to the cruise altitude take about 7 s at
+    /// the strongest drive (climb rate and accelerations bounded), and the outer birds of a wider
+    /// V have farther to fly to their slots at bounded speeds.
+    pub fn shortest_seconds(n: usize) -> f64 {
+        7.8 + 0.042 * n.max(1) as f64
+    }
+
+    /// A warning when the take-off duration of `opts` cannot be met within 25 % for `n` birds:
+    /// shorter than [`Self::shortest_seconds`] allows, or longer than twice the natural
+    /// duration; it names `initiate.takeoff`, the duration the take-off will have and why.
     pub fn warning(n: usize, opts: &InitiateOptions) -> Option<String> {
         let t = opts.takeoff?;
-        let natural = Self::natural_seconds(n);
-        let (lo, hi) = (0.75 * natural, 2.0 * natural);
-        if t < lo || t > hi {
-            let near = t.clamp(lo, hi);
+        if !matches!(opts.start, Start::Ground(_)) {
+            return None;
+        }
+        let shortest = Self::shortest_seconds(n);
+        let longest = 2.0 * Self::natural_seconds(n);
+        if t * 1.25 < shortest {
             Some(format!(
-                "initiate.takeoff {t} s: {n} birds form in about {lo:.0} to {hi:.0} s with these rules (docs/initiation.md); the take-off will last about {near:.0} s"
+                "initiate.takeoff {t} s: {n} birds cannot take off in less than about {shortest:.0} s (the run and the climb to the cruise altitude take about 7 s at the strongest drive, and the outer birds of a wide V need longer to reach their slots); the take-off will last about {shortest:.0} s"
+            ))
+        } else if t > 1.25 * longest {
+            Some(format!(
+                "initiate.takeoff {t} s: {n} birds form in at most about {longest:.0} s with these rules (the drive is at its weakest); the take-off will last about {longest:.0} s"
             ))
         } else {
             None
@@ -356,12 +380,15 @@ impl TakeoffPlan {
         let root = (n.max(1) as f64).sqrt();
         let (width, depth, stagger) = match &opts.start {
             Start::Ground(g) => {
-                // About 10 square wingspans per bird (1.6 times what random packing of birds
-                // `min_spacing` = 2 apart needs), more for a slow take-off.
-                let base = (1.6 * g.min_spacing * root).max(4.0 * g.min_spacing) / drive.min(1.0);
+                // About 6.8 square wingspans per bird (1.1 times what random packing of birds
+                // `min_spacing` = 2 apart needs), more for a slow take-off; three times as wide
+                // as deep, at most GROUND_MAX_DEPTH deep (wider instead).
+                let base = (1.3 * g.min_spacing * root).max(4.0 * g.min_spacing) / drive.min(1.0);
+                let aspect = GROUND_ASPECT;
+                let depth = (base / aspect.sqrt()).min(GROUND_MAX_DEPTH);
                 (
-                    g.width.unwrap_or(1.4 * base),
-                    g.depth.unwrap_or(0.7 * base),
+                    g.width.unwrap_or(base * base / depth),
+                    g.depth.unwrap_or(depth),
                     g.stagger.unwrap_or(1.0 / drive),
                 )
             }
@@ -479,6 +506,20 @@ impl StartState {
         if let Some(v) = &s.speed {
             if let Some(i) = v.iter().position(|v| *v <= 0.0) {
                 return Err(Error::format(path, format!("speed[{i}]: must be positive")));
+            }
+        }
+        // Where an animation file may hold a bird: one 10¹² wingspans away made the take-off's
+        // neighbour grid crawl (75 s), one at 10³⁰⁰ overflowed it (a panic; issue 17).
+        let bound = crate::limits::MAX_COORDINATE;
+        for (name, a) in [("x", &s.x), ("y", &s.y)] {
+            if let Some(i) = a.iter().position(|v| v.abs() > bound) {
+                return Err(Error::format(
+                    path,
+                    format!(
+                        "{name}[{i}]: {:e} wingspans; a start position must be within ±{bound:e} wingspans",
+                        a[i]
+                    ),
+                ));
             }
         }
         for i in 0..birds {

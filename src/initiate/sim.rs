@@ -171,6 +171,35 @@ pub const YIELD_FRACTION: f64 = 0.5;
 /// Least avoidance threshold between two birds settling into their slots, wingspans.
 pub const YIELD_FLOOR: f64 = 0.35;
 
+/// The final approach's funnel: a bird `FUNNEL_SLOPE` times its sideways error (beyond
+/// [`FUNNEL_WIDTH`]) behind or ahead of its slot closes along the heading no farther.
+pub const FUNNEL_SLOPE: f64 = 1.5;
+
+/// The funnel's largest distance behind or ahead of the slot, wingspans.
+pub const FUNNEL_MAX: f64 = 2.0;
+
+/// Sideways error within which a bird closes on its slot along the heading freely, wingspans.
+pub const FUNNEL_WIDTH: f64 = 0.25;
+
+/// Separation drive: two birds predicted to come closer than this (3-D) are pushed apart,
+/// wingspans.
+pub const SEPARATION_DISTANCE: f64 = 0.5;
+
+/// Separation drive between two birds with slots: at most this fraction of their slots' distance.
+pub const SEPARATION_FRACTION: f64 = 0.7;
+
+/// Separation drive: look-ahead of the predicted closest approach, seconds.
+pub const SEPARATION_HORIZON: f64 = 1.0;
+
+/// Separation drive: sideways speed away from a bird at contact, wingspans per second.
+pub const SEPARATION_SPEED: f64 = 4.0;
+
+/// Heading error from which a bird asks for less speed (so it turns tighter), radians (45°).
+pub const TURN_SLOW_FROM: f64 = std::f64::consts::FRAC_PI_4;
+
+/// Heading error at which a bird asks for the minimum speed, radians (135°).
+pub const TURN_SLOW_TO: f64 = 3.0 * std::f64::consts::FRAC_PI_4;
+
 /// Height between the two layers of birds away from their slots, wingspans.
 pub const LAYER_HEIGHT: f64 = 0.6;
 
@@ -1089,7 +1118,8 @@ impl Simulation {
             };
             // The whole way in the formation frame: eqs. (5)–(6) relative to a reference bird
             // that is itself still far from its slot would pass its lag down the arm.
-            let (w, v) = self.settle(i, c);
+            self.grid.within(&f.pos, f.pos[i], p.avoid_range, near);
+            let (w, v) = self.settle(i, c, near);
             (w, v, Some(j), self.target.side_of(c), Some(c))
         } else {
             // Perception: departed flockmates within the visual range.
@@ -1099,7 +1129,7 @@ impl Simulation {
             match self.choose(i, visible) {
                 Some((j, side, c, u)) => {
                     unseen = u;
-                    let (w, v) = self.steer(i, j, c);
+                    let (w, v) = self.steer(i, j, c, near);
                     (w, v, Some(j), Some(side), Some(c))
                 }
                 None if near.is_empty() => {
@@ -1220,17 +1250,18 @@ impl Simulation {
     /// The request of bird `i` following `j` into slot `c`: eqs. (5)–(6) ([`Self::pursue`]) far
     /// from the slot, the formation-frame controller ([`Self::settle`]) within the approach
     /// distance of it, blended (smoothstep) in between, so the request never jumps.
-    fn steer(&self, i: usize, j: usize, c: usize) -> (f64, f64) {
+    fn steer(&self, i: usize, j: usize, c: usize, near: &[usize]) -> (f64, f64) {
         let p = &self.params;
         let Some(&slot) = self.slot_pos.get(c) else {
             return self.pursue(i, j, c);
         };
         let r = (self.flock.pos[i] - slot).length();
+        let others = near;
         let near = p.approach_distance;
         if r >= 2.0 * near {
             return self.pursue(i, j, c);
         }
-        let settle = self.settle(i, c);
+        let settle = self.settle(i, c, others);
         if r <= near {
             return settle;
         }
@@ -1252,7 +1283,7 @@ impl Simulation {
     /// heading (turn rate = heading error / (3 τ_ω)) and a speed: a well-damped second-order
     /// approach whose time does not depend on where the reference bird is (no cascade down the
     /// arms). Requested turn rate (rad/s) and speed (wingspans/s).
-    fn settle(&self, i: usize, c: usize) -> (f64, f64) {
+    fn settle(&self, i: usize, c: usize, near: &[usize]) -> (f64, f64) {
         let p = &self.params;
         let f = &self.flock;
         let vf = self.lead_vel;
@@ -1264,18 +1295,91 @@ impl Simulation {
             let mag = (e.abs() / t).min((2.0 * p.approach_brake * e.abs()).sqrt());
             (mag * e.signum()).clamp(lo, hi)
         };
+        // The funnel: a bird still off its slot's line across the formation closes along it
+        // only to a distance that grows with the sideways error, so it comes in on its own
+        // lane from behind (or ahead) instead of cutting across its neighbours' slots.
+        let (ea, ec) = (e.dot(dc), e.dot(rc));
+        let room = (FUNNEL_SLOPE * (ec.abs() - FUNNEL_WIDTH).max(0.0)).min(FUNNEL_MAX);
+        let ea = if ea > 0.0 {
+            (ea - room).max(0.0)
+        } else {
+            (ea + room).min(0.0)
+        };
         let ua = shape(
-            e.dot(dc),
+            ea,
             0.7 * p.approach_time,
             -0.8 * (speed_f - p.min_speed).max(0.0),
             0.8 * (p.max_speed - speed_f).max(0.0),
         );
         let lat = 0.5 * speed_f;
-        let uc = shape(e.dot(rc), p.approach_time, -lat, lat);
-        let want = vf + dc * ua + rc * uc;
+        let uc = shape(ec, p.approach_time, -lat, lat);
+        let want = vf + dc * ua + rc * uc + self.separation(i, near);
         let h = want.x.atan2(want.y);
-        let w = wrap_angle(h - f.heading[i]) / (3.0 * p.turn_lag.max(0.05));
-        (w, want.length())
+        let herr = wrap_angle(h - f.heading[i]);
+        let w = herr / (3.0 * p.turn_lag.max(0.05));
+        // Facing away from where it wants to go, a bird slows down and turns tighter.
+        let away =
+            ((herr.abs() - TURN_SLOW_FROM) / (TURN_SLOW_TO - TURN_SLOW_FROM)).clamp(0.0, 1.0);
+        let slow = 1.0 - away * away * (3.0 - 2.0 * away);
+        let v = p.min_speed + (want.length() - p.min_speed).max(0.0) * slow;
+        (w, v.min(want.length().max(p.min_speed)))
+    }
+
+    /// The separation drive of the final approach, in 3-D with a look-ahead: for every flockmate
+    /// among `near` whose predicted closest approach (both flying straight, climb rates included)
+    /// within [`SEPARATION_HORIZON`] falls below the pair's separation distance
+    /// ([`SEPARATION_DISTANCE`], or [`SEPARATION_FRACTION`] of their slots' distance when that is
+    /// less), a horizontal velocity away from the predicted position of the other bird, growing
+    /// linearly to [`SEPARATION_SPEED`] at contact. Both birds of a pair take their half: the
+    /// drive is symmetric. Wingspans per second.
+    fn separation(&self, i: usize, near: &[usize]) -> DVec2 {
+        let f = &self.flock;
+        let pi = DVec3::new(f.pos[i].x, f.pos[i].y, f.z[i]);
+        let vi = self.vel.get(i).copied().unwrap_or(DVec3::ZERO);
+        let horizon = SEPARATION_HORIZON;
+        let dsep = SEPARATION_DISTANCE;
+        let gain = SEPARATION_SPEED;
+        let mut out = DVec2::ZERO;
+        for &k in near {
+            if k == i || f.phase[k] == Phase::Waiting {
+                continue;
+            }
+            let dp = DVec3::new(f.pos[k].x, f.pos[k].y, f.z[k]) - pi;
+            if dp.truncate().length_squared() > 4.0 * dsep * dsep + 36.0 * horizon * horizon {
+                continue;
+            }
+            let dv = self.vel.get(k).copied().unwrap_or(DVec3::ZERO) - vi;
+            let vv = dv.length_squared();
+            let t = if vv > 1e-12 {
+                (-dp.dot(dv) / vv).clamp(0.0, horizon)
+            } else {
+                0.0
+            };
+            let m = dp + dv * t;
+            let d = m.length();
+            let limit = match (f.slot[i], f.slot[k]) {
+                (Some(a), Some(b)) => dsep.min(
+                    SEPARATION_FRACTION * (self.target.slots[a] - self.target.slots[b]).length(),
+                ),
+                _ => dsep,
+            };
+            if d >= limit {
+                continue;
+            }
+            let away = -m.truncate();
+            let away = if away.length_squared() > 1e-12 {
+                away.normalize()
+            } else if i < k {
+                // Exactly above one another: apart across the cruise heading, by index.
+                -right_of(self.params.cruise_heading)
+            } else {
+                right_of(self.params.cruise_heading)
+            };
+            // Nearer in time counts more: a closest approach now is pressing.
+            let urgency = 1.0 - 0.5 * t / horizon.max(1e-9);
+            out += away * (gain * (limit - d) / limit * urgency);
+        }
+        out
     }
 
     /// Eqs. (5) and (6) with the fixes of docs/initiation.md, in physical time: requested turn

@@ -66,13 +66,7 @@ impl Chart for GeometryChart {
             .x_label_area_size(40)
             .y_label_area_size(50)
             .build_cartesian_2d(f0..f1, 0.0..180.0)?;
-        chart
-            .configure_mesh()
-            .x_desc("annotated frame")
-            .y_desc("degrees")
-            .label_style((FONT_FAMILY, 13))
-            .light_line_style(RGBColor(235, 235, 235))
-            .draw()?;
+        super::draw_mesh(&mut chart, "annotated frame", "degrees", 13)?;
         let shades = [
             RGBColor(120, 170, 120),
             RGBColor(120, 140, 200),
@@ -119,13 +113,7 @@ impl Chart for GeometryChart {
                 });
             chart.draw_series(pts.into_iter().map(|p| Circle::new(p, 3, c.filled())))?;
         }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font((FONT_FAMILY, 11))
-            .position(SeriesLabelPosition::UpperRight)
-            .draw()?;
+        super::draw_legend(&mut chart, 11, SeriesLabelPosition::UpperRight)?;
         let (lo, hi) = self
             .rows
             .iter()
@@ -136,13 +124,12 @@ impl Chart for GeometryChart {
             .x_label_area_size(40)
             .y_label_area_size(56)
             .build_cartesian_2d(f0..f1, (lo - 0.1)..(hi + 0.1))?;
-        chart
-            .configure_mesh()
-            .x_desc("annotated frame")
-            .y_desc("wingspans (< 0: wingtips overlap)")
-            .label_style((FONT_FAMILY, 13))
-            .light_line_style(RGBColor(235, 235, 235))
-            .draw()?;
+        super::draw_mesh(
+            &mut chart,
+            "annotated frame",
+            "wingspans (< 0: wingtips overlap)",
+            13,
+        )?;
         // Hummel's optimum: wingtip on the other's trailing vortex, π/4 − 1 wingspans.
         let opt = std::f64::consts::FRAC_PI_4 - 1.0;
         let red = RGBColor(200, 30, 30);
@@ -161,13 +148,7 @@ impl Chart for GeometryChart {
             ))?
             .label("this footage")
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 14, y)], c.stroke_width(2)));
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font((FONT_FAMILY, 11))
-            .position(SeriesLabelPosition::UpperRight)
-            .draw()?;
+        super::draw_legend(&mut chart, 11, SeriesLabelPosition::UpperRight)?;
         Ok(())
     }
 }

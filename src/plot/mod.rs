@@ -98,9 +98,78 @@ pub fn stages_title(anim: &crate::animation::Animation) -> String {
     }
 }
 
+/// Formation `k` (default 0) of a flock of several formations, as an animation of its own, and
+/// the words a chart's title adds for it (`None` for an animation of one formation). Errors
+/// name `plot.formation` and the file `origin` the animation was read from.
+pub fn one_formation(
+    anim: crate::animation::Animation,
+    k: Option<usize>,
+    origin: &Path,
+) -> Result<(crate::animation::Animation, Option<String>)> {
+    let count = anim.formation_count();
+    let k = k.unwrap_or(0);
+    if anim.formations.is_none() && k == 0 {
+        return Ok((anim, None));
+    }
+    let one = anim.formation(k).ok_or_else(|| {
+        Error::parameter(
+            "plot.formation",
+            format!(
+                "{k}: {} has {count} formation(s) (0..{})",
+                origin.display(),
+                count - 1
+            ),
+        )
+    })?;
+    Ok((one, Some(format!(", formation {k} of {count}"))))
+}
+
 /// Error type of a drawing operation on backend `DB`.
 pub type DrawResult<DB> =
     std::result::Result<(), DrawingAreaErrorKind<<DB as DrawingBackend>::ErrorType>>;
+
+/// Draws the grid and the axis descriptions every chart shares (light grey minor lines, tick
+/// labels of `label_size` points).
+pub fn draw_mesh<DB, X, Y>(
+    chart: &mut ChartContext<'_, DB, Cartesian2d<X, Y>>,
+    x_desc: &str,
+    y_desc: &str,
+    label_size: u32,
+) -> DrawResult<DB>
+where
+    DB: DrawingBackend,
+    X: Ranged + plotters::coord::ranged1d::ValueFormatter<X::ValueType>,
+    Y: Ranged + plotters::coord::ranged1d::ValueFormatter<Y::ValueType>,
+{
+    chart
+        .configure_mesh()
+        .x_desc(x_desc)
+        .y_desc(y_desc)
+        .label_style((FONT_FAMILY, label_size))
+        .light_line_style(RGBColor(235, 235, 235))
+        .draw()
+}
+
+/// Draws the legend box every chart shares (white, black border, labels of `label_size`
+/// points) at `position`.
+pub fn draw_legend<'a, DB, X, Y>(
+    chart: &mut ChartContext<'a, DB, Cartesian2d<X, Y>>,
+    label_size: u32,
+    position: SeriesLabelPosition,
+) -> DrawResult<DB>
+where
+    DB: DrawingBackend + 'a,
+    X: Ranged,
+    Y: Ranged,
+{
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font((FONT_FAMILY, label_size))
+        .position(position)
+        .draw()
+}
 
 /// A chart that can draw itself on any plotters backend.
 pub trait Chart {

@@ -1,8 +1,8 @@
 //! `formation plot paths`: top view of the birds' trajectories during initiation. Takes an
 //! animation file with an `initiation` stage (world frame, wingspans); draws two panels:
 //! the world (x east, y north, equal scales) and the same paths seen from a frame that moves with
-//! the cruise velocity of the steady flight (p − v_c t), where the birds can be seen gathering
-//! into the key shape. Starts are open circles, hand-over positions filled dots. Birds are
+//! the cruise velocity of the steady flight (p − v_c t), turned so that the flight direction is
+//! up whatever the heading, where the birds can be seen gathering into the key shape. Starts are open circles, hand-over positions filled dots. Birds are
 //! coloured by their rank at the hand-over (the perceptual map of [`super::bird_colour`], front
 //! dark), the leader's path red and thicker, with a legend. A file without a take-off is drawn
 //! whole and says so in its title.
@@ -19,7 +19,8 @@ use crate::error::{Error, Result};
 pub struct PathsChart {
     /// World-frame paths, one per bird: (x, y) per frame, wingspans.
     pub world: Vec<Vec<(f64, f64)>>,
-    /// The same paths minus the cruise motion, wingspans.
+    /// The same paths minus the cruise motion, across (right) and along the cruise direction,
+    /// from the leader's hand-over position, wingspans: the same at any heading.
     pub relative: Vec<Vec<(f64, f64)>>,
     /// Index of the leader (front-most bird at hand-over).
     pub leader: usize,
@@ -52,21 +53,15 @@ impl PathsChart {
             vx += last.speed[i] * s / n as f64;
             vy += last.speed[i] * c / n as f64;
         }
+        // The moving panel turns with the flock: across and along its cruise direction φ
+        // (clockwise from north), from the leader's hand-over position, so that it shows the
+        // same at any heading.
+        let (sin_phi, cos_phi) = vx.atan2(vy).sin_cos();
         let t0 = a.frames[start].t;
         let stride = ((end - start) / 600).max(1);
         let mut idx: Vec<usize> = (start..end).step_by(stride).collect();
         if idx.last() != Some(&(end - 1)) {
             idx.push(end - 1);
-        }
-        let mut world = vec![Vec::with_capacity(idx.len()); n];
-        let mut relative = vec![Vec::with_capacity(idx.len()); n];
-        for &k in &idx {
-            let f = &a.frames[k];
-            let dt = f.t - t0;
-            for i in 0..n {
-                world[i].push((f.x[i], f.y[i]));
-                relative[i].push((f.x[i] - vx * dt, f.y[i] - vy * dt));
-            }
         }
         let leader = (0..n)
             .max_by(|&i, &j| {
@@ -75,6 +70,19 @@ impl PathsChart {
                 pi.total_cmp(&pj)
             })
             .unwrap_or(0);
+        let t_end = last.t - t0;
+        let (ox, oy) = (last.x[leader] - vx * t_end, last.y[leader] - vy * t_end);
+        let mut world = vec![Vec::with_capacity(idx.len()); n];
+        let mut relative = vec![Vec::with_capacity(idx.len()); n];
+        for &k in &idx {
+            let f = &a.frames[k];
+            let dt = f.t - t0;
+            for i in 0..n {
+                world[i].push((f.x[i], f.y[i]));
+                let (qx, qy) = (f.x[i] - vx * dt - ox, f.y[i] - vy * dt - oy);
+                relative[i].push((qx * cos_phi - qy * sin_phi, qx * sin_phi + qy * cos_phi));
+            }
+        }
         let secs = (end - start) as f64 / a.fps;
         let what = if a.stage("initiation").is_some() {
             "Take-off".to_string()
@@ -159,13 +167,7 @@ impl PathsChart {
             .x_label_area_size(40)
             .y_label_area_size(50)
             .build_cartesian_2d(x0..x1, y0..y1)?;
-        chart
-            .configure_mesh()
-            .x_desc(x_desc)
-            .y_desc(y_desc)
-            .label_style((FONT_FAMILY, 13))
-            .light_line_style(RGBColor(235, 235, 235))
-            .draw()?;
+        super::draw_mesh(&mut chart, x_desc, y_desc, 13)?;
         let n = paths.len();
         let labelled = super::legend_ranks(n);
         let mut order: Vec<usize> = (0..n).collect();
@@ -199,13 +201,7 @@ impl PathsChart {
             }
         }
         if legend {
-            chart
-                .configure_series_labels()
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .label_font((FONT_FAMILY, 12))
-                .position(SeriesLabelPosition::UpperLeft)
-                .draw()?;
+            super::draw_legend(&mut chart, 12, SeriesLabelPosition::UpperLeft)?;
         }
         Ok(())
     }
@@ -231,9 +227,9 @@ impl Chart for PathsChart {
         self.panel(
             &right,
             &self.relative,
-            "moving with the cruise velocity (○ start, ● hand-over)",
-            "east − v_x t, wingspans",
-            "north − v_y t, wingspans",
+            "moving with the cruise velocity, flight direction up (○ start, ● hand-over)",
+            "across the flight, wingspans (leader at hand-over = 0)",
+            "along the flight − V t, wingspans",
             true,
         )?;
         Ok(())

@@ -14,9 +14,10 @@ use crate::error::{Error, Result};
 use crate::shape::Shape;
 
 /// Which quantity the bars show.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum PowerMetric {
     /// Relative power reduction ξ_i = e_i / E.
+    #[default]
     Xi,
     /// Power reduction e_i (Hummel's model without the drag ratio).
     E,
@@ -44,7 +45,8 @@ pub struct PowerChart {
 pub enum PowerOf {
     /// Key shape `k` (index into `key_shapes`), with the feasible ranges.
     Key(usize),
-    /// Frame `k`, in the formation frame of a flock heading +y.
+    /// Frame `k`, in the formation frame of its leader (any heading): bars at the birds'
+    /// offsets to the right of the leader's heading.
     Frame(usize),
 }
 
@@ -80,16 +82,19 @@ impl PowerChart {
                         ),
                     )
                 })?;
+                // The formation frame of SPEC §2 at this frame, whatever the heading: lateral
+                // offsets to the right of the leader's heading, distances behind it along it.
+                let rel = anim.relative(k);
+                let lateral: Vec<f64> = rel.iter().map(|r| r.lateral).collect();
                 let (e, xi) = match (&fr.e, &fr.xi) {
                     (Some(e), Some(xi)) => (e.clone(), xi.clone()),
                     _ => {
-                        // World → formation frame for a flock heading +y: y behind = −north.
-                        let back: Vec<f64> = fr.y.iter().map(|v| -v).collect();
-                        let p = power_reduction(&fr.x, &back)?;
+                        let behind: Vec<f64> = rel.iter().map(|r| r.behind).collect();
+                        let p = power_reduction(&lateral, &behind)?;
                         (p.e, p.xi)
                     }
                 };
-                (fr.x.clone(), e, xi, format!("frame {k}"))
+                (lateral, e, xi, format!("frame {k}"))
             }
             PowerOf::Key(k) => {
                 let ks = anim.key_shapes.get(k).ok_or_else(|| {
@@ -132,6 +137,39 @@ impl PowerChart {
             ranges: anim.xi_ranges.clone(),
             leader,
         })
+    }
+
+    /// The chart of the file at `path`: a shape file (SPEC §4.3), or formation `formation` of an
+    /// animation file and its key shape or frame `of` (default: key shape 0), told apart by
+    /// content ([`crate::sniff`]). Errors name `plot.formation`, `plot.key` or `plot.frame`.
+    pub fn from_file(
+        path: &Path,
+        formation: Option<usize>,
+        of: Option<PowerOf>,
+        metric: PowerMetric,
+    ) -> Result<PowerChart> {
+        if crate::sniff::path_kind(path)? == crate::sniff::Kind::Animation {
+            let (anim, which) = super::one_formation(Animation::read(path)?, formation, path)?;
+            let of = of.unwrap_or(PowerOf::Key(0));
+            let mut chart = PowerChart::from_animation(&anim, path, of, metric)?;
+            chart.title.push_str(which.as_deref().unwrap_or(""));
+            return Ok(chart);
+        }
+        let refuse = |option: &str, what: &str| {
+            Err(Error::parameter(
+                option,
+                format!("{} is a shape file, which has no {what}", path.display()),
+            ))
+        };
+        if formation.is_some() {
+            return refuse("plot.formation", "formations");
+        }
+        if of.is_some() {
+            return refuse("plot.key/plot.frame", "key shapes or frames");
+        }
+        let shape: Shape = crate::io::read_json(path)?;
+        shape.validate(path, 2)?;
+        PowerChart::from_shape(&shape, path, metric)
     }
 
     /// The chart of a shape file's shape (already validated), read from `origin`.
@@ -231,13 +269,7 @@ impl Chart for PowerChart {
                 )?;
             }
         }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font((FONT_FAMILY, 14))
-            .position(SeriesLabelPosition::UpperRight)
-            .draw()?;
+        super::draw_legend(&mut chart, 14, SeriesLabelPosition::UpperRight)?;
         Ok(())
     }
 }

@@ -113,13 +113,12 @@ impl Chart for SavingsChart {
             .x_label_area_size(40)
             .y_label_area_size(56)
             .build_cartesian_2d(-0.5..max_rank + 0.5, bottom..top)?;
-        chart
-            .configure_mesh()
-            .x_desc("rank (0 = leader, counted from the front)")
-            .y_desc("saving, % of solo induced power")
-            .label_style((FONT_FAMILY, 13))
-            .light_line_style(RGBColor(235, 235, 235))
-            .draw()?;
+        super::draw_mesh(
+            &mut chart,
+            "rank (0 = leader, counted from the front)",
+            "saving, % of solo induced power",
+            13,
+        )?;
         band(&mut chart, (-0.5, max_rank + 0.5))?;
         let n = s.birds.len();
         let mut by_rank: Vec<&crate::animation::stats::BirdStats> = s.birds.iter().collect();
@@ -157,13 +156,7 @@ impl Chart for SavingsChart {
             )))?
             .label(format!("this flock's mean: {:.1} %", 100.0 * flock))
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 14, y)], grey));
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font((FONT_FAMILY, 12))
-            .position(SeriesLabelPosition::LowerRight)
-            .draw()?;
+        super::draw_legend(&mut chart, 12, SeriesLabelPosition::LowerRight)?;
         // Right: the flock's saving over time.
         let t0 = s.saving_over_time.first().map_or(0.0, |p| p.0);
         let t1 = s
@@ -177,13 +170,12 @@ impl Chart for SavingsChart {
             .x_label_area_size(40)
             .y_label_area_size(56)
             .build_cartesian_2d(t0..t1, bottom..top)?;
-        chart
-            .configure_mesh()
-            .x_desc(self.time_label.as_str())
-            .y_desc("flock saving, % of solo induced power")
-            .label_style((FONT_FAMILY, 13))
-            .light_line_style(RGBColor(235, 235, 235))
-            .draw()?;
+        super::draw_mesh(
+            &mut chart,
+            self.time_label.as_str(),
+            "flock saving, % of solo induced power",
+            13,
+        )?;
         band(&mut chart, (t0, t1))?;
         if let Some((a, b)) = self.takeoff {
             let c = RGBColor(150, 150, 150);
@@ -207,13 +199,7 @@ impl Chart for SavingsChart {
             .legend(move |(x, y)| {
                 PathElement::new(vec![(x, y), (x + 14, y)], line.stroke_width(2))
             });
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font((FONT_FAMILY, 12))
-            .position(SeriesLabelPosition::LowerRight)
-            .draw()?;
+        super::draw_legend(&mut chart, 12, SeriesLabelPosition::LowerRight)?;
         Ok(())
     }
 }

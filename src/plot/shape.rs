@@ -158,13 +158,12 @@ impl Chart for ShapeChart {
             .y_label_area_size(56)
             // y grows downward: behind the leader is lower on the page, flight is up.
             .build_cartesian_2d(x0..x1, y1..y0)?;
-        chart
-            .configure_mesh()
-            .x_desc("x: lateral offset right of the flight direction (wingspans)")
-            .y_desc("y: distance behind the leader (wingspans)")
-            .label_style((FONT_FAMILY, 14))
-            .light_line_style(RGBColor(235, 235, 235))
-            .draw()?;
+        super::draw_mesh(
+            &mut chart,
+            "x: lateral offset right of the flight direction (wingspans)",
+            "y: distance behind the leader (wingspans)",
+            14,
+        )?;
 
         if let Some(t) = self.threshold {
             let mut labelled = false;

@@ -105,13 +105,7 @@ impl Chart for WingbeatChart {
                     PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2))
                 });
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .label_font((FONT_FAMILY, 13))
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()?;
+        super::draw_legend(&mut chart, 13, SeriesLabelPosition::UpperRight)?;
 
         let mut spread = ChartBuilder::on(&bottom)
             .margin(12)
@@ -142,13 +136,7 @@ impl Chart for WingbeatChart {
                 (0.01, 0.08),
                 (FONT_FAMILY, 12),
             )))?;
-        spread
-            .configure_series_labels()
-            .position(SeriesLabelPosition::LowerRight)
-            .label_font((FONT_FAMILY, 13))
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()?;
+        super::draw_legend(&mut spread, 13, SeriesLabelPosition::LowerRight)?;
         Ok(())
     }
 }

@@ -174,13 +174,7 @@ impl Chart for XiChart {
             }
         }
         {
-            chart
-                .configure_series_labels()
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .label_font((FONT_FAMILY, 13))
-                .position(SeriesLabelPosition::UpperRight)
-                .draw()?;
+            super::draw_legend(&mut chart, 13, SeriesLabelPosition::UpperRight)?;
         }
         Ok(())
     }

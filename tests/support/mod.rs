@@ -8,9 +8,14 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+/// The path of the built `formation` binary (for `sh -c` wrappers and the like).
+pub fn bin_path() -> &'static str {
+    env!("CARGO_BIN_EXE_formation")
+}
+
 /// The built `formation` binary, ready for arguments.
 pub fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_formation"))
+    Command::new(bin_path())
 }
 
 /// Runs the binary with `args` and returns everything it did.
@@ -26,6 +31,16 @@ pub fn run_quiet(args: &[&str]) -> (i32, String) {
         .output()
         .expect("run formation");
     (code(&out), stderr(&out))
+}
+
+/// Runs `formation --quiet ARGS` with `dir` as the working directory.
+pub fn run_in(dir: &Path, args: &[&str]) -> Output {
+    bin()
+        .current_dir(dir)
+        .arg("--quiet")
+        .args(args)
+        .output()
+        .expect("run formation")
 }
 
 /// The exit code, −1 for a signal.
@@ -79,17 +94,39 @@ pub fn data(name: &str) -> PathBuf {
         .join(name)
 }
 
-/// Exit 2 and exactly one line on stderr containing every `needle`.
+/// A file of the repository, by its path relative to the repository's root.
+pub fn repo_file(rel: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)
+}
+
+/// Exit 2 and exactly one line on stderr, starting with `error: `, no panic, containing every
+/// `needle`.
 pub fn assert_usage_error(out: &Output, needles: &[&str]) {
-    let err = stderr(out);
-    assert_eq!(out.status.code(), Some(2), "stderr: {err}");
+    assert_usage_error_in("", out, needles);
+}
+
+/// [`assert_usage_error`] for one `needle`, with `what` (the case) in every failure message.
+pub fn assert_refused(out: &Output, needle: &str, what: &str) {
+    assert_usage_error_in(what, out, &[needle]);
+}
+
+/// [`assert_usage_error`], with `what` (the case: its arguments, say) in every failure message.
+pub fn assert_usage_error_in(what: &str, out: &Output, needles: &[&str]) {
+    assert_usage_text(what, code(out), &stderr(out), needles);
+}
+
+/// [`assert_usage_error_in`] for a run already reduced to its exit `code` and stderr `err`.
+pub fn assert_usage_text(what: &str, code: i32, err: &str, needles: &[&str]) {
+    assert_eq!(code, 2, "{what}: exit {code}, stderr: {err}");
     assert_eq!(
         err.trim_end().lines().count(),
         1,
-        "one line expected: {err}"
+        "{what}: one line expected: {err}"
     );
+    assert!(err.starts_with("error: "), "{what}: {err}");
+    assert!(!err.contains("panicked"), "{what}: {err}");
     for n in needles {
-        assert!(err.contains(n), "{err:?} should mention {n:?}");
+        assert!(err.contains(n), "{what}: {err:?} should mention {n:?}");
     }
 }
 
