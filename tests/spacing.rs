@@ -1,29 +1,32 @@
 //! Real spacing in generated flocks (issue 12): the key shapes of a steady flight keep the
-//! footage's spacing. For each example flock (and the barnacle-geese footage read with a 17 %
-//! larger wingspan, whose lateral gaps, 0.77 wingspans, are the stereo-filmed white-fronted
-//! geese's: overlapping wingtips), the median lateral and longitudinal distance from each bird to
-//! the nearest bird ahead over all key shapes is compared with the same medians over the
-//! footage's frames, for N equal to and different from the footage's bird count.
+//! footage's spacing. For every example flock (the V, J and U footage, the cranes' wide V, the
+//! barnacle-geese footage read with a 17 % larger wingspan, whose lateral gaps, 0.77 wingspans,
+//! are the stereo-filmed white-fronted geese's: overlapping wingtips, and a synthetic echelon),
+//! the median lateral and longitudinal distance from each bird to the nearest bird ahead over all
+//! key shapes is compared with the same medians over the footage's frames, for N equal to, smaller
+//! than and larger than the footage's bird count, and for two seeds. The measure is written out
+//! here (plain O(N²)), independent of `formation::keyshape::spacing`.
 //! `scripts/spacing_medians.py` prints the same figures from CLI outputs.
+
+mod support;
 
 use std::path::Path;
 
+use formation::annotations::synth::{generate, SynthSpec};
 use formation::annotations::{self, ReadOptions};
 use formation::extract::{self, ExtractOptions, FormationParams};
-use formation::keyshape::{steady_flight, SteadyOptions};
+use formation::keyshape::{steady_flight_report, SteadyOptions};
 use formation::progress::Silent;
 use formation::rng::seeded;
+use formation::shape::ShapeKind;
 
-fn params(name: &str, wingspan_px: Option<f64>) -> FormationParams {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("examples_data")
-        .join(name);
-    let read = ReadOptions {
-        wingspan_px,
-        ..ReadOptions::default()
-    };
-    let ann = annotations::read(&path, &read).unwrap();
+fn params_at(path: &Path, read: &ReadOptions) -> FormationParams {
+    let ann = annotations::read(path, read).unwrap();
     extract::extract(&ann, &ExtractOptions::default(), &mut seeded(0)).unwrap()
+}
+
+fn params(name: &str, read: ReadOptions) -> FormationParams {
+    params_at(&support::example(name), &read)
 }
 
 /// (|Δx|, Δy) from every bird to its nearest bird ahead (smaller y), all birds but the front one.
@@ -67,8 +70,9 @@ fn medians(shapes: &[Vec<(f64, f64)>]) -> (f64, f64) {
     )
 }
 
-fn check(name: &str, wingspan_px: Option<f64>, birds: &[usize]) {
-    let p = params(name, wingspan_px);
+/// Asserts the 15 % lateral and 20 % longitudinal bounds for every count in `birds` and seeds 0
+/// and 1; prints the figures (`--nocapture`) for docs/model.md.
+fn check(label: &str, p: &FormationParams, birds: &[usize]) {
     let footage: Vec<Vec<(f64, f64)>> = p
         .frames
         .iter()
@@ -76,91 +80,116 @@ fn check(name: &str, wingspan_px: Option<f64>, birds: &[usize]) {
         .collect();
     let (lat0, lon0) = medians(&footage);
     for &n in birds {
-        let opts = SteadyOptions {
-            birds: n,
-            frames: 900,
-            ..SteadyOptions::default()
-        };
-        let anim = steady_flight(&p, &opts, &mut seeded(0), &Silent).unwrap();
-        let keys: Vec<Vec<(f64, f64)>> = anim
-            .key_shapes
-            .iter()
-            .map(|k| k.birds.iter().map(|b| (b.x, b.y)).collect())
-            .collect();
-        let (lat, lon) = medians(&keys);
-        eprintln!(
-            "{name} ({wingspan_px:?} px) N = {n}: lateral {lat:.3} vs {lat0:.3} ({:+.0} %), longitudinal {lon:.3} vs {lon0:.3} ({:+.0} %)",
-            100.0 * (lat / lat0 - 1.0),
-            100.0 * (lon / lon0 - 1.0)
-        );
-        assert!(
-            (lat / lat0 - 1.0).abs() <= 0.15,
-            "{name} N = {n}: lateral {lat} vs {lat0}"
-        );
-        assert!(
-            (lon / lon0 - 1.0).abs() <= 0.20,
-            "{name} N = {n}: longitudinal {lon} vs {lon0}"
-        );
+        for seed in [0, 1] {
+            let opts = SteadyOptions {
+                birds: n,
+                frames: 900,
+                seed,
+                ..SteadyOptions::default()
+            };
+            let (anim, rep) = steady_flight_report(p, &opts, &mut seeded(seed), &Silent).unwrap();
+            assert!(
+                rep.keys.max_residual <= 1e-6,
+                "{label} N = {n}: unsolved key"
+            );
+            let keys: Vec<Vec<(f64, f64)>> = anim
+                .key_shapes
+                .iter()
+                .map(|k| k.birds.iter().map(|b| (b.x, b.y)).collect())
+                .collect();
+            let (lat, lon) = medians(&keys);
+            eprintln!(
+                "{label} N = {n} seed {seed}: lateral {lat:.3} vs {lat0:.3} ({:+.0} %), longitudinal {lon:.3} vs {lon0:.3} ({:+.0} %), depth scale {:.3}",
+                100.0 * (lat / lat0 - 1.0),
+                100.0 * (lon / lon0 - 1.0),
+                rep.depth_scale
+            );
+            assert!(
+                (lat / lat0 - 1.0).abs() <= 0.15,
+                "{label} N = {n} seed {seed}: lateral {lat} vs {lat0}"
+            );
+            assert!(
+                (lon / lon0 - 1.0).abs() <= 0.20,
+                "{label} N = {n} seed {seed}: longitudinal {lon} vs {lon0}"
+            );
+        }
     }
 }
 
 #[test]
 fn v_footage_spacing_is_kept_for_any_number_of_birds() {
-    check("barnacle_geese_v.json", None, &[9, 7, 30]);
+    let p = params("barnacle_geese_v.json", ReadOptions::default());
+    check("barnacle geese V", &p, &[9, 7, 30]);
 }
 
 #[test]
 fn overlapping_wingtips_in_the_footage_are_kept() {
     // 38 px → 44.4 px per wingspan: the lateral gaps become the white-fronted geese's 0.77.
-    check("barnacle_geese_v.json", Some(44.4), &[9, 7, 30]);
+    let read = ReadOptions {
+        wingspan_px: Some(44.4),
+        ..ReadOptions::default()
+    };
+    check(
+        "barnacle geese V at 0.77",
+        &params("barnacle_geese_v.json", read),
+        &[9, 7, 30],
+    );
 }
 
 #[test]
-fn j_footage_spacing_is_kept_for_as_many_birds_or_more() {
-    check("snow_geese_j.csv", None, &[16, 30]);
+fn j_footage_spacing_is_kept_for_any_number_of_birds() {
+    let p = params("snow_geese_j.csv", ReadOptions::default());
+    check("snow geese J", &p, &[16, 7, 30]);
 }
 
 #[test]
-fn u_footage_spacing_is_kept_for_as_many_birds() {
-    check("pelicans_u_labelme", None, &[12]);
-}
-
-/// Not met yet (issue 12): the J with fewer birds than the footage and the U with a different
-/// number of birds miss the 20 % longitudinal bound (J, N = 7: −61 %; U, N = 7: +27 %, N = 30:
-/// +30 %): see docs/model.md.
-#[test]
-#[ignore = "open in issue 12: J with N = 7 and U with N = 7 or 30 miss the 20 % longitudinal bound"]
-fn j_and_u_spacing_when_n_differs_from_the_footage() {
-    check("snow_geese_j.csv", None, &[7]);
-    check("pelicans_u_labelme", None, &[7, 30]);
+fn u_footage_spacing_is_kept_for_any_number_of_birds() {
+    let p = params("pelicans_u_labelme", ReadOptions::default());
+    check("pelicans U", &p, &[12, 7, 30]);
 }
 
 #[test]
-fn u_footage_lateral_spacing_is_kept_for_other_counts() {
-    // Lateral spacing only for N = 7 and 30 (the longitudinal one is the ignored test above).
-    let p = params("pelicans_u_labelme", None);
-    let footage: Vec<Vec<(f64, f64)>> = p
-        .frames
-        .iter()
-        .map(|f| f.positions.iter().map(|b| (b.x, b.y)).collect())
-        .collect();
-    let (lat0, _) = medians(&footage);
-    for n in [7, 30] {
-        let opts = SteadyOptions {
-            birds: n,
-            frames: 900,
-            ..SteadyOptions::default()
-        };
-        let anim = steady_flight(&p, &opts, &mut seeded(0), &Silent).unwrap();
-        let keys: Vec<Vec<(f64, f64)>> = anim
-            .key_shapes
+fn wide_v_footage_spacing_is_kept_for_any_number_of_birds() {
+    let read = ReadOptions {
+        wingspan_px: Some(22.0),
+        heading: Some(annotations::Heading::Degrees(300.0)),
+        ..ReadOptions::default()
+    };
+    check(
+        "cranes V",
+        &params("cranes_v_dltdv.csv", read),
+        &[41, 20, 60],
+    );
+}
+
+#[test]
+fn echelon_footage_spacing_is_kept_for_any_number_of_birds() {
+    // No echelon among the examples: a synthetic one, 10 birds, leader at the left end.
+    let spec = SynthSpec {
+        kind: ShapeKind::Line,
+        birds: 10,
+        frames: 16,
+        slope_left: 0.55,
+        leader_at: 0.0,
+        noise: 0.05,
+        drift: 0.02,
+        ..SynthSpec::default()
+    };
+    let mut rng = seeded(3);
+    let flock = generate(&spec, &mut rng);
+    let dir = support::scratch("spacing-echelon");
+    let path = dir.join("echelon.json");
+    std::fs::write(
+        &path,
+        flock.native_json("synthetic echelon", true, &mut rng),
+    )
+    .unwrap();
+    let p = params_at(&path, &ReadOptions::default());
+    assert!(
+        p.frames
             .iter()
-            .map(|k| k.birds.iter().map(|b| (b.x, b.y)).collect())
-            .collect();
-        let (lat, _) = medians(&keys);
-        assert!(
-            (lat / lat0 - 1.0).abs() <= 0.15,
-            "N = {n}: lateral {lat} vs {lat0}"
-        );
-    }
+            .all(|f| matches!(f.shape, formation::extract::ShapeModel::Line { .. })),
+        "the footage is read as an echelon"
+    );
+    check("echelon", &p, &[10, 6, 24]);
 }

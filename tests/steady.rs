@@ -159,8 +159,10 @@ fn case(params: &FormationParams, birds: usize) {
         "  frames outside range {} max excess {:.2e}",
         rep.frames_outside_range, rep.max_frame_excess
     );
+    // Between keys both x (the lateral drift) and y are interpolated and ξ is recomputed: it
+    // may leave the ranges slightly (measured up to 1.2e-3 for 16 → 28 birds).
     assert!(
-        rep.max_frame_excess <= 1e-3,
+        rep.max_frame_excess <= 2e-3,
         "frame ξ leaves the ranges by {}",
         rep.max_frame_excess
     );
@@ -302,6 +304,99 @@ fn odd_movies_still_give_valid_flights() {
             };
             let (anim, rep) = steady_flight_report(p, &opts, &mut seeded(2), &Silent).unwrap();
             check(&anim, &rep, &opts);
+        }
+    }
+}
+
+/// Living lateral spacing (issue 19): over a two-minute flight from the example footage the
+/// lateral gaps between neighbours vary about as much as the footage's (standard deviation over
+/// time within a factor of 2), at least 90 % of the key shapes take their drifted lateral
+/// positions, every key is solved, and the motion stays smooth; equal seeds, equal bytes.
+#[test]
+fn lateral_gaps_breathe_like_the_footage() {
+    use formation::annotations::{self, ReadOptions};
+    use formation::extract::{self, ExtractOptions};
+    use std::collections::BTreeMap;
+    for (name, birds) in [("barnacle_geese_v.json", 9), ("snow_geese_j.csv", 16)] {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("examples_data")
+            .join(name);
+        let ann = annotations::read(&path, &ReadOptions::default()).unwrap();
+        let p = extract::extract(&ann, &ExtractOptions::default(), &mut seeded(0)).unwrap();
+        // The footage's variation, measured here from the positions: the sd over the frames of
+        // each pair of lateral neighbours' gap, median over the pairs.
+        let mut series: BTreeMap<(usize, usize), Vec<f64>> = BTreeMap::new();
+        for f in &p.frames {
+            let mut b: Vec<(f64, usize)> = f.positions.iter().map(|q| (q.x, q.id)).collect();
+            b.sort_by(|a, c| a.0.total_cmp(&c.0));
+            for w in b.windows(2) {
+                series
+                    .entry((w[0].1, w[1].1))
+                    .or_default()
+                    .push(w[1].0 - w[0].0);
+            }
+        }
+        let sd = |v: &[f64]| {
+            let m = v.iter().sum::<f64>() / v.len() as f64;
+            (v.iter().map(|g| (g - m).powi(2)).sum::<f64>() / v.len() as f64).sqrt()
+        };
+        let median = |mut v: Vec<f64>| {
+            v.sort_by(f64::total_cmp);
+            v[v.len() / 2]
+        };
+        let footage = median(
+            series
+                .values()
+                .filter(|v| v.len() >= p.frames.len() / 2)
+                .map(|v| sd(v))
+                .collect(),
+        );
+        let opts = SteadyOptions {
+            birds,
+            frames: 3600,
+            seed: 5,
+            ..SteadyOptions::default()
+        };
+        let (anim, rep) = steady_flight_report(&p, &opts, &mut seeded(5), &Silent).unwrap();
+        let keys = anim.key_shapes.len();
+        eprintln!(
+            "{name}: drift {:.3}, lateral_held {} of {} keys, {:?}",
+            rep.lateral_drift,
+            rep.keys.lateral_held,
+            keys - 1,
+            rep.keys
+        );
+        assert!(
+            (rep.keys.lateral_held as f64) <= 0.1 * (keys - 1) as f64,
+            "{name}: {} of {} keys kept the previous lateral positions",
+            rep.keys.lateral_held,
+            keys - 1
+        );
+        assert_eq!(rep.keys.held, 0, "{name}: a key was held");
+        // Each gap's sd over the key shapes' lateral positions, median over the gaps.
+        let gaps: Vec<f64> = (0..birds - 1)
+            .map(|i| {
+                let v: Vec<f64> = anim
+                    .key_shapes
+                    .iter()
+                    .map(|k| k.birds[i + 1].x - k.birds[i].x)
+                    .collect();
+                sd(&v)
+            })
+            .collect();
+        let generated = median(gaps);
+        eprintln!("{name}: lateral gap sd {generated:.3} vs footage {footage:.3}");
+        assert!(
+            generated >= footage / 2.0 && generated <= footage * 2.0,
+            "{name}: lateral gap sd {generated} vs the footage's {footage}"
+        );
+        check(&anim, &rep, &opts);
+        // The frames' lateral positions move smoothly too.
+        for f in 1..anim.frames.len() {
+            for i in 0..birds {
+                let dx = (anim.frames[f].x[i] - anim.frames[f - 1].x[i]).abs();
+                assert!(dx < 0.05, "{name} frame {f} bird {i}: lateral step {dx}");
+            }
         }
     }
 }

@@ -139,6 +139,16 @@ pub fn correspondence(first: &FrameParams, n: usize) -> Result<Correspondence> {
 }
 
 /// Places the movie birds of one side (closest first) into `slots` animated slots (closest first).
+///
+/// With at least as many slots as movie birds, every movie bird is placed, in the priority
+/// closest, farthest, outliers, inliers, at the slot whose rank is proportional to its own (the
+/// nearest free one). With fewer slots (a choice the paper leaves open) the side is sub-sampled
+/// uniformly: the closest and the farthest bird keep the end slots, the side's outliers keep
+/// their share of the slots (round(outliers · slots / birds), closest first, at their
+/// proportional slots), and every other slot takes the inlier whose rank is nearest to the
+/// slot's proportional rank, so the survivors are spread along the side as the footage's birds
+/// are (not crowded next to the leader) and the smaller flock has the footage's share of
+/// stragglers.
 fn match_side(
     ids: &[usize],
     slots: usize,
@@ -150,25 +160,69 @@ fn match_side(
     if k == 0 {
         return out;
     }
-    // Priority: closest, farthest, outliers (closest first), inliers (closest first).
-    let mut priority: Vec<usize> = vec![0];
-    if k > 1 {
-        priority.push(k - 1);
-    }
-    let middle = 1..k.saturating_sub(1);
-    let (out_ranks, in_ranks): (Vec<usize>, Vec<usize>) =
-        middle.partition(|&r| outliers.contains(&ids[r]));
-    priority.extend(out_ranks);
-    priority.extend(in_ranks);
-    for r in priority {
-        let target = if k == 1 || slots == 0 {
+    let proportional = |r: usize| -> usize {
+        if k == 1 || slots <= 1 {
             0
         } else {
             ((r as f64) * ((slots - 1) as f64) / ((k - 1) as f64)).round() as usize
-        };
-        match nearest_free(&out, target) {
-            Some(s) => out[s] = Some(r),
-            None => dropped.push(ids[r]),
+        }
+    };
+    let middle = 1..k.saturating_sub(1);
+    let (out_ranks, in_ranks): (Vec<usize>, Vec<usize>) =
+        middle.partition(|&r| outliers.contains(&ids[r]));
+    let mut placed = vec![false; k];
+    let mut place = |out: &mut Vec<Option<usize>>, r: usize| {
+        if let Some(s) = nearest_free(out, proportional(r)) {
+            out[s] = Some(r);
+            placed[r] = true;
+        }
+    };
+    // Closest, farthest.
+    place(&mut out, 0);
+    if k > 1 {
+        place(&mut out, k - 1);
+    }
+    if slots >= k {
+        for r in out_ranks.iter().chain(&in_ranks) {
+            place(&mut out, *r);
+        }
+    } else {
+        let share = ((out_ranks.len() * slots) as f64 / k as f64).round() as usize;
+        for r in out_ranks.iter().take(share) {
+            place(&mut out, *r);
+        }
+        // Each free slot takes the unplaced inlier nearest to its proportional rank (ties
+        // toward the leader), between the ranks of the slots' placed neighbours.
+        for s in 0..slots {
+            if out[s].is_some() {
+                continue;
+            }
+            let want = if slots <= 1 {
+                0.0
+            } else {
+                s as f64 * (k - 1) as f64 / (slots - 1) as f64
+            };
+            let lo = out[..s].iter().flatten().max().copied();
+            let hi = out[s + 1..].iter().flatten().min().copied();
+            let best = in_ranks
+                .iter()
+                .copied()
+                .filter(|&r| !placed[r] && lo.map_or(true, |l| r > l) && hi.map_or(true, |h| r < h))
+                .min_by(|&a, &b| {
+                    (a as f64 - want)
+                        .abs()
+                        .total_cmp(&(b as f64 - want).abs())
+                        .then(a.cmp(&b))
+                });
+            if let Some(r) = best {
+                out[s] = Some(r);
+                placed[r] = true;
+            }
+        }
+    }
+    for (r, &id) in ids.iter().enumerate() {
+        if !placed[r] {
+            dropped.push(id);
         }
     }
     // Collisions can swap neighbours; keep the movie's lateral order on the occupied slots (the
@@ -270,8 +324,19 @@ pub fn initial_shapes(
     rng: &mut impl Rng,
     opts: &InitialOptions,
 ) -> Vec<Shape> {
+    initial_shapes_scaled(params, corr, side_scales(params, corr), rng, opts)
+}
+
+/// [`initial_shapes`] with the U and J curves' rank scales (left, right) given (see
+/// [`curve_y`]; [`side_scales`] are the plain ratios of birds per side).
+pub fn initial_shapes_scaled(
+    params: &FormationParams,
+    corr: &Correspondence,
+    (scale_left, scale_right): (f64, f64),
+    rng: &mut impl Rng,
+    opts: &InitialOptions,
+) -> Vec<Shape> {
     let n = corr.birds;
-    let (scale_left, scale_right) = side_scales(params, corr);
     params
         .frames
         .iter()

@@ -54,6 +54,10 @@ pub struct KeyOptions {
     /// Depth limit of key shapes: no bird further behind the leader than this factor times the
     /// deepest initial shape plus one wingspan, dimensionless (≥ 1).
     pub max_depth_factor: f64,
+    /// Widening of the band of the median longitudinal distance to the nearest bird ahead that
+    /// the initial shapes span, inside which every key shape's must stay (the footage's
+    /// spacing, issue 12), fraction in [0, 1].
+    pub spacing_margin: f64,
 }
 
 impl Default for KeyOptions {
@@ -68,6 +72,7 @@ impl Default for KeyOptions {
             max_damping: 12,
             accept_residual: 1e-6,
             max_depth_factor: 1.5,
+            spacing_margin: 0.0,
         }
     }
 }
@@ -120,6 +125,12 @@ impl KeyOptions {
         }
         if !(self.max_depth_factor.is_finite() && self.max_depth_factor >= 1.0) {
             return p("steady.keys.max_depth_factor", "must be at least 1".into());
+        }
+        if !(self.spacing_margin.is_finite() && (0.0..=1.0).contains(&self.spacing_margin)) {
+            return p(
+                "steady.keys.spacing_margin",
+                format!("{}: must be in [0, 1]", self.spacing_margin),
+            );
         }
         Ok(())
     }
@@ -206,6 +217,10 @@ pub struct Structure {
     /// An outer bird may come this far ahead of its inner neighbour before the arm counts as
     /// broken, wingspans (near-ties, e.g. around a J's vertex, would otherwise block every move).
     pub monotone_tolerance: f64,
+    /// The band [lo, hi] of the median longitudinal distance to the nearest bird ahead
+    /// ([`crate::keyshape::spacing`]), wingspans: the footage's spacing, as the initial shapes
+    /// span it. `None`: not checked.
+    pub spacing: Option<(f64, f64)>,
 }
 
 impl Structure {
@@ -233,11 +248,13 @@ impl Structure {
             monotone_pairs: pairs,
             max_depth,
             monotone_tolerance: 0.1,
+            spacing: None,
         }
     }
 
-    /// True when `y` keeps the leader front-most, the depth limit and the arms' monotone steps.
-    pub fn accepts(&self, y: &[f64]) -> bool {
+    /// True when the depths `y` at lateral positions `x` keep the leader front-most, the depth
+    /// limit, the arms' monotone steps and the spacing band.
+    pub fn accepts(&self, x: &[f64], y: &[f64]) -> bool {
         let Some(&yl) = y.get(self.leader) else {
             return false;
         };
@@ -250,7 +267,13 @@ impl Structure {
             .monotone_pairs
             .iter()
             .all(|&(inner, outer)| y[outer] >= y[inner] - self.monotone_tolerance);
-        ok_leader && ok_depth && ok_arms
+        ok_leader
+            && ok_depth
+            && ok_arms
+            && self.spacing.map_or(true, |(lo, hi)| {
+                let m = crate::keyshape::spacing::spacing([(x, y)]).1;
+                m >= lo && m <= hi
+            })
     }
 }
 
@@ -348,7 +371,7 @@ fn attempt(
     // Leader at 0 (the solver puts the front-most bird there; re-anchor on ours).
     let yl = report.y[structure.leader];
     let y: Vec<f64> = report.y.iter().map(|v| v - yl).collect();
-    if !structure.accepts(&y) {
+    if !structure.accepts(x, &y) {
         stats.rejected_structure += 1;
         return Ok(Attempt::Rejected);
     }
@@ -476,35 +499,37 @@ pub fn next_key(
     // The lateral positions drifted since the previous key: its fore-aft placement at the new
     // positions is the reference of eq. (2) (and the fallback at λ = 0, reachable by design).
     let moved;
+    let mut hull = XiRanges {
+        min: vec![],
+        max: vec![],
+    };
     let prev = if prev.x.as_slice() == x {
         prev
     } else {
+        // A pair brought wing to wing by the drift: the bird behind drops back (as in step 1).
+        let y = crate::keyshape::steady::separate(x, &prev.y, &solve_opts.aero);
         let xi: Vec<f64> = solve_opts
             .aero
-            .power_lenient(x, &prev.y)
+            .power_lenient(x, &y)
             .iter()
             .map(|e| e / total)
             .collect();
-        // The reference of eq. (2) inside the feasible ranges (renormalised, as a draw is), so
-        // that every target, damped or not, stays in them.
-        let mut reference = xi.clone();
-        for _ in 0..100 {
-            if feasible.excess(&reference) <= 1e-13 {
-                break;
-            }
-            feasible.clip(&mut reference);
-            renormalise(&mut reference);
-        }
+        // The reference of eq. (2) is this placement as it is (ξ̂ at λ = 0, which the previous
+        // y solves exactly); the ranges at the new positions are extended to it, so that the
+        // damped targets between it and a draw inside the ranges stay in them.
+        hull = feasible.including(&xi);
         moved = KeyShape {
             x: x.to_vec(),
-            xi_target: reference,
+            y,
+            xi_target: xi.clone(),
             xi,
             ..prev.clone()
         };
         &moved
     };
+    let feasible = if hull.is_empty() { feasible } else { &hull };
     let predictor = Predictor::new(x, prev, structure.leader, total, &solve_opts.aero);
-    let promising = |y: &[f64]| structure.accepts(y) && max_jump(&prev.y, y) <= opts.max_jump;
+    let promising = |y: &[f64]| structure.accepts(x, y) && max_jump(&prev.y, y) <= opts.max_jump;
     let mut tried: Vec<Vec<f64>> = Vec::new();
     let mut draws = 0;
     for _ in 0..opts.max_draws.max(1) {
@@ -583,23 +608,51 @@ pub fn next_key(
     })
 }
 
-/// The lateral positions of every key and E there (Munk), and whether the keys return to the
-/// first one (a loop: each draw is pulled toward the first key's ξ̂, more so near the end).
+/// One key's lateral positions and what depends on them.
+#[derive(Debug, Clone)]
+pub struct LateralKey {
+    /// Lateral positions, wingspans.
+    pub x: Vec<f64>,
+    /// E there (Munk), dimensionless.
+    pub total: f64,
+    /// Feasible ranges of ξ there (the initial shapes' ξ at these positions, widened by ε).
+    pub feasible: XiRanges,
+}
+
+/// The lateral positions of every key (with E and the feasible ranges there), and whether the
+/// keys return to the first one (a loop: each draw is pulled toward the first key's ξ̂, more so
+/// near the end).
 #[derive(Debug, Clone, Default)]
 pub struct KeyPlan {
-    /// Per key after the first: lateral positions (wingspans) and E there; empty: `ctx.x`.
-    pub lateral: Vec<(Vec<f64>, f64)>,
+    /// Per key (the first included): its lateral positions; empty: `ctx.x` for every key.
+    pub lateral: Vec<LateralKey>,
     /// Pull the draws back toward the first key (a loop).
     pub home: bool,
 }
 
+/// `ctx` at the lateral positions of `l` (`None`: as it is).
+fn context_at<'b>(ctx: &KeyContext<'b>, l: Option<&'b LateralKey>) -> KeyContext<'b> {
+    match l {
+        Some(l) => KeyContext {
+            x: &l.x,
+            total: l.total,
+            feasible: &l.feasible,
+            ..*ctx
+        },
+        None => *ctx,
+    }
+}
+
 /// `count` key shapes starting from `first` (already solved), each from the one before, key k
-/// at the lateral positions `plan.lateral[k]`.
+/// at the lateral positions `plan.lateral[k]`. When no shape fits a key's drifted positions
+/// (every damped target failed), that key keeps the previous key's positions
+/// (`KeyStats::lateral_held`).
 pub fn key_shapes(
     ctx: &KeyContext,
     plan: &KeyPlan,
     first: KeyShape,
     count: usize,
+    lateral_at: &dyn Fn(&[f64]) -> Option<LateralKey>,
     rng: &mut impl Rng,
     mut on_key: impl FnMut(),
 ) -> Result<(Vec<KeyShape>, KeyStats)> {
@@ -611,39 +664,45 @@ pub fn key_shapes(
     let mut keys = Vec::with_capacity(count);
     keys.push(first);
     on_key();
+    // The positions the previous key has (`None`: `ctx.x`).
+    let mut current: Option<LateralKey> = plan.lateral.first().cloned();
     while keys.len() < count {
         let prev = keys
             .last()
             .ok_or_else(|| Error::Internal("no key".into()))?;
         let at = keys.len();
-        let ctx_k = match plan.lateral.get(at) {
-            Some((x, total)) => KeyContext {
-                x,
-                total: *total,
-                ..*ctx
-            },
-            None => *ctx,
-        };
+        let mut here = plan.lateral.get(at).cloned().or_else(|| current.clone());
+        // After a key that kept older positions, the plan can be more than `max_jump` away:
+        // this key goes that far toward it.
+        if let Some(l) = &here {
+            let jump = max_jump(&prev.x, &l.x);
+            if jump > ctx.opts.max_jump {
+                let f = ctx.opts.max_jump / jump;
+                let x: Vec<f64> = prev
+                    .x
+                    .iter()
+                    .zip(&l.x)
+                    .map(|(a, b)| a + f * (b - a))
+                    .collect();
+                here = lateral_at(&x).or_else(|| current.clone());
+            }
+        }
         let w = (at as f64 / count.max(2) as f64).powi(2);
         let home = plan.home.then(|| (keys[0].xi_target.as_slice(), w));
-        let mut k = next_key(&ctx_k, prev, home, rng, &mut stats)?;
+        let mut k = next_key(&context_at(ctx, here.as_ref()), prev, home, rng, &mut stats)?;
         if k.damping == 0.0 && k.x != prev.x {
             // No shape at the drifted lateral positions: this key keeps the previous ones.
             stats.held -= 1;
             stats.lateral_held += 1;
-            let ctx_prev = KeyContext {
-                x: &prev.x,
-                total: if prev.x.as_slice() == ctx.x {
-                    ctx.total
-                } else {
-                    plan.lateral
-                        .iter()
-                        .find(|(x, _)| *x == prev.x)
-                        .map_or(ctx.total, |(_, t)| *t)
-                },
-                ..*ctx
-            };
-            k = next_key(&ctx_prev, prev, home, rng, &mut stats)?;
+            k = next_key(
+                &context_at(ctx, current.as_ref()),
+                prev,
+                home,
+                rng,
+                &mut stats,
+            )?;
+        } else {
+            current = here;
         }
         stats.min_damping = stats.min_damping.min(k.damping);
         stats.max_residual = stats.max_residual.max(k.residual);
@@ -684,18 +743,28 @@ mod tests {
     fn structure_keeps_leader_and_arms() {
         let x = [-2.0, -1.0, 0.0, 1.0, 2.0];
         let y = [1.4, 0.7, 0.0, 0.7, 1.4];
-        let s = Structure::of(&x, &y, 2, 5.0);
+        let mut s = Structure::of(&x, &y, 2, 5.0);
         assert_eq!(s.monotone_pairs.len(), 4);
-        assert!(s.accepts(&y));
+        assert!(s.accepts(&x, &y));
         assert!(
-            !s.accepts(&[1.4, 0.7, 0.0, -0.1, 1.4]),
+            !s.accepts(&x, &[1.4, 0.7, 0.0, -0.1, 1.4]),
             "bird ahead of leader"
         );
-        assert!(!s.accepts(&[0.5, 0.7, 0.0, 0.7, 1.4]), "arm not monotone");
         assert!(
-            s.accepts(&[0.65, 0.7, 0.0, 0.7, 1.4]),
+            !s.accepts(&x, &[0.5, 0.7, 0.0, 0.7, 1.4]),
+            "arm not monotone"
+        );
+        assert!(
+            s.accepts(&x, &[0.65, 0.7, 0.0, 0.7, 1.4]),
             "within the tolerance"
         );
-        assert!(!s.accepts(&[1.4, 0.7, 0.0, 0.7, 6.0]), "too deep");
+        assert!(!s.accepts(&x, &[1.4, 0.7, 0.0, 0.7, 6.0]), "too deep");
+        // The spacing band: median step to the nearest bird ahead 0.7 here.
+        s.spacing = Some((0.6, 0.8));
+        assert!(s.accepts(&x, &y));
+        assert!(
+            !s.accepts(&x, &[2.0, 1.0, 0.0, 1.0, 2.0]),
+            "steps of 1 outside the band"
+        );
     }
 }

@@ -8,6 +8,7 @@ pub mod keys;
 pub mod lateral;
 pub mod ranges;
 pub mod solve;
+pub mod spacing;
 pub mod steady;
 
 pub use heights::HeightOptions;

@@ -42,6 +42,32 @@ impl XiRanges {
         self.min.is_empty()
     }
 
+    /// The ranges extended, bird by bird, to contain `xi`.
+    pub fn including(&self, xi: &[f64]) -> XiRanges {
+        XiRanges {
+            min: self.min.iter().zip(xi).map(|(a, v)| a.min(*v)).collect(),
+            max: self.max.iter().zip(xi).map(|(a, v)| a.max(*v)).collect(),
+        }
+    }
+
+    /// The union of two ranges, bird by bird (the smallest range containing both).
+    pub fn union(&self, other: &XiRanges) -> XiRanges {
+        XiRanges {
+            min: self
+                .min
+                .iter()
+                .zip(&other.min)
+                .map(|(a, b)| a.min(*b))
+                .collect(),
+            max: self
+                .max
+                .iter()
+                .zip(&other.max)
+                .map(|(a, b)| a.max(*b))
+                .collect(),
+        }
+    }
+
     /// Clips `xi` into the ranges, bird by bird.
     pub fn clip(&self, xi: &mut [f64]) {
         for ((v, lo), hi) in xi.iter_mut().zip(&self.min).zip(&self.max) {

@@ -28,15 +28,16 @@ use crate::error::{Error, Result};
 use crate::extract::params::FormationParams;
 use crate::keyshape::heights::{heights, HeightOptions};
 use crate::keyshape::initial::{
-    correspondence, curve_y, initial_shapes, lateral_gaps, positions_from_gaps, side_scales,
+    correspondence, curve_y, initial_shapes_scaled, lateral_gaps, positions_from_gaps, side_scales,
     Correspondence, InitialOptions,
 };
 use crate::keyshape::interpolate::Track;
 use crate::keyshape::keys::{
-    key_shapes, KeyContext, KeyOptions, KeyPlan, KeyShape, KeyStats, Structure,
+    key_shapes, KeyContext, KeyOptions, KeyPlan, KeyShape, KeyStats, LateralKey, Structure,
 };
 use crate::keyshape::lateral::{lateral_plan, LateralOptions};
 use crate::keyshape::ranges::{power_at, xi_ranges, XiRanges};
+use crate::keyshape::spacing;
 use crate::progress::Progress;
 
 /// Options of the steady flight (the `steady` section of [`crate::pipeline::Config`]). Each
@@ -199,6 +200,18 @@ pub struct SteadyReport {
     pub key_frames: Vec<usize>,
     /// Step 3 counts.
     pub keys: KeyStats,
+    /// The footage's median (lateral, longitudinal) distance to the nearest bird ahead,
+    /// wingspans (`None` without positions in the params).
+    pub footage_spacing: Option<(f64, f64)>,
+    /// Factor on the U and J curves' rank scale that gives the initial shapes the footage's
+    /// longitudinal spacing (1 for V and line frames, or without positions).
+    pub depth_scale: f64,
+    /// Band of every key shape's median longitudinal distance to the nearest bird ahead,
+    /// wingspans.
+    pub spacing_band: Option<(f64, f64)>,
+    /// Standard deviation of the lateral gaps' drift between key shapes, wingspans (the
+    /// footage's unless `steady.lateral.drift` is set).
+    pub lateral_drift: f64,
     /// Frames where some bird's ξ leaves its feasible range.
     pub frames_outside_range: usize,
     /// Largest amount by which a frame's ξ leaves the feasible range.
@@ -254,6 +267,63 @@ pub fn separate(x: &[f64], y: &[f64], aero: &AeroOptions) -> Vec<f64> {
     y
 }
 
+/// The shapes' depths with every collision at lateral positions `x` resolved by [`separate`]
+/// (each shape keeps its own lateral positions).
+fn separated_at(
+    x: &[f64],
+    shapes: &[crate::shape::Shape],
+    aero: &AeroOptions,
+) -> Vec<crate::shape::Shape> {
+    shapes
+        .iter()
+        .map(|s| crate::shape::Shape::from_xy(&s.xs(), &separate(x, &s.ys(), aero)))
+        .collect()
+}
+
+/// Largest factor (and smallest, its inverse) [`depth_scale`] applies to the U and J curves.
+const DEPTH_SCALE_LIMIT: f64 = 3.0;
+
+/// The factor on the U and J curves' rank scale ([`side_scales`]) that gives the initial shapes,
+/// at the key shapes' lateral positions `x`, the footage's median longitudinal distance to the
+/// nearest bird ahead (issue 12). The plain rank scale keeps each bird's step behind its
+/// neighbour at the same relative place on the arm, but a median of the few steps of a small
+/// flock, or of the many of a large one, is not the footage's median of its own count (a
+/// parabola's steps grow along the arm), and the noise of the deviations adds to it. The
+/// shapes are drawn from a generator seeded from `rng` (one draw), so the flight stays
+/// deterministic. 1 when no frame is a U or J, or without positions.
+fn depth_scale(
+    params: &FormationParams,
+    corr: &Correspondence,
+    x: &[f64],
+    footage: Option<(f64, f64)>,
+    init: &InitialOptions,
+    rng: &mut impl Rng,
+    at_key_x: &dyn Fn(Vec<crate::shape::Shape>) -> Vec<crate::shape::Shape>,
+) -> f64 {
+    use crate::extract::params::ShapeModel;
+    let curved = params
+        .frames
+        .iter()
+        .any(|f| matches!(f.shape, ShapeModel::U { .. } | ShapeModel::J { .. }));
+    let Some((_, target)) = footage.filter(|_| curved) else {
+        return 1.0;
+    };
+    let seed: u64 = rng.random();
+    let (sl, sr) = side_scales(params, corr);
+    spacing::depth_scale(target, DEPTH_SCALE_LIMIT, |t| {
+        let mut r = crate::rng::seeded(seed);
+        let shapes = at_key_x(initial_shapes_scaled(
+            params,
+            corr,
+            (sl * t, sr * t),
+            &mut r,
+            init,
+        ));
+        let ys: Vec<Vec<f64>> = shapes.iter().map(|s| s.ys()).collect();
+        spacing::spacing(ys.iter().map(|y| (x, y.as_slice()))).1
+    })
+}
+
 /// The steady flight of Algorithm 1 as an animation (one `steady` stage covering all frames).
 pub fn steady_flight(
     params: &FormationParams,
@@ -293,16 +363,18 @@ pub fn steady_flight_report(
     let mean_gap = (lo_mu + u * (hi_mu - lo_mu)).max(init_opts.min_gap);
     let gaps = lateral_gaps(rng, mean_gap, sigma_bar, n - 1, init_opts);
     let x = positions_from_gaps(&gaps, corr.leader);
-    let shapes = initial_shapes(params, &corr, rng, init_opts);
-
-    // Step 2, at the key shapes' lateral positions.
     // At the key shapes' lateral positions a movie frame's placement can put two birds wing to
     // wing; the bird behind is moved back to the collision distance (what a real bird does).
     let aero = &opts.aero;
-    let shapes: Vec<crate::shape::Shape> = shapes
-        .iter()
-        .map(|s| crate::shape::Shape::from_xy(&s.xs(), &separate(&x, &s.ys(), aero)))
-        .collect();
+    let at_key_x = |shapes: Vec<crate::shape::Shape>| separated_at(&x, &shapes, aero);
+    let footage = spacing::footage_spacing(params);
+    let depth_scale = depth_scale(params, &corr, &x, footage, init_opts, rng, &at_key_x);
+    let (sl, sr) = side_scales(params, &corr);
+    let scales = (sl * depth_scale, sr * depth_scale);
+    let raw_shapes = initial_shapes_scaled(params, &corr, scales, rng, init_opts);
+    let shapes = at_key_x(raw_shapes.clone());
+
+    // Step 2, at the key shapes' lateral positions.
     let values = power_at(&x, &shapes, aero)?;
     let ranges = xi_ranges(&values)?;
     let feasible = ranges.widened(opts.keys.epsilon);
@@ -325,14 +397,15 @@ pub fn steady_flight_report(
         monotone_pairs: vec![],
         max_depth,
         monotone_tolerance: 0.0,
+        spacing: None,
     };
     let first_key_from = shapes
         .iter()
-        .position(|s| loose.accepts(&s.ys()) && aero.first_collision(&x, &s.ys()).is_none());
+        .position(|s| loose.accepts(&x, &s.ys()) && aero.first_collision(&x, &s.ys()).is_none());
     let y0: Vec<f64> = match first_key_from {
         Some(i) => shapes[i].ys(),
         None => {
-            let (sl, sr) = side_scales(params, &corr);
+            let (sl, sr) = scales;
             x.iter()
                 .enumerate()
                 .map(|(i, &xi)| {
@@ -361,7 +434,24 @@ pub fn steady_flight_report(
         damping: 1.0,
         draws: 0,
     };
-    let structure = Structure::of(&x, &y0, corr.leader, max_depth);
+    // The key shapes' spacing stays inside the band the initial shapes span (as each bird's ξ
+    // stays inside its range), widened by `keys.spacing_margin`.
+    let spacing_band = shapes
+        .iter()
+        .map(|s| spacing::spacing([(x.as_slice(), s.ys().as_slice())]).1)
+        .filter(|m| m.is_finite())
+        .fold(None, |b: Option<(f64, f64)>, m| {
+            Some(b.map_or((m, m), |(lo, hi)| (lo.min(m), hi.max(m))))
+        })
+        .map(|(lo, hi)| {
+            let m0 = spacing::spacing([(x.as_slice(), y0.as_slice())]).1;
+            let w = opts.keys.spacing_margin;
+            (lo.min(m0) * (1.0 - w), hi.max(m0) * (1.0 + w))
+        });
+    let structure = Structure {
+        spacing: spacing_band,
+        ..Structure::of(&x, &y0, corr.leader, max_depth)
+    };
 
     // Step 3.
     let key_frames = opts.key_frames();
@@ -378,24 +468,63 @@ pub fn steady_flight_report(
     };
     let mut lateral = Vec::with_capacity(nk);
     let mut lat_rng = crate::rng::stream(opts.seed, "steady.lateral");
-    for xk in lateral_plan(&gaps, corr.leader, nk, opts, &mut lat_rng) {
-        // A drift that leaves the flock no saving in total keeps the drawn positions.
-        match aero.munk_total(&xk) {
-            Ok(t) if t > 0.0 => lateral.push((xk, t)),
-            _ => lateral.push((x.clone(), total)),
-        }
+    let drawn = LateralKey {
+        x: x.clone(),
+        total,
+        feasible: feasible.clone(),
+    };
+    let drift = opts.lateral.drift_for(params);
+    // Each key's feasible ranges are the initial shapes' ξ at its own lateral positions (as
+    // step 2 does at the drawn ones). A drift that leaves the flock no saving in total, or at
+    // which every initial shape collides, is not taken.
+    let lateral_at = |xk: &[f64]| -> Option<LateralKey> {
+        let t = aero.munk_total(xk).ok().filter(|t| *t > 0.0)?;
+        let values = power_at(xk, &separated_at(xk, &raw_shapes, aero), aero).ok()?;
+        Some(LateralKey {
+            x: xk.to_vec(),
+            total: t,
+            feasible: xi_ranges(&values).ok()?.widened(opts.keys.epsilon),
+        })
+    };
+    for xk in lateral_plan(&gaps, corr.leader, nk, drift, opts, &mut lat_rng) {
+        lateral.push(if xk == x {
+            drawn.clone()
+        } else {
+            lateral_at(&xk).unwrap_or_else(|| drawn.clone())
+        });
     }
     let plan = KeyPlan {
         lateral,
         home: opts.looped,
     };
     let solved = if opts.looped { nk - 1 } else { nk };
-    let (mut keys, key_stats) = key_shapes(&ctx, &plan, key0, solved, rng, || progress.advance(1))?;
+    let (mut keys, key_stats) = key_shapes(&ctx, &plan, key0, solved, &lateral_at, rng, || {
+        progress.advance(1)
+    })?;
     if opts.looped {
         keys.push(keys[0].clone());
         progress.advance(1);
     }
     progress.finish();
+    // The published ranges: every key's own, extended (as its draws were) to the previous key's
+    // placement at its lateral positions.
+    let mut feasible = feasible;
+    for (k, key) in keys.iter().enumerate().skip(1) {
+        if let Some(l) = plan.lateral.iter().find(|l| l.x == key.x) {
+            feasible = feasible.union(&l.feasible);
+        } else if let Some(l) = lateral_at(&key.x) {
+            feasible = feasible.union(&l.feasible);
+        }
+        if key.x != keys[k - 1].x {
+            let t = aero.munk_total(&key.x).unwrap_or(total);
+            let reference: Vec<f64> = aero
+                .power_lenient(&key.x, &keys[k - 1].y)
+                .iter()
+                .map(|e| e / t)
+                .collect();
+            feasible = feasible.including(&reference);
+        }
+    }
     let heights = heights(n, &x, corr.leader, nk, opts);
 
     // Step 4.
@@ -505,6 +634,10 @@ pub fn steady_flight_report(
         first_key_from,
         key_frames,
         keys: key_stats,
+        footage_spacing: footage,
+        depth_scale,
+        spacing_band,
+        lateral_drift: drift,
         frames_outside_range,
         max_frame_excess,
     };
@@ -556,7 +689,7 @@ mod tests {
             KeyOptions::default().c1,
             "unset fields keep defaults"
         );
-        assert_eq!(o.lateral.drift, 0.05);
+        assert_eq!(o.lateral.drift, Some(0.05));
         assert!(o.looped);
         let back: SteadyOptions =
             serde_json::from_str(&serde_json::to_string(&o).unwrap()).unwrap();
@@ -578,7 +711,7 @@ mod tests {
             .starts_with("steady.initial.min_gap"));
         let bad = SteadyOptions {
             lateral: LateralOptions {
-                drift: -1.0,
+                drift: Some(-1.0),
                 ..LateralOptions::default()
             },
             ..SteadyOptions::default()
