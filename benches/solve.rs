@@ -40,8 +40,8 @@ fn bench_solve(c: &mut Criterion) {
         let check = solve(&x, &xi, Some(&guess), &opts).unwrap();
         assert!(check.converged, "N = {n} did not converge");
         eprintln!(
-            "N = {n}: {} evaluations, residual {:.2e}",
-            check.evaluations, check.residual
+            "N = {n}: {} evaluations, residual {:.2e} ({})",
+            check.evaluations, check.residual, check.termination
         );
         group.bench_with_input(BenchmarkId::new("perturbed_start", n), &n, |b, _| {
             b.iter(|| solve(black_box(&x), black_box(&xi), Some(&guess), &opts).unwrap())

@@ -106,7 +106,13 @@ pub const MAX_MESSAGE_CHARS: usize = 400;
 /// (newlines, ESC, BEL) shown as escapes, numbers of more than 24 digits (1e308 printed in full)
 /// shortened to scientific notation (every 64-bit integer keeps its digits), and the whole cut to [`MAX_MESSAGE_CHARS`].
 pub fn one_line(message: &str) -> String {
-    let mut out = String::with_capacity(message.len().min(MAX_MESSAGE_CHARS + 64));
+    one_line_within(message, MAX_MESSAGE_CHARS)
+}
+
+/// [`one_line`] cut at `max` characters instead of [`MAX_MESSAGE_CHARS`] (warnings, which carry
+/// advice after the file's name, are allowed longer lines).
+pub fn one_line_within(message: &str, max: usize) -> String {
+    let mut out = String::with_capacity(message.len().min(max + 64));
     let mut number = String::new();
     let flush = |number: &mut String, out: &mut String| {
         let digits = number.bytes().filter(u8::is_ascii_digit).count();
@@ -134,9 +140,9 @@ pub fn one_line(message: &str) -> String {
     }
     flush(&mut number, &mut out);
     let count = out.chars().count();
-    if count > MAX_MESSAGE_CHARS {
-        let cut: String = out.chars().take(MAX_MESSAGE_CHARS).collect();
-        return format!("{cut}… ({} more characters)", count - MAX_MESSAGE_CHARS);
+    if count > max {
+        let cut: String = out.chars().take(max).collect();
+        return format!("{cut}… ({} more characters)", count - max);
     }
     out
 }

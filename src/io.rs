@@ -11,10 +11,12 @@ use serde::Serialize;
 
 use crate::error::{Error, Result};
 
-/// Upper bound on the size of any input file we read fully into memory, bytes: 2 GiB, enough for
-/// the largest animation file `formation` writes (10⁷ bird-frames of pretty JSON, about 2 GB; see
-/// [`crate::limits::MAX_BIRD_FRAMES`]).
-pub const MAX_INPUT_BYTES: u64 = 2 * 1024 * 1024 * 1024;
+/// Upper bound on the size of any input file we read fully into memory, bytes: 4 GiB, enough for
+/// the largest animation file `formation` writes (10⁷ bird-frames of pretty JSON: 1.97 GB for
+/// 100 birds × 100 000 frames, 2.9 GB for 100 000 birds × 100 frames of a wide sky of
+/// formations, whose coordinates have more digits; see [`crate::limits::MAX_BIRD_FRAMES`]). It
+/// was 2 GiB, which refused the latter (issue 17).
+pub const MAX_INPUT_BYTES: u64 = 4 * 1024 * 1024 * 1024;
 
 /// Opens an input for reading, refusing directories and regular files over the size limit up
 /// front. Devices, FIFOs and process substitutions (`<(…)`) are read too, through a bounded
@@ -123,7 +125,9 @@ fn not_utf8(path: &Path, offset: usize) -> Error {
 }
 
 /// Parses JSON text into `T`, turning serde's message into one line naming the file, line and column.
+/// A leading byte-order mark (written by some Windows editors) is skipped.
 pub fn parse_json<T: DeserializeOwned>(path: &Path, text: &str) -> Result<T> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     if text.trim().is_empty() {
         return Err(Error::format(path, "file is empty, expected JSON"));
     }

@@ -37,7 +37,9 @@ pub const MAX_FRAME_PIXELS: u64 = 7680 * 4320;
 pub const MAX_PICTURE_PIXELS: u64 = 20_000_000_000;
 
 /// Most birds in a shape or target (`power`, `solve`). `power` is quadratic in birds (10 000
-/// birds: about a second); the solve's cost is measured in `docs/performance.md`.
+/// birds: about a second); one `formation solve` of 10 000 birds from a perturbed start takes
+/// about 2 s on the shared 2-core machine under load 8–10 (a progress bar shows from 1000 birds;
+/// `docs/performance.md`, issue 12 third round).
 pub const MAX_SHAPE_BIRDS: usize = 10_000;
 
 /// Largest coordinate in an animation file or shape, wingspans in magnitude (10⁷ wingspans is

@@ -71,3 +71,77 @@ fn an_animation_lasting_years_is_refused_without_allocating() {
     assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 0);
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// The small steady flight of the `path` target: 5 birds, 2 s at 10 fps, a key every second.
+fn path_flight() -> Animation {
+    let p: FormationParams = formation::io::parse_json(
+        &support::data("steady_v9_params.json"),
+        &std::fs::read_to_string(support::data("steady_v9_params.json")).unwrap(),
+    )
+    .unwrap();
+    let opts = SteadyOptions {
+        birds: 5,
+        frames: 20,
+        fps: 10.0,
+        keys: KeyOptions {
+            key_every_s: 1.0,
+            ..KeyOptions::default()
+        },
+        ..SteadyOptions::default()
+    };
+    steady_flight(&p, &opts, &mut stream(0, "steady"), &Silent).unwrap()
+}
+
+/// An open path that turns back onto its own leg 28 000 wingspans long (`[30000, 0, 10]` then
+/// back to the start): widening smoothed it for all 400 rounds, 13 s in the fuzzer's build (4 s
+/// in release; a 49 000-wingspan leg at `--speed 1` took 35 s). The smoothing's work is bounded
+/// now; the path still flies, with the widening warning.
+#[test]
+fn a_path_turning_back_onto_a_long_leg_is_widened_in_bounded_time() {
+    use formation::course::file;
+    let path = data("path-slow-232ab045.json");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let points = file::parse_str(&path, &text, None, 1.5).unwrap();
+    let mut anim = path_flight();
+    let mut config = formation::pipeline::Config::default();
+    config.course.path = Some(path.clone());
+    let start = std::time::Instant::now();
+    let report = formation::pipeline::course_stage(&mut anim, Some(&points), &config).unwrap();
+    assert!(!report.widened.is_empty());
+    assert!(start.elapsed() < std::time::Duration::from_secs(10));
+}
+
+/// A closed path shaped as a thin spike (`(0,0) → (11,0) → (10,13) → (0,500) → (0,0)`, CRLF and a
+/// form feed from the fuzzer): long enough around for the flock's turns, but widening it shrank
+/// it towards nothing, and the stretch smoothed around each tight sample grew without bound (a
+/// hang in `course::spline::widen`). Now the collapse is detected and the path refused.
+#[test]
+fn a_closed_spike_path_is_refused_not_widened_forever() {
+    use formation::course::file;
+    let path = data("path-timeout-f1861c65.csv");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let points = file::parse_str(&path, &text, None, 1.5).unwrap();
+    assert!(points.closed);
+    let mut anim = path_flight();
+    let mut config = formation::pipeline::Config::default();
+    config.course.path = Some(path.clone());
+    let start = std::time::Instant::now();
+    let e = formation::pipeline::course_stage(&mut anim, Some(&points), &config).unwrap_err();
+    assert_eq!(e.exit_code(), 2);
+    assert!(e.to_string().contains("cannot be widened"), "{e}");
+    assert!(start.elapsed() < std::time::Duration::from_secs(10));
+}
+
+/// A bird model (a formation `.glb` with bytes changed by the fuzzer) whose inverse bind matrix
+/// of `body` is singular: its inverse was NaN, so the `.glb` export failed with "internal error"
+/// (exit 1) and the `.usda` text held NaN. Now the model is refused naming the joint.
+#[test]
+fn a_bird_model_with_a_singular_bind_matrix_is_refused() {
+    let path = data("bird_model-nan-5da5f56a.glb");
+    let bytes = std::fs::read(&path).unwrap();
+    let e =
+        formation::export::bird_model::parse(&path, &bytes, formation::wingbeat::Species::Goose)
+            .unwrap_err();
+    assert_eq!(e.exit_code(), 2);
+    assert!(e.to_string().contains("cannot be inverted"), "{e}");
+}

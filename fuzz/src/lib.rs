@@ -136,3 +136,77 @@ pub fn target(data: &[u8]) {
     let opts = formation::keyshape::SolveOptions::default();
     let _ = formation::keyshape::solve(&target.x, &target.xi, target.y.as_deref(), &opts);
 }
+
+/// Two small steady flights (5 birds, 2 s at 10 fps, a key every second; one plain, one looped)
+/// flown once, that the `path` target maps onto each accepted path (and `bird_model` exports).
+fn path_flights() -> &'static [formation::Animation; 2] {
+    use formation::extract::params::FormationParams;
+    static FLIGHTS: std::sync::OnceLock<[formation::Animation; 2]> = std::sync::OnceLock::new();
+    FLIGHTS.get_or_init(|| {
+        let path = Path::new("steady_v9_params.json");
+        let text = include_str!("../../tests/data/steady_v9_params.json");
+        let p: FormationParams = formation::io::parse_json(path, text).expect("params");
+        let fly = |looped: bool| {
+            let mut config = Config {
+                seconds: None,
+                ..Config::default()
+            };
+            config.steady.birds = 5;
+            config.steady.frames = 20;
+            config.steady.fps = 10.0;
+            // A loop needs at least one key interval.
+            config.steady.keys.key_every_s = 1.0;
+            config.steady.looped = looped;
+            steady_stage(&p, &config, &Silent).expect("steady").0
+        };
+        [fly(false), fly(true)]
+    })
+}
+
+/// Path file (`--path FILE` of `steady`, `initiate`, `animate`): `course::file::read` is
+/// `io::read_text` + `course::file::parse_str`, tried with the file's units and with `--path-units
+/// m`. Whatever is accepted goes through the course step (`pipeline::course_stage`: the
+/// backwards check, turn widening, the loop's laps, banks and pitches) on a small plain and a
+/// small looped steady flight.
+pub fn path(data: &[u8]) {
+    use formation::course::{file, PathUnits};
+    let Some(t) = text(data) else { return };
+    let origin = Path::new(PATH);
+    for units in [None, Some(PathUnits::M)] {
+        let Ok(points) = file::parse_str(origin, t, units, 1.5) else {
+            continue;
+        };
+        for flight in path_flights() {
+            let mut anim = flight.clone();
+            let mut config = Config::default();
+            config.course.path = Some(origin.to_path_buf());
+            let _ = formation::pipeline::course_stage(&mut anim, Some(&points), &config);
+        }
+    }
+}
+
+/// Bird model (`--bird-model FILE.glb` of `render`, `steady`, `initiate`, `animate`):
+/// `export::bird_model::load` is `io::read_bytes` + `bird_model::parse`. Whatever is accepted is
+/// put on the birds of a small flight in a glTF binary and a USD text; a number in the USD text
+/// that is not finite is a finding too (the model would have reached the file poisoned).
+pub fn bird_model(data: &[u8]) {
+    use formation::export::{bird_model, gltf, usd};
+    use formation::wingbeat::Species;
+    let Ok(asset) = bird_model::parse(Path::new(PATH), data, Species::Goose) else {
+        return;
+    };
+    let anim = &path_flights()[0];
+    let opts = gltf::SceneOptions {
+        asset: Some(asset),
+        ..gltf::SceneOptions::default()
+    };
+    let _ = gltf::glb_bytes_with(anim, 1.5, &opts);
+    let mut text = Vec::new();
+    if usd::write_usda(anim, 1.5, &opts, &mut text).is_ok() {
+        let text = String::from_utf8_lossy(&text);
+        let poisoned = text
+            .split(|c: char| !c.is_ascii_alphanumeric())
+            .any(|w| w == "NaN" || w == "inf");
+        assert!(!poisoned, "a non-finite number in the USD text of an accepted bird model");
+    }
+}

@@ -55,7 +55,9 @@
 use serde::{Deserialize, Serialize};
 
 mod field;
-pub use field::Field;
+mod tree;
+pub use field::{ApproxField, Field};
+pub use tree::TreeOptions;
 
 use crate::animation::Animation;
 use crate::error::{Error, Result};
@@ -498,7 +500,7 @@ impl AeroOptions {
     /// expansion with the lateral part summed once).
     pub fn power_unchecked(&self, x: &[f64], y: &[f64]) -> Vec<f64> {
         if x.len() >= FIELD_MIN {
-            return Field::new(self, x, 0.0).power_band(y, None, None);
+            return Field::new(self, x, 0.0).power(y);
         }
         let mut e = vec![0.0; x.len()];
         self.accumulate(x, y, &mut e, None);

@@ -60,8 +60,16 @@ impl Animation {
             })
             .collect();
         let formations = of.iter().copied().max().map_or(1, |m| m + 1);
-        for fm in 0..formations {
-            let mut members: Vec<usize> = (0..n).filter(|&i| out[i].formation == fm).collect();
+        // Birds by formation in one pass (filtering all birds once per formation was quadratic
+        // for a sky of many small formations: 11 111 formations of 100 000 birds took 14 s a
+        // frame in `formation report`, issue 17).
+        let mut by_formation: Vec<Vec<usize>> = vec![Vec::new(); formations];
+        for (i, r) in out.iter().enumerate() {
+            if let Some(m) = by_formation.get_mut(r.formation) {
+                m.push(i);
+            }
+        }
+        for mut members in by_formation {
             members.sort_by(|&a, &b| {
                 (!out[a].leader)
                     .cmp(&!out[b].leader)

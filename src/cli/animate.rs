@@ -122,7 +122,7 @@ pub fn run(args: AnimateArgs, g: Global) -> Result<()> {
     super::write_animation(&anim, &args.output, &config.render, g)?;
     super::summary::animate(g, &anim, &report, &args.output);
     if let (Some(f), false) = (&report.skein, g.quiet) {
-        eprintln!("{}", super::steady::flock_summary(f));
+        super::stdout::diagnostic(&super::steady::flock_summary(f));
     }
     Ok(())
 }

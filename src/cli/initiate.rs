@@ -242,7 +242,7 @@ impl InitiateFlags {
         o.validate()?;
         initiate::check_size(birds, 0, o.max_steps)?;
         if let Some(w) = TakeoffPlan::warning(birds, &o) {
-            eprintln!("warning: {}", super::flags::rewrite(Cmd::Initiate, &w));
+            super::stdout::warning(&super::flags::rewrite(Cmd::Initiate, &w));
         }
         Ok(o)
     }

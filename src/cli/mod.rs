@@ -136,7 +136,7 @@ pub fn warn_lines(cmd: flags::Cmd, g: Global, warnings: &[&str]) -> Result<()> {
         }
     }
     for w in warnings {
-        eprintln!("warning: {}", flags::rewrite(cmd, w));
+        stdout::warning(&flags::rewrite(cmd, w));
     }
     Ok(())
 }
@@ -172,7 +172,10 @@ pub fn install_signal_cleanup() {
                         signal_hook::low_level::signal_name(sig).unwrap_or("?")
                     ),
                 };
-                eprintln!("error: {what}; no output written");
+                // Not eprintln!: a panic here (stderr on a full device) would end only this
+                // thread, leaving the run stopped on the lock it holds.
+                let line = format!("error: {what}; no output written\n");
+                let _ = std::io::Write::write_all(&mut std::io::stderr(), line.as_bytes());
                 std::process::exit(128 + sig);
             }
         });

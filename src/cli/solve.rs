@@ -4,12 +4,17 @@ use std::path::PathBuf;
 
 use clap::Args;
 use formation::io::{write_json_atomic, OutputKind};
-use formation::keyshape::{solve, SolveOptions};
+use formation::keyshape::solve::solve_with_progress;
+use formation::keyshape::SolveOptions;
 use formation::{Error, Result};
 use serde::{Deserialize, Serialize};
 
 use super::power::in_file;
+use super::progress::TermProgress;
 use super::Global;
+
+/// Solves of at least this many birds show a progress bar (smaller ones take milliseconds).
+const PROGRESS_FROM: usize = 1000;
 
 /// Arguments of `formation solve`.
 #[derive(Debug, Args)]
@@ -51,7 +56,7 @@ struct Solved {
 }
 
 /// Runs `formation solve`.
-pub fn run(args: SolveArgs, _g: Global) -> Result<()> {
+pub fn run(args: SolveArgs, g: Global) -> Result<()> {
     OutputKind::from_path(&args.output, &[OutputKind::Json])?;
     let opts = SolveOptions {
         tolerance: args.tolerance,
@@ -68,7 +73,9 @@ pub fn run(args: SolveArgs, _g: Global) -> Result<()> {
     })?;
     let target: Target = formation::io::read_json(&args.target)?;
     formation::limits::check_shape_size(&format!("{}: x", args.target.display()), target.x.len())?;
-    let rep = solve(&target.x, &target.xi, target.y.as_deref(), &opts)
+    // Flocks of a thousand birds and more take a noticeable time: a bar on a terminal.
+    let progress = TermProgress::new(g.quiet || target.x.len() < PROGRESS_FROM);
+    let rep = solve_with_progress(&target.x, &target.xi, target.y.as_deref(), &opts, &progress)
         .map_err(|e| in_file(&args.target, e))?;
     if !rep.converged && !args.keep_unconverged {
         return Err(Error::NotConverged(format!(

@@ -31,3 +31,41 @@ pub fn print(text: &str) -> Result<()> {
 pub fn println(text: &str) -> Result<()> {
     print(&format!("{text}\n"))
 }
+
+/// Longest line of a warning or summary on stderr, characters.
+pub const MAX_DIAGNOSTIC_CHARS: usize = 2000;
+
+/// Writes a summary (`text`, one or more lines) to stderr. Each line is made safe as errors are
+/// (`error::one_line_within`: control characters from file content or a file's name escaped,
+/// numbers of more than 24 digits shortened, cut at [`MAX_DIAGNOSTIC_CHARS`]). A failed write
+/// (stderr closed, on a full device) is ignored: a diagnostic never ends a run, so the run's
+/// outputs are still committed (`eprintln!` panicked there, exit 101, issue 17).
+pub fn diagnostic(text: &str) {
+    let mut safe = String::with_capacity(text.len() + 1);
+    for line in text.lines() {
+        safe.push_str(&formation::error::one_line_within(
+            line,
+            MAX_DIAGNOSTIC_CHARS,
+        ));
+        safe.push('\n');
+    }
+    write_stderr(&safe);
+}
+
+/// Writes `warning: TEXT` to stderr as one line, whatever `text` holds (a newline in a file's
+/// name is shown as `\n`), as [`diagnostic`] does otherwise.
+pub fn warning(text: &str) {
+    let line = formation::error::one_line_within(&format!("warning: {text}"), MAX_DIAGNOSTIC_CHARS);
+    write_stderr(&format!("{line}\n"));
+}
+
+fn write_stderr(text: &str) {
+    let mut err = std::io::stderr().lock();
+    let _ = err.write_all(text.as_bytes()).and_then(|()| err.flush());
+}
+
+/// A file's name for a summary line: control characters escaped (a newline in it would start a
+/// line of its own).
+pub fn file_name(p: &std::path::Path) -> String {
+    formation::error::one_line_within(&p.display().to_string(), MAX_DIAGNOSTIC_CHARS)
+}

@@ -27,12 +27,18 @@ pub fn print_deferred() {
     for (text, outputs) in items {
         let files: Vec<String> = outputs
             .iter()
-            .map(|p| format!("{} ({})", p.display(), human_size(&size_of(p))))
+            .map(|p| {
+                format!(
+                    "{} ({})",
+                    super::stdout::file_name(p),
+                    human_size(&size_of(p))
+                )
+            })
             .collect();
         if files.is_empty() {
-            eprintln!("{text}");
+            super::stdout::diagnostic(&text);
         } else {
-            eprintln!("{text}\nwrote {}", files.join(", "));
+            super::stdout::diagnostic(&format!("{text}\nwrote {}", files.join(", ")));
         }
     }
 }

@@ -14,6 +14,13 @@ use crate::error::{Error, Result};
 /// Largest number of control points of a path.
 pub const MAX_POINTS: usize = 100_000;
 
+/// Longest path, wingspans (along the straight legs between its points; 150 km for 1.5 m birds):
+/// the course is sampled every [`super::spline::SAMPLE_SPACING`] wingspans in at most
+/// [`super::spline::MAX_SAMPLES`] samples, and a longer path would be sampled more coarsely,
+/// losing its turns (a flight longer than the path flies straight on past an open path's end, or
+/// repeats a closed one).
+pub const MAX_LENGTH: f64 = 100_000.0;
+
 /// Two control points closer than this are the same point, wingspans.
 pub const REPEAT_DISTANCE: f64 = 1e-6;
 
@@ -59,15 +66,102 @@ pub struct PathPoints {
 #[serde(deny_unknown_fields)]
 struct JsonPath {
     units: Option<String>,
-    points: Vec<Vec<f64>>,
+    points: JsonPoints,
 }
 
-/// Reads `path` (JSON by content, else CSV); `units` is the flag's choice (`None`: the file's, or
-/// wingspans), `wingspan_m` converts metres.
+/// The `points` array, read point by point into `[x, y, z]`: a point of another length is named
+/// by its index, and reading stops after [`MAX_POINTS`] + 1 points, so memory stays a small
+/// multiple of the points kept (a `Vec` per point took 8 bytes of memory per byte of file).
+struct JsonPoints(Vec<[f64; 3]>);
+
+impl<'de> Deserialize<'de> for JsonPoints {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        struct Visit;
+        impl<'de> serde::de::Visitor<'de> for Visit {
+            type Value = JsonPoints;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("an array of [x, y, z] points")
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(
+                self,
+                mut seq: A,
+            ) -> std::result::Result<JsonPoints, A::Error> {
+                use serde::de::Error as _;
+                let mut pts = Vec::new();
+                while let Some(p) = seq.next_element::<Point>()? {
+                    let i = pts.len();
+                    if i == MAX_POINTS {
+                        return Err(A::Error::custom(format!(
+                            "points: more than {MAX_POINTS} points"
+                        )));
+                    }
+                    match p.0 {
+                        Some(xyz) => pts.push(xyz),
+                        None => {
+                            return Err(A::Error::custom(format!(
+                                "points[{i}]: {} numbers, expected [x, y, z]",
+                                p.1
+                            )))
+                        }
+                    }
+                }
+                Ok(JsonPoints(pts))
+            }
+        }
+        d.deserialize_seq(Visit)
+    }
+}
+
+/// One point of the `points` array, read without a heap allocation: `Some([x, y, z])`, or `None`
+/// and how many numbers a point of another length held.
+struct Point(Option<[f64; 3]>, usize);
+
+impl<'de> Deserialize<'de> for Point {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        struct Visit;
+        impl<'de> serde::de::Visitor<'de> for Visit {
+            type Value = Point;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a point [x, y, z]")
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(
+                self,
+                mut seq: A,
+            ) -> std::result::Result<Point, A::Error> {
+                let mut xyz = [0.0; 3];
+                let mut n = 0usize;
+                while let Some(v) = seq.next_element::<f64>()? {
+                    if n < 3 {
+                        xyz[n] = v;
+                    }
+                    n += 1;
+                }
+                Ok(Point((n == 3).then_some(xyz), n))
+            }
+        }
+        d.deserialize_seq(Visit)
+    }
+}
+
+/// Reads `path` (JSON by content, else CSV) through [`crate::io::read_text`] (size bounds,
+/// binary refusal) and parses it with [`parse_str`].
 pub fn read(path: &Path, units: Option<PathUnits>, wingspan_m: f64) -> Result<PathPoints> {
     let text = crate::io::read_text(path)?;
+    parse_str(path, &text, units, wingspan_m)
+}
+
+/// Parses the text of a path file (JSON by content, else CSV); `path` is only named in messages.
+/// `units` is the flag's choice (`None`: the file's, or wingspans), `wingspan_m` converts metres.
+pub fn parse_str(
+    path: &Path,
+    text: &str,
+    units: Option<PathUnits>,
+    wingspan_m: f64,
+) -> Result<PathPoints> {
+    // A byte-order mark (some spreadsheet and Windows editors write one) is not content.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let (raw, file_units) = if text.trim_start().starts_with('{') {
-        let j: JsonPath = crate::io::parse_json(path, &text)?;
+        let j: JsonPath = crate::io::parse_json(path, text)?;
         let u = match &j.units {
             None => None,
             Some(w) => Some(PathUnits::parse(w).ok_or_else(|| {
@@ -77,19 +171,9 @@ pub fn read(path: &Path, units: Option<PathUnits>, wingspan_m: f64) -> Result<Pa
                 )
             })?),
         };
-        let mut pts = Vec::with_capacity(j.points.len());
-        for (i, p) in j.points.iter().enumerate() {
-            if p.len() != 3 {
-                return Err(Error::format(
-                    path,
-                    format!("points[{i}]: {} numbers, expected [x, y, z]", p.len()),
-                ));
-            }
-            pts.push([p[0], p[1], p[2]]);
-        }
-        (pts, u)
+        (j.points.0, u)
     } else {
-        (read_csv(path, &text)?, None)
+        (read_csv(path, text)?, None)
     };
     let units = match (units, file_units) {
         (Some(a), Some(b)) if a != b => {
@@ -143,6 +227,12 @@ fn read_csv(path: &Path, text: &str) -> Result<Vec<[f64; 3]>> {
                 ),
             ));
         }
+        if pts.len() == MAX_POINTS {
+            return Err(Error::format(
+                path,
+                format!("line {}: more than {MAX_POINTS} points", ln + 1),
+            ));
+        }
         let mut p = [0.0; 3];
         for (k, c) in cells.iter().enumerate() {
             p[k] = c.parse::<f64>().map_err(|_| {
@@ -180,10 +270,14 @@ fn check(path: &Path, raw: Vec<[f64; 3]>, scale: f64) -> Result<PathPoints> {
             ));
         }
         let q = [p[0] * scale, p[1] * scale, p[2] * scale];
-        if q.iter().any(|v| v.abs() > bound) {
+        if let Some(k) = q.iter().position(|v| v.abs() > bound) {
             return Err(Error::format(
                 path,
-                format!("point {i}: beyond ±{bound:e} wingspans"),
+                format!(
+                    "point {i}: {} = {:.3e} wingspans is beyond ±{bound:e} wingspans",
+                    ["x", "y", "z"][k],
+                    q[k]
+                ),
             ));
         }
         points.push(q);
@@ -208,6 +302,18 @@ fn check(path: &Path, raw: Vec<[f64; 3]>, scale: f64) -> Result<PathPoints> {
     }
     let n = points.len();
     let closed = n >= 4 && dist(points[0], points[n - 1]) < REPEAT_DISTANCE;
+    let mut length = 0.0;
+    for i in 1..n {
+        length += dist(points[i], points[i - 1]);
+        if length > MAX_LENGTH {
+            return Err(Error::format(
+                path,
+                format!(
+                    "point {i}: the path is {length:.0} wingspans long by here, longer than the {MAX_LENGTH:.0} wingspans a path may be; cut it to the part the flock flies"
+                ),
+            ));
+        }
+    }
     if closed {
         points.pop();
     } else if n == 3 && dist(points[0], points[2]) < REPEAT_DISTANCE {

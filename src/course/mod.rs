@@ -23,6 +23,7 @@
 pub mod file;
 pub mod spline;
 
+use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
@@ -315,14 +316,30 @@ pub fn apply(
     check_backwards(points, depth, &origin)?;
     let (r_min, why) = min_radius(d_lo, d_hi, flight.speed, g, opts);
     let dense = spline::spline_points(&points.points, points.closed);
+    if points.closed {
+        check_loop_size(&dense, r_min, &origin)?;
+    }
     let (pts, ds) = spline::resample(&dense, spline::SAMPLE_SPACING);
-    let before = pts.clone();
     let (pts, ds, tight) =
         spline::widen(pts, ds, points.closed, 1.0 / r_min, spline::SAMPLE_SPACING);
+    let cannot = || {
+        Error::format(
+            &origin,
+            format!(
+                "the path cannot be widened to the flock's smallest turn radius of {r_min:.0} wingspans ({why}); draw it with wider turns"
+            ),
+        )
+    };
+    if pts.len() < 2 {
+        return Err(cannot());
+    }
     let course = Course::from_samples(pts, ds, points.closed);
+    if !(course.length() > 0.0 && course.length().is_finite()) {
+        return Err(cannot());
+    }
     report.length = course.length();
     for t in &tight {
-        let p = before[t.sample.min(before.len() - 1)];
+        let p = t.p;
         let point = (0..points.points.len())
             .min_by(|&a, &b| {
                 file::dist(points.points[a], p).total_cmp(&file::dist(points.points[b], p))
@@ -402,15 +419,22 @@ pub fn apply(
             };
             // Course-frame velocity (right, along, up).
             let (uh, uv) = (f.heading[i], f.speed[i]);
-            let (ux, uy) = (uv * uh.sin(), uv * uh.cos() + drift);
-            let along = uy * (c.cos_climb - d * c.turn);
+            let (su, cu) = (uh.sin(), uh.cos());
+            let (ux, uy) = (uv * su, uv * cu + drift);
+            // The along-track axis is stretched by k (faster outside a turn, slower in a climb).
+            let k = c.cos_climb - d * c.turn;
+            let along = uy * k;
             let vx = along * sh + ux * ch;
             let vy = along * ch - ux * sh;
             f.x[i] = c.p[0] + d * ch;
             f.y[i] = c.p[1] - d * sh;
             f.z[i] = z;
-            // atan2 is already in [−π, π].
-            f.heading[i] = vx.atan2(vy);
+            f.heading[i] = if drift == 0.0 && uv > 0.0 && k > 0.0 {
+                world_heading(c.heading, uh, su, cu, k)
+            } else {
+                // atan2 is already in [−π, π].
+                vx.atan2(vy)
+            };
             f.speed[i] = (vx * vx + vy * vy).sqrt();
         }
     }
@@ -436,6 +460,54 @@ pub fn apply(
         widened: !report.widened.is_empty(),
     });
     Ok(report)
+}
+
+/// Refuses a closed path too small for the flock's turns: seen from above, a closed curve whose
+/// turns have radii of at least `r_min` is at least 2π `r_min` long (its heading turns through at
+/// least a full turn, Fenchel's theorem), so widening a shorter one to `r_min` would shrink it
+/// to nothing. `dense` is the spline through the path.
+fn check_loop_size(dense: &[[f64; 3]], r_min: f64, origin: &Path) -> Result<()> {
+    let around: f64 = dense
+        .windows(2)
+        .map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]))
+        .sum();
+    let needed = 2.0 * std::f64::consts::PI * r_min;
+    if around < needed {
+        return Err(Error::format(
+            origin,
+            format!(
+                "the closed path is {around:.0} wingspans around (seen from above), too small for the flock: its turns need a radius of at least {r_min:.0} wingspans, so a closed path at least {needed:.0} wingspans around; draw it larger, or slow the flock"
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// The world heading of a bird flying at course-frame heading `uh` (sine `su`, cosine `cu`)
+/// where the course heads `course` and its along-track axis is stretched by `k` > 0: the heading
+/// of (sin uh, k cos uh) turned by `course`, i.e. `course + atan2(sin uh, k cos uh)`, written as
+/// `course + uh + δ` with tan δ = sin uh cos uh (1 − k) / (k cos² uh + sin² uh). δ is small
+/// (k is within a few percent of 1 and birds fly nearly along the track), so it costs a few
+/// multiplications instead of an atan2; wrapped into (−π, π] like atan2's result.
+fn world_heading(course: f64, uh: f64, su: f64, cu: f64, k: f64) -> f64 {
+    let t = su * cu * (1.0 - k) / (k * cu * cu + su * su);
+    let h = course + uh + atan_small(t);
+    if h > -PI && h <= PI {
+        h
+    } else {
+        spline::wrap(h)
+    }
+}
+
+/// atan t, by its series below |t| = 0.01 (the first term left out, t¹¹/11, is below 10⁻²⁰ of
+/// t), by libm above.
+fn atan_small(t: f64) -> f64 {
+    if t.abs() < 0.01 {
+        let t2 = t * t;
+        t * (1.0 - t2 * (1.0 / 3.0 - t2 * (0.2 - t2 * (1.0 / 7.0 - t2 / 9.0))))
+    } else {
+        t.atan()
+    }
 }
 
 /// Refuses a path that turns back on itself (more than 90° at a control point) with a segment
@@ -550,4 +622,44 @@ fn banks(anim: &Animation, g: f64, opts: &CourseOptions, cyclic: bool) -> Vec<Ve
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The heading without atan2 is the atan2 of the turned, stretched velocity, in (−π, π],
+    /// across headings, stretches and course headings of several turns.
+    #[test]
+    fn world_heading_is_the_turned_velocity_heading() {
+        let mut worst = 0.0f64;
+        for a in 0..73 {
+            let uh = -PI + a as f64 * (2.0 * PI / 72.0) + 1e-3;
+            for &k in &[0.3, 0.6, 0.93, 0.999, 1.0, 1.001, 1.07, 1.4, 2.5] {
+                for c in -9..=9 {
+                    let course = c as f64 * 0.77;
+                    let (su, cu) = (uh.sin(), uh.cos());
+                    let (sh, ch) = course.sin_cos();
+                    let (vx, vy) = (k * cu * sh + su * ch, k * cu * ch - su * sh);
+                    let reference = vx.atan2(vy);
+                    let h = world_heading(course, uh, su, cu, k);
+                    assert!(h > -PI && h <= PI, "{h}");
+                    worst = worst.max(spline::wrap(h - reference).abs());
+                }
+            }
+        }
+        assert!(worst < 1e-12, "{worst}");
+    }
+
+    #[test]
+    fn small_atan_matches_libm() {
+        for k in -2000..=2000 {
+            let t = k as f64 * 1.3e-5;
+            let (a, b) = (atan_small(t), t.atan());
+            assert!(
+                (a - b).abs() <= 2.0 * f64::EPSILON * b.abs(),
+                "{t}: {a} {b}"
+            );
+        }
+    }
 }

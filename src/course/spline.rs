@@ -25,6 +25,10 @@ pub const SAMPLE_SPACING: f64 = 0.25;
 /// Largest number of samples of a course.
 pub const MAX_SAMPLES: usize = 400_000;
 
+/// Most sample updates of [`widen`]'s smoothing (about a second): what is not widened by then
+/// stays as far as it got.
+pub const WIDEN_WORK: usize = 200_000_000;
+
 /// The course at one place.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CourseAt {
@@ -43,19 +47,27 @@ pub struct CourseAt {
     pub cos_climb: f64,
 }
 
-/// An evaluated course: samples at even arc length.
+/// One sample of an evaluated course.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Knot {
+    /// Position, wingspans.
+    p: [f64; 3],
+    /// Unit tangent.
+    t: [f64; 3],
+    /// Unwrapped heading, radians.
+    heading: f64,
+    /// dθ/ds, radians per wingspan.
+    turn: f64,
+    /// Climb angle, radians.
+    climb: f64,
+}
+
+/// An evaluated course: samples at even arc length, each sample's data together (an evaluation
+/// reads two neighbouring samples, two or three cache lines).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Course {
-    /// Samples (positions), wingspans.
-    pts: Vec<[f64; 3]>,
-    /// Unit tangents.
-    tan: Vec<[f64; 3]>,
-    /// Unwrapped heading of each sample, radians.
-    heading: Vec<f64>,
-    /// dθ/ds per sample, radians per wingspan.
-    turn: Vec<f64>,
-    /// Climb angle per sample, radians.
-    climb: Vec<f64>,
+    /// The samples.
+    knots: Vec<Knot>,
     /// Arc length between samples, wingspans.
     ds: f64,
     /// Whether the course is a closed loop (the last sample joins the first).
@@ -80,7 +92,14 @@ fn norm(a: [f64; 3]) -> f64 {
 
 /// Wraps an angle into (−π, π].
 pub fn wrap(a: f64) -> f64 {
-    let r = (a + PI).rem_euclid(2.0 * PI) - PI;
+    let r = a + PI;
+    // `rem_euclid` of a value already in [0, 2π) is that value: skip the (software) fmod, with
+    // the same result bit for bit.
+    let r = if (0.0..2.0 * PI).contains(&r) {
+        r
+    } else {
+        r.rem_euclid(2.0 * PI)
+    } - PI;
     if r <= -PI {
         r + 2.0 * PI
     } else {
@@ -172,7 +191,12 @@ pub fn resample(poly: &[[f64; 3]], spacing: f64) -> (Vec<[f64; 3]>, f64) {
 /// sample of an evenly spaced polyline, radians per wingspan.
 pub fn curvature(pts: &[[f64; 3]], ds: f64, closed: bool) -> Vec<f64> {
     let n = pts.len();
-    let dir = |a: [f64; 3], b: [f64; 3]| (b[0] - a[0]).atan2(b[1] - a[1]);
+    // The turn from a→b to b→c: one atan2 of the horizontal cross and dot products (in (−π, π],
+    // right turn positive), instead of the difference of two headings.
+    let turn = |a: [f64; 3], b: [f64; 3], c: [f64; 3]| {
+        let (ux, uy, vx, vy) = (b[0] - a[0], b[1] - a[1], c[0] - b[0], c[1] - b[1]);
+        (uy * vx - ux * vy).atan2(ux * vx + uy * vy)
+    };
     (0..n)
         .map(|i| {
             let (a, b, c) = if closed {
@@ -184,7 +208,7 @@ pub fn curvature(pts: &[[f64; 3]], ds: f64, closed: bool) -> Vec<f64> {
             } else {
                 (pts[i - 1], pts[i], pts[i + 1])
             };
-            wrap(dir(b, c) - dir(a, b)) / ds
+            turn(a, b, c) / ds
         })
         .collect()
 }
@@ -198,12 +222,16 @@ pub struct Tight {
     pub s: f64,
     /// Radius of the turn there, wingspans.
     pub radius: f64,
+    /// Position of that sample before widening, wingspans.
+    pub p: [f64; 3],
 }
 
 /// Widens every turn tighter than `max_turn` (radians per wingspan) by local smoothing of the
 /// horizontal course (Laplacian steps on the offending stretch and its surroundings, end points
 /// of an open path fixed), on a polyline of a spacing fitting the needed radius; returns the
-/// widened polyline (even spacing `spacing`), and the too-tight places found before.
+/// widened polyline (even spacing `spacing`), and the too-tight places found before. The
+/// polyline is empty when a closed path shrank below a full turn at the needed radius: it
+/// cannot be widened.
 pub fn widen(
     pts: Vec<[f64; 3]>,
     ds: f64,
@@ -223,6 +251,7 @@ pub fn widen(
                 sample: i,
                 s: i as f64 * ds,
                 radius: r,
+                p: pts[i],
             };
             match (last_bad, tight.last_mut()) {
                 (Some(b), Some(t)) if i - b <= join => {
@@ -242,31 +271,79 @@ pub fn widen(
     let coarse = (0.1 / max_turn).max(spacing);
     let (mut q, mut dq) = resample(&pts, coarse);
     let target = 0.92 * max_turn;
+    // Smoothing shrinks a closed curve; one shorter than a full turn at the needed radius
+    // cannot be flown (see `course::check_loop_size`) and would shrink to nothing (a thin spike
+    // did, and the stretch below grew without bound: a hang found by fuzzing, issue 17).
+    let shortest_loop = 2.0 * PI / max_turn;
+    // At most 400 rounds, and at most WIDEN_WORK sample updates in all: a path that turns back
+    // onto itself along a long leg is never widened and took 35 s (found by fuzzing, issue 17).
+    let mut work = 0usize;
     for _round in 0..400 {
-        let k = curvature(&q, dq, closed);
         let n = q.len();
+        work += 20 * n;
+        if work > WIDEN_WORK {
+            break;
+        }
+        if !(dq > 0.0 && dq.is_finite()) || (closed && dq * ((n - 1) as f64) < shortest_loop) {
+            return (Vec::new(), dq, tight);
+        }
+        let k = curvature(&q, dq, closed);
         let bad: Vec<usize> = (0..n).filter(|&i| k[i].abs() > target).collect();
         if bad.is_empty() {
             break;
         }
-        // Smooth around every offending sample, over a stretch of the needed quarter turn.
-        let reach = ((0.5 * PI / max_turn) / dq).ceil() as isize + 2;
+        // Smooth around every offending sample, over a stretch of the needed quarter turn (at
+        // most the whole curve), marked through a running count so the cost is linear.
+        let reach = (((0.5 * PI / max_turn) / dq).ceil() as usize + 2).min(n);
         let mut mark = vec![false; n];
-        for &b in &bad {
-            for o in -reach..=reach {
-                let j = b as isize + o;
-                let j = if closed {
-                    j.rem_euclid(n as isize - 1) as usize
-                } else if j <= 0 || j as usize >= n - 1 {
+        if closed {
+            let m = n - 1;
+            let mut delta = vec![0i64; m + 1];
+            for &b in &bad {
+                let (lo, hi) = (b as i64 - reach as i64, b as i64 + reach as i64);
+                if hi - lo + 1 >= m as i64 {
+                    delta[0] += 1;
+                    delta[m] -= 1;
                     continue;
+                }
+                let (lo, hi) = (
+                    lo.rem_euclid(m as i64) as usize,
+                    hi.rem_euclid(m as i64) as usize,
+                );
+                if lo <= hi {
+                    delta[lo] += 1;
+                    delta[hi + 1] -= 1;
                 } else {
-                    j as usize
-                };
-                mark[j] = true;
+                    delta[lo] += 1;
+                    delta[m] -= 1;
+                    delta[0] += 1;
+                    delta[hi + 1] -= 1;
+                }
+            }
+            let mut run = 0i64;
+            for j in 0..m {
+                run += delta[j];
+                mark[j] = run > 0;
+            }
+        } else {
+            let mut delta = vec![0i64; n + 1];
+            for &b in &bad {
+                let lo = b.saturating_sub(reach).max(1);
+                let hi = (b + reach).min(n.saturating_sub(2));
+                if lo <= hi {
+                    delta[lo] += 1;
+                    delta[hi + 1] -= 1;
+                }
+            }
+            let mut run = 0i64;
+            for j in 0..n {
+                run += delta[j];
+                mark[j] = run > 0;
             }
         }
+        let mut prev = Vec::new();
         for _ in 0..20 {
-            let prev = q.clone();
+            prev.clone_from(&q);
             for j in 0..n {
                 if !mark[j] {
                     continue;
@@ -288,6 +365,9 @@ pub fn widen(
         let (r, d) = resample(&q, coarse);
         q = r;
         dq = d;
+    }
+    if closed && dq * ((q.len() - 1) as f64) < shortest_loop {
+        return (Vec::new(), dq, tight);
     }
     let dense = spline_points(&q[..if closed { q.len() - 1 } else { q.len() }], closed);
     let (out, d) = resample(&dense, spacing);
@@ -311,8 +391,7 @@ impl Course {
             let l = norm(d).max(1e-12);
             tan.push([d[0] / l, d[1] / l, d[2] / l]);
         }
-        let mut heading = Vec::with_capacity(n);
-        let mut climb = Vec::with_capacity(n);
+        let mut heading: Vec<f64> = Vec::with_capacity(n);
         for t in &tan {
             let h = t[0].atan2(t[1]);
             let h = match heading.last() {
@@ -320,9 +399,8 @@ impl Course {
                 None => h,
             };
             heading.push(h);
-            climb.push(t[2].atan2(t[0].hypot(t[1])));
         }
-        let turn: Vec<f64> = (0..n)
+        let knots = (0..n)
             .map(|i| {
                 let (a, b, steps) = if closed && n > 2 {
                     let m = n - 1;
@@ -331,63 +409,70 @@ impl Course {
                     let (a, b) = (i.saturating_sub(1), (i + 1).min(n - 1));
                     (a, b, (b - a) as f64)
                 };
-                if steps > 0.0 {
+                let turn = if steps > 0.0 {
                     wrap(heading[b] - heading[a]) / (steps * ds)
                 } else {
                     0.0
+                };
+                let t = tan[i];
+                Knot {
+                    p: pts[i],
+                    t,
+                    heading: heading[i],
+                    turn,
+                    climb: t[2].atan2((t[0] * t[0] + t[1] * t[1]).sqrt()),
                 }
             })
             .collect();
-        Course {
-            pts,
-            tan,
-            heading,
-            turn,
-            climb,
-            ds,
-            closed,
-        }
+        Course { knots, ds, closed }
     }
 
     /// Arc length of the course, wingspans.
     pub fn length(&self) -> f64 {
-        (self.pts.len() - 1) as f64 * self.ds
+        (self.knots.len() - 1) as f64 * self.ds
     }
 
     /// Largest |turn rate| along the course, radians per wingspan.
     pub fn max_turn(&self) -> f64 {
-        self.turn.iter().fold(0.0, |m, t| m.max(t.abs()))
+        self.knots.iter().fold(0.0, |m, k| m.max(k.turn.abs()))
     }
 
     /// The course at arc length `s` (wingspans from the first point; straight on beyond the
-    /// ends of an open course, repeating for a closed one).
+    /// ends of an open course, repeating for a closed one). No search and no trigonometry: the
+    /// samples are evenly spaced, so the segment is `s / ds`.
     pub fn at(&self, s: f64) -> CourseAt {
         let len = self.length();
-        let n = self.pts.len();
-        let (s, laps) = if self.closed && len > 0.0 {
+        let k = &self.knots;
+        let n = k.len();
+        let (s, turns) = if self.closed && len > 0.0 {
             let laps = (s / len).floor();
-            (s - laps * len, laps)
+            (s - laps * len, laps * (k[n - 1].heading - k[0].heading))
         } else {
             (s, 0.0)
         };
-        let turns = laps * (self.heading[n - 1] - self.heading[0]);
         if !self.closed && (s < 0.0 || s > len) {
             let (i, over) = if s < 0.0 { (0, s) } else { (n - 1, s - len) };
-            let t = self.tan[i];
-            let p = self.pts[i];
+            let Knot {
+                p,
+                t,
+                heading,
+                climb,
+                ..
+            } = k[i];
             return CourseAt {
                 p: [p[0] + over * t[0], p[1] + over * t[1], p[2] + over * t[2]],
-                heading: self.heading[i],
+                heading,
                 turn: 0.0,
-                climb: self.climb[i],
-                sin_cos: self.heading[i].sin_cos(),
-                cos_climb: self.climb[i].cos(),
+                climb,
+                sin_cos: heading.sin_cos(),
+                cos_climb: climb.cos(),
             };
         }
         let x = (s / self.ds).clamp(0.0, (n - 1) as f64);
-        let j = (x.floor() as usize).min(n - 2);
+        // x ≥ 0 (or NaN, giving 0 as floor would): truncation is the floor, without a libm call.
+        let j = (x as usize).min(n - 2);
         let u = x - j as f64;
-        let (p0, p1, t0, t1) = (self.pts[j], self.pts[j + 1], self.tan[j], self.tan[j + 1]);
+        let (a, b) = (&k[j], &k[j + 1]);
         let (u2, u3) = (u * u, u * u * u);
         let (h00, h10, h01, h11) = (
             2.0 * u3 - 3.0 * u2 + 1.0,
@@ -396,14 +481,14 @@ impl Course {
             u3 - u2,
         );
         let l = self.ds;
-        let p = [0, 1, 2].map(|d| h00 * p0[d] + h10 * l * t0[d] + h01 * p1[d] + h11 * l * t1[d]);
-        let li = |v: &[f64]| v[j] + u * (v[j + 1] - v[j]);
+        let hermite = |d: usize| h00 * a.p[d] + h10 * l * a.t[d] + h01 * b.p[d] + h11 * l * b.t[d];
+        let p = [hermite(0), hermite(1), hermite(2)];
+        let li = |va: f64, vb: f64| va + u * (vb - va);
         // The unit horizontal tangent, interpolated and renormalised (no trigonometry per call).
-        let (ta, tb) = (self.tan[j], self.tan[j + 1]);
-        let (hx, hy) = (ta[0] + u * (tb[0] - ta[0]), ta[1] + u * (tb[1] - ta[1]));
+        let (hx, hy) = (li(a.t[0], b.t[0]), li(a.t[1], b.t[1]));
         let hl = (hx * hx + hy * hy).sqrt();
-        let hz = ta[2] + u * (tb[2] - ta[2]);
-        let heading = li(&self.heading) + turns;
+        let hz = li(a.t[2], b.t[2]);
+        let heading = li(a.heading, b.heading) + turns;
         let sin_cos = if hl > 1e-12 {
             (hx / hl, hy / hl)
         } else {
@@ -412,8 +497,8 @@ impl Course {
         CourseAt {
             p,
             heading,
-            turn: li(&self.turn),
-            climb: li(&self.climb),
+            turn: li(a.turn, b.turn),
+            climb: li(a.climb, b.climb),
             sin_cos,
             cos_climb: hl / (hl * hl + hz * hz).sqrt().max(1e-12),
         }

@@ -36,6 +36,8 @@ use crate::wingbeat::Species;
 pub const MAX_BYTES: u64 = 64 * 1024 * 1024;
 /// Largest accepted number of vertices over all meshes used.
 pub const MAX_VERTICES: usize = 200_000;
+/// Largest number of elements of one accessor (indices of up to 4 triangles per vertex).
+pub const MAX_ACCESSOR_ELEMENTS: usize = 12 * MAX_VERTICES;
 
 fn bad(path: &Path, msg: impl Into<String>) -> Error {
     Error::format(path, format!("render.bird_model: {}", msg.into()))
@@ -58,7 +60,13 @@ pub fn load(path: &Path, species: Species) -> Result<BirdAsset> {
         ));
     }
     let bytes = crate::io::read_bytes(path)?;
-    let (root, bin) = parse_glb(path, &bytes)?;
+    parse(path, &bytes, species)
+}
+
+/// Parses and checks the bytes of a bird model (`path` is only named in messages); what [`load`]
+/// does after reading the file.
+pub fn parse(path: &Path, bytes: &[u8], species: Species) -> Result<BirdAsset> {
+    let (root, bin) = parse_glb(path, bytes)?;
     let r = Reader {
         path,
         root: &root,
@@ -166,6 +174,16 @@ impl Reader<'_> {
             _ => return Err(self.err(format!("accessor {}: unknown component type", i.value()))),
         };
         let count = a.count.0 as usize;
+        // Every accessor the model uses holds vertices, indices (three per triangle) or one
+        // matrix per joint: more elements than that cannot be a model within the limits, and an
+        // accessor without a buffer view (zeros) costs memory for nothing (4·10⁹ MAT4 zeros in a
+        // 300-byte file tried to allocate 256 GB, issue 17).
+        if count > MAX_ACCESSOR_ELEMENTS {
+            return Err(self.err(format!(
+                "accessor {}: {count} elements, more than the {MAX_ACCESSOR_ELEMENTS} a bird model may have",
+                i.value()
+            )));
+        }
         let Some(view_i) = a.buffer_view else {
             return Ok((vec![0.0; count * width], width));
         };
@@ -185,12 +203,25 @@ impl Reader<'_> {
         let size = ct.size();
         let elem = size * width;
         let stride = view.byte_stride.map(|s| s.0).unwrap_or(elem);
-        let start = view.byte_offset.map_or(0, |o| o.0 as usize)
-            + a.byte_offset.map_or(0, |o| o.0 as usize);
-        let end_view = view.byte_offset.map_or(0, |o| o.0 as usize) + view.byte_length.0 as usize;
-        if count > 0
-            && (start + (count - 1) * stride + elem > end_view || end_view > self.bin.len())
-        {
+        // Offsets and lengths are the file's numbers (up to 2⁶⁴ − 1): checked arithmetic, so
+        // that an absurd one is "past the end" rather than an overflow.
+        let view_offset = view.byte_offset.map_or(0, |o| o.0 as usize);
+        let start = view_offset.checked_add(a.byte_offset.map_or(0, |o| o.0 as usize));
+        let end_view = view_offset.checked_add(view.byte_length.0 as usize);
+        let last = start.and_then(|s| {
+            count
+                .saturating_sub(1)
+                .checked_mul(stride)
+                .and_then(|o| o.checked_add(s))
+                .and_then(|o| o.checked_add(elem))
+        });
+        let (Some(start), Some(end_view), Some(last)) = (start, end_view, last) else {
+            return Err(self.err(format!(
+                "accessor {} runs past the end of its buffer",
+                i.value()
+            )));
+        };
+        if count > 0 && (last > end_view || end_view > self.bin.len()) {
             return Err(self.err(format!(
                 "accessor {} runs past the end of its buffer",
                 i.value()
@@ -440,7 +471,14 @@ impl Reader<'_> {
         let mut bind: [Option<Mat4>; 7] = [None; 7];
         for (slot, n) in skin.joints.iter().enumerate() {
             if let Some(j) = ours(n.value()) {
-                bind[j] = Some(ibm[slot].inverse());
+                let m = ibm[slot].inverse();
+                if !m.is_finite() {
+                    return Err(self.err(format!(
+                        "skin: the inverse bind matrix of joint {slot} ({}) cannot be inverted",
+                        JOINTS[j]
+                    )));
+                }
+                bind[j] = Some(m);
             }
         }
         let required = [bird::BODY, 3, 4, 5, 6];
@@ -588,6 +626,18 @@ impl Reader<'_> {
                 skel.bind_pos[j] = t;
                 skel.bind_rot[j] = r.normalize();
             }
+        }
+        // Finite inputs can still give a degenerate placement (a joint's matrix that overflows
+        // f32, a bind rotation of a singular matrix): refuse it here, not as an internal error
+        // of the glTF writer or a NaN in the USD text (found by fuzzing, issue 17).
+        let finite = mesh.positions.iter().all(|v| v.is_finite())
+            && mesh.normals.iter().all(|v| v.is_finite())
+            && skel.bind_pos.iter().all(|v| v.is_finite())
+            && skel.bind_rot.iter().all(|q| q.is_finite());
+        if !finite {
+            return Err(self.err(
+                "its transforms are degenerate (a matrix that cannot be inverted or overflows 32-bit floats); fix the model's joints and nodes",
+            ));
         }
         // A static model keeps the species' skeleton: `body` at the centre, so bank turns the
         // model about the centre of its bounding box.

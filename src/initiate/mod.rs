@@ -508,6 +508,20 @@ impl StartState {
                 return Err(Error::format(path, format!("speed[{i}]: must be positive")));
             }
         }
+        // Where an animation file may hold a bird: one 10¹² wingspans away made the take-off's
+        // neighbour grid crawl (75 s), one at 10³⁰⁰ overflowed it (a panic; issue 17).
+        let bound = crate::limits::MAX_COORDINATE;
+        for (name, a) in [("x", &s.x), ("y", &s.y)] {
+            if let Some(i) = a.iter().position(|v| v.abs() > bound) {
+                return Err(Error::format(
+                    path,
+                    format!(
+                        "{name}[{i}]: {:e} wingspans; a start position must be within ±{bound:e} wingspans",
+                        a[i]
+                    ),
+                ));
+            }
+        }
         for i in 0..birds {
             for j in 0..i {
                 if s.x[i] == s.x[j] && s.y[i] == s.y[j] {

@@ -27,10 +27,13 @@
 //! Symbols → code: x → `x`, ξ̂ → `xi_target` (renormalised: `target`), y → [`SolveReport::y`],
 //! E → `total`.
 
+use std::cell::Cell;
+
 use nalgebra::{DMatrix, DVector};
 
-use crate::aero::{AeroOptions, Field, COLLISION_SPAN};
+use crate::aero::{AeroOptions, ApproxField, Field, TreeOptions, COLLISION_SPAN};
 use crate::error::{Error, Result};
+use crate::progress::{Progress, Silent};
 
 /// Options of [`solve`].
 #[derive(Debug, Clone)]
@@ -58,6 +61,12 @@ pub struct SolveOptions {
     pub band_span: f64,
     /// For flocks above `dense_limit`: most conjugate-gradient products per Newton step.
     pub cg_limit: usize,
+    /// Flocks of at least this many birds iterate with the far pairs interpolated
+    /// ([`crate::aero::ApproxField`]) and check the result with the exact sums (the reported
+    /// residual is always exact), birds.
+    pub interpolate_from: usize,
+    /// The interpolation of the far pairs for `interpolate_from`.
+    pub interpolation: TreeOptions,
     /// The aerodynamic model's core radius and collision distance.
     pub aero: AeroOptions,
 }
@@ -72,6 +81,8 @@ impl Default for SolveOptions {
             dense_limit: 100,
             band_span: 60.0,
             cg_limit: 50,
+            interpolate_from: 2000,
+            interpolation: TreeOptions::default(),
             aero: AeroOptions::default(),
         }
     }
@@ -262,6 +273,65 @@ pub fn solve(
     y0: Option<&[f64]>,
     opts: &SolveOptions,
 ) -> Result<SolveReport> {
+    solve_with_progress(x, xi_target, y0, opts, &Silent)
+}
+
+/// [`solve`] reporting its progress to `progress`: one stage "solve" of 100 units, the fraction
+/// of the way from the first residual to the tolerance in orders of magnitude (Newton's steps
+/// gain more of them as they go, so the bar speeds up towards the end).
+pub fn solve_with_progress(
+    x: &[f64],
+    xi_target: &[f64],
+    y0: Option<&[f64]>,
+    opts: &SolveOptions,
+    progress: &dyn Progress,
+) -> Result<SolveReport> {
+    progress.start("solve", 100);
+    let tracker = Tracker {
+        progress,
+        tolerance: opts.tolerance,
+        first: Cell::new(f64::NAN),
+        shown: Cell::new(0),
+    };
+    let out = solve_tracked(x, xi_target, y0, opts, &tracker);
+    progress.finish();
+    out
+}
+
+/// Turns residuals into progress units (see [`solve_with_progress`]).
+struct Tracker<'a> {
+    progress: &'a dyn Progress,
+    tolerance: f64,
+    first: Cell<f64>,
+    shown: Cell<u64>,
+}
+
+impl Tracker<'_> {
+    /// The iteration reached residual ‖ξ − ξ̂‖ = `r`.
+    fn residual(&self, r: f64) {
+        if !(r.is_finite() && r > 0.0) {
+            return;
+        }
+        if self.first.get().is_nan() {
+            self.first.set(r.max(10.0 * self.tolerance));
+        }
+        let first = self.first.get();
+        let frac = ((first / r).ln() / (first / self.tolerance).ln()).clamp(0.0, 1.0);
+        let units = (frac * 100.0).floor() as u64;
+        if units > self.shown.get() {
+            self.progress.advance(units - self.shown.get());
+            self.shown.set(units);
+        }
+    }
+}
+
+fn solve_tracked(
+    x: &[f64],
+    xi_target: &[f64],
+    y0: Option<&[f64]>,
+    opts: &SolveOptions,
+    tracker: &Tracker,
+) -> Result<SolveReport> {
     let aero = &opts.aero;
     let target = validate(x, xi_target, y0, aero)?;
     let n = x.len();
@@ -304,8 +374,8 @@ pub fn solve(
             }
         }
         let rep = match &field {
-            None => newton(x, &target, total, &start, opts),
-            Some(f) => newton_krylov(f, &target, total, &start, opts),
+            None => newton(x, &target, total, &start, opts, tracker),
+            Some(f) => newton_krylov(f, &target, total, &start, opts, tracker),
         };
         evaluations += rep.evaluations;
         if rep.converged {
@@ -387,7 +457,14 @@ fn norm_diff(a: &[f64], b: &[f64]) -> f64 {
 /// the step retried) after one that does not. A step that would make two laterally overlapping
 /// birds pass each other is shortened to 90 % of the way to abreast. Stops at the tolerance,
 /// after `patience` Jacobians, or when λ exceeds 10¹².
-fn newton(x: &[f64], target: &[f64], total: f64, y0: &[f64], opts: &SolveOptions) -> SolveReport {
+fn newton(
+    x: &[f64],
+    target: &[f64],
+    total: f64,
+    y0: &[f64],
+    opts: &SolveOptions,
+    tracker: &Tracker,
+) -> SolveReport {
     let n = x.len();
     let aero = &opts.aero;
     let fixed = (0..n)
@@ -456,6 +533,7 @@ fn newton(x: &[f64], target: &[f64], total: f64, y0: &[f64], opts: &SolveOptions
                 r = tr;
                 full = tjac;
                 norm = tnorm;
+                tracker.residual(norm);
                 lambda = (lambda / 10.0).max(1e-15);
                 break;
             }
@@ -527,25 +605,190 @@ fn band_solve(l: &[f64], m: usize, b: usize, r: &[f64]) -> Vec<f64> {
     z
 }
 
-/// [`newton`] for large flocks: inexact Newton steps on the exact residual, each step's linear
-/// system J δ = −r solved by conjugate gradients on the **exact** Jacobian (J symmetric positive
-/// definite once one bird is fixed), preconditioned by the band of the pairs less than
-/// `band_span` apart laterally (a weighted graph Laplacian with a narrow band once the birds are
-/// sorted by x, factorised by Cholesky in O(N·b²)). The residual and the band come from one pass
-/// of [`Field::power_band`], each product J·v from one pass of [`Field::jacobian_times`] (far
-/// pairs by their expansion), so nothing of size N² is stored. The band alone misses the far
-/// pairs' coupling (∂g/∂y ~ a²/R³ summed over the flock), which matters for the slow, flock-wide
-/// modes: as a preconditioner it leaves J's spectrum within a small factor, and conjugate
-/// gradients converge in a few products. Each linear solve is accurate to a fraction
-/// η = min(10⁻², ‖r‖/‖r₀‖) of the residual (superlinear convergence); a step is shortened to keep
-/// the fore-aft order of overlapping pairs and halved until ‖r‖ decreases.
+/// The sums a Newton–conjugate-gradient iteration needs: e with the band and the near slopes,
+/// and products with the Jacobian. [`Field`] gives them exactly, [`ApproxField`] with the far
+/// pairs interpolated.
+trait Sums {
+    fn power_band(&self, y: &[f64], band: &mut Vec<f64>, near: &mut Vec<f64>) -> Vec<f64>;
+    fn jacobian_times(&self, y: &[f64], near: &[f64], v: &[f64]) -> Vec<f64>;
+    /// Whether the sums are exact (for the work counters).
+    fn exact(&self) -> bool;
+}
+
+impl Sums for Field {
+    fn power_band(&self, y: &[f64], band: &mut Vec<f64>, near: &mut Vec<f64>) -> Vec<f64> {
+        Field::power_band(self, y, Some(band), Some(near))
+    }
+    fn jacobian_times(&self, y: &[f64], near: &[f64], v: &[f64]) -> Vec<f64> {
+        Field::jacobian_times(self, y, near, v)
+    }
+    fn exact(&self) -> bool {
+        true
+    }
+}
+
+impl Sums for ApproxField<'_> {
+    fn power_band(&self, y: &[f64], band: &mut Vec<f64>, near: &mut Vec<f64>) -> Vec<f64> {
+        ApproxField::power_band(self, y, Some(band), Some(near))
+    }
+    fn jacobian_times(&self, y: &[f64], near: &[f64], v: &[f64]) -> Vec<f64> {
+        ApproxField::jacobian_times(self, y, near, v)
+    }
+    fn exact(&self) -> bool {
+        false
+    }
+}
+
+/// Work counters of [`newton_krylov`].
+#[derive(Debug, Default)]
+struct Work {
+    /// Exact evaluations of e (every pair).
+    exact: usize,
+    /// Evaluations with the far pairs interpolated.
+    interpolated: usize,
+    /// Jacobian products.
+    products: usize,
+    /// Exact checks that asked for another interpolated round.
+    corrections: usize,
+}
+
+/// Where [`krylov`] stopped.
+struct Inner {
+    y: Vec<f64>,
+    /// The sums' e at `y` (without the correction).
+    e: Vec<f64>,
+    why: &'static str,
+}
+
+/// [`newton`] for large flocks: inexact Newton steps, each step's linear system J δ = −r solved
+/// by conjugate gradients (J symmetric positive definite once one bird is fixed), preconditioned
+/// by the band of the pairs less than `band_span` apart laterally (a weighted graph Laplacian
+/// with a narrow band once the birds are sorted by x, factorised by Cholesky in O(N·b²)). The
+/// band alone misses the far pairs' coupling (∂g/∂y ~ a²/R³ summed over the flock), which
+/// matters for the slow, flock-wide modes: as a preconditioner it leaves J's spectrum within a
+/// small factor, and conjugate gradients converge in a few products. Each linear solve is
+/// accurate to a fraction η = min(10⁻², ‖r‖/‖r₀‖) of the residual (superlinear convergence); a
+/// step is shortened to keep the fore-aft order of overlapping pairs and halved until ‖r‖
+/// decreases.
+///
+/// Up to [`SolveOptions::interpolate_from`] birds every sum is exact ([`Field`]: every pair, far
+/// ones by their expansion). From there on the iteration runs on [`ApproxField`] (the far pairs'
+/// stagger-dependent part interpolated on a tree, about 10⁻⁷ of the far sum, O(N log N)-like
+/// instead of O(N²)), and its result is **checked with the exact sums**: if the exact residual
+/// is not below a tenth of the tolerance, the difference between the exact and the interpolated
+/// e at that point is added to the interpolated residual as a fixed correction and the
+/// iteration continues (a defect correction: each round gains the interpolation's relative
+/// accuracy); after three rounds the exact iteration finishes the job. The reported residual is
+/// always the exact one.
 fn newton_krylov(
     field: &Field,
     target: &[f64],
     total: f64,
     y0: &[f64],
     opts: &SolveOptions,
+    tracker: &Tracker,
 ) -> SolveReport {
+    let n = field.len();
+    let mut work = Work::default();
+    let exact_done = 0.1 * opts.tolerance;
+    let mut y = y0.to_vec();
+    let mut verified: Option<(Vec<f64>, &'static str)> = None;
+    if n >= opts.interpolate_from {
+        let approx = field.approximate(opts.interpolation);
+        let mut corr = vec![0.0; n];
+        for _round in 0..3 {
+            let inner = krylov(
+                &approx,
+                field,
+                target,
+                total,
+                &y,
+                &corr,
+                0.3 * exact_done,
+                opts,
+                &mut work,
+                tracker,
+            );
+            y = inner.y;
+            let e = field.power(&y);
+            work.exact += 1;
+            let r = norm_diff_scaled(&e, target, 1.0 / total);
+            tracker.residual(r);
+            if r <= exact_done {
+                verified = Some((e, inner.why));
+                break;
+            }
+            work.corrections += 1;
+            for ((c, ex), ap) in corr.iter_mut().zip(&e).zip(&inner.e) {
+                *c = ex - ap;
+            }
+            if r <= opts.tolerance && inner.why != "residual below tolerance" {
+                // Converged, and the interpolated iteration cannot do better.
+                verified = Some((e, inner.why));
+                break;
+            }
+        }
+    }
+    let (e, why) = match verified {
+        Some(v) => v,
+        None => {
+            let zero = vec![0.0; n];
+            let inner = krylov(
+                field, field, target, total, &y, &zero, exact_done, opts, &mut work, tracker,
+            );
+            y = inner.y;
+            (inner.e, inner.why)
+        }
+    };
+    let b = field.band_width();
+    let evaluations = work.exact + work.interpolated;
+    report(
+        target,
+        total,
+        y,
+        e,
+        evaluations,
+        opts,
+        format!(
+            "Newton–conjugate gradients, band preconditioner (bandwidth {b}; {} exact and {} interpolated evaluations, {} Jacobian products, {} corrections): {why}",
+            work.exact, work.interpolated, work.products, work.corrections
+        ),
+    )
+}
+
+/// ‖e·scale − t‖₂.
+fn norm_diff_scaled(e: &[f64], t: &[f64], scale: f64) -> f64 {
+    e.iter()
+        .zip(t)
+        .map(|(e, t)| (e * scale - t) * (e * scale - t))
+        .sum::<f64>()
+        .sqrt()
+}
+
+/// The Newton–conjugate-gradient iteration of [`newton_krylov`] on the residual
+/// (e + `corr`)/E − ξ̂ with e and the products from `sums`, from `y0` until the full residual is
+/// at most `done_at` (or the free birds' below a thousandth of the tolerance).
+#[allow(clippy::too_many_arguments)]
+fn krylov<S: Sums>(
+    sums: &S,
+    field: &Field,
+    target: &[f64],
+    total: f64,
+    y0: &[f64],
+    corr: &[f64],
+    done_at: f64,
+    opts: &SolveOptions,
+    work: &mut Work,
+    tracker: &Tracker,
+) -> Inner {
+    let exact = sums.exact();
+    let count = |work: &mut Work| {
+        if exact {
+            work.exact += 1;
+        } else {
+            work.interpolated += 1;
+        }
+    };
     let n = field.len();
     let x = field.x();
     let b = field.band_width();
@@ -567,18 +810,21 @@ fn newton_krylov(
     let mut full_band = Vec::new();
     let mut near = Vec::new();
     let mut y = y0.to_vec();
-    let mut e = field.power_band(&y, Some(&mut full_band), Some(&mut near));
-    let resid =
-        |e: &[f64]| -> Vec<f64> { e.iter().zip(target).map(|(e, t)| e * inv - t).collect() };
+    let mut e = sums.power_band(&y, &mut full_band, &mut near);
+    count(work);
+    let resid = |e: &[f64]| -> Vec<f64> {
+        e.iter()
+            .zip(corr)
+            .zip(target)
+            .map(|((e, c), t)| (e + c) * inv - t)
+            .collect()
+    };
     let mut r = resid(&e);
     let mut norm = merit(&r);
     let norm0 = norm;
-    let mut evaluations = 1;
-    let mut products = 0;
     let mut why = "iteration budget exhausted";
     let stop = opts.tolerance * 1e-3;
-    // Converged (with a margin of 10) on the full residual, the fixed bird's included.
-    let done = |r: &[f64]| r.iter().map(|v| v * v).sum::<f64>().sqrt() <= 0.1 * opts.tolerance;
+    let done = |r: &[f64]| r.iter().map(|v| v * v).sum::<f64>().sqrt() <= done_at;
     for _ in 0..opts.patience.max(1) {
         if norm <= stop || done(&r) {
             why = "residual below tolerance";
@@ -588,28 +834,7 @@ fn newton_krylov(
             why = "the start has an infinite saving (birds abreast with overlapping wingtips)";
             break;
         }
-        let band = drop_position(&full_band, n, b, pf, inv);
-        let mut damped = band.clone();
-        let mut shift = 0.0;
-        let l = loop {
-            if let Some(l) = band_cholesky(&damped, m, b) {
-                break Some(l);
-            }
-            // Not positive definite in floating point: shift the diagonal.
-            let mean = (0..m).map(|p| band[p * w_of(b)]).sum::<f64>() / m as f64;
-            shift = if shift == 0.0 {
-                1e-10 * mean
-            } else {
-                shift * 10.0
-            };
-            if !(shift < mean) {
-                break None;
-            }
-            damped = band.clone();
-            for p in 0..m {
-                damped[p * w_of(b)] += shift;
-            }
-        };
+        let l = band_factor(&full_band, n, b, pf, inv);
         let Some(l) = l else {
             why = "band preconditioner not positive definite";
             break;
@@ -628,8 +853,8 @@ fn newton_krylov(
             for (p, &i) in free.iter().enumerate() {
                 v[i] = dir[p];
             }
-            let jv = field.jacobian_times(&y, &near, &v);
-            products += 1;
+            let jv = sums.jacobian_times(&y, &near, &v);
+            work.products += 1;
             let ad: Vec<f64> = free.iter().map(|&i| jv[i] * inv).collect();
             let curv = dot(&dir, &ad);
             if !(curv > 0.0) {
@@ -665,8 +890,8 @@ fn newton_krylov(
                 .collect();
             let mut tband = Vec::new();
             let mut tnear = Vec::new();
-            let te = field.power_band(&trial, Some(&mut tband), Some(&mut tnear));
-            evaluations += 1;
+            let te = sums.power_band(&trial, &mut tband, &mut tnear);
+            count(work);
             let tr = resid(&te);
             let tnorm = merit(&tr);
             if tnorm.is_finite() && tnorm < norm {
@@ -676,6 +901,7 @@ fn newton_krylov(
                 norm = tnorm;
                 full_band = tband;
                 near = tnear;
+                tracker.residual(r.iter().map(|v| v * v).sum::<f64>().sqrt());
                 accepted = true;
                 break;
             }
@@ -686,17 +912,36 @@ fn newton_krylov(
             break;
         }
     }
-    report(
-        target,
-        total,
-        y,
-        e,
-        evaluations,
-        opts,
-        format!(
-            "Newton–conjugate gradients, band preconditioner (bandwidth {b}, {products} Jacobian products): {why}"
-        ),
-    )
+    Inner { y, e, why }
+}
+
+/// Cholesky factor of the free birds' band (`full` from [`Field::power_band`] without sorted
+/// position `pf`, times `scale`), the diagonal shifted a little if rounding makes it indefinite;
+/// `None` if even a shift of its mean diagonal does not help.
+fn band_factor(full: &[f64], n: usize, b: usize, pf: usize, scale: f64) -> Option<Vec<f64>> {
+    let m = n - 1;
+    let band = drop_position(full, n, b, pf, scale);
+    let mut damped = band.clone();
+    let mut shift = 0.0;
+    loop {
+        if let Some(l) = band_cholesky(&damped, m, b) {
+            return Some(l);
+        }
+        // Not positive definite in floating point: shift the diagonal.
+        let mean = (0..m).map(|p| band[p * w_of(b)]).sum::<f64>() / m as f64;
+        shift = if shift == 0.0 {
+            1e-10 * mean
+        } else {
+            shift * 10.0
+        };
+        if !(shift < mean) {
+            return None;
+        }
+        damped = band.clone();
+        for p in 0..m {
+            damped[p * w_of(b)] += shift;
+        }
+    }
 }
 
 fn w_of(b: usize) -> usize {
