@@ -29,7 +29,7 @@ fn v_shape(n: usize) -> Vec<DVec2> {
 
 fn flock(n: usize, seed: u64) -> (Vec<DVec2>, Vec<f64>, Vec<f64>, initiate::StepParams) {
     let opts = InitiateOptions::default();
-    let params = opts.step_params(&Cruise::new(0.0, 10.0), opts.k, opts.catchup_distance);
+    let params = opts.step_params(&Cruise::new(0.0, 10.0));
     let mut r = rng::seeded(seed);
     let (p, h, v) =
         initiate::random_start(n, &StartRegion::default(), &params, &mut r).expect("start");
@@ -68,9 +68,9 @@ fn step_1000(c: &mut Criterion) {
     let (pos, heading, speed, params) = flock(1000, 2);
     let target = TargetShape::new(&v_shape(1000)).expect("shape");
     let n = pos.len();
-    let z = vec![params.cruise_altitude; n];
-    let mut sim = Simulation::new(target, params, pos, z, heading, speed, vec![0.0; n]);
-    let per_decision = params.substeps as usize;
+    let z = vec![params.opts.cruise_altitude; n];
+    let mut sim = Simulation::new(target, params.clone(), pos, z, heading, speed, vec![0.0; n]);
+    let per_decision = params.opts.substeps as usize;
     // Let references and slots form first (1 s), so the step is a typical one.
     for _ in 0..30 * per_decision {
         sim.step();

@@ -383,7 +383,7 @@ fn diagnose() {
     let opts = InitiateOptions::default();
     let (mut sim, _) =
         initiate::start_simulation(&t, &cruise, &opts, &mut rng::stream(seed, "initiate")).unwrap();
-    let sp = sim.params;
+    let sp = sim.params.clone();
     let mut held = 0;
     let mut trace: Vec<Vec<Option<usize>>> = Vec::new();
     let plot_from = env_u("PLOT_FROM").unwrap_or(0) as usize;
@@ -495,7 +495,7 @@ fn diagnose() {
         }
     }
     for i in 0..n {
-        per.visible(i, &f.pos, f.heading[i], &sp.perception, &mut vis);
+        per.visible(i, &f.pos, f.heading[i], &sp.opts.perception, &mut vis);
         if env_u("BIRD") == Some(i as u64) {
             let mut v = vis.clone();
             v.sort_unstable();

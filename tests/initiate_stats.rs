@@ -62,7 +62,7 @@ fn air_sim(
     v: Vec<f64>,
 ) -> initiate::Simulation {
     let n = p.len();
-    let z = vec![params.cruise_altitude; n];
+    let z = vec![params.opts.cruise_altitude; n];
     initiate::Simulation::new(t, params, p, z, h, v, vec![0.0; n])
 }
 
@@ -150,18 +150,14 @@ fn diagnose() {
     } else {
         initiate_support::v_shape(n, 1.0, 0.6)
     });
-    let params = opts.step_params(
-        &initiate::Cruise::new(0.0, 10.0),
-        opts.k,
-        opts.catchup_distance,
-    );
+    let params = opts.step_params(&initiate::Cruise::new(0.0, 10.0));
     let mut r = rng::seeded(seed);
     let region = match &opts.start {
         initiate::Start::Random(r) => *r,
         _ => initiate::StartRegion::default(),
     };
     let (p, h, v) = initiate::random_start(n, &region, &params, &mut r).unwrap();
-    let mut sim = air_sim(t, params, p, h, v);
+    let mut sim = air_sim(t, params.clone(), p, h, v);
     let steps: usize = std::env::var("STEPS")
         .ok()
         .and_then(|s| s.parse().ok())
@@ -215,11 +211,7 @@ fn near_misses() {
         .unwrap_or(50);
     let opts = env_opts();
     let t = target(&initiate_support::v_shape(n, 1.0, 0.6));
-    let params = opts.step_params(
-        &initiate::Cruise::new(0.0, 10.0),
-        opts.k,
-        opts.catchup_distance,
-    );
+    let params = opts.step_params(&initiate::Cruise::new(0.0, 10.0));
     let region = match &opts.start {
         initiate::Start::Random(r) => *r,
         _ => initiate::StartRegion::default(),
@@ -227,7 +219,7 @@ fn near_misses() {
     for seed in 0..seeds {
         let mut r = rng::seeded(seed);
         let (p, h, v) = initiate::random_start(n, &region, &params, &mut r).unwrap();
-        let mut sim = air_sim(t.clone(), params, p, h, v);
+        let mut sim = air_sim(t.clone(), params.clone(), p, h, v);
         let mut prev: Option<initiate::sim::Flock> = None;
         for step in 0..2500 {
             sim.step();
@@ -297,11 +289,7 @@ fn hpr_agreement() {
         .and_then(|s| s.parse().ok())
         .unwrap_or(40);
     let opts = InitiateOptions::default();
-    let params = opts.step_params(
-        &initiate::Cruise::new(0.0, 10.0),
-        opts.k,
-        opts.catchup_distance,
-    );
+    let params = opts.step_params(&initiate::Cruise::new(0.0, 10.0));
     let cone = 0.35 * std::f64::consts::PI;
     for n in [9usize, 14, 41] {
         // Configurations: random take-off clusters, and the flock 5 s and 20 s into an initiation.
@@ -313,7 +301,7 @@ fn hpr_agreement() {
                     .unwrap();
             configs.push((p.clone(), h.clone()));
             let t = target(&initiate_support::v_shape(n, 1.0, 0.6));
-            let mut sim = air_sim(t, params, p, h, v);
+            let mut sim = air_sim(t, params.clone(), p, h, v);
             for step in 1..=2400 {
                 sim.step();
                 if step == 600 || step == 2400 {

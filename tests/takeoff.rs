@@ -359,12 +359,12 @@ fn smoothness_limits_hold_in_every_frame() {
 fn bank_is_the_coordinated_turn_in_a_steady_turn() {
     let opts = InitiateOptions::default();
     let cruise = Cruise::new(0.0, 10.0);
-    let p = opts.step_params(&cruise, opts.k, opts.catchup_distance);
+    let p = opts.step_params(&cruise);
     let dt = p.dt();
     for (turn_deg, v) in [(20.0f64, 10.0), (-45.0, 8.0), (60.0, 12.0)] {
         let mut s = BirdState {
             pos: DVec2::ZERO,
-            z: p.cruise_altitude,
+            z: p.opts.cruise_altitude,
             climb: 0.0,
             heading: 0.0,
             turn_rate: 0.0,
@@ -377,8 +377,10 @@ fn bank_is_the_coordinated_turn_in_a_steady_turn() {
         let mut prev = s;
         for _ in 0..(5.0 / dt) as usize {
             s = sim::fly(&s, turn_deg.to_radians(), v, &p, dt);
-            assert!((s.turn_rate - prev.turn_rate).abs() <= p.max_turn_accel * dt * (1.0 + 1e-9));
-            assert!((s.bank - prev.bank).abs() <= p.max_roll_rate * dt * (1.0 + 1e-9));
+            assert!(
+                (s.turn_rate - prev.turn_rate).abs() <= p.opts.max_turn_accel * dt * (1.0 + 1e-9)
+            );
+            assert!((s.bank - prev.bank).abs() <= p.opts.max_roll_rate * dt * (1.0 + 1e-9));
             prev = s;
         }
         let g = 9.81 / 1.5;

@@ -937,68 +937,41 @@ impl InitiateOptions {
         })
     }
 
-    /// The simulation's parameters for a cruise (heading, speed, wingspan) and a drive gain
-    /// `k` (per √wingspan; the take-off plan's).
-    pub fn step_params(&self, cruise: &Cruise, k: f64, catchup: f64) -> StepParams {
+    /// The simulation's parameters for a cruise (heading, speed, wingspan) without a take-off
+    /// plan: the options' own gain and catch-up distance, at the natural drive (1).
+    pub fn step_params(&self, cruise: &Cruise) -> StepParams {
+        self.derive_params(cruise, self.k, self.catchup_distance, 1.0)
+    }
+
+    /// The simulation's parameters for a cruise under a take-off plan: the plan's gain,
+    /// catch-up distance and drive (accelerations of the run and the climb, the climb rate and
+    /// the approach scaled by it).
+    pub fn plan_params(&self, cruise: &Cruise, plan: &TakeoffPlan) -> StepParams {
+        self.derive_params(cruise, plan.k, plan.catchup_distance, plan.drive)
+    }
+
+    /// The options and the values derived from them: the speeds in wingspans per second from
+    /// their factors of the cruise speed, gravity, the reference memory in decisions, and the
+    /// drive-scaled take-off values.
+    fn derive_params(&self, cruise: &Cruise, k: f64, catchup: f64, drive: f64) -> StepParams {
         let vc = cruise.speed;
         StepParams {
-            perception: self.perception,
-            visual_range: self.visual_range,
-            alpha: self.alpha,
+            opts: std::sync::Arc::new(self.clone()),
             k,
-            reaction_time: self.reaction_time,
-            substeps: self.substeps,
-            max_turn: self.max_turn_rate,
-            max_turn_accel: self.max_turn_accel,
-            turn_lag: self.turn_lag,
-            max_turn_jerk: self.max_turn_jerk,
-            max_accel: self.max_accel,
-            max_jerk: self.max_jerk,
-            speed_lag: self.speed_lag,
             min_speed: self.min_speed * vc,
             max_speed: self.max_speed * vc,
             cruise_heading: cruise.heading,
             cruise_speed: vc,
-            cruise_altitude: self.cruise_altitude,
-            climb_rate: self.climb_rate,
-            vertical_accel: self.vertical_accel,
+            climb_rate: self.climb_rate * drive,
+            vertical_accel: self.vertical_accel * drive,
             gravity: cruise.gravity(),
-            max_roll_rate: self.max_roll_rate,
-            roll_lag: self.roll_lag,
-            max_roll_accel: self.max_roll_accel,
-            run_accel: self.run_accel,
-            separation_distance: self.separation_distance,
-            lookahead: self.lookahead,
-            avoid_distance: self.avoid_distance,
-            avoid_range: self.avoid_range,
-            avoid_horizon: self.avoid_horizon,
-            lost_speed_factor: self.lost_speed_factor,
-            leader_hysteresis: self.leader_hysteresis,
-            sticky_reference: self.sticky_reference,
+            run_accel: self.run_accel * drive,
             reference_memory: (self.reference_memory() / self.reaction_time).round() as u32,
-            turn_distance_cap: self.turn_distance_cap,
-            linear_zone: self.linear_zone,
             catchup_distance: catchup,
-            gap_speed: self.gap_speed,
             gather_speed: self.gather_speed * vc,
-            assign_slots: self.assign_slots,
-            approach_distance: self.approach_distance,
-            approach_time: self.approach_time,
-            approach_brake: self.approach_brake,
+            approach_time: self.approach_time / drive,
+            approach_brake: self.approach_brake * drive,
         }
-    }
-
-    /// The simulation's parameters for a cruise under a take-off plan: [`Self::step_params`]
-    /// with the plan's gain and drive (accelerations of the run and the climb, the climb rate
-    /// and the approach scaled by it).
-    pub fn plan_params(&self, cruise: &Cruise, plan: &TakeoffPlan) -> StepParams {
-        let mut p = self.step_params(cruise, plan.k, plan.catchup_distance);
-        p.run_accel *= plan.drive;
-        p.climb_rate *= plan.drive;
-        p.vertical_accel *= plan.drive;
-        p.approach_time /= plan.drive;
-        p.approach_brake *= plan.drive;
-        p
     }
 
     /// The convergence tolerances: the options' distance, heading and speed, and steady flight
@@ -1125,7 +1098,7 @@ pub fn random_start(
     // Headings and speeds: no two birds start on a course that brings them closer than the
     // avoidance distance before they could turn a quarter circle away (straight-line
     // prediction); a draw that does is redrawn, up to START_DRAWS times (then the safest is kept).
-    let horizon = std::f64::consts::FRAC_PI_2 / params.max_turn;
+    let horizon = std::f64::consts::FRAC_PI_2 / params.opts.max_turn_rate;
     let mut heading: Vec<f64> = Vec::with_capacity(n);
     let mut speed: Vec<f64> = Vec::with_capacity(n);
     for i in 0..n {
@@ -1155,7 +1128,7 @@ pub fn random_start(
             if miss > best.0 {
                 best = (miss, h, v);
             }
-            if miss >= params.avoid_distance {
+            if miss >= params.opts.avoid_distance {
                 break;
             }
         }
@@ -1252,7 +1225,9 @@ pub fn start_simulation(
     let plan = TakeoffPlan::new(n, opts);
     let mut params = opts.plan_params(cruise, &plan);
     if opts.widen_field {
-        let field = &mut params.perception.fov_per_eye;
+        let field = &mut std::sync::Arc::make_mut(&mut params.opts)
+            .perception
+            .fov_per_eye;
         *field = field.max(target.required_field(FIELD_MARGIN));
     }
     let alt = opts.cruise_altitude;
@@ -1308,7 +1283,7 @@ pub fn simulate(
     }
     let (mut sim, plan) = start_simulation(target, cruise, opts, rng)?;
     let n = target.len();
-    let params = sim.params;
+    let params = sim.params.clone();
     let dt = params.dt();
     let limit = opts.time_limit(fps);
     let tol = opts.tolerances();
@@ -1335,7 +1310,7 @@ pub fn simulate(
             last_liftoff: 0.0,
             leader_changes: 0,
             birds_in_slot: 0,
-            field_per_eye: params.perception.fov_per_eye,
+            field_per_eye: params.opts.perception.fov_per_eye,
         },
     };
     let mut prev: Vec<sim::BirdState> = (0..n).map(|i| sim.bird(i)).collect();
@@ -1401,7 +1376,7 @@ pub fn simulate(
             push(&mut run, &prev, &cur, u);
         }
         std::mem::swap(&mut prev, &mut cur);
-        if sim.steps % params.substeps as usize != 0 {
+        if sim.steps % params.opts.substeps as usize != 0 {
             continue;
         }
         run.stats.min_distance = run.stats.min_distance.min(sim.min_distance());
@@ -1409,7 +1384,7 @@ pub fn simulate(
             liftoff_done = true;
             run.stats.last_liftoff = sim.time;
         }
-        if liftoff_done && sim.steps % (8 * params.substeps as usize) == 0 {
+        if liftoff_done && sim.steps % (8 * params.opts.substeps as usize) == 0 {
             run.stats.max_stray = run.stats.max_stray.max(sim.stray_distance());
         }
         if sim.in_formation(&tol) {
@@ -1421,7 +1396,7 @@ pub fn simulate(
             in_formation_since = None;
         }
         if sim.steps % 256 == 0 {
-            progress.advance(256 * params.substeps as u64);
+            progress.advance(256 * params.opts.substeps as u64);
         }
         if converged {
             break;

@@ -4,7 +4,7 @@
 //! Output frames are samples of this one simulation, so the same seed gives the same take-off at
 //! any output frame rate.
 //!
-//! With assigned slots (the default, [`StepParams::assign_slots`]) every bird has its slot from
+//! With assigned slots (the default, [`super::InitiateOptions::assign_slots`]) every bird has its slot from
 //! the start ([`assign_slots`]) and flies the final approach in the formation frame
 //! (`Simulation::settle`); the paper's correspondence below applies otherwise.
 //!
@@ -33,9 +33,7 @@
 
 use glam::{DVec2, DVec3};
 
-use super::perception::{
-    bearing, choose_reference, direction, right_of, Perceiver, PerceptionParams,
-};
+use super::perception::{bearing, choose_reference, direction, right_of, Perceiver};
 use super::target::{Side, TargetShape};
 
 /// Collision avoidance ignores flockmates whose speed relative to the bird is below this
@@ -46,36 +44,17 @@ pub const AVOID_MIN_RELATIVE_SPEED: f64 = 0.08;
 /// seconds.
 pub const AVOID_COMMIT: f64 = 0.3;
 
-/// Parameters of the drives, actions and flight dynamics, in seconds (derived from
-/// [`super::InitiateOptions`]).
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// Parameters of the drives, actions and flight dynamics of one run: the options themselves
+/// (every pass-through value is read from [`Self::opts`]) and the values derived from them for a
+/// cruise and a take-off plan (built by [`super::InitiateOptions::plan_params`]).
+#[derive(Debug, Clone, PartialEq)]
 pub struct StepParams {
-    /// Perception model.
-    pub perception: PerceptionParams,
-    /// Visual range: flockmates farther than this are not perceived, wingspans.
-    pub visual_range: f64,
-    /// α of eq. (6), dimensionless.
-    pub alpha: f64,
-    /// |K| of eq. (5), per √wingspan.
+    /// The options of the initiation, as given but for the visual field, widened to the shape's
+    /// when [`super::InitiateOptions::widen_field`] (shared: a step copies its parameters
+    /// cheaply).
+    pub opts: std::sync::Arc<super::InitiateOptions>,
+    /// |K| of eq. (5), per √wingspan (the take-off plan's).
     pub k: f64,
-    /// Reaction time τ: one decision per τ; the paper's "one time step", seconds.
-    pub reaction_time: f64,
-    /// Internal integration steps per decision.
-    pub substeps: u32,
-    /// Maximum turn rate, radians per second.
-    pub max_turn: f64,
-    /// Maximum change of the turn rate, radians per second squared.
-    pub max_turn_accel: f64,
-    /// Time constant of the turn rate following its request, seconds.
-    pub turn_lag: f64,
-    /// Maximum rate of change of the turn rate's change, radians per second cubed.
-    pub max_turn_jerk: f64,
-    /// Maximum acceleration (and deceleration), wingspans per second squared.
-    pub max_accel: f64,
-    /// Maximum change of the acceleration, wingspans per second cubed.
-    pub max_jerk: f64,
-    /// Time constant of the speed following its request, seconds.
-    pub speed_lag: f64,
     /// Minimum flight speed (lift-off speed), wingspans per second.
     pub min_speed: f64,
     /// Maximum flight speed, wingspans per second.
@@ -84,70 +63,34 @@ pub struct StepParams {
     pub cruise_heading: f64,
     /// Cruise speed, wingspans per second.
     pub cruise_speed: f64,
-    /// Cruise altitude (`z`), wingspans above the ground.
-    pub cruise_altitude: f64,
-    /// Largest climb (and descent) rate, wingspans per second.
+    /// Largest climb (and descent) rate, scaled by the plan's drive, wingspans per second.
     pub climb_rate: f64,
-    /// Largest vertical acceleration, wingspans per second squared.
+    /// Largest vertical acceleration, scaled by the plan's drive, wingspans per second squared.
     pub vertical_accel: f64,
     /// Gravity, wingspans per second squared (9.81 m/s² / wingspan in metres).
     pub gravity: f64,
-    /// Maximum roll rate, radians per second.
-    pub max_roll_rate: f64,
-    /// Time constant of the bank following the coordinated-turn bank, seconds.
-    pub roll_lag: f64,
-    /// Maximum roll acceleration, radians per second squared.
-    pub max_roll_accel: f64,
-    /// Acceleration of the take-off run, wingspans per second squared.
+    /// Acceleration of the take-off run, scaled by the plan's drive, wingspans per second
+    /// squared.
     pub run_accel: f64,
-    /// Separation drive: two birds sharing a reference within this distance → the rear one
-    /// chooses another, wingspans (paper: 10).
-    pub separation_distance: f64,
-    /// Look-ahead distance of a bird near or ahead of its target: it steers at the point this far
-    /// ahead of itself on the target's line, wingspans.
-    pub lookahead: f64,
-    /// Collision avoidance: predicted closest approach below which a bird evades, wingspans.
-    pub avoid_distance: f64,
-    /// Collision avoidance: only birds nearer than this are considered, wingspans.
-    pub avoid_range: f64,
-    /// Collision avoidance: prediction horizon, seconds.
-    pub avoid_horizon: f64,
-    /// Speed factor of a bird without a reference bird (slows a little until it sees the flock).
-    pub lost_speed_factor: f64,
-    /// A bird replaces the leader only when it is this much farther ahead, wingspans.
-    pub leader_hysteresis: f64,
-    /// Keep the current reference bird while it stays visible and acceptable.
-    pub sticky_reference: bool,
     /// A kept reference hidden for at most this many decisions is kept all the same.
     pub reference_memory: u32,
-    /// Upper bound of the distance divisor of eq. (6), wingspans.
-    pub turn_distance_cap: f64,
-    /// Half-width of the linear zone of eq. (5)'s √|r − v_j τ| around its fixed point, wingspans.
-    pub linear_zone: f64,
-    /// Beyond this distance eq. (5)'s √|r − v_j τ| grows linearly (catch-up), wingspans.
+    /// Beyond this distance eq. (5)'s √|r − v_j τ| grows linearly (catch-up), wingspans (the
+    /// take-off plan's).
     pub catchup_distance: f64,
-    /// Eq. (5) with the longitudinal gap to the target instead of the whole distance.
-    pub gap_speed: bool,
     /// Speed of the leader while flockmates are still on the ground, wingspans per second.
     pub gather_speed: f64,
-    /// Slots assigned once at the start ([`assign_slots`]) instead of the paper's §6.2.1
-    /// correspondence through reference birds re-evaluated at every decision.
-    pub assign_slots: bool,
-    /// Final approach: within this distance of its slot a bird flies the formation-frame
-    /// controller alone; between it and twice it the controller and eqs. (5)–(6) are blended,
-    /// wingspans.
-    pub approach_distance: f64,
-    /// Final approach: time constant of the slot error across the formation, seconds.
+    /// Final approach: time constant of the slot error across the formation, divided by the
+    /// plan's drive, seconds.
     pub approach_time: f64,
-    /// Final approach: deceleration the closing speed on the slot is braked with, wingspans per
-    /// second squared.
+    /// Final approach: deceleration the closing speed on the slot is braked with, scaled by the
+    /// plan's drive, wingspans per second squared.
     pub approach_brake: f64,
 }
 
 impl StepParams {
     /// The integration step, seconds: τ / substeps.
     pub fn dt(&self) -> f64 {
-        self.reaction_time / self.substeps.max(1) as f64
+        self.opts.reaction_time / self.opts.substeps.max(1) as f64
     }
 }
 
@@ -458,7 +401,7 @@ fn approach(x: f64, target: f64, max_step: f64) -> f64 {
 /// limits of [`StepParams`] hold by construction: |Δω| ≤ ω̇_max dt, |Δa| ≤ j_max dt,
 /// |a| ≤ a_max, |Δφ| ≤ p_max dt, |Δw| ≤ a_z dt.
 pub fn fly(s: &BirdState, want_turn: f64, want_speed: f64, p: &StepParams, dt: f64) -> BirdState {
-    fly_at(s, want_turn, want_speed, p.cruise_altitude, p, dt)
+    fly_at(s, want_turn, want_speed, p.opts.cruise_altitude, p, dt)
 }
 
 /// As [`fly`], climbing towards altitude `want_z` (wingspans) instead of the cruise altitude.
@@ -475,25 +418,27 @@ pub fn fly_at(
     // itself changing at a bounded rate (so the turn rate cannot flip sign from one frame to the
     // next); near the request the change is the braking one, ω̇² = 2 j |ω* − ω|, so it arrives
     // without overshoot.
-    let w_req = want_turn.clamp(-p.max_turn, p.max_turn);
+    let w_req = want_turn.clamp(-p.opts.max_turn_rate, p.opts.max_turn_rate);
     let err = w_req - s.turn_rate;
-    let brake = (2.0 * p.max_turn_jerk * err.abs()).sqrt();
-    let a_turn = (err / p.turn_lag)
-        .clamp(-p.max_turn_accel, p.max_turn_accel)
+    let brake = (2.0 * p.opts.max_turn_jerk * err.abs()).sqrt();
+    let a_turn = (err / p.opts.turn_lag)
+        .clamp(-p.opts.max_turn_accel, p.opts.max_turn_accel)
         .clamp(-brake, brake);
-    n.turn_accel = approach(s.turn_accel, a_turn, p.max_turn_jerk * dt);
-    n.turn_rate = (s.turn_rate + n.turn_accel * dt).clamp(-p.max_turn, p.max_turn);
+    n.turn_accel = approach(s.turn_accel, a_turn, p.opts.max_turn_jerk * dt);
+    n.turn_rate =
+        (s.turn_rate + n.turn_accel * dt).clamp(-p.opts.max_turn_rate, p.opts.max_turn_rate);
     // Speed: the acceleration follows (v* − v)/τ_v with bounded jerk. Near the speed limits the
     // wanted acceleration is the braking one (a² = 2 j Δv), so the bound is met without a kink.
     let v_req = want_speed.clamp(p.min_speed, p.max_speed);
-    let a_lag = (v_req - s.speed) / p.speed_lag;
+    let a_lag = (v_req - s.speed) / p.opts.speed_lag;
     let room_up = (p.max_speed - s.speed).max(0.0);
     let room_down = (s.speed - p.min_speed).max(0.0);
     let a_want = a_lag
-        .clamp(-p.max_accel, p.max_accel)
-        .min((2.0 * p.max_jerk * room_up).sqrt())
-        .max(-(2.0 * p.max_jerk * room_down).sqrt());
-    n.accel = approach(s.accel, a_want, p.max_jerk * dt).clamp(-p.max_accel, p.max_accel);
+        .clamp(-p.opts.max_accel, p.opts.max_accel)
+        .min((2.0 * p.opts.max_jerk * room_up).sqrt())
+        .max(-(2.0 * p.opts.max_jerk * room_down).sqrt());
+    n.accel =
+        approach(s.accel, a_want, p.opts.max_jerk * dt).clamp(-p.opts.max_accel, p.opts.max_accel);
     n.speed = (s.speed + n.accel * dt).clamp(p.min_speed.min(s.speed), p.max_speed.max(s.speed));
     n.heading = wrap_angle(s.heading + n.turn_rate * dt);
     // Coordinated turn: tan φ = v ω / g.
@@ -501,11 +446,11 @@ pub fn fly_at(
     // the bank cannot swing back and forth from frame to frame.
     let phi_t = (n.speed * n.turn_rate / p.gravity).atan();
     let e = phi_t - s.bank;
-    let brake = (2.0 * p.max_roll_accel * e.abs()).sqrt();
-    let p_want = (e / p.roll_lag)
-        .clamp(-p.max_roll_rate, p.max_roll_rate)
+    let brake = (2.0 * p.opts.max_roll_accel * e.abs()).sqrt();
+    let p_want = (e / p.opts.roll_lag)
+        .clamp(-p.opts.max_roll_rate, p.opts.max_roll_rate)
         .clamp(-brake, brake);
-    n.roll_rate = approach(s.roll_rate, p_want, p.max_roll_accel * dt);
+    n.roll_rate = approach(s.roll_rate, p_want, p.opts.max_roll_accel * dt);
     n.bank = s.bank + n.roll_rate * dt;
     // Climb: towards the cruise altitude, arriving with zero climb rate.
     let dz = want_z - s.z;
@@ -520,7 +465,7 @@ pub fn fly_at(
 /// the run acceleration (bounded jerk) until the lift-off speed.
 pub fn run(s: &BirdState, p: &StepParams, dt: f64) -> BirdState {
     let mut n = *s;
-    n.accel = approach(s.accel, p.run_accel, p.max_jerk * dt);
+    n.accel = approach(s.accel, p.run_accel, p.opts.max_jerk * dt);
     n.speed = s.speed + n.accel * dt;
     n.pos = s.pos + direction(s.heading) * (0.5 * (s.speed + n.speed) * dt);
     n
@@ -601,7 +546,7 @@ impl Simulation {
             next_branch: vec![None; n],
             next_unseen: vec![0; n],
         };
-        if sim.params.assign_slots && n > 0 {
+        if sim.params.opts.assign_slots && n > 0 {
             let (slot, leader) =
                 assign_slots(&sim.target, &sim.flock.pos, sim.params.cruise_heading);
             sim.flock.leader = leader;
@@ -809,7 +754,7 @@ impl Simulation {
         let d = self.dir_of(j);
         // Right of d = (sin θ, cos θ) is (cos θ, −sin θ).
         let r = DVec2::new(d.y, -d.x);
-        f.pos[j] + d * (f.speed[j] * self.params.reaction_time) + r * offset.x - d * offset.y
+        f.pos[j] + d * (f.speed[j] * self.params.opts.reaction_time) + r * offset.x - d * offset.y
     }
 
     /// Flight direction of bird `j` (cached for the current decision).
@@ -848,7 +793,7 @@ impl Simulation {
                     && f.reference[k] == Some(j)
                     && f.side[k] == Some(side)
                     && f.slot[k] == Some(c)
-                    && ((f.pos[k] - f.pos[i]).length() < self.params.separation_distance
+                    && ((f.pos[k] - f.pos[i]).length() < self.params.opts.separation_distance
                         || (f.pos[k] - t).length() < SETTLED_DISTANCE)
                     && (f.pos[k] - t).length() < my + margin
             });
@@ -890,9 +835,9 @@ impl Simulation {
         if n == 0 {
             return;
         }
-        let p = self.params;
+        let p = self.params.clone();
         let dt = p.dt();
-        if self.steps % p.substeps.max(1) as usize == 0 {
+        if self.steps % p.opts.substeps.max(1) as usize == 0 {
             self.decide_all();
         }
         for i in 0..n {
@@ -916,7 +861,7 @@ impl Simulation {
                 }
                 Phase::Airborne => {
                     let (w, v) = self.flock.request[i];
-                    let z = p.cruise_altitude + self.flock.alt_offset[i];
+                    let z = p.opts.cruise_altitude + self.flock.alt_offset[i];
                     fly_at(&s, w, v, z, &p, dt)
                 }
             };
@@ -929,7 +874,7 @@ impl Simulation {
     /// One decision of every bird from the current state (Jacobi: all read the same state).
     fn decide_all(&mut self) {
         let n = self.len();
-        let p = self.params;
+        let p = self.params.clone();
         self.update_departed();
         if self.departed.is_empty() {
             return;
@@ -938,11 +883,12 @@ impl Simulation {
         // The leader is the front-most departed bird (with hysteresis against flip-flopping);
         // with assigned slots it is the one of the leader slot throughout.
         let lead = self.flock.leader;
-        if let Some(front) = self.front_most(dc).filter(|_| !p.assign_slots) {
+        if let Some(front) = self.front_most(dc).filter(|_| !p.opts.assign_slots) {
             let lead_gone = self.flock.phase[lead] == Phase::Waiting;
             if front != lead
                 && (lead_gone
-                    || (self.flock.pos[front] - self.flock.pos[lead]).dot(dc) > p.leader_hysteresis)
+                    || (self.flock.pos[front] - self.flock.pos[lead]).dot(dc)
+                        > p.opts.leader_hysteresis)
             {
                 self.flock.leader = front;
                 self.leader_changes += 1;
@@ -978,7 +924,7 @@ impl Simulation {
         grid.build(
             &self.flock.pos,
             &all,
-            p.avoid_range.max(p.visual_range / 4.0),
+            p.opts.avoid_range.max(p.opts.visual_range / 4.0),
         );
         self.grid = grid;
         let mut decisions = std::mem::take(&mut self.decisions);
@@ -1045,7 +991,7 @@ impl Simulation {
         std::mem::swap(&mut f.side, &mut self.next_side);
         std::mem::swap(&mut f.branch, &mut self.next_branch);
         std::mem::swap(&mut f.unseen, &mut self.next_unseen);
-        if !p.assign_slots {
+        if !p.opts.assign_slots {
             self.match_slots();
         }
     }
@@ -1086,7 +1032,7 @@ impl Simulation {
     ) -> Decision {
         let p = &self.params;
         let f = &self.flock;
-        let tau = p.reaction_time;
+        let tau = p.opts.reaction_time;
         let mut unseen = 0;
         let (turn, want_speed, reference, side, branch) = if i == f.leader {
             let dd = wrap_angle(p.cruise_heading - f.heading[i]);
@@ -1099,8 +1045,8 @@ impl Simulation {
             } else {
                 p.cruise_speed
             };
-            (p.alpha * dd / tau, v, None, None, None)
-        } else if let Some(c) = f.slot[i].filter(|_| p.assign_slots) {
+            (p.opts.alpha * dd / tau, v, None, None, None)
+        } else if let Some(c) = f.slot[i].filter(|_| p.opts.assign_slots) {
             // Assigned slot: the reference is the bird of the nearest airborne ancestor of the
             // slot (its reference slot, or farther up the tree while that bird is on the ground).
             let mut s = c;
@@ -1118,14 +1064,15 @@ impl Simulation {
             };
             // The whole way in the formation frame: eqs. (5)–(6) relative to a reference bird
             // that is itself still far from its slot would pass its lag down the arm.
-            self.grid.within(&f.pos, f.pos[i], p.avoid_range, near);
+            self.grid.within(&f.pos, f.pos[i], p.opts.avoid_range, near);
             let (w, v) = self.settle(i, c, near);
             (w, v, Some(j), self.target.side_of(c), Some(c))
         } else {
             // Perception: departed flockmates within the visual range.
-            self.grid.within(&f.pos, f.pos[i], p.visual_range, near);
+            self.grid
+                .within(&f.pos, f.pos[i], p.opts.visual_range, near);
             near.retain(|&j| f.phase[j] != Phase::Waiting);
-            perceiver.visible_among(i, &f.pos, near, f.heading[i], &p.perception, visible);
+            perceiver.visible_among(i, &f.pos, near, f.heading[i], &p.opts.perception, visible);
             match self.choose(i, visible) {
                 Some((j, side, c, u)) => {
                     unseen = u;
@@ -1138,7 +1085,7 @@ impl Simulation {
                     let c = self.departed.iter().map(|&j| f.pos[j]).sum::<DVec2>()
                         / self.departed.len().max(1) as f64;
                     let dd = bearing(f.heading[i], c - f.pos[i]);
-                    (p.alpha * dd / tau, p.max_speed, None, None, None)
+                    (p.opts.alpha * dd / tau, p.max_speed, None, None, None)
                 }
                 None => {
                     let d = direction(f.heading[i]);
@@ -1151,13 +1098,14 @@ impl Simulation {
                         // than the separation distance): close on the nearest, a little faster
                         // than the cruise, instead of falling back ever farther.
                         Some((rel, _))
-                            if rel.length() > p.separation_distance
+                            if rel.length() > p.opts.separation_distance
                                 && visible.iter().all(|&j| (f.pos[j] - f.pos[i]).dot(d) > 0.0) =>
                         {
                             let dd = bearing(f.heading[i], rel);
-                            let gain = (0.02 * (rel.length() - p.separation_distance)).min(0.3);
+                            let gain =
+                                (0.02 * (rel.length() - p.opts.separation_distance)).min(0.3);
                             (
-                                p.alpha * dd / (p.turn_distance_cap * tau),
+                                p.opts.alpha * dd / (p.opts.turn_distance_cap * tau),
                                 p.cruise_speed * (1.0 + gain),
                                 None,
                                 None,
@@ -1168,8 +1116,8 @@ impl Simulation {
                             // Lost: turn toward the cruise heading and slow a little.
                             let dd = wrap_angle(p.cruise_heading - f.heading[i]);
                             (
-                                p.alpha * dd / tau,
-                                p.lost_speed_factor * p.cruise_speed,
+                                p.opts.alpha * dd / tau,
+                                p.opts.lost_speed_factor * p.cruise_speed,
                                 None,
                                 None,
                                 None,
@@ -1179,8 +1127,11 @@ impl Simulation {
                 }
             }
         };
-        let (mut w, mut v) = (turn.clamp(-p.max_turn, p.max_turn), want_speed);
-        self.grid.within(&f.pos, f.pos[i], p.avoid_range, near);
+        let (mut w, mut v) = (
+            turn.clamp(-p.opts.max_turn_rate, p.opts.max_turn_rate),
+            want_speed,
+        );
+        self.grid.within(&f.pos, f.pos[i], p.opts.avoid_range, near);
         // With assigned slots, neighbours across the formation fly in two layers while they are
         // away from their slots (half a wingspan apart in height), merging as they settle, so
         // that two birds passing each other on the way are apart in 3-D.
@@ -1195,11 +1146,11 @@ impl Simulation {
             w = turn;
             alt_offset = dz;
             if slow {
-                v = v.min(f.speed[i] - p.max_accel * p.speed_lag);
+                v = v.min(f.speed[i] - p.opts.max_accel * p.opts.speed_lag);
             }
         }
         Decision {
-            turn_rate: w.clamp(-p.max_turn, p.max_turn),
+            turn_rate: w.clamp(-p.opts.max_turn_rate, p.opts.max_turn_rate),
             speed: v.clamp(p.min_speed, p.max_speed),
             alt_offset,
             reference,
@@ -1215,7 +1166,7 @@ impl Simulation {
     /// forget the bird it follows when another passes in front of it for a moment).
     fn choose(&self, i: usize, visible: &[usize]) -> Option<(usize, Side, usize, u32)> {
         let f = &self.flock;
-        if self.params.sticky_reference {
+        if self.params.opts.sticky_reference {
             if let (Some(j), Some(side)) = (f.reference[i], f.side[i]) {
                 let seen = visible.contains(&j);
                 let remembered = seen || f.unseen[i] < self.params.reference_memory;
@@ -1233,7 +1184,7 @@ impl Simulation {
             visible,
             &f.pos,
             f.heading[i],
-            self.params.perception.reference_cone,
+            self.params.opts.perception.reference_cone,
             |j| {
                 for side in self.sides_for(i, j).into_iter().flatten() {
                     if let Some(c) = self.acceptable(i, j, side, visible) {
@@ -1257,7 +1208,7 @@ impl Simulation {
         };
         let r = (self.flock.pos[i] - slot).length();
         let others = near;
-        let near = p.approach_distance;
+        let near = p.opts.approach_distance;
         if r >= 2.0 * near {
             return self.pursue(i, j, c);
         }
@@ -1316,7 +1267,7 @@ impl Simulation {
         let want = vf + dc * ua + rc * uc + self.separation(i, near);
         let h = want.x.atan2(want.y);
         let herr = wrap_angle(h - f.heading[i]);
-        let w = herr / (3.0 * p.turn_lag.max(0.05));
+        let w = herr / (3.0 * p.opts.turn_lag.max(0.05));
         // Facing away from where it wants to go, a bird slows down and turns tighter.
         let away =
             ((herr.abs() - TURN_SLOW_FROM) / (TURN_SLOW_TO - TURN_SLOW_FROM)).clamp(0.0, 1.0);
@@ -1389,7 +1340,7 @@ impl Simulation {
     fn pursue(&self, i: usize, j: usize, c: usize) -> (f64, f64) {
         let p = &self.params;
         let f = &self.flock;
-        let tau = p.reaction_time;
+        let tau = p.opts.reaction_time;
         let offset = match f.slot[j] {
             Some(sj) => self.target.offset(sj, c),
             None => self.target.mean_offset,
@@ -1402,10 +1353,10 @@ impl Simulation {
         let behind = to_t.dot(dj);
         // Near or ahead of the target: steer at a point ahead on the target's line instead of
         // turning back toward it (turnaround fix).
-        let aim = if behind >= p.lookahead {
+        let aim = if behind >= p.opts.lookahead {
             t
         } else {
-            t + dj * (p.lookahead - behind)
+            t + dj * (p.opts.lookahead - behind)
         };
         let to_aim = aim - f.pos[i];
         let dd = bearing(f.heading[i], to_aim);
@@ -1428,7 +1379,7 @@ impl Simulation {
         // With `gap_speed`, the distance is the longitudinal gap alone: the lateral error is the
         // heading's business (eq. 6), and with the full distance K's sign flip at the target
         // (|u| ≈ the lateral error there) is a jump of 2 K φ v_j in the wanted speed.
-        let (k, u) = if p.gap_speed {
+        let (k, u) = if p.opts.gap_speed {
             let g = behind - step_j;
             let k = if g <= 0.0 {
                 -p.k
@@ -1441,7 +1392,7 @@ impl Simulation {
         } else {
             (k, (signed_r - step_j).abs())
         };
-        let z = p.linear_zone;
+        let z = p.opts.linear_zone;
         // Far from the fixed point (beyond the catch-up distance u₁) the term grows linearly,
         // √u₁ · u/u₁, so that a bird far behind closes the gap in seconds, not tens of seconds
         // (eq. 5's √ alone closes 25 wingspans in 1/(v_j K) ≈ 17 s at 10 wingspans/s).
@@ -1457,10 +1408,10 @@ impl Simulation {
         // Braking distance: close on the target no faster than the speed that can still be shed
         // before reaching it, v ≤ v_j + √(2 a g) with g the longitudinal gap (no overshoot); the
         // speed lag adds a distance v τ_v, taken off the gap.
-        let gap = (behind - step_j - (f.speed[i] - vj).max(0.0) * p.speed_lag).max(0.0);
-        v = v.min(vj + (2.0 * p.max_accel * gap).sqrt());
+        let gap = (behind - step_j - (f.speed[i] - vj).max(0.0) * p.opts.speed_lag).max(0.0);
+        v = v.min(vj + (2.0 * p.opts.max_accel * gap).sqrt());
         // Eq. (6) as a rate, the divisor capped so that a far bird can still turn to its target.
-        let w = p.alpha * dd / (r.clamp(1.0, p.turn_distance_cap) * tau);
+        let w = p.opts.alpha * dd / (r.clamp(1.0, p.opts.turn_distance_cap) * tau);
         (w, v)
     }
 
@@ -1482,7 +1433,7 @@ impl Simulation {
         let miss = |dp: DVec3, dv: DVec3| -> f64 {
             let vv = dv.length_squared();
             let tau = if vv > 1e-12 {
-                (-dp.dot(dv) / vv).clamp(0.0, p.avoid_horizon)
+                (-dp.dot(dv) / vv).clamp(0.0, p.opts.avoid_horizon)
             } else {
                 0.0
             };
@@ -1506,12 +1457,12 @@ impl Simulation {
                     if self.slot_err.get(i).is_some_and(|&e| e < YIELD_DISTANCE)
                         && self.slot_err.get(k).is_some_and(|&e| e < YIELD_DISTANCE) =>
                 {
-                    p.avoid_distance.min(
+                    p.opts.avoid_distance.min(
                         (YIELD_FRACTION * (self.target.slots[a] - self.target.slots[b]).length())
                             .max(YIELD_FLOOR),
                     )
                 }
-                _ => p.avoid_distance,
+                _ => p.opts.avoid_distance,
             };
             let is_threat = (closing && m < limit) || d < limit;
             if is_threat && threat.map_or(true, |t| d < t.0) {
@@ -1532,9 +1483,9 @@ impl Simulation {
             }
             worst
         };
-        let m = p.max_turn;
+        let m = p.opts.max_turn_rate;
         let mut best = (score(want), want);
-        if best.0 < p.avoid_distance {
+        if best.0 < p.opts.avoid_distance {
             for w in [-m, -0.5 * m, 0.0, 0.5 * m, m] {
                 let sc = score(w);
                 let better = sc > best.0 + 1e-9
@@ -1549,11 +1500,11 @@ impl Simulation {
         // higher index when level) climbs, the other dives, by 1.5 avoidance distances, while the
         // threat lasts (airborne birds only; the hand-over needs the cruise altitude back).
         let above = f.z[i] > f.z[other] || (f.z[i] == f.z[other] && i > other);
-        let dz = if f.phase[other] == Phase::Airborne && f.z[i] > 0.5 * p.avoid_distance {
+        let dz = if f.phase[other] == Phase::Airborne && f.z[i] > 0.5 * p.opts.avoid_distance {
             if above {
-                1.5 * p.avoid_distance
+                1.5 * p.opts.avoid_distance
             } else {
-                -1.5 * p.avoid_distance
+                -1.5 * p.opts.avoid_distance
             }
         } else {
             0.0
@@ -1599,7 +1550,7 @@ impl Simulation {
         (0..n).all(|i| {
             let s = f.slot[i].unwrap_or(0);
             (f.pos[i] - slots[s]).length() <= tol.distance
-                && (f.z[i] - p.cruise_altitude).abs() <= tol.distance
+                && (f.z[i] - p.opts.cruise_altitude).abs() <= tol.distance
                 && wrap_angle(f.heading[i] - p.cruise_heading).abs() <= tol.heading
                 && (f.speed[i] - p.cruise_speed).abs() <= tol.speed * p.cruise_speed
                 && f.turn_rate[i].abs() <= tol.turn_rate
