@@ -25,8 +25,16 @@ pub enum Stream {
     Initiate,
     /// Wingbeats: per-bird frequencies, amplitudes and initial phases.
     Wingbeat,
-    /// Flocks of several formations (skeins): formation sizes, arrangement, drift.
+    /// Flocks of several formations (skeins): per-formation drift.
     Skein,
+    /// §5 steady flight: the slow drift of the lateral gaps from key shape to key shape.
+    SteadyLateral,
+    /// Steady flight: the birds' small height differences.
+    SteadyHeight,
+    /// Skeins: how many birds each formation has.
+    SkeinSizes,
+    /// Skeins: where the formations fly relative to one another.
+    SkeinLayout,
 }
 
 impl Stream {
@@ -39,6 +47,10 @@ impl Stream {
             Stream::Initiate => "initiate",
             Stream::Wingbeat => "wingbeat",
             Stream::Skein => "skein",
+            Stream::SteadyLateral => "steady.lateral",
+            Stream::SteadyHeight => "steady.height",
+            Stream::SkeinSizes => "skein/sizes",
+            Stream::SkeinLayout => "skein/layout",
         }
     }
 }
@@ -80,6 +92,16 @@ pub fn formation_stream(seed: u64, stage: Stream, k: usize) -> FlockRng {
     stream(seed, format!("{}/formation/{k}", stage.label()).as_str())
 }
 
+/// The generator of retry `t` (≥ 1) of formation `k` for `stage` (label
+/// `"{stage}/formation/{k}/try/{t}"`): a formation whose first draw fails draws afresh without
+/// touching any other formation's numbers.
+pub fn retry_stream(seed: u64, stage: Stream, k: usize, t: usize) -> FlockRng {
+    stream(
+        seed,
+        format!("{}/formation/{k}/try/{t}", stage.label()).as_str(),
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -93,6 +115,10 @@ mod tests {
             Stream::Initiate,
             Stream::Wingbeat,
             Stream::Skein,
+            Stream::SteadyLateral,
+            Stream::SteadyHeight,
+            Stream::SkeinSizes,
+            Stream::SkeinLayout,
         ] {
             let a: u64 = stream(42, s).random();
             let b: u64 = stream(42, s.label()).random();
@@ -104,5 +130,8 @@ mod tests {
         let a: u64 = formation_stream(42, Stream::Steady, 0).random();
         let b: u64 = formation_stream(42, Stream::Steady, 1).random();
         assert!(a != b && a != s);
+        let r: u64 = retry_stream(42, Stream::Skein, 3, 2).random();
+        let l: u64 = stream(42, "skein/formation/3/try/2").random();
+        assert_eq!(r, l);
     }
 }

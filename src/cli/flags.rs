@@ -120,6 +120,13 @@ pub const FLAGS: &[(&str, &str, &[Cmd])] = &[
         "--start-width/--start-depth",
         INITIATE,
     ),
+    ("initiate.start.width", "--start-width", INITIATE),
+    ("initiate.start.depth", "--start-depth", INITIATE),
+    (
+        "initiate.start.heading_spread",
+        "--heading-spread",
+        INITIATE,
+    ),
     ("initiate.start.ground.width", "--start-width", INITIATE),
     ("initiate.start.ground.depth", "--start-depth", INITIATE),
     (

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use clap::{Args, ValueEnum};
 use formation::animation::Animation;
 use formation::initiate::{
-    self, GroundStart, InitiateOptions, PerceptionMode, Start, StartRegion, StartState,
+    self, GroundStart, InitiateOptions, PerceptionMode, Start, StartChoice, StartRegion,
     TakeoffPlan, HPR_GAMMA_DEFAULT,
 };
 use formation::io::OutputKind;
@@ -50,6 +50,33 @@ pub struct InitiateArgs {
 /// The library's defaults, for the flags' `default_value_t`.
 fn d() -> InitiateOptions {
     InitiateOptions::default()
+}
+
+/// The help of `--start-width`, with the library's rules for its default.
+fn start_width_help() -> String {
+    format!(
+        "Width of the take-off area (ground) or start region (air) across the cruise heading, wingspans [default: ground from the flock size and --takeoff, {} times the depth; air {}√N, at least {}]",
+        initiate::GROUND_ASPECT,
+        initiate::AIR_WIDTH_PER_ROOT_BIRD,
+        initiate::AIR_MIN_WIDTH
+    )
+}
+
+/// The help of `--start-depth`, with the library's rules for its default.
+fn start_depth_help() -> String {
+    format!(
+        "Depth of the take-off area or start region along the cruise heading, wingspans [default: ground from the flock size and --takeoff, at most {}; air the width]",
+        initiate::GROUND_MAX_DEPTH
+    )
+}
+
+/// The help of `--heading-spread`, with the library's defaults for each start.
+fn heading_spread_help() -> String {
+    format!(
+        "Start headings are uniform within this many degrees of the cruise heading [default: ground {}, air {}]",
+        deg(GroundStart::default().heading_spread),
+        deg(StartRegion::default().heading_spread)
+    )
 }
 
 /// An angle of the library's defaults (radians) as the degrees a flag shows.
@@ -140,20 +167,17 @@ pub struct InitiateFlags {
     /// cruise altitude), `air` (the paper's: scattered in the air at the cruise altitude), or a
     /// start file: JSON {"x": [...], "y": [...], "heading": [...], "speed": [...]} (world frame,
     /// wingspans, radians clockwise from north, wingspans per second; heading and speed optional).
-    #[arg(long, default_value = "ground")]
+    #[arg(long, default_value = d().start.word())]
     pub start: String,
     /// Width of the take-off area (ground) or start region (air) across the cruise heading,
-    /// wingspans [default: from the flock size and --takeoff (ground: about 10 square wingspans
-    /// per bird with the depth); air 30, or 6√N for large flocks].
-    #[arg(long, allow_negative_numbers = true)]
+    /// wingspans.
+    #[arg(long, allow_negative_numbers = true, help = start_width_help())]
     pub start_width: Option<f64>,
-    /// Depth of the take-off area or start region along the cruise heading, wingspans
-    /// [default: ground half the width; air the width].
-    #[arg(long, allow_negative_numbers = true)]
+    /// Depth of the take-off area or start region along the cruise heading, wingspans.
+    #[arg(long, allow_negative_numbers = true, help = start_depth_help())]
     pub start_depth: Option<f64>,
-    /// Start headings are uniform within this many degrees of the cruise heading [default:
-    /// ground 5, air 180 (any)].
-    #[arg(long, allow_negative_numbers = true)]
+    /// Start headings are uniform within this many degrees of the cruise heading.
+    #[arg(long, allow_negative_numbers = true, help = heading_spread_help())]
     pub heading_spread: Option<f64>,
 }
 
@@ -200,45 +224,15 @@ impl InitiateFlags {
             },
             PerceptionArg::Exact => PerceptionMode::Exact,
         };
-        o.start = match self.start.as_str() {
-            "ground" => {
-                let g = GroundStart::default();
-                Start::Ground(GroundStart {
-                    width: self.start_width,
-                    depth: self.start_depth,
-                    heading_spread: self
-                        .heading_spread
-                        .map_or(g.heading_spread, |h| rad(h, g.heading_spread)),
-                    ..g
-                })
-            }
-            "air" => {
-                let r = StartRegion::default();
-                Start::Random(StartRegion {
-                    width: self.start_width,
-                    depth: self.start_depth,
-                    heading_spread: self
-                        .heading_spread
-                        .map_or(r.heading_spread, |h| rad(h, r.heading_spread)),
-                    ..r
-                })
-            }
-            path => {
-                for (flag, given) in [
-                    ("--start-width", self.start_width.is_some()),
-                    ("--start-depth", self.start_depth.is_some()),
-                    ("--heading-spread", self.heading_spread.is_some()),
-                ] {
-                    if given {
-                        return Err(Error::parameter(
-                            flag,
-                            "does not apply to a start file (--start FILE); give --start ground or air",
-                        ));
-                    }
-                }
-                Start::Given(StartState::read(std::path::Path::new(path), birds)?)
-            }
-        };
+        o.start = Start::from_choice(
+            &StartChoice {
+                kind: self.start.clone(),
+                width: self.start_width,
+                depth: self.start_depth,
+                heading_spread_deg: self.heading_spread,
+            },
+            birds,
+        )?;
         o.validate()?;
         initiate::check_size(birds, 0, o.max_steps)?;
         if let Some(w) = TakeoffPlan::warning(birds, &o) {
@@ -260,7 +254,7 @@ pub fn run(args: InitiateArgs, g: Global) -> Result<()> {
     // Issue 19: the take-off climbs to the path's first point, then the course step maps the
     // whole flight onto the path.
     let course = super::course::course_config(&args.path, &steady, &args.steady, &mut opts)?;
-    let mut rng = formation::rng::stream(g.seed, "initiate");
+    let mut rng = formation::rng::stream(g.seed, formation::rng::Stream::Initiate);
     let progress = TermProgress::new(g.quiet);
     let (mut anim, stats) = if steady.formations.is_some() {
         // A flock of several formations takes off formation by formation (issue 13).

@@ -61,6 +61,13 @@ pub const GROUND_ASPECT: f64 = 3.0;
 /// last of them lifts off.
 pub const GROUND_MAX_DEPTH: f64 = 22.0;
 
+/// Smallest automatic width (and depth) of the paper's airborne start region, wingspans.
+pub const AIR_MIN_WIDTH: f64 = 30.0;
+
+/// Automatic width of the airborne start region per square root of the flock's bird count,
+/// wingspans (used when it exceeds [`AIR_MIN_WIDTH`]).
+pub const AIR_WIDTH_PER_ROOT_BIRD: f64 = 6.0;
+
 /// Gravity, metres per second squared.
 pub const GRAVITY_M_S2: f64 = 9.81;
 
@@ -449,10 +456,91 @@ impl Default for StartRegion {
     }
 }
 
+/// A start chosen by name, as a command line or a config file gives it: the kind (`ground`,
+/// `air` for the paper's scattered start, or else the path of a start file) and optional
+/// overrides of the start's region. Angles are in degrees, as people give them.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct StartChoice {
+    /// `ground`, `air`, or the path of a start file.
+    pub kind: String,
+    /// Width of the take-off area or start region across the cruise heading, wingspans.
+    pub width: Option<f64>,
+    /// Depth of the take-off area or start region along the cruise heading, wingspans.
+    pub depth: Option<f64>,
+    /// Half-width of the start headings around the cruise heading, degrees.
+    pub heading_spread_deg: Option<f64>,
+}
+
+impl Start {
+    /// The word that names this kind of start: `ground`, `air` or `file`.
+    pub fn word(&self) -> &'static str {
+        match self {
+            Start::Ground(_) => "ground",
+            Start::Random(_) => "air",
+            Start::Given(_) => "file",
+        }
+    }
+
+    /// The start `choice` names for a flock of `birds`: a start file is read (and checked
+    /// against the flock); the region overrides apply to `ground` and `air` only, and giving one
+    /// with a start file is an error naming it (`initiate.start.width`, `.depth`,
+    /// `.heading_spread`). A heading spread equal to the default's display in degrees is the
+    /// default exactly.
+    pub fn from_choice(choice: &StartChoice, birds: usize) -> Result<Start> {
+        let spread = |default: f64| {
+            choice.heading_spread_deg.map_or(default, |h| {
+                if h == display_degrees(default) {
+                    default
+                } else {
+                    h.to_radians()
+                }
+            })
+        };
+        Ok(match choice.kind.as_str() {
+            "ground" => {
+                let g = GroundStart::default();
+                Start::Ground(GroundStart {
+                    width: choice.width,
+                    depth: choice.depth,
+                    heading_spread: spread(g.heading_spread),
+                    ..g
+                })
+            }
+            "air" => {
+                let r = StartRegion::default();
+                Start::Random(StartRegion {
+                    width: choice.width,
+                    depth: choice.depth,
+                    heading_spread: spread(r.heading_spread),
+                    ..r
+                })
+            }
+            path => {
+                for (name, given) in [
+                    ("initiate.start.width", choice.width.is_some()),
+                    ("initiate.start.depth", choice.depth.is_some()),
+                    (
+                        "initiate.start.heading_spread",
+                        choice.heading_spread_deg.is_some(),
+                    ),
+                ] {
+                    if given {
+                        return Err(Error::parameter(
+                            name,
+                            "does not apply to a start file (initiate.start FILE); give initiate.start ground or air",
+                        ));
+                    }
+                }
+                Start::Given(StartState::read(std::path::Path::new(path), birds)?)
+            }
+        })
+    }
+}
+
 impl StartRegion {
     /// Width and depth for `n` birds, wingspans.
     pub fn size(&self, n: usize) -> (f64, f64) {
-        let auto = (6.0 * (n as f64).sqrt()).max(30.0);
+        let auto = (AIR_WIDTH_PER_ROOT_BIRD * (n as f64).sqrt()).max(AIR_MIN_WIDTH);
         let w = self.width.unwrap_or(auto);
         (w, self.depth.unwrap_or(w))
     }

@@ -74,7 +74,7 @@ pub fn heights(
     opts: &SteadyOptions,
 ) -> Vec<Vec<f64>> {
     let h = &opts.heights;
-    let mut rng = crate::rng::stream(opts.seed, "steady.height");
+    let mut rng = crate::rng::stream(opts.seed, crate::rng::Stream::SteadyHeight);
     let rho = h.correlation;
     let nf = n as f64;
     let walk_var = h.neighbour.powi(2) * (nf * nf - 1.0) / (6.0 * nf);

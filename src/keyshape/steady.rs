@@ -467,7 +467,7 @@ pub fn steady_flight_report(
         total,
     };
     let mut lateral = Vec::with_capacity(nk);
-    let mut lat_rng = crate::rng::stream(opts.seed, "steady.lateral");
+    let mut lat_rng = crate::rng::stream(opts.seed, crate::rng::Stream::SteadyLateral);
     let drawn = LateralKey {
         x: x.clone(),
         total,

@@ -10,7 +10,7 @@
 //! north, SPEC §2); the take-off's own start region is centred on each formation's place.
 //!
 //! - Formation k draws from `rng::formation_stream(seed, Stream::Steady | Initiate | Skein, k)`;
-//!   the sizes and the arrangement from `rng::stream(seed, "skein/sizes" | "skein/layout")`.
+//!   the sizes and the arrangement from `rng::stream(seed, Stream::SkeinSizes | SkeinLayout)`; a retry `t` from `rng::retry_stream`.
 //! - Each formation's steady flight starts from a different movie frame: the params' frames are
 //!   rotated by a random number of places, so with footage of several kinds (V, J, echelon) the
 //!   formations start in different kinds and shapes.
@@ -37,7 +37,7 @@ use crate::extract::params::FormationParams;
 use crate::initiate::{self, InitiateOptions, InitiateStats, InitiationRun};
 use crate::keyshape::{steady_flight_report, SteadyOptions, SteadyReport};
 use crate::progress::{Progress, Silent};
-use crate::rng::{formation_stream, stream, Stream};
+use crate::rng::{formation_stream, retry_stream, stream, Stream};
 
 pub use layout::{Drift, Envelope, Placement};
 pub use sizes::{formation_count, formation_sizes};
@@ -166,7 +166,7 @@ impl SkeinOptions {
     pub fn sizes(&self, n: usize, n_hat: usize, seed: u64) -> Result<Vec<usize>> {
         self.validate(n)?;
         let k = formation_count(n, n_hat, self.formations, self.formation_size);
-        formation_sizes(n, k, &mut stream(seed, "skein/sizes"))
+        formation_sizes(n, k, &mut stream(seed, Stream::SkeinSizes))
     }
 }
 
@@ -322,7 +322,7 @@ fn finish(
         &departures,
         o.skein.clearance,
         o.skein.spread,
-        &mut stream(o.seed, "skein/layout"),
+        &mut stream(o.seed, Stream::SkeinLayout),
     );
     let lanes = placements.iter().map(|p| p.lane + 1).max().unwrap_or(1);
     let centre = centre_of(&env, &placements, o.initiate.is_some());
@@ -369,8 +369,8 @@ fn steady_of(
         )
     } else {
         (
-            stream(o.seed, format!("skein/formation/{f}/try/{t}").as_str()),
-            stream(o.seed, format!("steady/formation/{f}/try/{t}").as_str()),
+            retry_stream(o.seed, Stream::Skein, f, t),
+            retry_stream(o.seed, Stream::Steady, f, t),
         )
     };
     let rotation = own.random_range(0..params.frames.len().max(1));
@@ -447,7 +447,7 @@ fn takeoff_run(
         let mut rng = if t == 0 {
             formation_stream(seed, Stream::Initiate, f)
         } else {
-            stream(seed, format!("initiate/formation/{f}/try/{t}").as_str())
+            retry_stream(seed, Stream::Initiate, f, t)
         };
         let run = initiate::simulate(&target, steady.fps, &cruise, opts, &mut rng, &Silent)
             .map_err(|e| in_formation(e, f, n))?;
