@@ -170,6 +170,20 @@ fn bad_input_is_exit_2_with_one_line() {
             vec!["initiate", s, "-o", o, "--start", s],
             "unexpected JSON structure",
         ),
+        // A start file fixes every position: the region flags do not apply, and the message
+        // names the flag given and the flag to use instead.
+        (
+            vec!["initiate", s, "-o", o, "--start", s, "--start-width", "9"],
+            "--start-width: does not apply to a start file (--start FILE); give --start ground or air",
+        ),
+        (
+            vec!["initiate", s, "-o", o, "--start", s, "--start-depth", "9"],
+            "--start-depth: does not apply",
+        ),
+        (
+            vec!["initiate", s, "-o", o, "--start", s, "--heading-spread", "9"],
+            "--heading-spread: does not apply",
+        ),
     ];
     for (args, needle) in cases {
         assert_usage_error_in(&format!("{args:?}"), &run(&args), &[needle]);
