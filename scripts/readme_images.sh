@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerates the pictures in README.md, docs/usage.md and docs/export.md from the bundled example
+# Regenerates the pictures in README.md, docs/usage.md, docs/export.md and docs/initiation.md from the bundled example
 # data with the release binary, and prints the size of the README job's GIF (to keep the numbers
 # in README.md and docs/export.md honest). Usage: bash scripts/readme_images.sh
 set -euo pipefail
@@ -18,6 +18,10 @@ $B animate "$T/geese.json" --birds 14 -o "$T/flock.json" -o "$T/frames/" --pictu
 n=$(ls "$T/frames" | wc -l)
 echo "$n frames at 1 fps"
 cp "$T/frames/frame_00006.png" "$I/usage-initiation.png"
+# docs/initiation.md: the README job's ground take-off, two frames (2 s and 6 s) and its paths.
+cp "$T/frames/frame_00002.png" docs/takeoff-ground-2s.png
+cp "$T/frames/frame_00006.png" docs/takeoff-ground-6s.png
+$B plot paths "$T/flock.json" -o docs/takeoff-paths.png
 last=$(ls "$T/frames" | tail -n 3 | head -n 1)
 cp "$T/frames/$last" "$I/usage-steady.png"
 # The ground observer: the flock passes over at 70 % of the film; show it a second before.
