@@ -15,8 +15,8 @@ pub struct PathFlags {
     /// (docs/paths.md). A last point equal to the first closes the path.
     #[arg(long)]
     pub path: Option<PathBuf>,
-    /// Units of the path's coordinates: wingspans or m [default: the file's "units", else
-    /// wingspans].
+    /// Units of the path's coordinates: wingspans or m (when not given: the file's "units", else
+    /// wingspans).
     #[arg(long = "path-units", value_name = "UNITS", value_parser = parse_units)]
     pub path_units: Option<PathUnits>,
 }

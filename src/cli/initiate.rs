@@ -70,6 +70,18 @@ fn start_depth_help() -> String {
     )
 }
 
+/// The help of `--takeoff`, with the library's natural and shortest take-offs for two flock sizes.
+fn takeoff_help() -> String {
+    let (nat, short) = (TakeoffPlan::natural_seconds, TakeoffPlan::shortest_seconds);
+    format!(
+        "Take-off duration, seconds: the birds start closer or farther apart and drive harder or softer to form in about this time; outside what the flock can fly a warning gives the duration it will have [default: the natural one, {:.1} s for 14 birds and {:.1} s for 100; the shortest about {:.1} and {:.1} s; `--json` reports it as planned_seconds]",
+        nat(14),
+        nat(100),
+        short(14),
+        short(100)
+    )
+}
+
 /// The help of `--heading-spread`, with the library's defaults for each start.
 fn heading_spread_help() -> String {
     format!(
@@ -107,10 +119,8 @@ pub struct InitiateFlags {
     #[arg(long, allow_negative_numbers = true, default_value_t = d().max_time)]
     pub max_seconds: f64,
     /// Take-off duration, seconds: the birds start closer or farther apart and drive harder or
-    /// softer to form in about this time (down to about 7.8 + 0.042 N s for N birds and up to
-    /// about twice the natural one; outside that a warning with the duration it will have) [default: the natural one, which grows with the
-    /// flock size; `--json` reports it as planned_seconds].
-    #[arg(long, allow_negative_numbers = true)]
+    /// softer to form in about this time.
+    #[arg(long, allow_negative_numbers = true, help = takeoff_help())]
     pub takeoff: Option<f64>,
     /// Cruise altitude of the steady flight above the ground (`z`), wingspans.
     #[arg(long, allow_negative_numbers = true, default_value_t = d().cruise_altitude)]
