@@ -15,6 +15,7 @@ use std::path::Path;
 use formation::annotations::synth::{generate, SynthSpec};
 use formation::annotations::{self, ReadOptions};
 use formation::extract::{self, ExtractOptions, FormationParams};
+use formation::keyshape::spacing::median;
 use formation::keyshape::{steady_flight_report, SteadyOptions};
 use formation::progress::Silent;
 use formation::rng::seeded;
@@ -50,16 +51,6 @@ fn nearest_ahead(birds: &[(f64, f64)]) -> Vec<(f64, f64)> {
         }
     }
     out
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    }
 }
 
 fn medians(shapes: &[Vec<(f64, f64)>]) -> (f64, f64) {
