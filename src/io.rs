@@ -20,8 +20,10 @@ pub const MAX_INPUT_BYTES: u64 = 4 * 1024 * 1024 * 1024;
 
 /// Opens an input for reading, refusing directories and regular files over the size limit up
 /// front. Devices, FIFOs and process substitutions (`<(…)`) are read too, through a bounded
-/// reader: their size is only known once read.
-fn open_input(path: &Path) -> Result<(std::io::Take<fs::File>, u64)> {
+/// reader: their size is only known once read. Also gives the size of a regular file, so that
+/// its whole text is read into one allocation of that size (no doubling: reading a 28 MB file
+/// took a 32 MiB buffer beside the 16 MiB one it grew from).
+fn open_input(path: &Path) -> Result<(std::io::Take<fs::File>, u64, usize)> {
     let meta = fs::metadata(path).map_err(|e| Error::io(path, e))?;
     if meta.is_dir() {
         return Err(Error::format(path, "is a directory, expected a file"));
@@ -35,7 +37,13 @@ fn open_input(path: &Path) -> Result<(std::io::Take<fs::File>, u64)> {
         return Err(too_big(path, Some(meta.len()), limit));
     }
     let file = fs::File::open(path).map_err(|e| Error::io(path, e))?;
-    Ok((std::io::Read::take(file, limit + 1), limit))
+    // One byte more than the file, so that reaching its end needs no reallocation either.
+    let hint = if meta.is_file() {
+        usize::try_from(meta.len()).map_or(0, |n| n.saturating_add(1))
+    } else {
+        0
+    };
+    Ok((std::io::Read::take(file, limit + 1), limit, hint))
 }
 
 fn too_big(path: &Path, len: Option<u64>, limit: u64) -> Error {
@@ -66,8 +74,8 @@ pub const MAX_STREAM_BYTES: u64 = 256 * 1024 * 1024;
 /// Reads a whole file as bytes, with the path in the error and a size limit that also holds for
 /// devices and pipes (`/dev/zero` is refused after 2 GiB, not read until memory runs out).
 pub fn read_bytes(path: &Path) -> Result<Vec<u8>> {
-    let (mut reader, limit) = open_input(path)?;
-    let mut buf = Vec::new();
+    let (mut reader, limit, hint) = open_input(path)?;
+    let mut buf = Vec::with_capacity(hint);
     std::io::Read::read_to_end(&mut reader, &mut buf).map_err(|e| Error::io(path, e))?;
     if buf.len() as u64 > limit {
         return Err(too_big(path, None, limit));
@@ -79,8 +87,8 @@ pub fn read_bytes(path: &Path) -> Result<Vec<u8>> {
 /// byte, bytes that are not UTF-8: `/dev/zero`, `/dev/urandom`, an image given by mistake) is
 /// refused after the first chunk rather than after reading it all.
 pub fn read_text(path: &Path) -> Result<String> {
-    let (mut reader, limit) = open_input(path)?;
-    let mut buf: Vec<u8> = Vec::new();
+    let (mut reader, limit, hint) = open_input(path)?;
+    let mut buf: Vec<u8> = Vec::with_capacity(hint);
     let mut chunk = vec![0u8; READ_CHUNK];
     // Bytes of `buf` known to be complete, valid UTF-8.
     let mut valid = 0usize;
