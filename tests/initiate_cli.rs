@@ -128,6 +128,30 @@ fn bad_input_is_exit_2_with_one_line() {
             vec!["initiate", s, "-o", o, "--climb-rate", "0"],
             "--climb-rate",
         ),
+        // Higher than the birds can climb within the time limit (2.5 wingspans/s, 300 s): the
+        // highest reachable altitude is given, up front (before: 300 s of simulation, then
+        // "did not converge").
+        (
+            vec!["initiate", s, "-o", o, "--cruise-altitude", "10000"],
+            "--cruise-altitude: 10000 wingspans cannot be reached",
+        ),
+        (
+            vec!["initiate", s, "-o", o, "--cruise-altitude", "10000"],
+            "at most about 746 wingspans",
+        ),
+        (
+            vec![
+                "initiate",
+                s,
+                "-o",
+                o,
+                "--cruise-altitude",
+                "300",
+                "--max-seconds",
+                "100",
+            ],
+            "at most about 246 wingspans",
+        ),
         (
             vec![
                 "initiate",
