@@ -105,6 +105,8 @@ fn bad_input_is_exit_2_with_one_line() {
                 "air",
                 "--start-width",
                 "2",
+                "--start-depth",
+                "2",
             ],
             "region",
         ),

@@ -557,12 +557,21 @@ impl Start {
 
 impl StartRegion {
     /// Width and depth for `n` birds, wingspans: by default 4.5√N wide (at least 20) and half
-    /// as deep, 10 to 15 wingspans.
+    /// as deep, 10 to 15 wingspans, wider where random packing needs it (more than about 300
+    /// birds 1.5 apart).
     pub fn size(&self, n: usize) -> (f64, f64) {
         let auto = (AIR_WIDTH_PER_ROOT_BIRD * (n as f64).sqrt()).max(AIR_MIN_WIDTH);
-        let w = self.width.unwrap_or(auto);
         let (lo, hi) = AIR_DEPTH_RANGE;
-        (w, self.depth.unwrap_or((0.5 * w).clamp(lo, hi)))
+        let depth = self
+            .depth
+            .unwrap_or((0.5 * self.width.unwrap_or(auto)).clamp(lo, hi));
+        // Wide enough for random packing (about half the area) with a tenth to spare, as the
+        // take-off area: 1000 birds 1.5 apart need 259 × 15 wingspans.
+        let packing = 1.1 * n as f64 * PI / 4.0 * self.min_spacing * self.min_spacing / 0.5;
+        let w = self
+            .width
+            .unwrap_or_else(|| auto.max(packing / depth.max(1e-9)));
+        (w, depth)
     }
 }
 
