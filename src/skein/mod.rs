@@ -289,9 +289,16 @@ fn finish(
     let sizes: Vec<usize> = anims.iter().map(|a| a.birds).collect();
     if let Some(init) = o.initiate {
         if matches!(init.start, initiate::Start::Given(_)) {
+            // From formation parameters the flock can be flown as one formation; a steady
+            // flight read from a file has its formations already.
+            let one = if redo.is_some() {
+                "fly the flock as one formation (skein.formations 1)"
+            } else {
+                "give a steady flight of one formation (skein.formations 1)"
+            };
             return Err(Error::parameter(
                 "initiate.start",
-                format!("a start file places the birds of one formation; a flock of {k} formations takes off from the ground or starts in the air (or give skein.formations 1)"),
+                format!("a start file places the birds of one formation; a flock of {k} formations takes off from the ground or starts in the air (initiate.start ground or air), or {one}"),
             ));
         }
         progress.start("formations: take-off", k as u64);
