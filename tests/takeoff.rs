@@ -730,7 +730,12 @@ fn dump() {
 #[ignore]
 fn closest() {
     let n = env_u("N").unwrap_or(41) as usize;
-    for seed in env_u("SEED0").unwrap_or(0)..env_u("SEEDS").unwrap_or(10) {
+    let seeds: Vec<u64> = match std::env::var("SEEDLIST") {
+        Ok(l) => l.split(',').filter_map(|s| s.trim().parse().ok()).collect(),
+        Err(_) => (env_u("SEED0").unwrap_or(0)..env_u("SEEDS").unwrap_or(10)).collect(),
+    };
+    let until = env_u("TMAX").unwrap_or(80) as f64;
+    for seed in seeds {
         let mut opts = InitiateOptions::default();
         if std::env::var("AIR").is_ok() {
             opts.start = Start::Random(Default::default());
@@ -745,7 +750,7 @@ fn closest() {
             initiate::start_simulation(&t, &Cruise::new(0.0, 10.0), &opts, &mut rng::seeded(seed))
                 .unwrap();
         let mut best = (f64::INFINITY, 0.0, String::new());
-        while sim.time < 80.0 {
+        while sim.time < until {
             sim.step();
             let f = &sim.flock;
             for a in 0..n {

@@ -1421,6 +1421,7 @@ pub fn start_simulation(
     let mut sim = Simulation::new(target.clone(), params, pos, z, heading, speed, depart);
     if matches!(opts.start, Start::Random(_)) {
         sim.scatter_heights(AIR_HEIGHT_BAND, rng);
+        sim.separate_heights(AIR_HEIGHT_BAND, rng);
     }
     Ok((sim, plan))
 }

@@ -165,6 +165,19 @@ pub const AIR_GATHER_ANGLE: f64 = std::f64::consts::FRAC_PI_2;
 /// flockmate predicted to come closer than the separation distance, at contact, wingspans.
 pub const VERTICAL_SEPARATION: f64 = 1.0;
 
+/// How far ahead an airborne start's heights are checked against a dry run of the turns, s.
+pub const AIR_PREDICT_SECONDS: f64 = 2.5;
+
+/// Birds of an airborne start that the dry run brings this close horizontally are put at
+/// different heights, wingspans.
+pub const AIR_PREDICT_MISS: f64 = 1.0;
+
+/// The height difference an airborne start asks between birds whose turns cross, wingspans.
+pub const AIR_LAYER_GAP: f64 = 0.8;
+
+/// Draws of a bird's start height before the best is kept.
+pub const AIR_HEIGHT_DRAWS: usize = 40;
+
 /// Samples of the predicted arcs over the separation horizon (airborne starts).
 pub const ARC_SAMPLES: usize = 20;
 
@@ -660,6 +673,71 @@ impl Simulation {
             let e = (self.flock.pos[i] - slots[s]).length();
             let u = ((e - LAYER_MERGE) / LAYER_MERGE).clamp(0.0, 1.0);
             self.flock.z[i] += self.layer[i] * LAYER_HEIGHT * u * u * (3.0 - 2.0 * u);
+        }
+    }
+
+    /// An airborne start's heights checked against the turning paths: a dry run of the first
+    /// [`AIR_PREDICT_SECONDS`] (the birds turning round on their own circles, which neither a
+    /// straight-line nor a current-arc prediction foresees) finds the pairs that come within
+    /// [`AIR_PREDICT_MISS`] wingspans horizontally; each bird's height within ±`band` wingspans
+    /// is then redrawn (up to [`AIR_HEIGHT_DRAWS`] times, keeping the best) until it is at least
+    /// [`AIR_LAYER_GAP`] wingspans from every such partner drawn before it, so that birds whose
+    /// turns cross pass above and below each other from the start.
+    pub fn separate_heights(&mut self, band: f64, rng: &mut impl rand::Rng) {
+        let n = self.len();
+        if band <= 0.0 || self.layer.len() != n || n < 2 {
+            return;
+        }
+        let mut dry = self.clone();
+        let mut partners: Vec<Vec<usize>> = vec![Vec::new(); n];
+        let (mut grid, mut near) = (Grid::default(), Vec::new());
+        let all: Vec<usize> = (0..n).collect();
+        while dry.time < AIR_PREDICT_SECONDS {
+            dry.step();
+            let f = &dry.flock;
+            grid.build(&f.pos, &all, AIR_PREDICT_MISS);
+            for i in 0..n {
+                grid.within(&f.pos, f.pos[i], AIR_PREDICT_MISS, &mut near);
+                for &k in &near {
+                    if k < i && !partners[i].contains(&k) {
+                        partners[i].push(k);
+                        partners[k].push(i);
+                    }
+                }
+            }
+        }
+        let b = band / LAYER_HEIGHT;
+        let gap = AIR_LAYER_GAP / LAYER_HEIGHT;
+        let slots = self.slot_positions();
+        for i in 0..n {
+            let before: Vec<usize> = partners[i].iter().copied().filter(|&k| k < i).collect();
+            if before.is_empty() {
+                continue;
+            }
+            let clear = |l: f64| {
+                before
+                    .iter()
+                    .map(|&k| (self.layer[k] - l).abs())
+                    .fold(f64::INFINITY, f64::min)
+            };
+            let mut best = (clear(self.layer[i]), self.layer[i]);
+            for _ in 0..AIR_HEIGHT_DRAWS {
+                if best.0 >= gap {
+                    break;
+                }
+                let l = rng.random_range(-b..=b);
+                let c = clear(l);
+                if c > best.0 {
+                    best = (c, l);
+                }
+            }
+            let (old, new) = (self.layer[i], best.1);
+            self.layer[i] = new;
+            if let Some(s) = self.flock.slot[i] {
+                let e = (self.flock.pos[i] - slots[s]).length();
+                let u = ((e - LAYER_MERGE) / LAYER_MERGE).clamp(0.0, 1.0);
+                self.flock.z[i] += (new - old) * LAYER_HEIGHT * u * u * (3.0 - 2.0 * u);
+            }
         }
     }
 
