@@ -587,9 +587,9 @@ fn air_start_converges_over_seeds_and_flock_sizes() {
     for (n, seeds, apart, within) in [
         (9usize, many, true, true),
         (14, many, true, true),
-        (41, many, false, true),
-        (100, many, false, true),
-        (300, few, false, false),
+        (41, many, true, true),
+        (100, many, true, true),
+        (300, few, true, false),
     ] {
         let (mut ok, mut closest, mut stray) = (0u64, f64::INFINITY, 0.0f64);
         for seed in 0..seeds {
@@ -600,7 +600,7 @@ fn air_start_converges_over_seeds_and_flock_sizes() {
             closest = closest.min(s.min_distance);
             stray = stray.max(s.max_stray);
         }
-        println!("{n} birds from the air: {ok}/{seeds} converged, closest {closest:.3}, stray {stray:.1}");
+        println!("{n} birds from the air: {ok}/{seeds} converged, closest {closest:.4}, stray {stray:.1}");
         assert!(
             ok * 100 >= 99 * seeds,
             "{n} birds from the air: {ok}/{seeds} converged"

@@ -166,7 +166,7 @@ pub const AIR_GATHER_ANGLE: f64 = std::f64::consts::FRAC_PI_2;
 pub const VERTICAL_SEPARATION: f64 = 1.0;
 
 /// How far ahead an airborne start's heights are checked against a dry run of the turns, s.
-pub const AIR_PREDICT_SECONDS: f64 = 2.5;
+pub const AIR_PREDICT_SECONDS: f64 = 4.5;
 
 /// Birds of an airborne start that the dry run brings this close horizontally are put at
 /// different heights, wingspans.
