@@ -16,6 +16,8 @@
 //! A turn tighter than the flock can fly (an inner bird below `min_speed`, an outer one above
 //! `max_speed`, or a bank beyond `max_bank`) is widened by local smoothing of the path
 //! ([`spline::widen`]) and reported once, with the place on the path ([`CourseReport::widened`]).
+//! A turn that widening cannot make flyable (still too tight, or the course pulled far off the
+//! drawn path: [`spline::unflown`]) is an error naming the place and the radius to give it.
 //!
 //! Without a path the course frame is the world frame; only the cruise altitude of a flight
 //! without a take-off is added, and pitch is filled in.
