@@ -53,7 +53,12 @@ fn assert_refused_turn(out: &std::process::Output, path: &Path, point: &str, ani
     let name = path.file_name().unwrap().to_str().unwrap();
     assert_usage_error(
         out,
-        &[name, point, "wingspans along the path", "radius of at least"],
+        &[
+            name,
+            point,
+            "wingspans along the path",
+            "radius of at least",
+        ],
     );
     assert!(!anim.exists(), "no output after a refusal");
 }
@@ -174,7 +179,10 @@ fn widened_turns_are_flown_within_the_birds_bank_and_speed_limits() {
         let out = fly(&p, &out_file, "55");
         let err = stderr(&out);
         assert_eq!(code(&out), 0, "{name}: {err}");
-        assert!(err.contains("widened"), "{name}: the widening is said: {err}");
+        assert!(
+            err.contains("widened"),
+            "{name}: the widening is said: {err}"
+        );
         let anim = Animation::read(&out_file).unwrap();
         let (bank, slow) = needed_bank_and_slowest(&anim);
         // 5 % for the finite differences of headings between frames.
@@ -182,7 +190,10 @@ fn widened_turns_are_flown_within_the_birds_bank_and_speed_limits() {
             bank <= 1.05 * MAX_BANK_DEG,
             "{name}: a bird needs a bank of {bank:.1}°"
         );
-        assert!(slow >= MIN_SPEED, "{name}: a bird flies at {slow:.3} of cruise");
+        assert!(
+            slow >= MIN_SPEED,
+            "{name}: a bird flies at {slow:.3} of cruise"
+        );
         assert!(bank > 5.0, "{name}: the flock did turn ({bank:.1}°)");
     }
     std::fs::remove_dir_all(&dir).unwrap();
