@@ -707,4 +707,45 @@ mod tests {
         let c = Course::from_samples(w, ds, false);
         assert!(c.max_turn() <= 1.0 / 40.0 * 1.02, "{}", 1.0 / c.max_turn());
     }
+
+    /// Widens `pts` for a needed radius `r` and checks the result: (flown radius, verdict).
+    fn widened(pts: &[[f64; 3]], r: f64) -> (f64, Option<UnflownKind>) {
+        let (p, ds) = resample(&spline_points(pts, false), SAMPLE_SPACING);
+        let (w, dw, tight) = widen(p.clone(), ds, false, 1.0 / r, SAMPLE_SPACING);
+        assert!(!tight.is_empty());
+        let c = Course::from_samples(w, dw, false);
+        (
+            1.0 / c.max_turn(),
+            unflown(&p, ds, &c, 1.0 / r).map(|u| u.kind),
+        )
+    }
+
+    #[test]
+    fn sharp_corners_widen_to_the_needed_radius_at_any_radius() {
+        // A 135° corner between long legs: the smoothed stretch must grow beyond a quarter
+        // turn, and the finished spline (not only the coarse polyline) must meet the radius.
+        // Before, radii of 19 to 23 were flown for 22.5 to 25 needed.
+        let corner = [[0.0, 0.0, 0.0], [0.0, 300.0, 0.0], [300.0, 0.0, 0.0]];
+        for r in [20.0, 22.0, 22.5, 23.0, 23.4, 23.8, 24.0, 25.0, 30.0, 40.0] {
+            let (flown, verdict) = widened(&corner, r);
+            assert!(flown >= r / 1.02, "needed {r}, flown {flown}");
+            assert_eq!(verdict, None, "needed {r}");
+        }
+    }
+
+    #[test]
+    fn a_hairpin_narrower_than_the_turn_is_told_not_flown() {
+        // Legs 10 apart, the turn needs 46 across: smoothing pulls the legs together and the
+        // hairpin shrinks to a stub far from the drawn tip.
+        let hairpin = [
+            [0.0, 0.0, 0.0],
+            [0.0, 300.0, 0.0],
+            [10.0, 300.0, 0.0],
+            [10.0, 0.0, 0.0],
+        ];
+        match widened(&hairpin, 23.0).1 {
+            Some(UnflownKind::Away(d)) => assert!(d > WIDEN_REACH * 23.0, "{d}"),
+            other => panic!("{other:?}"),
+        }
+    }
 }
