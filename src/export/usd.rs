@@ -248,7 +248,7 @@ fn mesh_attr<T: AsRef<str>>(s: &mut String, decl: &str, values: &[T], meta: &[&s
     let values: Vec<&str> = values.iter().map(AsRef::as_ref).collect();
     let _ = write!(s, "        {decl} = [{}]", values.join(", "));
     if !meta.is_empty() {
-        let _ = write!(s, " (\n");
+        let _ = writeln!(s, " (");
         for m in meta {
             let _ = writeln!(s, "            {m}");
         }
