@@ -63,54 +63,49 @@ fn assert_refused_turn(out: &std::process::Output, path: &Path, point: &str, ani
     assert!(!anim.exists(), "no output after a refusal");
 }
 
+/// Flies a path of `points` named `name` and checks it is refused ([`assert_refused_turn`]);
+/// returns the message.
+fn refusal(name: &str, points: &[[f64; 3]]) -> String {
+    let dir = scratch(&format!("turn-{name}"));
+    let p = path_file(&dir, name, points);
+    let out_file = dir.join("a.json");
+    let out = fly(&p, &out_file, "20");
+    assert_refused_turn(&out, &p, "point ", &out_file);
+    std::fs::remove_dir_all(&dir).unwrap();
+    stderr(&out)
+}
+
 /// Two legs 10 wingspans apart joined by a square end: the flock needs a turn about 46
 /// wingspans across, which smoothing cannot make (on main the hairpin shrank to a 10-wingspan
 /// stub and the flock flew straight on past it).
 #[test]
 fn a_hairpin_narrower_than_the_turn_is_refused_naming_its_point() {
-    let dir = scratch("turn-hairpin");
-    let p = path_file(
-        &dir,
-        "hairpin",
-        &[
-            [0.0, 0.0, 10.0],
-            [0.0, 300.0, 10.0],
-            [10.0, 300.0, 10.0],
-            [10.0, 0.0, 10.0],
-        ],
-    );
-    let out_file = dir.join("a.json");
-    let out = fly(&p, &out_file, "20");
-    assert_refused_turn(&out, &p, "point ", &out_file);
-    let err = stderr(&out);
+    let hairpin = [
+        [0.0, 0.0, 10.0],
+        [0.0, 300.0, 10.0],
+        [10.0, 300.0, 10.0],
+        [10.0, 0.0, 10.0],
+    ];
+    let err = refusal("hairpin", &hairpin);
     assert!(
         err.contains("point 1 ") || err.contains("point 2 "),
         "the place is the hairpin's end: {err}"
     );
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// The fuzzer's path that turns back onto its own leg, shortened so the flock reaches the turn:
-/// on main the widening stopped at its round limit with a radius of about 1 wingspan there and
-/// the flock flew it with every bank at the 40° limit where 47° were needed.
+/// on main the widening stopped at its round limit with a radius of 13.7 wingspans left, and the
+/// flock flew it with banks clamped at the 40° limit where 47° were needed.
 #[test]
 fn a_turn_back_onto_a_long_leg_is_refused_not_flown_at_the_bank_limit() {
-    let dir = scratch("turn-back");
-    let p = path_file(
-        &dir,
-        "back",
-        &[
-            [0.0, 0.0, 10.0],
-            [0.0, 100.0, 10.0],
-            [2200.0, 1.0, 15.0],
-            [3000.0, 0.0, 10.0],
-            [0.0, 0.0, 1.0],
-        ],
-    );
-    let out_file = dir.join("a.json");
-    let out = fly(&p, &out_file, "20");
-    assert_refused_turn(&out, &p, "point ", &out_file);
-    std::fs::remove_dir_all(&dir).unwrap();
+    let back = [
+        [0.0, 0.0, 10.0],
+        [0.0, 100.0, 10.0],
+        [2200.0, 1.0, 15.0],
+        [3000.0, 0.0, 10.0],
+        [0.0, 0.0, 1.0],
+    ];
+    refusal("back", &back);
 }
 
 /// The fuzzer's own input (a leg 28 000 wingspans long, then back): the smoothing reaches its
