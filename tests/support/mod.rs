@@ -109,6 +109,39 @@ fn children_cpu_time(times: &str) -> std::time::Duration {
     std::time::Duration::from_secs_f64(secs)
 }
 
+/// A clock of the calling thread's CPU time (Linux: `/proc/thread-self/schedstat`, in ns), or
+/// of the wall-clock time where that is not available. Bounds on work done in the test process
+/// use it: unlike the wall-clock time it does not grow when the machine is loaded or the tests
+/// share a core.
+pub struct WorkClock {
+    start_ns: Option<u64>,
+    wall: std::time::Instant,
+}
+
+impl WorkClock {
+    /// Starts the clock.
+    pub fn start() -> Self {
+        WorkClock {
+            start_ns: thread_cpu_ns(),
+            wall: std::time::Instant::now(),
+        }
+    }
+
+    /// The time on the clock since [`WorkClock::start`].
+    pub fn elapsed(&self) -> std::time::Duration {
+        match (self.start_ns, thread_cpu_ns()) {
+            (Some(a), Some(b)) => std::time::Duration::from_nanos(b.saturating_sub(a)),
+            _ => self.wall.elapsed(),
+        }
+    }
+}
+
+/// The calling thread's time on a CPU so far, in nanoseconds (Linux).
+fn thread_cpu_ns() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
+    text.split_whitespace().next()?.parse().ok()
+}
+
 /// The exit code, −1 for a signal.
 pub fn code(out: &Output) -> i32 {
     out.status.code().unwrap_or(-1)
