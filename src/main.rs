@@ -15,14 +15,20 @@ fn main() -> ExitCode {
         Err(e) => {
             use clap::error::ErrorKind;
             return match e.kind() {
-                ErrorKind::DisplayHelp
-                | ErrorKind::DisplayVersion
-                | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
+                ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
+                    // On stderr, and the run fails anyway.
                     let _ = e.print();
-                    if e.kind() == ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand {
-                        ExitCode::from(2)
-                    } else {
-                        ExitCode::SUCCESS
+                    ExitCode::from(2)
+                }
+                ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => {
+                    // On stdout, as tables and --json are: a reader that goes away ends it
+                    // quietly, any other failure (a full device) is exit 2 naming stdout.
+                    match e.print().and_then(|()| std::io::stdout().flush()) {
+                        Err(w) if w.kind() != std::io::ErrorKind::BrokenPipe => {
+                            let _ = writeln!(std::io::stderr(), "error: stdout: {w}");
+                            ExitCode::from(2)
+                        }
+                        _ => ExitCode::SUCCESS,
                     }
                 }
                 _ => {

@@ -198,7 +198,7 @@ impl Config {
         if self.steady.looped && self.initiation {
             return Err(Error::parameter(
                 "steady.loop",
-                "a loop is a steady flight alone and cannot begin with a take-off; fly it without the take-off (initiation off)",
+                "a loop is a steady flight alone and cannot begin with a take-off; fly it without the take-off (initiation false)",
             ));
         }
         self.render.validate()?;

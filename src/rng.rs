@@ -102,6 +102,50 @@ pub fn retry_stream(seed: u64, stage: Stream, k: usize, t: usize) -> FlockRng {
     )
 }
 
+/// Whose numbers a stage draws: the run's own (a flock of one formation), formation `k`'s of a
+/// flock of several, or retry `t` of formation `k`'s. Every stage of one formation draws from
+/// the same scope, so formations of equal size do not share any plan (lateral gaps, their drift,
+/// the heights), and a run of one formation draws exactly what it did before flocks of several
+/// formations existed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum Scope {
+    /// The run's streams ([`stream`]).
+    #[default]
+    Run,
+    /// Formation `k`'s streams ([`formation_stream`]).
+    Formation(usize),
+    /// Retry `t` (≥ 1) of formation `k` ([`retry_stream`]).
+    Retry {
+        /// The formation.
+        formation: usize,
+        /// The retry, from 1.
+        attempt: usize,
+    },
+}
+
+impl Scope {
+    /// Formation `k`'s first draw (`t` = 0) or its retry `t`.
+    pub fn formation(k: usize, t: usize) -> Scope {
+        if t == 0 {
+            Scope::Formation(k)
+        } else {
+            Scope::Retry {
+                formation: k,
+                attempt: t,
+            }
+        }
+    }
+
+    /// The generator of `stage` in this scope.
+    pub fn stream(self, seed: u64, stage: Stream) -> FlockRng {
+        match self {
+            Scope::Run => stream(seed, stage),
+            Scope::Formation(k) => formation_stream(seed, stage, k),
+            Scope::Retry { formation, attempt } => retry_stream(seed, stage, formation, attempt),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -133,5 +177,32 @@ mod tests {
         let r: u64 = retry_stream(42, Stream::Skein, 3, 2).random();
         let l: u64 = stream(42, "skein/formation/3/try/2").random();
         assert_eq!(r, l);
+    }
+
+    #[test]
+    fn scopes_are_the_derived_streams() {
+        let draw = |mut g: FlockRng| -> u64 { g.random() };
+        for s in [Stream::SteadyLateral, Stream::SteadyHeight, Stream::Steady] {
+            assert_eq!(draw(Scope::Run.stream(9, s)), draw(stream(9, s)));
+            assert_eq!(
+                draw(Scope::formation(4, 0).stream(9, s)),
+                draw(formation_stream(9, s, 4))
+            );
+            assert_eq!(
+                draw(Scope::formation(4, 2).stream(9, s)),
+                draw(retry_stream(9, s, 4, 2))
+            );
+            let all = [
+                draw(Scope::Run.stream(9, s)),
+                draw(Scope::formation(0, 0).stream(9, s)),
+                draw(Scope::formation(1, 0).stream(9, s)),
+                draw(Scope::formation(1, 1).stream(9, s)),
+            ];
+            for i in 0..all.len() {
+                for j in i + 1..all.len() {
+                    assert_ne!(all[i], all[j], "{s:?}: scopes {i} and {j}");
+                }
+            }
+        }
     }
 }

@@ -4,7 +4,7 @@
 
 mod support;
 
-use formation::animation::Animation;
+use formation::animation::{Animation, FormationRecord};
 use formation::pipeline::{Config, Pipeline};
 use formation::skein::min_separation;
 use support::{assert_usage_error, example, run, s, scratch};
@@ -154,6 +154,79 @@ fn small_flocks_and_formations_one_stay_one_formation() {
             let text = std::fs::read_to_string(&out).unwrap();
             assert!(!text.contains("\"formations\""));
             assert!(!a.key_shapes.is_empty());
+        }
+    }
+}
+
+/// How each follower of `fm` has moved against its leader since the first frame, across the
+/// course (`z` false) or in height (`z` true), wingspans: `[frame][follower]`, the followers in
+/// the formation's order. Formations of one size fill their slots in the same order, so equal
+/// plans would give equal tables whatever each formation's own gaps.
+fn moves_against_leader(a: &Animation, fm: &FormationRecord, z: bool) -> Vec<Vec<f64>> {
+    let of = |f: &formation::animation::Frame, i: usize| if z { f.z[i] } else { f.x[i] };
+    let first = &a.frames[0];
+    a.frames
+        .iter()
+        .map(|f| {
+            fm.birds
+                .iter()
+                .filter(|&&i| i != fm.leader)
+                .map(|&i| (of(f, i) - of(f, fm.leader)) - (of(first, i) - of(first, fm.leader)))
+                .collect()
+        })
+        .collect()
+}
+
+/// The steady flight's slow lateral drift and the birds' heights are drawn per formation
+/// (`rng::Scope::Formation`): formations of one size must not breathe sideways or step in
+/// height in lock-step (they did when both were drawn from the run's seed alone: the lateral
+/// moves of every two formations of one size agreed to 1e-14 wingspans).
+#[test]
+fn formations_of_equal_size_breathe_independently() {
+    for seed in [0, 1, 2] {
+        let mut c = config(120, seed, 20.0);
+        c.initiation = false;
+        let (a, _) = Pipeline::from_path(example("barnacle_geese_v.json"))
+            .run(&c)
+            .unwrap();
+        let fs = a.formations.as_ref().expect("several formations");
+        let mut pairs = 0;
+        for (p, fp) in fs.iter().enumerate() {
+            for (q, fq) in fs.iter().enumerate().skip(p + 1) {
+                if fp.birds.len() != fq.birds.len() {
+                    continue;
+                }
+                pairs += 1;
+                for (z, what) in [(false, "lateral"), (true, "height")] {
+                    let (mp, mq) = (
+                        moves_against_leader(&a, fp, z),
+                        moves_against_leader(&a, fq, z),
+                    );
+                    let most = mp
+                        .iter()
+                        .flatten()
+                        .zip(mq.iter().flatten())
+                        .map(|(u, v)| (u - v).abs())
+                        .fold(0.0, f64::max);
+                    // Independent drifts of about 0.1 wingspans (lateral) and heights of 0.14
+                    // differ by 0.3 wingspans or more somewhere over 20 s.
+                    assert!(
+                        most > 0.05,
+                        "seed {seed}: formations {p} and {q} ({} birds) move in lock-step ({what}: they differ by at most {most:.2e} wingspans)",
+                        fp.birds.len()
+                    );
+                }
+            }
+        }
+        assert!(pairs >= 5, "seed {seed}: only {pairs} pairs of equal size");
+        if seed == 0 {
+            let (b, _) = Pipeline::from_path(example("barnacle_geese_v.json"))
+                .run(&c)
+                .unwrap();
+            assert!(
+                serde_json::to_string(&a).unwrap() == serde_json::to_string(&b).unwrap(),
+                "same seed, another flock"
+            );
         }
     }
 }

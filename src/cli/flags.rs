@@ -2,7 +2,8 @@
 //! `formation::pipeline::Config`) to the flags of each command. Library errors name option paths;
 //! [`name_flags`] rewrites every path that the command that was run has a flag for, in the error's
 //! name and in its message, so that every message names a flag that exists for that command.
-//! Paths without a flag (options only a config file can set) are left as they are.
+//! Paths without a flag (options only a config file can set) are left as they are. A row may
+//! also hold a path with its value (`initiation false`), for a switch whose flag sets that value.
 
 use formation::Error;
 
@@ -85,6 +86,14 @@ pub const FLAGS: &[(&str, &str, &[Cmd])] = &[
     ("course.units", "--path-units", SCENE_COURSE),
     ("course.cruise_altitude", "--cruise-altitude", STEADY),
     ("skein.formations", "--formations", STEADY),
+    // `initiate` reads a steady flight, whose formations the steady flight's command made.
+    (
+        "skein.formations 1",
+        "`formation steady` with --formations 1",
+        &[Initiate],
+    ),
+    // `animate` has the take-off on unless `--no-initiation`.
+    ("initiation false", "--no-initiation", &[Animate]),
     ("skein.formation_size", "--formation-size", STEADY),
     ("skein.clearance", "--clearance", STEADY),
     ("initiate.max_steps", "--max-steps", INITIATE),
@@ -174,7 +183,8 @@ pub const FLAGS: &[(&str, &str, &[Cmd])] = &[
 /// replaced only as a whole word (`steady.keys.c1` is not found in `steady.keys.c10`); longer paths first,
 /// so that `render.width/render.height` becomes one `--size`. Paths without a dot (`seconds`,
 /// `output`) are ordinary words in running text, so they are replaced only in an error's name
-/// ([`rewrite_name`]).
+/// ([`rewrite_name`]); a path with its value (`initiation false`) is no ordinary phrase and is
+/// replaced everywhere.
 pub fn rewrite(cmd: Cmd, text: &str) -> String {
     replace_paths(cmd, text, true)
 }
@@ -198,7 +208,9 @@ fn applies(cmds: &[Cmd], cmd: Cmd) -> bool {
 fn replace_paths(cmd: Cmd, text: &str, dotted_only: bool) -> String {
     let mut paths: Vec<(&str, &str)> = FLAGS
         .iter()
-        .filter(|(p, _, cmds)| applies(cmds, cmd) && (!dotted_only || p.contains('.')))
+        .filter(|(p, _, cmds)| {
+            applies(cmds, cmd) && (!dotted_only || p.contains('.') || p.contains(' '))
+        })
         .map(|(p, f, _)| (*p, *f))
         .collect();
     paths.sort_by_key(|(p, _)| std::cmp::Reverse(p.len()));
@@ -284,6 +296,21 @@ mod tests {
         assert_eq!(
             rewrite(Initiate, "initiate.min_speed/initiate.max_speed: x"),
             "--min-speed/--max-speed: x"
+        );
+        // Paths with a value: the switch that sets it, and a flag of the command that made
+        // `initiate`'s input.
+        assert_eq!(
+            rewrite(Animate, "without the take-off (initiation false)"),
+            "without the take-off (--no-initiation)"
+        );
+        assert_eq!(rewrite(Steady, "(initiation false)"), "(initiation false)");
+        assert_eq!(
+            rewrite(Initiate, "one formation (skein.formations 1)"),
+            "one formation (`formation steady` with --formations 1)"
+        );
+        assert_eq!(
+            rewrite(Animate, "one formation (skein.formations 1)"),
+            "one formation (--formations 1)"
         );
     }
 }

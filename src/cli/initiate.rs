@@ -177,7 +177,7 @@ pub struct InitiateFlags {
     /// cruise altitude), `air` (the paper's: scattered in the air at the cruise altitude), or a
     /// start file: JSON {"x": [...], "y": [...], "heading": [...], "speed": [...]} (world frame,
     /// wingspans, radians clockwise from north, wingspans per second; heading and speed optional).
-    #[arg(long, default_value = d().start.word())]
+    #[arg(long, default_value = d().start.word(), value_parser = super::start::parse_start)]
     pub start: String,
     /// Width of the take-off area (ground) or start region (air) across the cruise heading,
     /// wingspans.

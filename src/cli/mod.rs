@@ -16,6 +16,7 @@ pub mod progress;
 mod render;
 mod report;
 mod solve;
+mod start;
 mod stdout;
 mod steady;
 pub mod summary;

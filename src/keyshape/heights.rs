@@ -65,16 +65,17 @@ impl HeightOptions {
 /// the lateral order (step `neighbour`) plus a tilt across the flock that brings the expected
 /// spread to `spread` (one arm a little higher than the other, as in the footage), both
 /// evolving from key to key as AR(1) processes (`correlation`). A loop's last key repeats the
-/// first. Drawn from the seed's `steady.height` stream.
+/// first. Drawn from `rng` (the flight's `steady.height` stream, see
+/// [`crate::keyshape::steady_flight_in`]).
 pub fn heights(
     n: usize,
     x: &[f64],
     leader: usize,
     keys: usize,
     opts: &SteadyOptions,
+    rng: &mut crate::rng::FlockRng,
 ) -> Vec<Vec<f64>> {
     let h = &opts.heights;
-    let mut rng = crate::rng::stream(opts.seed, crate::rng::Stream::SteadyHeight);
     let rho = h.correlation;
     let nf = n as f64;
     let walk_var = h.neighbour.powi(2) * (nf * nf - 1.0) / (6.0 * nf);
@@ -96,11 +97,11 @@ pub fn heights(
         }
         out
     };
-    let mut field = draw(&mut rng);
+    let mut field = draw(rng);
     let mut out = Vec::with_capacity(keys);
     for k in 0..keys {
         if k > 0 {
-            let fresh = draw(&mut rng);
+            let fresh = draw(rng);
             for (f, g) in field.iter_mut().zip(fresh) {
                 *f = rho * *f + (1.0 - rho * rho).sqrt() * g;
             }

@@ -16,4 +16,6 @@ pub use initial::InitialOptions;
 pub use keys::KeyOptions;
 pub use lateral::LateralOptions;
 pub use solve::{solve, SolveOptions, SolveReport};
-pub use steady::{steady_flight, steady_flight_report, SteadyOptions, SteadyReport};
+pub use steady::{
+    steady_flight, steady_flight_in, steady_flight_report, SteadyOptions, SteadyReport,
+};

@@ -39,6 +39,7 @@ use crate::keyshape::lateral::{lateral_plan, LateralOptions};
 use crate::keyshape::ranges::{power_at, xi_ranges, XiRanges};
 use crate::keyshape::spacing;
 use crate::progress::Progress;
+use crate::rng::{Scope, Stream};
 
 /// Options of the steady flight (the `steady` section of [`crate::pipeline::Config`]). Each
 /// step's options are their own section (`steady.keys`, `steady.initial`, …), defined once.
@@ -334,10 +335,26 @@ pub fn steady_flight(
     steady_flight_report(params, opts, rng, progress).map(|(a, _)| a)
 }
 
-/// [`steady_flight`] plus the report of what each step did.
+/// [`steady_flight`] plus the report of what each step did. The slow drift of the lateral gaps
+/// and the birds' heights draw from the run's own `steady.lateral` and `steady.height` streams of
+/// `opts.seed` ([`Scope::Run`]); one formation of a flock of several is [`steady_flight_in`].
 pub fn steady_flight_report(
     params: &FormationParams,
     opts: &SteadyOptions,
+    rng: &mut impl Rng,
+    progress: &dyn Progress,
+) -> Result<(Animation, SteadyReport)> {
+    steady_flight_in(params, opts, Scope::Run, rng, progress)
+}
+
+/// [`steady_flight_report`] with the drift of the lateral gaps and the heights drawn from
+/// `scope`'s `steady.lateral` and `steady.height` streams of `opts.seed`: each formation of a
+/// flock of several ([`Scope::Formation`]) breathes sideways and steps in height on its own,
+/// instead of every formation of one size repeating the same plan.
+pub fn steady_flight_in(
+    params: &FormationParams,
+    opts: &SteadyOptions,
+    scope: Scope,
     rng: &mut impl Rng,
     progress: &dyn Progress,
 ) -> Result<(Animation, SteadyReport)> {
@@ -467,7 +484,7 @@ pub fn steady_flight_report(
         total,
     };
     let mut lateral = Vec::with_capacity(nk);
-    let mut lat_rng = crate::rng::stream(opts.seed, crate::rng::Stream::SteadyLateral);
+    let mut lat_rng = scope.stream(opts.seed, Stream::SteadyLateral);
     let drawn = LateralKey {
         x: x.clone(),
         total,
@@ -525,7 +542,14 @@ pub fn steady_flight_report(
             feasible = feasible.including(&reference);
         }
     }
-    let heights = heights(n, &x, corr.leader, nk, opts);
+    let heights = heights(
+        n,
+        &x,
+        corr.leader,
+        nk,
+        opts,
+        &mut scope.stream(opts.seed, Stream::SteadyHeight),
+    );
 
     // Step 4.
     progress.start("steady: frames", opts.frames as u64);

@@ -12,10 +12,11 @@
 //! course (L ≈ √(2K · pitch_y / pitch_x), so the flock is about twice as wide as deep) and, in
 //! each lane, one behind the other. Each formation's *envelope* is measured over the whole
 //! animation, take-off, drift and key-shape changes included: its lateral extent over all frames,
-//! and its fore-aft extent frame by frame. With w̃ the median envelope width and s = `spread`:
-//! a lane is s·w̃/2 wider than its widest envelope and each formation sits at a random place
-//! across it; neighbouring lanes are the clearance plus s·u·w̃/2 apart (u uniform in [0, 1], drawn
-//! per gap). Along a lane, each formation is placed behind the one ahead so that in *every frame*
+//! and its fore-aft extent frame by frame. With w̃ the median envelope width (of an even count,
+//! the mean of the middle two: [`crate::keyshape::spacing::median`], the one median of the
+//! library) and s = `spread`: a lane is s·w̃/2 wider than its widest envelope and each formation
+//! sits at a random place across it; neighbouring lanes are the clearance plus s·u·w̃/2 apart
+//! (u uniform in [0, 1], drawn per gap). Along a lane, each formation is placed behind the one ahead so that in *every frame*
 //! its front-most bird is the clearance plus s·u·w̃ behind the rear-most bird of the one ahead
 //! (line formations are wider than deep, so the width sets the scale of the gaps both ways); the
 //! first formation of each lane is set back by a random fraction of a row (staggered rows). After
@@ -27,6 +28,7 @@ use rand::Rng;
 use serde::Serialize;
 
 use crate::animation::Animation;
+use crate::keyshape::spacing::median;
 
 /// Range of the drift period, seconds.
 pub const DRIFT_PERIOD_S: [f64; 2] = [60.0, 120.0];
@@ -166,9 +168,13 @@ pub struct Placement {
     pub row: usize,
 }
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v.get(v.len() / 2).copied().unwrap_or(0.0)
+/// w̃ and the median depth of `env`, wingspans: the library's one median
+/// ([`crate::keyshape::spacing::median`], the mean of the middle two of an even count).
+fn median_size(env: &[Envelope]) -> (f64, f64) {
+    (
+        median(env.iter().map(Envelope::width).collect()),
+        median(env.iter().map(Envelope::depth).collect()),
+    )
 }
 
 /// The arrangement of formations with envelopes `env` (all over the same frames), `clearance`
@@ -184,8 +190,10 @@ pub fn arrange(
     rng: &mut impl Rng,
 ) -> Vec<Placement> {
     let k = env.len();
-    let w_med = median(env.iter().map(Envelope::width).collect());
-    let d_med = median(env.iter().map(Envelope::depth).collect());
+    if k == 0 {
+        return Vec::new();
+    }
+    let (w_med, d_med) = median_size(env);
     let pitch_x = w_med + clearance + spread * w_med;
     let pitch_y = d_med + clearance + 0.5 * spread * w_med;
     let lanes = ((ASPECT * k as f64 * pitch_y / pitch_x.max(1e-9))
@@ -294,6 +302,27 @@ mod tests {
             })
             .collect();
         a
+    }
+
+    #[test]
+    fn the_typical_formation_size_is_the_libraries_median() {
+        let env = |w: f64, d: f64| Envelope {
+            x: [-w / 2.0, w / 2.0],
+            rear: vec![-d, -0.5 * d],
+            front: vec![0.0, 0.0],
+        };
+        // An even count: the mean of the middle two (the upper one, 30 and 3, before).
+        let four = [
+            env(40.0, 4.0),
+            env(10.0, 1.0),
+            env(30.0, 3.0),
+            env(20.0, 2.0),
+        ];
+        assert_eq!(median_size(&four), (25.0, 2.5));
+        assert_eq!(median_size(&four[..3]), (30.0, 3.0));
+        let widths: Vec<f64> = four.iter().map(Envelope::width).collect();
+        assert_eq!(median_size(&four).0, median(widths));
+        assert!(arrange(&[], &[], 5.0, 0.5, &mut crate::rng::seeded(0)).is_empty());
     }
 
     #[test]

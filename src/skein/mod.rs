@@ -9,8 +9,11 @@
 //! Lengths in wingspans, times in seconds, the course frame (the world frame of a flock cruising
 //! north, SPEC §2); the take-off's own start region is centred on each formation's place.
 //!
-//! - Formation k draws from `rng::formation_stream(seed, Stream::Steady | Initiate | Skein, k)`;
-//!   the sizes and the arrangement from `rng::stream(seed, Stream::SkeinSizes | SkeinLayout)`; a retry `t` from `rng::retry_stream`.
+//! - Formation k draws every one of its own numbers from `rng::Scope::Formation(k)` (the streams
+//!   `rng::formation_stream(seed, Stream::Steady | SteadyLateral | SteadyHeight | Initiate |
+//!   Skein, k)`), so formations of equal size do not share their lateral drift or heights; a
+//!   retry `t` from `rng::Scope::Retry` (`rng::retry_stream`). The sizes and the arrangement
+//!   come from `rng::stream(seed, Stream::SkeinSizes | SkeinLayout)`.
 //! - Each formation's steady flight starts from a different movie frame: the params' frames are
 //!   rotated by a random number of places, so with footage of several kinds (V, J, echelon) the
 //!   formations start in different kinds and shapes.
@@ -35,9 +38,9 @@ use crate::animation::{Animation, FormationRecord, Frame, Stage};
 use crate::error::{Error, Result};
 use crate::extract::params::FormationParams;
 use crate::initiate::{self, InitiateOptions, InitiateStats, InitiationRun};
-use crate::keyshape::{steady_flight_report, SteadyOptions, SteadyReport};
+use crate::keyshape::{steady_flight_in, SteadyOptions, SteadyReport};
 use crate::progress::{Progress, Silent};
-use crate::rng::{formation_stream, retry_stream, stream, Stream};
+use crate::rng::{stream, Scope, Stream};
 
 pub use layout::{Drift, Envelope, Placement};
 pub use sizes::{formation_count, formation_sizes};
@@ -286,9 +289,16 @@ fn finish(
     let sizes: Vec<usize> = anims.iter().map(|a| a.birds).collect();
     if let Some(init) = o.initiate {
         if matches!(init.start, initiate::Start::Given(_)) {
+            // From formation parameters the flock can be flown as one formation; a steady
+            // flight read from a file has its formations already.
+            let one = if redo.is_some() {
+                "fly the flock as one formation (skein.formations 1)"
+            } else {
+                "give a steady flight of one formation (skein.formations 1)"
+            };
             return Err(Error::parameter(
                 "initiate.start",
-                format!("a start file places the birds of one formation; a flock of {k} formations takes off from the ground or starts in the air (or give skein.formations 1)"),
+                format!("a start file places the birds of one formation; a flock of {k} formations takes off from the ground or starts in the air (initiate.start ground or air), or {one}"),
             ));
         }
         progress.start("formations: take-off", k as u64);
@@ -362,17 +372,9 @@ fn steady_of(
     o: &FlockOptions,
 ) -> Result<(Animation, FormationReport)> {
     use rand::Rng;
-    let (mut own, mut steady_rng) = if t == 0 {
-        (
-            formation_stream(o.seed, Stream::Skein, f),
-            formation_stream(o.seed, Stream::Steady, f),
-        )
-    } else {
-        (
-            retry_stream(o.seed, Stream::Skein, f, t),
-            retry_stream(o.seed, Stream::Steady, f, t),
-        )
-    };
+    let scope = Scope::formation(f, t);
+    let mut own = scope.stream(o.seed, Stream::Skein);
+    let mut steady_rng = scope.stream(o.seed, Stream::Steady);
     let rotation = own.random_range(0..params.frames.len().max(1));
     let mut p = params.clone();
     p.frames.rotate_left(rotation);
@@ -380,7 +382,7 @@ fn steady_of(
         birds: n,
         ..o.steady.clone()
     };
-    let (mut anim, steady) = steady_flight_report(&p, &opts, &mut steady_rng, &Silent)
+    let (mut anim, steady) = steady_flight_in(&p, &opts, scope, &mut steady_rng, &Silent)
         .map_err(|e| in_formation(e, f, n))?;
     let drift = Drift::draw(
         opts.speed,
@@ -444,11 +446,7 @@ fn takeoff_run(
             .map_err(|e| in_formation(e, f, n))?;
         let (target, cruise) =
             initiate::steady_target(steady).map_err(|e| in_formation(e, f, n))?;
-        let mut rng = if t == 0 {
-            formation_stream(seed, Stream::Initiate, f)
-        } else {
-            retry_stream(seed, Stream::Initiate, f, t)
-        };
+        let mut rng = Scope::formation(f, t).stream(seed, Stream::Initiate);
         let run = initiate::simulate(&target, steady.fps, &cruise, opts, &mut rng, &Silent)
             .map_err(|e| in_formation(e, f, n))?;
         if run.stats.converged && run.stats.min_distance >= MIN_TAKEOFF_DISTANCE {
