@@ -105,6 +105,8 @@ fn bad_input_is_exit_2_with_one_line() {
                 "air",
                 "--start-width",
                 "2",
+                "--start-depth",
+                "2",
             ],
             "region",
         ),
@@ -127,6 +129,30 @@ fn bad_input_is_exit_2_with_one_line() {
         (
             vec!["initiate", s, "-o", o, "--climb-rate", "0"],
             "--climb-rate",
+        ),
+        // Higher than the birds can climb within the time limit (2.5 wingspans/s, 300 s): the
+        // highest reachable altitude is given, up front (before: 300 s of simulation, then
+        // "did not converge").
+        (
+            vec!["initiate", s, "-o", o, "--cruise-altitude", "10000"],
+            "--cruise-altitude: 10000 wingspans cannot be reached",
+        ),
+        (
+            vec!["initiate", s, "-o", o, "--cruise-altitude", "10000"],
+            "at most about 746 wingspans",
+        ),
+        (
+            vec![
+                "initiate",
+                s,
+                "-o",
+                o,
+                "--cruise-altitude",
+                "300",
+                "--max-seconds",
+                "100",
+            ],
+            "at most about 246 wingspans",
         ),
         (
             vec![

@@ -422,6 +422,9 @@ fn a_take_off_that_never_converges_is_flown_again_then_reported() {
     // TAKEOFF_TRIES take-offs (fresh steady flights and starts), then the run fails naming one.
     let mut c = config(60, 0, 2.0);
     c.initiate.max_time = 3.0;
+    // Low enough to climb to in 3 s (a cruise altitude out of the climb's reach within the time
+    // limit is refused up front, exit 2).
+    c.initiate.cruise_altitude = 2.0;
     let e = Pipeline::from_path(example("barnacle_geese_v.json"))
         .run(&c)
         .unwrap_err();

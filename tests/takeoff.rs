@@ -31,6 +31,20 @@ fn env_shape() -> (f64, f64) {
     (f("GAP", 1.0), f("BACK", 0.6))
 }
 
+/// The air start's region from `AIRW`, `AIRD` and `AIRSPACING` (wingspans), when set.
+fn env_air(opts: &mut InitiateOptions) {
+    if let Start::Random(r) = &mut opts.start {
+        r.width = std::env::var("AIRW").ok().and_then(|v| v.parse().ok());
+        r.depth = std::env::var("AIRD").ok().and_then(|v| v.parse().ok());
+        if let Some(k) = std::env::var("AIRSPACING")
+            .ok()
+            .and_then(|v| v.parse().ok())
+        {
+            r.min_spacing = k;
+        }
+    }
+}
+
 fn env_u(name: &str) -> Option<u64> {
     std::env::var(name).ok().and_then(|v| v.parse().ok())
 }
@@ -104,6 +118,7 @@ fn table() {
     if std::env::var("AIR").is_ok() {
         opts.start = Start::Random(Default::default());
     }
+    env_air(&mut opts);
     for (name, field) in [
         ("APPROACH", &mut opts.approach_distance),
         ("APPTIME", &mut opts.approach_time),
@@ -442,7 +457,13 @@ fn ground_birds_start_at_rest_and_end_at_the_cruise_altitude() {
         ..Default::default()
     };
     let (a, _) = init(&steady(&v_shape(9, 1.0, 0.6), 30, 30.0, 10.0), &opts, 4);
-    assert!(a.frames[0].z.iter().all(|&z| z == opts.cruise_altitude));
+    // Scattered in height within the band around the cruise altitude.
+    let band = initiate::AIR_HEIGHT_BAND + 1e-9;
+    assert!(a.frames[0]
+        .z
+        .iter()
+        .all(|&z| (z - opts.cruise_altitude).abs() <= band));
+    assert!(a.frames[0].z.iter().any(|&z| z != opts.cruise_altitude));
     assert!(a.frames[0].speed.iter().all(|&v| v > 0.0));
 }
 
@@ -546,9 +567,12 @@ fn convergence_over_seeds_and_flock_sizes() {
 }
 
 /// The paper's airborne start (`--start air`: scattered, any heading) converges in at least 99 %
-/// of the runs for 9, 14, 41 and 100 birds (100 seeds) and 300 birds (10 seeds). Strays and the
-/// closest approach of the air start are not yet within issue 18's 30 and 0.3 wingspans
-/// (docs/initiation.md, Limitations): they are reported, not asserted.
+/// of the runs for 9, 14, 41 and 100 birds (100 seeds) and 300 birds (10 seeds), within the
+/// smoothness limits, and no bird strays more than 30 wingspans beyond the formed flock (9–100
+/// birds). The closest approach (3-D) is at least 0.3 wingspans for 9 and 14 birds; for 41, 100
+/// and 300 birds it is not yet (docs/initiation.md, Limitations), and 300 birds stray up to
+/// about 34 wingspans: those are printed, not asserted. Measured (docs/initiation.md): closest
+/// 0.389/0.309/0.178/0.099/0.134, strays 23.9/25.8/25.7/28.8/33.6 wingspans.
 #[test]
 fn air_start_converges_over_seeds_and_flock_sizes() {
     let opts = InitiateOptions {
@@ -560,24 +584,75 @@ fn air_start_converges_over_seeds_and_flock_sizes() {
     } else {
         (100, 10)
     };
-    for (n, seeds) in [
-        (9usize, many),
-        (14, many),
-        (41, many),
-        (100, many),
-        (300, few),
+    for (n, seeds, apart, within) in [
+        (9usize, many, true, true),
+        (14, many, true, true),
+        (41, many, false, true),
+        (100, many, false, true),
+        (300, few, false, false),
     ] {
-        let mut ok = 0u64;
+        let (mut ok, mut closest, mut stray) = (0u64, f64::INFINITY, 0.0f64);
         for seed in 0..seeds {
             let s = run_stats_shape(n, 0.7, 0.35, seed, &opts);
             assert!(s.max_turn_accel <= opts.max_turn_accel * (1.0 + 1e-9));
             assert!(s.max_accel <= opts.max_accel * (1.0 + 1e-9));
             ok += u64::from(s.converged);
+            closest = closest.min(s.min_distance);
+            stray = stray.max(s.max_stray);
         }
+        println!("{n} birds from the air: {ok}/{seeds} converged, closest {closest:.3}, stray {stray:.1}");
         assert!(
             ok * 100 >= 99 * seeds,
             "{n} birds from the air: {ok}/{seeds} converged"
         );
+        if within {
+            assert!(
+                stray <= 30.0,
+                "{n} birds from the air: a bird strayed {stray:.1} wingspans"
+            );
+        }
+        if apart {
+            assert!(
+                closest >= 0.3,
+                "{n} birds from the air: closest approach {closest:.3}"
+            );
+        }
+    }
+}
+
+/// Take-offs of other lengths keep the limits too: `--takeoff 8` (9, 14, 41 birds; 100 cannot
+/// take off that fast and is warned about) and `--takeoff 20` (9, 14, 41, 100 birds), 21 seeds
+/// each at real spacing: every run converges, the closest approach (3-D) is at least 0.3
+/// wingspans and no bird strays more than 30 wingspans. Before, `--takeoff 20` widened the
+/// take-off area by 1/drive (41 birds: 53 × 18 wingspans) and 41 birds came 0.20 close and
+/// strayed 35 wingspans; the area now grows by 1/√drive. Measured (docs/initiation.md): `--takeoff
+/// 8` closest 0.607/0.481/0.426, strays 10.5/11.0/13.5; `--takeoff 20` closest
+/// 0.569/0.586/0.442/0.336, strays 19.7/19.1/21.8/23.5.
+#[test]
+fn takeoff_8_and_20_keep_apart_and_close_in() {
+    let seeds = if cfg!(debug_assertions) { 2 } else { 21 };
+    for (want, sizes) in [(8.0, &[9usize, 14, 41][..]), (20.0, &[9, 14, 41, 100][..])] {
+        let opts = InitiateOptions {
+            takeoff: Some(want),
+            ..Default::default()
+        };
+        for &n in sizes {
+            for seed in 0..seeds {
+                let s = run_stats_shape(n, 0.7, 0.35, seed, &opts);
+                let label = format!("--takeoff {want}, {n} birds, seed {seed}");
+                assert!(s.converged, "{label}: did not converge");
+                assert!(
+                    s.min_distance >= 0.3,
+                    "{label}: two birds came {:.3} wingspans close (3-D)",
+                    s.min_distance
+                );
+                assert!(
+                    s.max_stray <= 30.0,
+                    "{label}: a bird strayed {:.1} wingspans",
+                    s.max_stray
+                );
+            }
+        }
     }
 }
 
@@ -655,8 +730,15 @@ fn dump() {
 #[ignore]
 fn closest() {
     let n = env_u("N").unwrap_or(41) as usize;
-    for seed in 0..env_u("SEEDS").unwrap_or(10) {
-        let opts = InitiateOptions::default();
+    for seed in env_u("SEED0").unwrap_or(0)..env_u("SEEDS").unwrap_or(10) {
+        let mut opts = InitiateOptions::default();
+        if std::env::var("AIR").is_ok() {
+            opts.start = Start::Random(Default::default());
+        }
+        env_air(&mut opts);
+        if let Ok(t) = std::env::var("TAKEOFF") {
+            opts.takeoff = t.parse().ok();
+        }
         let (gap, back) = env_shape();
         let t = shape_target(n, gap, back);
         let (mut sim, _) =
@@ -704,6 +786,7 @@ fn pair() {
     if std::env::var("AIR").is_ok() {
         opts.start = Start::Random(Default::default());
     }
+    env_air(&mut opts);
     let (gap, back) = env_shape();
     let t = shape_target(n, gap, back);
     let (mut sim, _) =
@@ -751,6 +834,7 @@ fn strays() {
     if std::env::var("AIR").is_ok() {
         opts.start = Start::Random(Default::default());
     }
+    env_air(&mut opts);
     let (gap, back) = env_shape();
     let t = shape_target(n, gap, back);
     let (mut sim, plan) =

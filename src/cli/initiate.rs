@@ -65,8 +65,10 @@ fn start_width_help() -> String {
 /// The help of `--start-depth`, with the library's rules for its default.
 fn start_depth_help() -> String {
     format!(
-        "Depth of the take-off area or start region along the cruise heading, wingspans [default: ground from the flock size and --takeoff, at most {}; air the width]",
-        initiate::GROUND_MAX_DEPTH
+        "Depth of the take-off area or start region along the cruise heading, wingspans [default: ground from the flock size and --takeoff, at most {}; air half the width, {} to {}]",
+        initiate::GROUND_MAX_DEPTH,
+        initiate::AIR_DEPTH_RANGE.0,
+        initiate::AIR_DEPTH_RANGE.1
     )
 }
 

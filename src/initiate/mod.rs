@@ -61,12 +61,29 @@ pub const GROUND_ASPECT: f64 = 3.0;
 /// last of them lifts off.
 pub const GROUND_MAX_DEPTH: f64 = 22.0;
 
-/// Smallest automatic width (and depth) of the paper's airborne start region, wingspans.
-pub const AIR_MIN_WIDTH: f64 = 30.0;
+/// Smallest automatic width of the paper's airborne start region, wingspans.
+pub const AIR_MIN_WIDTH: f64 = 20.0;
 
 /// Automatic width of the airborne start region per square root of the flock's bird count,
 /// wingspans (used when it exceeds [`AIR_MIN_WIDTH`]).
-pub const AIR_WIDTH_PER_ROOT_BIRD: f64 = 6.0;
+pub const AIR_WIDTH_PER_ROOT_BIRD: f64 = 4.5;
+
+/// Automatic depth of the airborne start region: half its width, within these bounds,
+/// wingspans. Shallow and wide like the V the birds fly into: a deeper region leaves the birds
+/// at its back far from every slot (in a 30 × 30 region they began 24 wingspans from the
+/// nearest one).
+pub const AIR_DEPTH_RANGE: (f64, f64) = (10.0, 15.0);
+
+/// Half-height of the band the airborne start scatters the birds in around the cruise altitude,
+/// wingspans.
+pub const AIR_HEIGHT_BAND: f64 = 1.5;
+
+/// The airborne start's headings: no two birds predicted (flying straight) to come closer than
+/// this within [`START_HORIZON`], wingspans (redrawn up to [`START_DRAWS`] times).
+pub const START_MISS: f64 = 1.0;
+
+/// The airborne start's heading draws look this far ahead, seconds.
+pub const START_HORIZON: f64 = 1.5;
 
 /// Gravity, metres per second squared.
 pub const GRAVITY_M_S2: f64 = 9.81;
@@ -390,7 +407,8 @@ impl TakeoffPlan {
                 // About 6.8 square wingspans per bird (1.1 times what random packing of birds
                 // `min_spacing` = 2 apart needs), more for a slow take-off; three times as wide
                 // as deep, at most GROUND_MAX_DEPTH deep (wider instead).
-                let base = (1.3 * g.min_spacing * root).max(4.0 * g.min_spacing) / drive.min(1.0);
+                let base =
+                    (1.3 * g.min_spacing * root).max(4.0 * g.min_spacing) / drive.min(1.0).sqrt();
                 let aspect = GROUND_ASPECT;
                 let depth = (base / aspect.sqrt()).min(GROUND_MAX_DEPTH);
                 (
@@ -435,9 +453,9 @@ pub fn display_degrees(rad: f64) -> f64 {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct StartRegion {
-    /// Width across the cruise heading, wingspans (`None`: 30, or 6√N for large flocks).
+    /// Width across the cruise heading, wingspans (`None`: 20, or 4.5√N for more than 19 birds).
     pub width: Option<f64>,
-    /// Depth along the cruise heading, wingspans (`None`: as the width).
+    /// Depth along the cruise heading, wingspans (`None`: half the width, 10 to 15).
     pub depth: Option<f64>,
     /// Half-width of the heading distribution around the cruise heading, radians (π: any heading).
     pub heading_spread: f64,
@@ -538,11 +556,22 @@ impl Start {
 }
 
 impl StartRegion {
-    /// Width and depth for `n` birds, wingspans.
+    /// Width and depth for `n` birds, wingspans: by default 4.5√N wide (at least 20) and half
+    /// as deep, 10 to 15 wingspans, wider where random packing needs it (more than about 300
+    /// birds 1.5 apart).
     pub fn size(&self, n: usize) -> (f64, f64) {
         let auto = (AIR_WIDTH_PER_ROOT_BIRD * (n as f64).sqrt()).max(AIR_MIN_WIDTH);
-        let w = self.width.unwrap_or(auto);
-        (w, self.depth.unwrap_or(w))
+        let (lo, hi) = AIR_DEPTH_RANGE;
+        let depth = self
+            .depth
+            .unwrap_or((0.5 * self.width.unwrap_or(auto)).clamp(lo, hi));
+        // Wide enough for random packing (about half the area) with a tenth to spare, as the
+        // take-off area: 1000 birds 1.5 apart need 259 × 15 wingspans.
+        let packing = 1.1 * n as f64 * PI / 4.0 * self.min_spacing * self.min_spacing / 0.5;
+        let w = self
+            .width
+            .unwrap_or_else(|| auto.max(packing / depth.max(1e-9)));
+        (w, depth)
     }
 }
 
@@ -1134,12 +1163,26 @@ pub fn check_steady(steady: &Animation, origin: &Path) -> Result<()> {
 /// Random start positions, headings and speeds (wingspans, radians, wingspans per second):
 /// positions uniform in the region at least `min_spacing` apart; headings uniform within the
 /// spread and speeds between the minimum and the cruise speed, redrawn while two birds would,
-/// flying straight, come closer than the avoidance distance within the time a quarter turn takes
-/// (no take-off on a collision course that no turn could avoid).
+/// flying straight, come closer than [`START_MISS`] within [`START_HORIZON`] (no start on a
+/// collision course: the birds turn round at once, and a pair that close has no room to).
 pub fn random_start(
     n: usize,
     region: &StartRegion,
     params: &StepParams,
+    rng: &mut impl Rng,
+) -> Result<(Vec<DVec2>, Vec<f64>, Vec<f64>)> {
+    scatter(n, region, params, START_MISS, START_HORIZON, rng)
+}
+
+/// [`random_start`] with the predicted miss distance (wingspans) a start heading must keep from
+/// the birds drawn before it within `horizon` seconds (the ground start's positions are drawn
+/// with the avoidance distance and a quarter turn's time).
+fn scatter(
+    n: usize,
+    region: &StartRegion,
+    params: &StepParams,
+    miss: f64,
+    horizon: f64,
     rng: &mut impl Rng,
 ) -> Result<(Vec<DVec2>, Vec<f64>, Vec<f64>)> {
     let (w, d) = region.size(n);
@@ -1186,7 +1229,7 @@ pub fn random_start(
     // Headings and speeds: no two birds start on a course that brings them closer than the
     // avoidance distance before they could turn a quarter circle away (straight-line
     // prediction); a draw that does is redrawn, up to START_DRAWS times (then the safest is kept).
-    let horizon = std::f64::consts::FRAC_PI_2 / params.opts.max_turn_rate;
+    let want_miss = params.opts.avoid_distance.max(miss);
     let mut heading: Vec<f64> = Vec::with_capacity(n);
     let mut speed: Vec<f64> = Vec::with_capacity(n);
     for i in 0..n {
@@ -1216,7 +1259,7 @@ pub fn random_start(
             if miss > best.0 {
                 best = (miss, h, v);
             }
-            if miss >= params.opts.avoid_distance {
+            if miss >= want_miss {
                 break;
             }
         }
@@ -1258,7 +1301,15 @@ pub fn ground_start(
         heading_spread: 0.0,
         min_spacing: g.min_spacing,
     };
-    let (pos, _, _) = random_start(n, &region, params, rng)?;
+    let quarter_turn = std::f64::consts::FRAC_PI_2 / params.opts.max_turn_rate;
+    let (pos, _, _) = scatter(
+        n,
+        &region,
+        params,
+        params.opts.avoid_distance,
+        quarter_turn,
+        rng,
+    )?;
     let heading: Vec<f64> = (0..n)
         .map(|_| {
             let h = if g.heading_spread > 0.0 {
@@ -1318,6 +1369,22 @@ pub fn start_simulation(
             .fov_per_eye;
         *field = field.max(target.required_field(FIELD_MARGIN));
     }
+    if matches!(opts.start, Start::Ground(_)) {
+        let reach = reachable_altitude(params.climb_rate, params.vertical_accel, opts.max_time);
+        if opts.cruise_altitude > reach {
+            return Err(Error::parameter(
+                "initiate.cruise_altitude",
+                format!(
+                    "{} wingspans cannot be reached: climbing at most {:.3} wingspans/s (initiate.climb_rate, times the take-off's drive {:.2}) the birds reach at most about {:.0} wingspans within the time limit of {} s (initiate.max_time)",
+                    opts.cruise_altitude,
+                    params.climb_rate,
+                    plan.drive,
+                    reach.floor(),
+                    opts.max_time
+                ),
+            ));
+        }
+    }
     let alt = opts.cruise_altitude;
     let (pos, z, heading, speed, depart) = match &opts.start {
         Start::Ground(g) => {
@@ -1351,8 +1418,23 @@ pub fn start_simulation(
             (pos, vec![alt; n], heading, speed, vec![0.0; n])
         }
     };
-    let sim = Simulation::new(target.clone(), params, pos, z, heading, speed, depart);
+    let mut sim = Simulation::new(target.clone(), params, pos, z, heading, speed, depart);
+    if matches!(opts.start, Start::Random(_)) {
+        sim.scatter_heights(AIR_HEIGHT_BAND, rng);
+    }
     Ok((sim, plan))
+}
+
+/// The highest altitude a bird climbing from the ground at most `climb_rate` (wingspans per
+/// second, reached and shed at `vertical_accel`, wingspans per second squared) can reach and
+/// level off at within `seconds`: w (T − w/a), or a T²/4 when it never reaches the full rate.
+pub fn reachable_altitude(climb_rate: f64, vertical_accel: f64, seconds: f64) -> f64 {
+    let (w, a, t) = (climb_rate, vertical_accel, seconds);
+    if t >= 2.0 * w / a {
+        w * (t - w / a)
+    } else {
+        a * t * t / 4.0
+    }
 }
 
 /// Runs the simulation until convergence or the time limit, without the hand-over, sampling the

@@ -157,6 +157,17 @@ pub const RUN_LANE: f64 = 1.5;
 /// Least time between the departures of two birds in one run lane, seconds.
 pub const RUN_GAP: f64 = 0.2;
 
+/// An airborne start's gathering leader flies at the gathering speed while a flockmate's heading
+/// is more than this far off the cruise heading (still turning round), radians (90°).
+pub const AIR_GATHER_ANGLE: f64 = std::f64::consts::FRAC_PI_2;
+
+/// An airborne start's vertical separation: the altitude offset a bird asks for, away from a
+/// flockmate predicted to come closer than the separation distance, at contact, wingspans.
+pub const VERTICAL_SEPARATION: f64 = 1.0;
+
+/// Samples of the predicted arcs over the separation horizon (airborne starts).
+pub const ARC_SAMPLES: usize = 20;
+
 /// Flocks at least this large decide in parallel (one thread per core).
 pub const PARALLEL_MIN_BIRDS: usize = 128;
 
@@ -627,6 +638,31 @@ impl Simulation {
         sim
     }
 
+    /// An airborne start scattered in height: each bird's layer offset is drawn uniformly
+    /// within ±`band` wingspans (instead of the two layers ±[`LAYER_HEIGHT`]/2) and the bird
+    /// starts at it (merging into the cruise altitude near its slot, as the layers do).
+    pub fn scatter_heights(&mut self, band: f64, rng: &mut impl rand::Rng) {
+        if band <= 0.0 || self.layer.len() != self.len() {
+            return;
+        }
+        let b = band / LAYER_HEIGHT;
+        for l in self.layer.iter_mut() {
+            *l = rng.random_range(-b..=b);
+        }
+        let slots = self.slot_positions();
+        for i in 0..self.len() {
+            let Some(s) = self.flock.slot[i] else {
+                continue;
+            };
+            if self.flock.phase[i] != Phase::Airborne {
+                continue;
+            }
+            let e = (self.flock.pos[i] - slots[s]).length();
+            let u = ((e - LAYER_MERGE) / LAYER_MERGE).clamp(0.0, 1.0);
+            self.flock.z[i] += self.layer[i] * LAYER_HEIGHT * u * u * (3.0 - 2.0 * u);
+        }
+    }
+
     /// Number of birds.
     pub fn len(&self) -> usize {
         self.flock.pos.len()
@@ -1038,7 +1074,15 @@ impl Simulation {
             let dd = wrap_angle(p.cruise_heading - f.heading[i]);
             // While flockmates are still on the ground the leader flies at the gathering speed
             // (a fraction of the cruise speed), so that the last to leave is not left far behind.
-            let v = if self.departed.len() < f.pos.len()
+            // From the air, it also waits while a flockmate is still turning round (heading
+            // more than 90° off the cruise heading): flown away at cruise speed, the leader left
+            // those birds up to 50 wingspans behind every slot.
+            let turning = self.airborne_start()
+                && f.heading.iter().enumerate().any(|(k, &h)| {
+                    k != i && wrap_angle(h - p.cruise_heading).abs() > AIR_GATHER_ANGLE
+                });
+            let v = if turning
+                || self.departed.len() < f.pos.len()
                 || f.phase.iter().any(|&ph| ph != Phase::Airborne)
             {
                 p.gather_speed.max(p.min_speed)
@@ -1142,6 +1186,9 @@ impl Simulation {
             }
             _ => 0.0,
         };
+        if self.airborne_start() && f.slot[i].is_some() {
+            alt_offset += self.vertical_separation(i, near);
+        }
         if let Some((turn, slow, dz)) = self.avoidance(i, w, near) {
             w = turn;
             alt_offset = dz;
@@ -1283,6 +1330,88 @@ impl Simulation {
     /// less), a horizontal velocity away from the predicted position of the other bird, growing
     /// linearly to [`SEPARATION_SPEED`] at contact. Both birds of a pair take their half: the
     /// drive is symmetric. Wingspans per second.
+    /// True for a start in the air (the paper's scattered start or a start file): the leader
+    /// gathers while birds turn round, and the separation drive predicts turning paths and acts
+    /// in height as well. The ground start keeps its straight-line separation.
+    fn airborne_start(&self) -> bool {
+        !matches!(self.params.opts.start, super::Start::Ground(_))
+    }
+
+    /// The closest predicted approach of birds `i` and `k` within `horizon` seconds, each flying
+    /// on at its current speed, turn rate and climb rate (arcs, sampled [`ARC_SAMPLES`] times):
+    /// the time and `k`'s position relative to `i` then (3-D, wingspans). Birds turning round
+    /// after a scattered start are on arcs, which a straight-line prediction misses.
+    fn arc_closest(&self, i: usize, k: usize, horizon: f64) -> (f64, DVec3) {
+        let f = &self.flock;
+        let at = |b: usize, t: f64| -> DVec3 {
+            let (h, v, w) = (f.heading[b], f.speed[b], f.turn_rate[b]);
+            let xy = if w.abs() * t < 1e-6 {
+                direction(h) * (v * t)
+            } else {
+                let r = v / w;
+                DVec2::new(h.cos() - (h + w * t).cos(), (h + w * t).sin() - h.sin()) * r
+            };
+            DVec3::new(
+                f.pos[b].x + xy.x,
+                f.pos[b].y + xy.y,
+                f.z[b] + f.climb[b] * t,
+            )
+        };
+        let steps = ARC_SAMPLES;
+        let mut best = (0.0, at(k, 0.0) - at(i, 0.0));
+        for s in 1..=steps {
+            let t = horizon * s as f64 / steps as f64;
+            let m = at(k, t) - at(i, t);
+            if m.length_squared() < best.1.length_squared() {
+                best = (t, m);
+            }
+        }
+        best
+    }
+
+    /// The vertical part of an airborne start's separation drive: for the most pressing
+    /// flockmate among `near` predicted on its arc ([`Self::arc_closest`]) to come closer than
+    /// the pair's separation distance within [`SEPARATION_HORIZON`], an altitude offset away
+    /// from it (the higher bird up, the lower down; by index when level), growing linearly to
+    /// [`VERTICAL_SEPARATION`] at contact. Birds turning round at their largest turn rate have
+    /// no sideways freedom left; they pass above and below. Wingspans.
+    fn vertical_separation(&self, i: usize, near: &[usize]) -> f64 {
+        let f = &self.flock;
+        let horizon = SEPARATION_HORIZON;
+        let dsep = SEPARATION_DISTANCE;
+        let mut out = 0.0f64;
+        for &k in near {
+            if k == i || f.phase[k] != Phase::Airborne {
+                continue;
+            }
+            let (t, m) = self.arc_closest(i, k, horizon);
+            let d = m.length();
+            let limit = match (f.slot[i], f.slot[k]) {
+                (Some(a), Some(b)) => dsep.min(
+                    SEPARATION_FRACTION * (self.target.slots[a] - self.target.slots[b]).length(),
+                ),
+                _ => dsep,
+            };
+            if d >= limit {
+                continue;
+            }
+            let dz = f.z[k] - f.z[i];
+            let sign = if dz.abs() > 1e-9 {
+                -dz.signum()
+            } else if i < k {
+                -1.0
+            } else {
+                1.0
+            };
+            let urgency = 1.0 - 0.5 * t / horizon.max(1e-9);
+            let push = sign * VERTICAL_SEPARATION * (limit - d) / limit * urgency;
+            if push.abs() > out.abs() {
+                out = push;
+            }
+        }
+        out
+    }
+
     fn separation(&self, i: usize, near: &[usize]) -> DVec2 {
         let f = &self.flock;
         let pi = DVec3::new(f.pos[i].x, f.pos[i].y, f.z[i]);
@@ -1301,12 +1430,16 @@ impl Simulation {
             }
             let dv = self.vel.get(k).copied().unwrap_or(DVec3::ZERO) - vi;
             let vv = dv.length_squared();
-            let t = if vv > 1e-12 {
-                (-dp.dot(dv) / vv).clamp(0.0, horizon)
+            let (t, m) = if self.airborne_start() {
+                self.arc_closest(i, k, horizon)
             } else {
-                0.0
+                let t = if vv > 1e-12 {
+                    (-dp.dot(dv) / vv).clamp(0.0, horizon)
+                } else {
+                    0.0
+                };
+                (t, dp + dv * t)
             };
-            let m = dp + dv * t;
             let d = m.length();
             let limit = match (f.slot[i], f.slot[k]) {
                 (Some(a), Some(b)) => dsep.min(
