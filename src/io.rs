@@ -853,6 +853,8 @@ mod tests {
     #[test]
     fn uncommitted_file_leaves_nothing_and_keeps_existing() {
         let dir = std::env::temp_dir().join(format!("formation-io-test-{}", std::process::id()));
+        // Empty: a run that died here with the same PID (PIDs wrap) may have left files.
+        let _ = fs::remove_dir_all(&dir);
         fs::create_dir_all(&dir).unwrap();
         let target = dir.join("out.json");
         fs::write(&target, b"old").unwrap();

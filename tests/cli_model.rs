@@ -3,8 +3,6 @@
 
 mod support;
 
-use std::path::Path;
-
 use support::{assert_usage_text, example_arg as example, run_full as run, scratch};
 
 #[test]
@@ -190,6 +188,8 @@ fn solve_bad_inputs() {
 
 #[test]
 fn core_radius_flag_is_checked() {
+    let never = scratch("core-radius").join("never.json");
+    let never_arg = never.display().to_string();
     for flag in ["-0.1", "NaN", "inf"] {
         for cmd in ["power", "solve"] {
             let mut args = vec![cmd.to_string()];
@@ -199,7 +199,7 @@ fn core_radius_flag_is_checked() {
                 example("equal_savings_target.json")
             });
             if cmd == "solve" {
-                args.extend(["-o".into(), "/tmp/formation-core-radius-never.json".into()]);
+                args.extend(["-o".into(), never_arg.clone()]);
             }
             args.extend(["--core-radius".into(), flag.into()]);
             let refs: Vec<&str> = args.iter().map(|s| s.as_str()).collect();
@@ -212,7 +212,7 @@ fn core_radius_flag_is_checked() {
             );
         }
     }
-    assert!(!Path::new("/tmp/formation-core-radius-never.json").exists());
+    assert!(!never.exists());
     // A valid radius changes the numbers only slightly away from the vortex lines.
     let (code, a, _) = run(&[
         "power",

@@ -2,6 +2,7 @@
 //! keeps every bird inside the picture, and equal inputs give byte-identical files.
 
 use std::path::{Path, PathBuf};
+use std::process::Command;
 
 use formation::export::synthetic::{synthetic_flock, SyntheticParams};
 use formation::export::{plan_outputs, write_outputs, Film, RenderOptions};
@@ -145,7 +146,18 @@ fn every_output_opens_in_an_independent_reader() {
 #[test]
 fn equal_inputs_give_byte_identical_outputs_whatever_the_thread_count() {
     let d = scratch("det");
-    let names = ["a.gif", "a.glb", "a.csv", "a.json"];
+    let mut names = vec!["a.gif", "a.glb", "a.csv", "a.json"];
+    // Video too when ffmpeg is there (CI installs it): its encoders' output depends on their
+    // thread count, which must therefore not follow the machine's cores.
+    let ffmpeg = Command::new(formation::export::pictures::ffmpeg_program())
+        .arg("-version")
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if ffmpeg {
+        names.extend(["a.mp4", "a.webm"]);
+    } else {
+        eprintln!("video skipped: no ffmpeg (apt-get install ffmpeg)");
+    }
     for (run, threads) in [(0, 1), (1, 3)] {
         let anim = flock(2.0, 20.0);
         let outs: Vec<PathBuf> = names.iter().map(|n| d.join(format!("{run}{n}"))).collect();

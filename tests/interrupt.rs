@@ -67,9 +67,36 @@ fn snapshot(dir: &Path) -> Vec<(String, Vec<u8>)> {
 }
 
 fn has_temporary(dir: &Path) -> bool {
+    !temporaries(dir).is_empty()
+}
+
+/// Names of the temporaries under `dir`.
+fn temporaries(dir: &Path) -> Vec<String> {
     snapshot(dir)
-        .iter()
-        .any(|(name, _)| name.contains(".formation-"))
+        .into_iter()
+        .map(|(name, _)| name)
+        .filter(|name| name.contains(".formation-"))
+        .collect()
+}
+
+/// Waits until `child` is writing its output: a temporary that is still there 200 ms after it
+/// was first seen. A run first creates and removes a probe temporary or two (to check that the
+/// output's directory is writable before any work); a SIGKILL that landed between a probe's
+/// removal and the real temporary left none, and failed the test once in a full suite run.
+fn wait_for_lasting_temporary(dir: &Path, child: &mut std::process::Child) {
+    let start = Instant::now();
+    loop {
+        assert!(child.try_wait().unwrap().is_none(), "render ended early");
+        assert!(start.elapsed() < Duration::from_secs(120));
+        let seen = temporaries(dir);
+        if !seen.is_empty() {
+            std::thread::sleep(Duration::from_millis(200));
+            if temporaries(dir).iter().any(|n| seen.contains(n)) {
+                return;
+            }
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
 }
 
 /// Starts `formation render` writing `output` (then `later`), waits until it is writing, sends
@@ -193,12 +220,7 @@ fn a_killed_runs_temporary_is_removed_by_the_next_run() {
         .stderr(Stdio::null())
         .spawn()
         .unwrap();
-    let start = Instant::now();
-    while !has_temporary(&dir) {
-        assert!(child.try_wait().unwrap().is_none(), "render ended early");
-        assert!(start.elapsed() < Duration::from_secs(120));
-        std::thread::sleep(Duration::from_millis(5));
-    }
+    wait_for_lasting_temporary(&dir, &mut child);
     child.kill().unwrap();
     child.wait().unwrap();
     assert!(has_temporary(&dir), "SIGKILL should leave the temporary");

@@ -16,6 +16,8 @@
 //! A turn tighter than the flock can fly (an inner bird below `min_speed`, an outer one above
 //! `max_speed`, or a bank beyond `max_bank`) is widened by local smoothing of the path
 //! ([`spline::widen`]) and reported once, with the place on the path ([`CourseReport::widened`]).
+//! A turn that widening cannot make flyable (still too tight, or the course pulled far off the
+//! drawn path: [`spline::unflown`]) is an error naming the place and the radius to give it.
 //!
 //! Without a path the course frame is the world frame; only the cruise altitude of a flight
 //! without a take-off is added, and pitch is filled in.
@@ -319,9 +321,14 @@ pub fn apply(
     if points.closed {
         check_loop_size(&dense, r_min, &origin)?;
     }
-    let (pts, ds) = spline::resample(&dense, spline::SAMPLE_SPACING);
-    let (pts, ds, tight) =
-        spline::widen(pts, ds, points.closed, 1.0 / r_min, spline::SAMPLE_SPACING);
+    let (drawn, ds_drawn) = spline::resample(&dense, spline::SAMPLE_SPACING);
+    let (pts, ds, tight) = spline::widen(
+        drawn.clone(),
+        ds_drawn,
+        points.closed,
+        1.0 / r_min,
+        spline::SAMPLE_SPACING,
+    );
     let cannot = || {
         Error::format(
             &origin,
@@ -337,14 +344,37 @@ pub fn apply(
     if !(course.length() > 0.0 && course.length().is_finite()) {
         return Err(cannot());
     }
-    report.length = course.length();
-    for t in &tight {
-        let p = t.p;
-        let point = (0..points.points.len())
+    let nearest_point = |p: [f64; 3]| {
+        (0..points.points.len())
             .min_by(|&a, &b| {
                 file::dist(points.points[a], p).total_cmp(&file::dist(points.points[b], p))
             })
-            .unwrap_or(0);
+            .unwrap_or(0)
+    };
+    if !tight.is_empty() {
+        if let Some(u) = spline::unflown(&drawn, ds_drawn, &course, 1.0 / r_min) {
+            let point = nearest_point(u.p);
+            let what = match u.kind {
+                spline::UnflownKind::Tight(r) => format!(
+                    "is tighter than the flock can fly even after widening (it still turns at a radius of {r:.1} wingspans)"
+                ),
+                spline::UnflownKind::Away(d) => format!(
+                    "cannot be widened without taking the flock {d:.0} wingspans off the drawn path (its legs are too close together for the turn)"
+                ),
+            };
+            return Err(Error::format(
+                &origin,
+                format!(
+                    "the turn near point {point} ({}), {:.0} wingspans along the path, {what}; give that turn a radius of at least {r_min:.0} wingspans (in a tighter turn {why})",
+                    file::show(points.points[point]),
+                    u.s
+                ),
+            ));
+        }
+    }
+    report.length = course.length();
+    for t in &tight {
+        let point = nearest_point(t.p);
         report.widened.push(Widened {
             point,
             s: t.s,

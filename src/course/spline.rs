@@ -26,7 +26,7 @@ pub const SAMPLE_SPACING: f64 = 0.25;
 pub const MAX_SAMPLES: usize = 400_000;
 
 /// Most sample updates of [`widen`]'s smoothing (about a second): what is not widened by then
-/// stays as far as it got.
+/// stays as far as it got, and [`unflown`] tells whether that is flyable.
 pub const WIDEN_WORK: usize = 200_000_000;
 
 /// The course at one place.
@@ -270,7 +270,12 @@ pub fn widen(
     // Coarse spacing: a tenth of the needed radius (finer detail is too tight anyway).
     let coarse = (0.1 / max_turn).max(spacing);
     let (mut q, mut dq) = resample(&pts, coarse);
-    let target = 0.92 * max_turn;
+    let mut target = 0.92 * max_turn;
+    let finish = |q: &[[f64; 3]]| {
+        let dense = spline_points(&q[..if closed { q.len() - 1 } else { q.len() }], closed);
+        resample(&dense, spacing)
+    };
+    let mut done: Option<(Vec<[f64; 3]>, f64)> = None;
     // Smoothing shrinks a closed curve; one shorter than a full turn at the needed radius
     // cannot be flown (see `course::check_loop_size`) and would shrink to nothing (a thin spike
     // did, and the stretch below grew without bound: a hang found by fuzzing, issue 17).
@@ -278,7 +283,7 @@ pub fn widen(
     // At most 400 rounds, and at most WIDEN_WORK sample updates in all: a path that turns back
     // onto itself along a long leg is never widened and took 35 s (found by fuzzing, issue 17).
     let mut work = 0usize;
-    for _round in 0..400 {
+    for round in 0..400usize {
         let n = q.len();
         work += 20 * n;
         if work > WIDEN_WORK {
@@ -290,11 +295,26 @@ pub fn widen(
         let k = curvature(&q, dq, closed);
         let bad: Vec<usize> = (0..n).filter(|&i| k[i].abs() > target).collect();
         if bad.is_empty() {
-            break;
+            // The spline through the coarse polyline can turn a little tighter than the
+            // polyline's corners say: check the course itself, and aim lower while it does.
+            let (out, d) = finish(&q);
+            let worst = curvature(&out, d, closed)
+                .iter()
+                .fold(0.0f64, |m, c| m.max(c.abs()));
+            if worst <= max_turn {
+                done = Some((out, d));
+                break;
+            }
+            target *= 0.95;
+            continue;
         }
         // Smooth around every offending sample, over a stretch of the needed quarter turn (at
-        // most the whole curve), marked through a running count so the cost is linear.
-        let reach = (((0.5 * PI / max_turn) / dq).ceil() as usize + 2).min(n);
+        // most the whole curve), marked through a running count so the cost is linear. A sharp
+        // corner needs more: the arc of a corner turning through θ meets its legs R tan(θ/2)
+        // from the corner (2.4 R at 135°, beyond the quarter turn's 1.6 R), so while offending
+        // samples remain after ten rounds the stretch grows, to at most eight quarter turns.
+        let grow = 1.0 + (round.saturating_sub(10) as f64 / 10.0).min(7.0);
+        let reach = ((grow * (0.5 * PI / max_turn) / dq).ceil() as usize + 2).min(n);
         let mut mark = vec![false; n];
         if closed {
             let m = n - 1;
@@ -369,9 +389,112 @@ pub fn widen(
     if closed && dq * ((q.len() - 1) as f64) < shortest_loop {
         return (Vec::new(), dq, tight);
     }
-    let dense = spline_points(&q[..if closed { q.len() - 1 } else { q.len() }], closed);
-    let (out, d) = resample(&dense, spacing);
+    let (out, d) = done.unwrap_or_else(|| finish(&q));
     (out, d, tight)
+}
+
+/// Largest flown turn rate over the needed one that still passes [`unflown`]: the widening
+/// aims at 0.92 of the needed rate, and the final spline through its coarse polyline may
+/// overshoot that a little.
+const TURN_SLACK: f64 = 1.02;
+
+/// How far from the drawn path, in needed radii, a widened course may run: a corner turning
+/// through 165° widened to the needed radius R runs R (1 / cos 82.5° − 1) ≈ 6.7 R from its
+/// drawn point, so up to about 160° a sharp corner widens within this.
+pub const WIDEN_REACH: f64 = 6.0;
+
+/// Why a widened course still cannot be flown as the drawn path.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum UnflownKind {
+    /// The course still turns at this radius (wingspans), tighter than needed.
+    Tight(f64),
+    /// The course runs this far (wingspans) from the drawn path: the widening collapsed the
+    /// turn (two legs closer together than the turn's diameter cannot be smoothed apart).
+    Away(f64),
+}
+
+/// A place where widening did not give a flyable course that follows the drawn path.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Unflown {
+    /// Sample of the drawn (unwidened) course nearest to the place.
+    pub sample: usize,
+    /// Arc length of that sample along the drawn course, wingspans.
+    pub s: f64,
+    /// Position of that sample, wingspans.
+    pub p: [f64; 3],
+    /// What is wrong there.
+    pub kind: UnflownKind,
+}
+
+/// Checks a widened course against the limits and the drawn course `drawn` (evenly spaced
+/// `ds` apart): `None` when every turn of `course` is at most `max_turn` (with a 2 % slack) and
+/// every drawn sample lies within [`WIDEN_REACH`] needed radii of it; otherwise the worst place.
+/// The smoothing of [`widen`] stops after a bounded amount of work, and cannot separate two
+/// legs closer together than the turn's diameter: this is where that is told, not flown.
+pub fn unflown(drawn: &[[f64; 3]], ds: f64, course: &Course, max_turn: f64) -> Option<Unflown> {
+    let nearest_drawn = |p: [f64; 3]| {
+        (0..drawn.len())
+            .min_by(|&a, &b| {
+                let da = (drawn[a][0] - p[0]).hypot(drawn[a][1] - p[1]);
+                let db = (drawn[b][0] - p[0]).hypot(drawn[b][1] - p[1]);
+                da.total_cmp(&db)
+            })
+            .unwrap_or(0)
+    };
+    let place = |i: usize, kind| Unflown {
+        sample: i,
+        s: i as f64 * ds,
+        p: drawn[i],
+        kind,
+    };
+    let worst = course
+        .knots
+        .iter()
+        .max_by(|a, b| a.turn.abs().total_cmp(&b.turn.abs()))?;
+    if worst.turn.abs() > TURN_SLACK * max_turn {
+        let i = nearest_drawn(worst.p);
+        return Some(place(i, UnflownKind::Tight(1.0 / worst.turn.abs())));
+    }
+    // Every drawn sample (a few per needed radius) near some sample of the course: a grid of
+    // the course's samples (about one a wingspan) in cells of the reach, so each look-up
+    // reads its own cell and the eight around it.
+    let reach = WIDEN_REACH / max_turn;
+    let cell = |p: [f64; 3]| ((p[0] / reach).floor() as i64, (p[1] / reach).floor() as i64);
+    let mut grid: std::collections::HashMap<(i64, i64), Vec<[f64; 2]>> =
+        std::collections::HashMap::new();
+    let step = ((1.0 / course.ds).round() as usize).max(1);
+    for k in course.knots.iter().step_by(step).chain(course.knots.last()) {
+        grid.entry(cell(k.p)).or_default().push([k.p[0], k.p[1]]);
+    }
+    let stride = ((0.25 / max_turn / ds).floor() as usize).max(1);
+    let mut away: Option<(usize, f64)> = None;
+    for (i, p) in drawn.iter().enumerate().step_by(stride) {
+        let (cx, cy) = cell(*p);
+        let mut best = f64::INFINITY;
+        for gx in cx - 1..=cx + 1 {
+            for gy in cy - 1..=cy + 1 {
+                for q in grid.get(&(gx, gy)).into_iter().flatten() {
+                    best = best.min((q[0] - p[0]).hypot(q[1] - p[1]));
+                }
+            }
+        }
+        if best > reach && away.map_or(true, |(_, d)| best > d) {
+            away = Some((i, best));
+        }
+    }
+    away.map(|(i, d)| {
+        // Beyond the grid's cells the distance is only known to exceed the reach: measure it.
+        let d = if d.is_finite() {
+            d
+        } else {
+            course
+                .knots
+                .iter()
+                .map(|k| (k.p[0] - drawn[i][0]).hypot(k.p[1] - drawn[i][1]))
+                .fold(f64::INFINITY, f64::min)
+        };
+        place(i, UnflownKind::Away(d))
+    })
 }
 
 impl Course {
@@ -583,5 +706,46 @@ mod tests {
         assert!(tight[0].radius < 40.0);
         let c = Course::from_samples(w, ds, false);
         assert!(c.max_turn() <= 1.0 / 40.0 * 1.02, "{}", 1.0 / c.max_turn());
+    }
+
+    /// Widens `pts` for a needed radius `r` and checks the result: (flown radius, verdict).
+    fn widened(pts: &[[f64; 3]], r: f64) -> (f64, Option<UnflownKind>) {
+        let (p, ds) = resample(&spline_points(pts, false), SAMPLE_SPACING);
+        let (w, dw, tight) = widen(p.clone(), ds, false, 1.0 / r, SAMPLE_SPACING);
+        assert!(!tight.is_empty());
+        let c = Course::from_samples(w, dw, false);
+        (
+            1.0 / c.max_turn(),
+            unflown(&p, ds, &c, 1.0 / r).map(|u| u.kind),
+        )
+    }
+
+    #[test]
+    fn sharp_corners_widen_to_the_needed_radius_at_any_radius() {
+        // A 135° corner between long legs: the smoothed stretch must grow beyond a quarter
+        // turn, and the finished spline (not only the coarse polyline) must meet the radius.
+        // Before, radii of 19 to 23 were flown for 22.5 to 25 needed.
+        let corner = [[0.0, 0.0, 0.0], [0.0, 300.0, 0.0], [300.0, 0.0, 0.0]];
+        for r in [20.0, 22.0, 22.5, 23.0, 23.4, 23.8, 24.0, 25.0, 30.0, 40.0] {
+            let (flown, verdict) = widened(&corner, r);
+            assert!(flown >= r / 1.02, "needed {r}, flown {flown}");
+            assert_eq!(verdict, None, "needed {r}");
+        }
+    }
+
+    #[test]
+    fn a_hairpin_narrower_than_the_turn_is_told_not_flown() {
+        // Legs 10 apart, the turn needs 46 across: smoothing pulls the legs together and the
+        // hairpin shrinks to a stub far from the drawn tip.
+        let hairpin = [
+            [0.0, 0.0, 0.0],
+            [0.0, 300.0, 0.0],
+            [10.0, 300.0, 0.0],
+            [10.0, 0.0, 0.0],
+        ];
+        match widened(&hairpin, 23.0).1 {
+            Some(UnflownKind::Away(d)) => assert!(d > WIDEN_REACH * 23.0, "{d}"),
+            other => panic!("{other:?}"),
+        }
     }
 }

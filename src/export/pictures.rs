@@ -639,6 +639,11 @@ pub fn check_ffmpeg(output: &Path) -> Result<()> {
     }
 }
 
+/// Threads of ffmpeg's encoders, whatever the machine: x264's bitstream (and its options record)
+/// and VP9's tiling change with the thread count, so following the cores (as the frames'
+/// workers do) made equal inputs give other files on another machine or under `taskset`.
+pub const VIDEO_ENCODER_THREADS: usize = 4;
+
 /// Writes `film` as a video to `path` (atomically) by piping raw RGBA frames into `ffmpeg`.
 pub fn write_video(
     film: &Film,
@@ -665,7 +670,7 @@ pub fn write_video(
             "-crf",
             "20",
             "-threads",
-            &threads.to_string(),
+            &VIDEO_ENCODER_THREADS.to_string(),
             "-pix_fmt",
             "yuv420p",
             "-movflags",
@@ -687,7 +692,7 @@ pub fn write_video(
             "-row-mt",
             "1",
             "-threads",
-            &threads.to_string(),
+            &VIDEO_ENCODER_THREADS.to_string(),
             "-pix_fmt",
             "yuv420p",
             "-f",

@@ -239,6 +239,24 @@ pub fn write_usda(
 }
 
 /// The class `/_bird`: skeleton and skinned mesh, shared by reference.
+/// Per-vertex interpolation of a mesh attribute.
+const VERTEX: &str = "interpolation = \"vertex\"";
+
+/// One array attribute of the bird's mesh: `decl = [values]`, with its metadata lines in
+/// parentheses when there are any.
+fn mesh_attr<T: AsRef<str>>(s: &mut String, decl: &str, values: &[T], meta: &[&str]) {
+    let values: Vec<&str> = values.iter().map(AsRef::as_ref).collect();
+    let _ = write!(s, "        {decl} = [{}]", values.join(", "));
+    if !meta.is_empty() {
+        let _ = writeln!(s, " (");
+        for m in meta {
+            let _ = writeln!(s, "            {m}");
+        }
+        let _ = write!(s, "        )");
+    }
+    let _ = writeln!(s);
+}
+
 fn prototype(asset: &BirdAsset, ws: f32) -> String {
     let skel = &asset.skeleton;
     let paths = bird::usd_joint_paths();
@@ -305,40 +323,31 @@ fn prototype(asset: &BirdAsset, ws: f32) -> String {
     );
     let _ = writeln!(s, "        uniform bool doubleSided = 1");
     let _ = writeln!(s, "        float3[] extent = [{}, {}]", vec3(lo), vec3(hi));
-    let _ = writeln!(
-        s,
-        "        int[] faceVertexCounts = [{}]",
-        counts.join(", ")
-    );
-    let _ = writeln!(
-        s,
-        "        int[] faceVertexIndices = [{}]",
-        indices.join(", ")
-    );
-    let _ = writeln!(
-        s,
-        "        normal3f[] normals = [{}] (\n            interpolation = \"vertex\"\n        )",
-        normals.join(", ")
-    );
-    let _ = writeln!(s, "        point3f[] points = [{}]", points.join(", "));
-    let _ = writeln!(
-        s,
-        "        color3f[] primvars:displayColor = [{}] (\n            interpolation = \"uniform\"\n        )",
-        colours.join(", ")
+    mesh_attr(&mut s, "int[] faceVertexCounts", &counts, &[]);
+    mesh_attr(&mut s, "int[] faceVertexIndices", &indices, &[]);
+    mesh_attr(&mut s, "normal3f[] normals", &normals, &[VERTEX]);
+    mesh_attr(&mut s, "point3f[] points", &points, &[]);
+    mesh_attr(
+        &mut s,
+        "color3f[] primvars:displayColor",
+        &colours,
+        &["interpolation = \"uniform\""],
     );
     let _ = writeln!(
         s,
         "        matrix4d primvars:skel:geomBindTransform = ((1, 0, 0, 0), (0, 1, 0, 0), (0, 0, 1, 0), (0, 0, 0, 1))"
     );
-    let _ = writeln!(
-        s,
-        "        int[] primvars:skel:jointIndices = [{}] (\n            elementSize = 4\n            interpolation = \"vertex\"\n        )",
-        ji.join(", ")
+    mesh_attr(
+        &mut s,
+        "int[] primvars:skel:jointIndices",
+        &ji,
+        &["elementSize = 4", VERTEX],
     );
-    let _ = writeln!(
-        s,
-        "        float[] primvars:skel:jointWeights = [{}] (\n            elementSize = 4\n            interpolation = \"vertex\"\n        )",
-        jw.join(", ")
+    mesh_attr(
+        &mut s,
+        "float[] primvars:skel:jointWeights",
+        &jw,
+        &["elementSize = 4", VERTEX],
     );
     let _ = writeln!(s, "        rel skel:skeleton = </_bird/rig>");
     let _ = writeln!(

@@ -43,6 +43,105 @@ pub fn run_in(dir: &Path, args: &[&str]) -> Output {
         .expect("run formation")
 }
 
+/// What the shell prints before the child's CPU times (see [`run_capped`]).
+const CPU_MARK: &str = "@@formation-test-cpu@@\n";
+
+/// Runs `formation --quiet ARGS` in `dir` through `sh -c` with a memory cap (`ulimit -v
+/// mem_kib`, KiB) and an optional file-size cap (`ulimit -f`, 512-byte blocks). Gives the output
+/// and the CPU time (user + system) the run used: unlike the wall-clock time, it does not grow
+/// when the machine is loaded or the tests share a core, so a bound on it holds on any CI run.
+pub fn run_capped(
+    dir: &Path,
+    mem_kib: u64,
+    fsize: Option<u64>,
+    args: &[&str],
+) -> (Output, std::time::Duration) {
+    let mut script = format!("ulimit -v {mem_kib}; ");
+    if let Some(f) = fsize {
+        script += &format!("ulimit -f {f}; ");
+    }
+    // `times` (POSIX) prints the shell's own and then its children's user and system times.
+    script += &format!(
+        "\"$0\" --quiet \"$@\"; s=$?; printf '{}' >&2; times >&2; exit $s",
+        CPU_MARK.replace('\n', "\\n")
+    );
+    let mut out = Command::new("sh")
+        .current_dir(dir)
+        // glibc gives a thread that allocates its own arena, reserving 64 MiB of address space
+        // that `ulimit -v` counts though it is never used. Whether the signal-cleanup thread gets
+        // one before the main thread has taken the room depends on timing: CI once failed a
+        // 100 MiB run this way that needs under 60 MiB here. One arena makes the cap measure
+        // what the run allocates.
+        .env("MALLOC_ARENA_MAX", "1")
+        .arg("-c")
+        .arg(script)
+        .arg(bin_path())
+        .args(args)
+        .stdin(std::process::Stdio::null())
+        .output()
+        .expect("run formation through sh");
+    let text = String::from_utf8_lossy(&out.stderr).into_owned();
+    let at = text
+        .rfind(CPU_MARK)
+        .unwrap_or_else(|| panic!("no CPU times from sh: {text}"));
+    let cpu = children_cpu_time(&text[at + CPU_MARK.len()..]);
+    out.stderr.truncate(at);
+    (out, cpu)
+}
+
+/// The children's user + system time from the output of `times` (`0m0.10s 0m0.52s` on its
+/// second line; dash prints six decimals, bash three).
+fn children_cpu_time(times: &str) -> std::time::Duration {
+    let line = times
+        .lines()
+        .nth(1)
+        .unwrap_or_else(|| panic!("unexpected `times` output: {times:?}"));
+    let secs: f64 = line
+        .split_whitespace()
+        .map(|t| {
+            let (m, s) = t
+                .trim_end_matches('s')
+                .split_once('m')
+                .unwrap_or_else(|| panic!("unexpected `times` field {t:?}"));
+            m.parse::<f64>().unwrap() * 60.0 + s.parse::<f64>().unwrap()
+        })
+        .sum();
+    std::time::Duration::from_secs_f64(secs)
+}
+
+/// A clock of the calling thread's CPU time (Linux: `/proc/thread-self/schedstat`, in ns), or
+/// of the wall-clock time where that is not available. Bounds on work done in the test process
+/// use it: unlike the wall-clock time it does not grow when the machine is loaded or the tests
+/// share a core.
+pub struct WorkClock {
+    start_ns: Option<u64>,
+    wall: std::time::Instant,
+}
+
+impl WorkClock {
+    /// Starts the clock.
+    pub fn start() -> Self {
+        WorkClock {
+            start_ns: thread_cpu_ns(),
+            wall: std::time::Instant::now(),
+        }
+    }
+
+    /// The time on the clock since [`WorkClock::start`].
+    pub fn elapsed(&self) -> std::time::Duration {
+        match (self.start_ns, thread_cpu_ns()) {
+            (Some(a), Some(b)) => std::time::Duration::from_nanos(b.saturating_sub(a)),
+            _ => self.wall.elapsed(),
+        }
+    }
+}
+
+/// The calling thread's time on a CPU so far, in nanoseconds (Linux).
+fn thread_cpu_ns() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
+    text.split_whitespace().next()?.parse().ok()
+}
+
 /// The exit code, −1 for a signal.
 pub fn code(out: &Output) -> i32 {
     out.status.code().unwrap_or(-1)
