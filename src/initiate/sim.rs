@@ -709,8 +709,8 @@ impl Simulation {
         let b = band / LAYER_HEIGHT;
         let gap = AIR_LAYER_GAP / LAYER_HEIGHT;
         let slots = self.slot_positions();
-        for i in 0..n {
-            let before: Vec<usize> = partners[i].iter().copied().filter(|&k| k < i).collect();
+        for (i, mates) in partners.iter().enumerate() {
+            let before: Vec<usize> = mates.iter().copied().filter(|&k| k < i).collect();
             if before.is_empty() {
                 continue;
             }
