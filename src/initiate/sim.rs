@@ -1453,6 +1453,17 @@ impl Simulation {
     /// from it (the higher bird up, the lower down; by index when level), growing linearly to
     /// [`VERTICAL_SEPARATION`] at contact. Birds turning round at their largest turn rate have
     /// no sideways freedom left; they pass above and below. Wingspans.
+    /// The distance below which birds `i` and `k` push apart: `dsep`, or less for two birds
+    /// whose slots are closer than that (a fraction of their slots' distance).
+    fn separation_limit(&self, i: usize, k: usize, dsep: f64) -> f64 {
+        let f = &self.flock;
+        match (f.slot[i], f.slot[k]) {
+            (Some(a), Some(b)) => dsep
+                .min(SEPARATION_FRACTION * (self.target.slots[a] - self.target.slots[b]).length()),
+            _ => dsep,
+        }
+    }
+
     fn vertical_separation(&self, i: usize, near: &[usize]) -> f64 {
         let f = &self.flock;
         let horizon = SEPARATION_HORIZON;
@@ -1464,12 +1475,7 @@ impl Simulation {
             }
             let (t, m) = self.arc_closest(i, k, horizon);
             let d = m.length();
-            let limit = match (f.slot[i], f.slot[k]) {
-                (Some(a), Some(b)) => dsep.min(
-                    SEPARATION_FRACTION * (self.target.slots[a] - self.target.slots[b]).length(),
-                ),
-                _ => dsep,
-            };
+            let limit = self.separation_limit(i, k, dsep);
             if d >= limit {
                 continue;
             }
@@ -1519,12 +1525,7 @@ impl Simulation {
                 (t, dp + dv * t)
             };
             let d = m.length();
-            let limit = match (f.slot[i], f.slot[k]) {
-                (Some(a), Some(b)) => dsep.min(
-                    SEPARATION_FRACTION * (self.target.slots[a] - self.target.slots[b]).length(),
-                ),
-                _ => dsep,
-            };
+            let limit = self.separation_limit(i, k, dsep);
             if d >= limit {
                 continue;
             }
