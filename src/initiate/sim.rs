@@ -150,6 +150,14 @@ pub const LAYER_HEIGHT: f64 = 0.6;
 /// layer (smoothstep in between), wingspans.
 pub const LAYER_MERGE: f64 = 1.0;
 
+/// Height offset, wingspans, of a bird in layer `layer` (in units of [`LAYER_HEIGHT`]) that is
+/// `slot_err` wingspans from its slot: none within [`LAYER_MERGE`], all of it from twice that,
+/// a smoothstep in between.
+fn layer_offset(layer: f64, slot_err: f64) -> f64 {
+    let u = ((slot_err - LAYER_MERGE) / LAYER_MERGE).clamp(0.0, 1.0);
+    layer * LAYER_HEIGHT * u * u * (3.0 - 2.0 * u)
+}
+
 /// Width of a take-off run's lane: a bird on the ground leaves only after every bird ahead of it
 /// closer than this across the heading, wingspans.
 pub const RUN_LANE: f64 = 1.5;
@@ -671,8 +679,7 @@ impl Simulation {
                 continue;
             }
             let e = (self.flock.pos[i] - slots[s]).length();
-            let u = ((e - LAYER_MERGE) / LAYER_MERGE).clamp(0.0, 1.0);
-            self.flock.z[i] += self.layer[i] * LAYER_HEIGHT * u * u * (3.0 - 2.0 * u);
+            self.flock.z[i] += layer_offset(self.layer[i], e);
         }
     }
 
@@ -735,8 +742,7 @@ impl Simulation {
             self.layer[i] = new;
             if let Some(s) = self.flock.slot[i] {
                 let e = (self.flock.pos[i] - slots[s]).length();
-                let u = ((e - LAYER_MERGE) / LAYER_MERGE).clamp(0.0, 1.0);
-                self.flock.z[i] += (new - old) * LAYER_HEIGHT * u * u * (3.0 - 2.0 * u);
+                self.flock.z[i] += layer_offset(new - old, e);
             }
         }
     }
@@ -1258,10 +1264,7 @@ impl Simulation {
         // away from their slots (half a wingspan apart in height), merging as they settle, so
         // that two birds passing each other on the way are apart in 3-D.
         let mut alt_offset = match (self.layer.get(i), self.slot_err.get(i)) {
-            (Some(&l), Some(&e)) if e.is_finite() => {
-                let u = ((e - LAYER_MERGE) / LAYER_MERGE).clamp(0.0, 1.0);
-                l * LAYER_HEIGHT * u * u * (3.0 - 2.0 * u)
-            }
+            (Some(&l), Some(&e)) if e.is_finite() => layer_offset(l, e),
             _ => 0.0,
         };
         if self.airborne_start() && f.slot[i].is_some() {
