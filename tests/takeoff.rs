@@ -104,7 +104,7 @@ fn sweep(n: usize, seeds: u64, opts: &InitiateOptions) -> Sweep {
 }
 
 /// Durations over seeds and sizes: `SEEDS=20 SIZES=9,14,41,100 TAKEOFF=... cargo test --release
-/// --test takeoff table -- --ignored --nocapture`.
+/// --test takeoff table -- --ignored --nocapture` (`PERSEED=1`: a line per seed as well).
 #[test]
 #[ignore]
 fn table() {
@@ -174,6 +174,12 @@ fn table() {
         let mut planned = 0.0;
         for seed in 0..seeds {
             let s = run_stats_shape(n, gap, back, seed, &opts);
+            if std::env::var("PERSEED").is_ok() {
+                println!(
+                    "  N={n} seed {seed}: converged {} {:.1} s closest {:.3} stray {:.1}",
+                    s.converged, s.seconds, s.min_distance, s.max_stray
+                );
+            }
             planned = s.planned_seconds;
             if s.converged {
                 ok += 1;
@@ -599,12 +605,13 @@ fn convergence_over_seeds_and_flock_sizes() {
 
 /// The paper's airborne start (`--start air`: scattered, any heading) converges in at least 99 %
 /// of the runs for 9, 14, 41 and 100 birds (100 seeds) and 300 birds (10 seeds), within the
-/// smoothness limits, and no bird strays more than 30 wingspans beyond the formed flock (9–100
-/// birds), and the closest approach (3-D) is at least 0.3 wingspans for every size (since the
-/// start heights are checked against a dry run of the turns; before: 0.178/0.099/0.134 for
-/// 41/100/300 birds). 300 birds still stray up to about 34 wingspans (docs/initiation.md,
-/// Limitations): printed, not asserted. Measured (docs/initiation.md): closest
-/// 0.378/0.344/0.346/0.311/0.379, strays 23.9/25.8/25.7/28.8/33.6 wingspans.
+/// smoothness limits, no bird strays more than 30 wingspans beyond the formed flock, and the
+/// closest approach (3-D) is at least 0.3 wingspans for every size (since the start heights are
+/// checked against a dry run of the turns; before: 0.178/0.099/0.134 for 41/100/300 birds).
+/// 300 birds strayed up to 33.6 wingspans while the leader could be 17 wingspans off the
+/// middle of the start region; it is now within `AIR_LEADER_OFFSET` (8) of the middle bird.
+/// Measured (docs/initiation.md): closest 0.378/0.344/0.346/0.313/0.346, strays
+/// 23.9/25.8/25.7/28.8/28.3 wingspans.
 #[test]
 fn air_start_converges_over_seeds_and_flock_sizes() {
     let opts = InitiateOptions {
@@ -616,12 +623,12 @@ fn air_start_converges_over_seeds_and_flock_sizes() {
     } else {
         (100, 10)
     };
-    for (n, seeds, within) in [
-        (9usize, many, true),
-        (14, many, true),
-        (41, many, true),
-        (100, many, true),
-        (300, few, false),
+    for (n, seeds) in [
+        (9usize, many),
+        (14, many),
+        (41, many),
+        (100, many),
+        (300, few),
     ] {
         let w = sweep(n, seeds, &opts);
         assert!(w.max_turn_accel <= opts.max_turn_accel * (1.0 + 1e-9));
@@ -632,12 +639,10 @@ fn air_start_converges_over_seeds_and_flock_sizes() {
             ok * 100 >= 99 * seeds,
             "{n} birds from the air: {ok}/{seeds} converged"
         );
-        if within {
-            assert!(
-                stray <= 30.0,
-                "{n} birds from the air: a bird strayed {stray:.1} wingspans"
-            );
-        }
+        assert!(
+            stray <= 30.0,
+            "{n} birds from the air: a bird strayed {stray:.1} wingspans"
+        );
         assert!(
             closest >= 0.3,
             "{n} birds from the air: closest approach {closest:.3}"

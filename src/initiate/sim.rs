@@ -169,6 +169,12 @@ pub const RUN_GAP: f64 = 0.2;
 /// is more than this far off the cruise heading (still turning round), radians (90°).
 pub const AIR_GATHER_ANGLE: f64 = std::f64::consts::FRAC_PI_2;
 
+/// An airborne start's leader is at most this far across the cruise heading from the flock's
+/// middle bird, wingspans. The middle half of a 300-bird start region is 39 wingspans wide, and a
+/// leader 17 wingspans off the middle left the birds on the far side 56 wingspans across from it,
+/// level with it, and 24 wingspans from every slot before they had moved (docs/initiation.md).
+pub const AIR_LEADER_OFFSET: f64 = 8.0;
+
 /// An airborne start's vertical separation: the altitude offset a bird asks for, away from a
 /// flockmate predicted to come closer than the separation distance, at contact, wingspans.
 pub const VERTICAL_SEPARATION: f64 = 1.0;
@@ -579,8 +585,13 @@ impl Simulation {
             next_unseen: vec![0; n],
         };
         if sim.params.opts.assign_slots && n > 0 {
-            let (slot, leader) =
-                assign_slots(&sim.target, &sim.flock.pos, sim.params.cruise_heading);
+            let offset = sim.airborne_start().then_some(AIR_LEADER_OFFSET);
+            let (slot, leader) = assign_slots(
+                &sim.target,
+                &sim.flock.pos,
+                sim.params.cruise_heading,
+                offset,
+            );
             sim.flock.leader = leader;
             // The departure times, earliest first, go to the birds by the depth of their slot
             // behind the leader's (the leader leaves first; the tails of the arms last).
@@ -1835,10 +1846,16 @@ impl Simulation {
 
 /// The slot of every bird and the leader for start positions `pos` (wingspans) of a flock
 /// flying along `heading`: the leader is the front-most bird of the middle half across the
-/// heading; the other birds take the other slots in the order of their positions across the
-/// heading (the leftmost bird the leftmost slot, ties along the heading), so that no two birds
-/// cross sideways on their way to their slots.
-pub fn assign_slots(target: &TargetShape, pos: &[DVec2], heading: f64) -> (Vec<usize>, usize) {
+/// heading, and with `max_offset` (wingspans) of those at most that far across from the middle
+/// bird (the middle bird itself when none is); the other birds take the other slots in the order
+/// of their positions across the heading (the leftmost bird the leftmost slot, ties along the
+/// heading), so that no two birds cross sideways on their way to their slots.
+pub fn assign_slots(
+    target: &TargetShape,
+    pos: &[DVec2],
+    heading: f64,
+    max_offset: Option<f64>,
+) -> (Vec<usize>, usize) {
     let n = pos.len().min(target.len());
     let dc = direction(heading);
     let rc = right_of(heading);
@@ -1847,9 +1864,18 @@ pub fn assign_slots(target: &TargetShape, pos: &[DVec2], heading: f64) -> (Vec<u
     let mut by_x: Vec<usize> = (0..n).collect();
     by_x.sort_by(|&a, &b| across(a).total_cmp(&across(b)).then(a.cmp(&b)));
     let (lo, hi) = (n / 4, (n - n / 4).max(n / 4 + 1).min(n));
+    let middle = by_x.get(n / 2).copied().unwrap_or(0);
+    let near_middle = |i: usize| {
+        i == middle
+            || match max_offset {
+                Some(m) => (across(i) - across(middle)).abs() <= m,
+                None => true,
+            }
+    };
     let leader = by_x[lo..hi]
         .iter()
         .copied()
+        .filter(|&i| near_middle(i))
         .max_by(|&a, &b| along(a).total_cmp(&along(b)).then(b.cmp(&a)))
         .unwrap_or(0);
     let mut slots: Vec<usize> = (0..target.len()).filter(|&s| s != target.leader).collect();
@@ -1910,4 +1936,67 @@ pub fn wrap_angle(a: f64) -> f64 {
         a += 2.0 * PI;
     }
     a
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A V of `n` birds 0.7 wingspans across and 0.35 behind per rank (y behind the leader).
+    fn v(n: usize) -> TargetShape {
+        let pts: Vec<DVec2> = (0..n)
+            .map(|k| {
+                let rank = k.div_ceil(2) as f64;
+                let side = if k % 2 == 1 { 1.0 } else { -1.0 };
+                DVec2::new(side * 0.7 * rank, 0.35 * rank)
+            })
+            .collect();
+        TargetShape::new(&pts).unwrap()
+    }
+
+    /// 41 birds in a row across the heading (north), 2 wingspans apart, x = −40 … 40; the bird
+    /// at x = 16 is 3 wingspans ahead of the rest and the one at x = −6 one wingspan ahead.
+    fn row() -> Vec<DVec2> {
+        (0..41)
+            .map(|k| {
+                let x = 2.0 * k as f64 - 40.0;
+                let y = match x as i64 {
+                    16 => 3.0,
+                    -6 => 1.0,
+                    _ => 0.0,
+                };
+                DVec2::new(x, y)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_leader_is_the_front_most_bird_of_the_middle_half() {
+        let pos = row();
+        let (_, leader) = assign_slots(&v(41), &pos, 0.0, None);
+        assert_eq!(pos[leader], DVec2::new(16.0, 3.0));
+    }
+
+    #[test]
+    fn an_airborne_leader_is_near_the_middle_bird_and_the_slots_stay_in_order() {
+        let pos = row();
+        let t = v(41);
+        let (slot, leader) = assign_slots(&t, &pos, 0.0, Some(AIR_LEADER_OFFSET));
+        // x = 16 is 16 wingspans from the middle bird (x = 0): beyond 8, so x = −6 leads.
+        assert_eq!(pos[leader], DVec2::new(-6.0, 1.0));
+        assert_eq!(slot[leader], t.leader);
+        // The others keep their order across the heading in their slots' order.
+        let mut others: Vec<usize> = (0..pos.len()).filter(|&i| i != leader).collect();
+        others.sort_by(|&a, &b| pos[a].x.total_cmp(&pos[b].x));
+        for w in others.windows(2) {
+            assert!(t.slots[slot[w[0]]].x <= t.slots[slot[w[1]]].x);
+        }
+        let mut seen = slot.clone();
+        seen.sort_unstable();
+        seen.dedup();
+        assert_eq!(seen.len(), pos.len(), "one bird per slot");
+        // No bird within the offset: the middle bird leads.
+        let (_, leader) = assign_slots(&t, &pos, 0.0, Some(0.5));
+        assert_eq!(pos[leader], DVec2::new(0.0, 0.0));
+    }
 }
