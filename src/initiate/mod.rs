@@ -335,7 +335,8 @@ pub struct TakeoffPlan {
     pub catchup_distance: f64,
     /// How hard the birds drive: the natural duration over the wanted one, within
     /// [[`TakeoffPlan::MIN_DRIVE`], [`TakeoffPlan::MAX_DRIVE`]]. The run and vertical
-    /// accelerations and the climb rate are multiplied by it, the approach time divided by it;
+    /// accelerations and the climb rate are multiplied by it, the approach time divided by it
+    /// (by at most [`TakeoffPlan::MAX_APPROACH_DRIVE`]);
     /// the departure stagger is 1 s over it; below 1 the take-off area also grows by 1/drive.
     pub drive: f64,
 }
@@ -346,6 +347,12 @@ impl TakeoffPlan {
     /// The strongest drive: a take-off down to about 0.7 of the natural one (the climb to the
     /// cruise altitude bounds it).
     pub const MAX_DRIVE: f64 = 1.6;
+    /// The strongest drive of the final approach to the slots: a short take-off runs, climbs
+    /// and departs faster, but no bird closes on its slot harder than in the natural take-off.
+    /// Driven 1.6 times as hard, birds of neighbouring slots came 0.29 wingspans close (100
+    /// birds, `initiate.takeoff` 8 s, 2 of 21 seeds) and 0.22 (300 birds, 10 seeds); at 1 they
+    /// keep 0.36 and 0.34, and the take-off lasts 0.4–1.1 s longer (docs/initiation.md).
+    pub const MAX_APPROACH_DRIVE: f64 = 1.0;
 
     /// The natural take-off of `n` birds from the ground at the default options, seconds:
     /// measured medians (docs/initiation.md) about 9.5 s for 9–14 birds, 10.7 s for 41, 12.7 s
@@ -361,12 +368,12 @@ impl TakeoffPlan {
     }
 
     /// The shortest take-off of `n` birds from the ground at the strongest drive, seconds:
-    /// measured medians 8.3 s for 9 birds, 8.5 for 14, 8.9 for 41, 11.1 for 100, 20.5 for 300
-    /// (docs/initiation.md). The run, lift-off and climb to the cruise altitude take about 7 s at
+    /// measured medians 7.9 s for 9 birds, 8.3 for 14, 9.2 for 41, 11.7 for 100, 22.4 for 300
+    /// (`initiate.takeoff` 5 s, docs/initiation.md); fitted 8.1, 8.4, 9.7, 12.6 and 22.4. The run, lift-off and climb to the cruise altitude take about 7 s at
     /// the strongest drive (climb rate and accelerations bounded), and the outer birds of a wider
     /// V have farther to fly to their slots at bounded speeds.
     pub fn shortest_seconds(n: usize) -> f64 {
-        7.8 + 0.042 * n.max(1) as f64
+        7.7 + 0.049 * n.max(1) as f64
     }
 
     /// A warning when the take-off duration of `opts` cannot be met within 25 % for `n` birds:
@@ -1061,8 +1068,8 @@ impl InitiateOptions {
     }
 
     /// The simulation's parameters for a cruise under a take-off plan: the plan's gain,
-    /// catch-up distance and drive (accelerations of the run and the climb, the climb rate and
-    /// the approach scaled by it).
+    /// catch-up distance and drive (accelerations of the run and the climb, the climb rate and,
+    /// up to [`TakeoffPlan::MAX_APPROACH_DRIVE`], the approach scaled by it).
     pub fn plan_params(&self, cruise: &Cruise, plan: &TakeoffPlan) -> StepParams {
         self.derive_params(cruise, plan.k, plan.catchup_distance, plan.drive)
     }
@@ -1086,8 +1093,8 @@ impl InitiateOptions {
             reference_memory: (self.reference_memory() / self.reaction_time).round() as u32,
             catchup_distance: catchup,
             gather_speed: self.gather_speed * vc,
-            approach_time: self.approach_time / drive,
-            approach_brake: self.approach_brake * drive,
+            approach_time: self.approach_time / drive.min(TakeoffPlan::MAX_APPROACH_DRIVE),
+            approach_brake: self.approach_brake * drive.min(TakeoffPlan::MAX_APPROACH_DRIVE),
         }
     }
 
