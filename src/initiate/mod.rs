@@ -369,9 +369,10 @@ impl TakeoffPlan {
 
     /// The shortest take-off of `n` birds from the ground at the strongest drive, seconds:
     /// measured medians 7.9 s for 9 birds, 8.3 for 14, 9.2 for 41, 11.7 for 100, 22.4 for 300
-    /// (`initiate.takeoff` 5 s, docs/initiation.md); fitted 8.1, 8.4, 9.7, 12.6 and 22.4. The run, lift-off and climb to the cruise altitude take about 7 s at
-    /// the strongest drive (climb rate and accelerations bounded), and the outer birds of a wider
-    /// V have farther to fly to their slots at bounded speeds.
+    /// (`initiate.takeoff` 5 s, docs/initiation.md); fitted 8.1, 8.4, 9.7, 12.6 and 22.4. The
+    /// run, lift-off and climb to the cruise altitude take about 7 s at the strongest drive
+    /// (climb rate and accelerations bounded), and the outer birds of a wider V have farther to
+    /// fly to their slots at bounded speeds.
     pub fn shortest_seconds(n: usize) -> f64 {
         7.7 + 0.049 * n.max(1) as f64
     }
@@ -1079,6 +1080,7 @@ impl InitiateOptions {
     /// drive-scaled take-off values.
     fn derive_params(&self, cruise: &Cruise, k: f64, catchup: f64, drive: f64) -> StepParams {
         let vc = cruise.speed;
+        let approach = drive.min(TakeoffPlan::MAX_APPROACH_DRIVE);
         StepParams {
             opts: std::sync::Arc::new(self.clone()),
             k,
@@ -1093,8 +1095,8 @@ impl InitiateOptions {
             reference_memory: (self.reference_memory() / self.reaction_time).round() as u32,
             catchup_distance: catchup,
             gather_speed: self.gather_speed * vc,
-            approach_time: self.approach_time / drive.min(TakeoffPlan::MAX_APPROACH_DRIVE),
-            approach_brake: self.approach_brake * drive.min(TakeoffPlan::MAX_APPROACH_DRIVE),
+            approach_time: self.approach_time / approach,
+            approach_brake: self.approach_brake * approach,
         }
     }
 
