@@ -75,6 +75,7 @@ pub mod rng;
 pub mod shape;
 pub mod skein;
 pub mod sniff;
+pub mod track;
 pub mod wingbeat;
 
 pub use animation::Animation;

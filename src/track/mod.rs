@@ -1,0 +1,618 @@
+//! From footage to annotations: find the birds in every frame and link them into tracks.
+//!
+//! [`detect`] finds the birds of one frame (sky model, regions standing out from it, sub-pixel
+//! centroids, touching birds split); [`tracker`] links them across frames by assignment with
+//! constant-velocity prediction; [`Tracking`] runs both over a sequence of frames and gives
+//! [`Tracked`]: per frame the birds with stable ids and a confidence, the wingspan in pixels (the
+//! median of the birds' spans) and the flight direction (from the tracks' motion). [`source`]
+//! reads frames from a video (through the system `ffmpeg`), a directory or a glob.
+//! [`Tracked::to_native`] writes the native annotation JSON that `extract` reads.
+
+pub mod detect;
+pub mod source;
+pub mod tracker;
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use serde_json::{json, Value};
+
+use crate::error::{Error, Result};
+use crate::progress::Progress;
+use detect::{Blob, Gray, Sky};
+
+/// Whether birds are darker or brighter than the sky.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Polarity {
+    /// Chosen on the first frame: the side that stands out more.
+    #[default]
+    Auto,
+    /// Dark birds on a bright sky (the usual silhouette).
+    Dark,
+    /// Bright birds on a dark sky (lit from the side, or an infrared camera).
+    Bright,
+}
+
+impl std::str::FromStr for Polarity {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "auto" => Ok(Polarity::Auto),
+            "dark" => Ok(Polarity::Dark),
+            "bright" => Ok(Polarity::Bright),
+            _ => Err(format!("`{s}` is not a polarity; use auto, dark or bright")),
+        }
+    }
+}
+
+/// Options of tracking; checked by [`TrackOptions::validate`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct TrackOptions {
+    /// Dark or bright birds.
+    pub polarity: Polarity,
+    /// Annotate every K-th frame (1 = all).
+    pub every: usize,
+    /// First frame and one past the last to read (0-based), `None` = to the end.
+    pub frames: (usize, Option<usize>),
+    /// Region of interest `[x, y, w, h]`, pixels; `None` = the whole frame.
+    pub roi: Option<[usize; 4]>,
+    /// Frames per second, overriding the video's (needed for image frames to carry times).
+    pub fps: Option<f64>,
+}
+
+impl Default for TrackOptions {
+    fn default() -> Self {
+        TrackOptions {
+            polarity: Polarity::Auto,
+            every: 1,
+            frames: (0, None),
+            roi: None,
+            fps: None,
+        }
+    }
+}
+
+impl TrackOptions {
+    /// Checks the options that do not depend on the footage.
+    pub fn validate(&self) -> Result<()> {
+        if self.every == 0 {
+            return Err(Error::parameter(
+                "track.every",
+                "must be at least 1 (1 = every frame, 5 = every fifth)",
+            ));
+        }
+        if let (a, Some(b)) = self.frames {
+            if b <= a {
+                return Err(Error::parameter(
+                    "track.frames",
+                    format!("{a}..{b} holds no frame; give A..B with B > A (B excluded), or A.. to the end"),
+                ));
+            }
+        }
+        if let Some([_, _, w, h]) = self.roi {
+            if w == 0 || h == 0 {
+                return Err(Error::parameter(
+                    "track.roi",
+                    "the region has zero width or height; give x,y,w,h in pixels",
+                ));
+            }
+        }
+        if let Some(f) = self.fps {
+            if !(f.is_finite() && f > 0.0 && f <= crate::limits::MAX_FPS) {
+                return Err(Error::parameter(
+                    "track.fps",
+                    format!("{f} is not a frame rate; give frames per second, e.g. 25"),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The region of interest checked against a `width × height` frame.
+    pub fn roi_in(&self, width: usize, height: usize) -> Result<[usize; 4]> {
+        match self.roi {
+            None => Ok([0, 0, width, height]),
+            Some([x, y, w, h]) => {
+                if x.saturating_add(w) > width || y.saturating_add(h) > height {
+                    return Err(Error::parameter(
+                        "track.roi",
+                        format!("{x},{y},{w},{h} reaches outside the {width}x{height} frame"),
+                    ));
+                }
+                Ok([x, y, w, h])
+            }
+        }
+    }
+
+    /// Whether frame `k` of the footage is processed.
+    pub fn wants(&self, k: usize) -> bool {
+        k >= self.frames.0 && !self.done(k) && (k - self.frames.0) % self.every == 0
+    }
+
+    /// Whether no frame from `k` on is processed.
+    pub fn done(&self, k: usize) -> bool {
+        self.frames.1.is_some_and(|b| k >= b)
+    }
+}
+
+/// One tracked bird in one frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TrackedBird {
+    /// Track id, stable across frames.
+    pub id: usize,
+    /// Position, pixels (x right): the centroid smoothed along the track.
+    pub x: f64,
+    /// Position, pixels (y down).
+    pub y: f64,
+    /// 0–1: how sure the detection and its track are (see [`Tracked::confidence`]).
+    pub confidence: f64,
+    /// The detection.
+    pub blob: Blob,
+}
+
+/// One processed frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TrackedFrame {
+    /// Frame number in the footage (0-based).
+    pub index: usize,
+    /// Image file name, for image frames.
+    pub image: Option<String>,
+    /// Wingspan, pixels: the median over the frame's birds of each one's widest span within
+    /// 6 processed frames either side.
+    pub wingspan_px: f64,
+    /// Flight direction, degrees clockwise from image-up.
+    pub heading_deg: f64,
+    /// The birds.
+    pub birds: Vec<TrackedBird>,
+}
+
+/// The result of tracking footage.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Tracked {
+    /// Describes the footage.
+    pub source: String,
+    /// Frame size, pixels.
+    pub width: usize,
+    /// Frame size, pixels.
+    pub height: usize,
+    /// Frames per second of the footage, when known.
+    pub fps: Option<f64>,
+    /// Polarity used.
+    pub polarity: Polarity,
+    /// Processed frames in order.
+    pub frames: Vec<TrackedFrame>,
+}
+
+/// Runs detection and tracking frame by frame.
+pub struct Tracking {
+    opts: TrackOptions,
+    polarity: Option<Polarity>,
+    tracker: tracker::Tracker,
+    size: Option<(usize, usize)>,
+    roi: [usize; 4],
+    frames: Vec<TrackedFrame>,
+    last_span: Option<f64>,
+}
+
+/// Processed frames either side over which a bird's widest spread is its wingspan.
+const SPAN_WINDOW: usize = 6;
+
+/// Processed frames either side over which a bird's position is smoothed by a straight line.
+const SMOOTH_WINDOW: usize = 4;
+
+/// Frames a heading is measured over, either side.
+const HEADING_WINDOW: usize = 3;
+
+fn median(mut v: Vec<f64>) -> Option<f64> {
+    if v.is_empty() {
+        return None;
+    }
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    Some(if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    })
+}
+
+impl Tracking {
+    /// Starts with checked options.
+    pub fn new(opts: &TrackOptions) -> Result<Tracking> {
+        opts.validate()?;
+        Ok(Tracking {
+            opts: opts.clone(),
+            polarity: match opts.polarity {
+                Polarity::Auto => None,
+                p => Some(p),
+            },
+            tracker: tracker::Tracker::default(),
+            size: None,
+            roi: [0, 0, 0, 0],
+            frames: Vec::new(),
+            last_span: None,
+        })
+    }
+
+    /// Processes frame number `index` of the footage; `name` names it in messages.
+    pub fn push(
+        &mut self,
+        index: usize,
+        image: Option<String>,
+        g: &Gray,
+        name: &Path,
+    ) -> Result<()> {
+        match self.size {
+            None => {
+                self.roi = self.opts.roi_in(g.width, g.height)?;
+                self.size = Some((g.width, g.height));
+            }
+            Some((w, h)) if (w, h) != (g.width, g.height) => {
+                return Err(Error::format(
+                    name,
+                    format!(
+                        "frame {index} is {}x{}, the first frame was {w}x{h}; all frames must be the same size",
+                        g.width, g.height
+                    ),
+                ))
+            }
+            _ => {}
+        }
+        let sky = Sky::model(g);
+        let polarity = *self
+            .polarity
+            .get_or_insert_with(|| detect::auto_polarity(g, &sky));
+        let blobs = detect::detect_frame(g, &sky, polarity, self.roi);
+        if blobs.is_empty() {
+            return Err(Error::format(
+                name,
+                format!(
+                    "frame {index}: no bird found; check --polarity (dark birds on a bright sky, or bright on dark), --roi, or leave the frame out with --frames"
+                ),
+            ));
+        }
+        let span = median(blobs.iter().filter(|b| !b.split).map(|b| b.span).collect())
+            .or_else(|| median(blobs.iter().map(|b| b.span).collect()))
+            .unwrap_or(1.0);
+        let ids = self
+            .tracker
+            .step(&blobs, self.last_span.unwrap_or(span).max(span));
+        self.last_span = Some(span);
+        self.frames.push(TrackedFrame {
+            index,
+            image,
+            wingspan_px: span,
+            heading_deg: f64::NAN,
+            birds: blobs
+                .iter()
+                .zip(ids)
+                .map(|(b, id)| TrackedBird {
+                    id,
+                    x: b.x,
+                    y: b.y,
+                    confidence: 0.0,
+                    blob: *b,
+                })
+                .collect(),
+        });
+        Ok(())
+    }
+
+    /// Finishes: headings and confidences.
+    pub fn finish(self, source: &str, fps: Option<f64>) -> Result<Tracked> {
+        let Some((width, height)) = self.size else {
+            return Err(Error::format(
+                source,
+                "no frame was read in the chosen range; check --frames and --every",
+            ));
+        };
+        let mut frames = self.frames;
+        // Each track's observations: processed-frame position -> (x, y).
+        let mut tracks: BTreeMap<usize, Vec<(usize, f64, f64)>> = BTreeMap::new();
+        for (k, f) in frames.iter().enumerate() {
+            for b in &f.birds {
+                tracks.entry(b.id).or_default().push((k, b.x, b.y));
+            }
+        }
+        // Positions: a straight line fitted to each bird's centroids over SMOOTH_WINDOW
+        // processed frames either side, taken at the frame (the silhouette's centre of mass
+        // moves back and forth with the wingbeat; the bird's motion is smooth over this time).
+        let observed = tracks.clone();
+        for (k, f) in frames.iter_mut().enumerate() {
+            for b in &mut f.birds {
+                let obs: Vec<&(usize, f64, f64)> = observed[&b.id]
+                    .iter()
+                    .filter(|o| o.0 + SMOOTH_WINDOW >= k && o.0 <= k + SMOOTH_WINDOW)
+                    .collect();
+                if obs.len() < 3 {
+                    continue;
+                }
+                let n = obs.len() as f64;
+                let mt = obs.iter().map(|o| o.0 as f64).sum::<f64>() / n;
+                let mx = obs.iter().map(|o| o.1).sum::<f64>() / n;
+                let my = obs.iter().map(|o| o.2).sum::<f64>() / n;
+                let stt = obs.iter().map(|o| (o.0 as f64 - mt).powi(2)).sum::<f64>();
+                let stx = obs
+                    .iter()
+                    .map(|o| (o.0 as f64 - mt) * (o.1 - mx))
+                    .sum::<f64>();
+                let sty = obs
+                    .iter()
+                    .map(|o| (o.0 as f64 - mt) * (o.2 - my))
+                    .sum::<f64>();
+                let dt = k as f64 - mt;
+                b.x = mx + stx / stt * dt;
+                b.y = my + sty / stt * dt;
+            }
+        }
+        // Wingspan: each bird's widest spread within a wingbeat or two (a wing raised or swept
+        // back shortens the span seen from below), then the median over the frame's birds.
+        let spans: BTreeMap<usize, Vec<(usize, f64)>> = {
+            let mut m: BTreeMap<usize, Vec<(usize, f64)>> = BTreeMap::new();
+            for (k, f) in frames.iter().enumerate() {
+                for b in f.birds.iter().filter(|b| !b.blob.split) {
+                    m.entry(b.id).or_default().push((k, b.blob.span));
+                }
+            }
+            m
+        };
+        for (k, f) in frames.iter_mut().enumerate() {
+            let (lo, hi) = (k.saturating_sub(SPAN_WINDOW), k + SPAN_WINDOW);
+            let widest: Vec<f64> = f
+                .birds
+                .iter()
+                .filter_map(|b| {
+                    spans.get(&b.id).and_then(|v| {
+                        v.iter()
+                            .filter(|o| o.0 >= lo && o.0 <= hi)
+                            .map(|o| o.1)
+                            .fold(None, |m: Option<f64>, s| Some(m.map_or(s, |m| m.max(s))))
+                    })
+                })
+                .collect();
+            if let Some(w) = median(widest) {
+                f.wingspan_px = w;
+            }
+        }
+        let shape_heading = |f: &TrackedFrame| shape_heading(&f.birds);
+        let n = frames.len();
+        let mut headings = Vec::with_capacity(n);
+        for (k, frame) in frames.iter().enumerate() {
+            let (lo, hi) = (
+                k.saturating_sub(HEADING_WINDOW),
+                (k + HEADING_WINDOW).min(n - 1),
+            );
+            let (mut sx, mut sy, mut steps) = (0.0, 0.0, 0.0);
+            for b in &frame.birds {
+                let obs = &tracks[&b.id];
+                let first = obs.iter().find(|o| o.0 >= lo);
+                let last = obs.iter().rev().find(|o| o.0 <= hi);
+                if let (Some(a), Some(c)) = (first, last) {
+                    if c.0 > a.0 {
+                        sx += c.1 - a.1;
+                        sy += c.2 - a.2;
+                        steps += (c.0 - a.0) as f64;
+                    }
+                }
+            }
+            let moving = steps > 0.0
+                && sx.hypot(sy) / steps >= 0.05 * frame.wingspan_px * self.opts.every as f64;
+            headings.push(if moving {
+                sx.atan2(-sy).to_degrees().rem_euclid(360.0)
+            } else {
+                shape_heading(frame)
+            });
+        }
+        for (f, h) in frames.iter_mut().zip(headings) {
+            f.heading_deg = h;
+        }
+        // Confidence: contrast × track length × not cut from a larger region.
+        let lengths: BTreeMap<usize, usize> = tracks.iter().map(|(id, o)| (*id, o.len())).collect();
+        for f in &mut frames {
+            for b in &mut f.birds {
+                let contrast = 1.0 - 0.5f64.powf(b.blob.snr / detect::HIGH_SIGMA as f64);
+                let length = (lengths[&b.id] as f64 / 5.0).min(1.0);
+                let split = if b.blob.split { 0.8 } else { 1.0 };
+                b.confidence = (contrast * length * split * 1000.0).round() / 1000.0;
+            }
+        }
+        Ok(Tracked {
+            source: source.to_string(),
+            width,
+            height,
+            fps: self.opts.fps.or(fps),
+            polarity: self.polarity.unwrap_or(Polarity::Dark),
+            frames,
+        })
+    }
+}
+
+/// The flight direction from the birds' shapes alone (no motion): across the wings' mean
+/// axis, pointing to the end of the flock where fewer birds are (a V's apex, a J's short arm).
+fn shape_heading(birds: &[TrackedBird]) -> f64 {
+    let (c, s) = birds.iter().fold((0.0, 0.0), |(c, s), b| {
+        (c + (2.0 * b.blob.axis).cos(), s + (2.0 * b.blob.axis).sin())
+    });
+    let wing = 0.5 * s.atan2(c);
+    // Flight axis, image coordinates (x right, y down).
+    let (ux, uy) = (-wing.sin(), wing.cos());
+    let t: Vec<f64> = birds.iter().map(|b| b.x * ux + b.y * uy).collect();
+    let mid = median(t.clone()).unwrap_or(0.0);
+    let lo = t.iter().cloned().fold(f64::INFINITY, f64::min);
+    let hi = t.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+    let (dx, dy) = if hi - mid >= mid - lo {
+        (ux, uy)
+    } else {
+        (-ux, -uy)
+    };
+    dx.atan2(-dy).to_degrees().rem_euclid(360.0)
+}
+
+/// Circular mean of angles in degrees.
+fn mean_angle(a: impl Iterator<Item = f64>) -> f64 {
+    let (c, s) = a.fold((0.0, 0.0), |(c, s), d: f64| {
+        (c + d.to_radians().cos(), s + d.to_radians().sin())
+    });
+    s.atan2(c).to_degrees().rem_euclid(360.0)
+}
+
+fn round_to(v: f64, digits: i32) -> f64 {
+    let p = 10f64.powi(digits);
+    (v * p).round() / p
+}
+
+impl Tracked {
+    /// The flock's flight direction over the whole footage (circular mean), degrees.
+    pub fn heading_deg(&self) -> f64 {
+        mean_angle(self.frames.iter().map(|f| f.heading_deg))
+    }
+
+    /// The median wingspan over frames, pixels.
+    pub fn wingspan_px(&self) -> f64 {
+        median(self.frames.iter().map(|f| f.wingspan_px).collect()).unwrap_or(1.0)
+    }
+
+    /// Number of distinct track ids.
+    pub fn track_count(&self) -> usize {
+        let mut ids: Vec<usize> = self
+            .frames
+            .iter()
+            .flat_map(|f| f.birds.iter().map(|b| b.id))
+            .collect();
+        ids.sort_unstable();
+        ids.dedup();
+        ids.len()
+    }
+
+    /// The native annotation JSON (what `extract` reads), with the footage's `fps`, each frame's
+    /// time `t`, measured `wingspan_px` and `heading`, and each bird's `confidence`.
+    pub fn to_native(&self) -> Value {
+        let frames: Vec<Value> = self
+            .frames
+            .iter()
+            .map(|f| {
+                let mut o = json!({
+                    "index": f.index,
+                    "wingspan_px": round_to(f.wingspan_px, 2),
+                    "heading": round_to(f.heading_deg, 1),
+                    "birds": f.birds.iter().map(|b| json!({
+                        "id": b.id,
+                        "x": round_to(b.x, 2),
+                        "y": round_to(b.y, 2),
+                        "confidence": b.confidence,
+                    })).collect::<Vec<_>>(),
+                });
+                if let Some(fps) = self.fps {
+                    o["t"] = json!(round_to(f.index as f64 / fps, 6));
+                }
+                if let Some(img) = &f.image {
+                    o["image"] = json!(img);
+                }
+                o
+            })
+            .collect();
+        let mut top = json!({
+            "source": self.source,
+            "heading": round_to(self.heading_deg(), 1),
+            "wingspan_px": round_to(self.wingspan_px(), 2),
+            "image_size": [self.width, self.height],
+            "polarity": match self.polarity { Polarity::Bright => "bright", _ => "dark" },
+        });
+        if let Some(fps) = self.fps {
+            top["fps"] = json!(fps);
+        }
+        top["frames"] = Value::Array(frames);
+        top
+    }
+}
+
+/// Tracks the footage at `input` (a video, a directory of images or a glob).
+pub fn track_path(
+    input: &Path,
+    opts: &TrackOptions,
+    progress: &dyn Progress,
+    mut keep: impl FnMut(usize, &Gray),
+) -> Result<Tracked> {
+    opts.validate()?;
+    let mut run = Tracking::new(opts)?;
+    let source = input.display().to_string();
+    match source::open(input)? {
+        source::Input::Images(files) => {
+            let wanted: Vec<(usize, &std::path::PathBuf)> = files
+                .iter()
+                .enumerate()
+                .filter(|(k, _)| opts.wants(*k))
+                .collect();
+            if wanted.is_empty() {
+                return Err(Error::parameter(
+                    "track.frames",
+                    format!(
+                        "no frame in the chosen range: the footage has {} frames",
+                        files.len()
+                    ),
+                ));
+            }
+            progress.start("tracking", wanted.len() as u64);
+            for (k, p) in wanted {
+                let g = source::read_image(p)?;
+                let name = p.file_name().map(|n| n.to_string_lossy().into_owned());
+                run.push(k, name, &g, p)?;
+                keep(k, &g);
+                progress.advance(1);
+            }
+            progress.finish();
+            run.finish(&source, None)
+        }
+        source::Input::Video {
+            path,
+            width,
+            height,
+            fps,
+        } => {
+            opts.roi_in(width, height)?;
+            let mut v = source::VideoFrames::start(&path, width, height)?;
+            progress.start("tracking", 0);
+            let mut k = 0usize;
+            loop {
+                if opts.done(k) {
+                    v.stop();
+                    break;
+                }
+                let frame = match v.next_frame() {
+                    Ok(Some(g)) => g,
+                    Ok(None) => {
+                        v.finish(k)?;
+                        break;
+                    }
+                    Err(e) => {
+                        v.stop();
+                        return Err(e);
+                    }
+                };
+                if opts.wants(k) {
+                    if let Err(e) = run.push(k, None, &frame, &path) {
+                        v.stop();
+                        return Err(e);
+                    }
+                    keep(k, &frame);
+                    progress.advance(1);
+                }
+                k += 1;
+            }
+            progress.finish();
+            if k == 0 {
+                return Err(Error::format(
+                    &path,
+                    "ffmpeg gave no frame: the video is empty or cannot be decoded",
+                ));
+            }
+            run.finish(&source, fps).map_err(|e| match e {
+                Error::Format { .. } => Error::parameter(
+                    "track.frames",
+                    format!("no frame in the chosen range: the video has {k} frames"),
+                ),
+                e => e,
+            })
+        }
+    }
+}
