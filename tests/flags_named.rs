@@ -167,6 +167,24 @@ fn commands() -> Vec<Command> {
             ]),
         },
         Command {
+            name: &["track"],
+            base: strings(&[
+                "track",
+                &data("track_frames").to_string_lossy(),
+                "-o",
+                "OUT/a.json",
+            ]),
+            cases: vec![
+                ("--polarity", "grey", None),
+                ("--every", "0", None),
+                ("--frames", "3..1", None),
+                ("--roi", "0,0,999,10", None),
+                ("--fps", "-2", None),
+                o("OUT/a.txt"),
+                seed.clone(),
+            ],
+        },
+        Command {
             name: &["power"],
             base: strings(&["power", &shape]),
             cases: vec![("--core-radius", "nan", None), seed.clone()],

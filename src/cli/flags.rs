@@ -38,6 +38,8 @@ pub enum Cmd {
     PlotSavings,
     /// `formation report`.
     Report,
+    /// `formation track`.
+    Track,
 }
 
 use Cmd::*;
@@ -60,6 +62,11 @@ pub const FLAGS: &[(&str, &str, &[Cmd])] = &[
     // The output files (`export::write_outputs`' `outputs`, `io::OutputKind`).
     ("output", "-o", EVERY),
     ("report", "--report", &[Steady]),
+    ("track.polarity", "--polarity", &[Track]),
+    ("track.every", "--every", &[Track]),
+    ("track.frames", "--frames", &[Track]),
+    ("track.roi", "--roi", &[Track]),
+    ("track.fps", "--fps", &[Track]),
     ("read.heading", "--heading", READ),
     ("read.wingspan_px", "--wingspan-px", READ),
     ("read.y_origin", "--y-origin", READ),

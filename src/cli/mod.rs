@@ -20,6 +20,7 @@ mod start;
 mod stdout;
 mod steady;
 pub mod summary;
+mod track;
 mod wingbeat;
 
 /// Animate bird flocks flying in line formations (V, U, J, echelon), after Klotsman & Tal.
@@ -72,6 +73,9 @@ enum Command {
     /// One self-contained HTML page (inline SVG charts) about annotations, params or an
     /// animation: parameters per frame with fits, savings per bird, take-off, field comparison.
     Report(report::ReportArgs),
+    /// Find and track the birds of footage (a video, a directory of images or a glob) and write
+    /// native annotations for `extract`.
+    Track(track::TrackArgs),
 }
 
 /// Runs the parsed command line.
@@ -94,6 +98,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Render(a) => (Cmd::Render, render::run(a, g)),
         Command::Plot(a) => (a.cmd(), plot::run(a, g)),
         Command::Report(a) => (Cmd::Report, report::run(a, g)),
+        Command::Track(a) => (Cmd::Track, track::run(a, g)),
     };
     // Library errors name option paths; the user typed this command's flags.
     result.map_err(|e| flags::name_flags(cmd, e))?;

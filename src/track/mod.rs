@@ -15,7 +15,7 @@ pub mod tracker;
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use serde_json::{json, Value};
+use serde::Serialize;
 
 use crate::error::{Error, Result};
 use crate::progress::Progress;
@@ -267,7 +267,7 @@ impl Tracking {
             return Err(Error::format(
                 name,
                 format!(
-                    "frame {index}: no bird found; check --polarity (dark birds on a bright sky, or bright on dark), --roi, or leave the frame out with --frames"
+                    "frame {index}: no bird found; check track.polarity (dark birds on a bright sky, or bright on dark), track.roi, or leave the frame out with track.frames"
                 ),
             ));
         }
@@ -303,7 +303,7 @@ impl Tracking {
         let Some((width, height)) = self.size else {
             return Err(Error::format(
                 source,
-                "no frame was read in the chosen range; check --frames and --every",
+                "no frame was read in the chosen range; check track.frames and track.every",
             ));
         };
         let mut frames = self.frames;
@@ -486,43 +486,72 @@ impl Tracked {
 
     /// The native annotation JSON (what `extract` reads), with the footage's `fps`, each frame's
     /// time `t`, measured `wingspan_px` and `heading`, and each bird's `confidence`.
-    pub fn to_native(&self) -> Value {
-        let frames: Vec<Value> = self
-            .frames
-            .iter()
-            .map(|f| {
-                let mut o = json!({
-                    "index": f.index,
-                    "wingspan_px": round_to(f.wingspan_px, 2),
-                    "heading": round_to(f.heading_deg, 1),
-                    "birds": f.birds.iter().map(|b| json!({
-                        "id": b.id,
-                        "x": round_to(b.x, 2),
-                        "y": round_to(b.y, 2),
-                        "confidence": b.confidence,
-                    })).collect::<Vec<_>>(),
-                });
-                if let Some(fps) = self.fps {
-                    o["t"] = json!(round_to(f.index as f64 / fps, 6));
-                }
-                if let Some(img) = &f.image {
-                    o["image"] = json!(img);
-                }
-                o
-            })
-            .collect();
-        let mut top = json!({
-            "source": self.source,
-            "heading": round_to(self.heading_deg(), 1),
-            "wingspan_px": round_to(self.wingspan_px(), 2),
-            "image_size": [self.width, self.height],
-            "polarity": match self.polarity { Polarity::Bright => "bright", _ => "dark" },
-        });
-        if let Some(fps) = self.fps {
-            top["fps"] = json!(fps);
+    /// Pretty-printed, fields in the documented order, ending with a newline.
+    pub fn to_native(&self) -> String {
+        #[derive(Serialize)]
+        struct Bird {
+            id: usize,
+            x: f64,
+            y: f64,
+            confidence: f64,
         }
-        top["frames"] = Value::Array(frames);
-        top
+        #[derive(Serialize)]
+        struct Frame<'a> {
+            index: usize,
+            #[serde(skip_serializing_if = "Option::is_none")]
+            t: Option<f64>,
+            #[serde(skip_serializing_if = "Option::is_none")]
+            image: Option<&'a str>,
+            wingspan_px: f64,
+            heading: f64,
+            birds: Vec<Bird>,
+        }
+        #[derive(Serialize)]
+        struct File<'a> {
+            source: &'a str,
+            #[serde(skip_serializing_if = "Option::is_none")]
+            fps: Option<f64>,
+            heading: f64,
+            wingspan_px: f64,
+            image_size: [usize; 2],
+            polarity: &'static str,
+            frames: Vec<Frame<'a>>,
+        }
+        let file = File {
+            source: &self.source,
+            fps: self.fps,
+            heading: round_to(self.heading_deg(), 1),
+            wingspan_px: round_to(self.wingspan_px(), 2),
+            image_size: [self.width, self.height],
+            polarity: match self.polarity {
+                Polarity::Bright => "bright",
+                _ => "dark",
+            },
+            frames: self
+                .frames
+                .iter()
+                .map(|f| Frame {
+                    index: f.index,
+                    t: self.fps.map(|fps| round_to(f.index as f64 / fps, 6)),
+                    image: f.image.as_deref(),
+                    wingspan_px: round_to(f.wingspan_px, 2),
+                    heading: round_to(f.heading_deg, 1),
+                    birds: f
+                        .birds
+                        .iter()
+                        .map(|b| Bird {
+                            id: b.id,
+                            x: round_to(b.x, 2),
+                            y: round_to(b.y, 2),
+                            confidence: b.confidence,
+                        })
+                        .collect(),
+                })
+                .collect(),
+        };
+        let mut text = serde_json::to_string_pretty(&file).unwrap_or_default();
+        text.push('\n');
+        text
     }
 }
 
