@@ -18,6 +18,7 @@ mod csv_formats;
 mod labelme;
 mod native;
 pub mod synth;
+mod trackers;
 
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
@@ -123,6 +124,15 @@ pub enum Format {
     Labelme,
     /// A directory of Labelme JSON files, one per frame.
     LabelmeDir,
+    /// SLEAP analysis CSV (`track,frame_idx,...,NODE.x,NODE.y,...`).
+    Sleap,
+    /// DeepLabCut multi-animal CSV (header rows scorer, individuals, bodyparts, coords).
+    Dlc,
+    /// MOTChallenge / CVAT MOT text (`frame,id,left,top,width,height,...`, no header).
+    Mot,
+    /// idtracker.ai `trajectories.csv` (`time,x1,y1,x2,y2,...`).
+    #[serde(rename = "idtracker")]
+    IdTracker,
 }
 
 impl Format {
@@ -134,6 +144,10 @@ impl Format {
             Format::Dltdv => "DLTdv CSV",
             Format::Labelme => "Labelme JSON",
             Format::LabelmeDir => "Labelme directory",
+            Format::Sleap => "SLEAP analysis CSV",
+            Format::Dlc => "DeepLabCut CSV",
+            Format::Mot => "MOT text",
+            Format::IdTracker => "idtracker.ai CSV",
         }
     }
 }
@@ -370,6 +384,9 @@ fn detect_text(path: &Path, text: &str) -> Result<Format> {
             "top level: no \"frames\" (native annotations) or \"shapes\" (Labelme) field",
         ));
     }
+    if let Some(f) = trackers::detect(t) {
+        return Ok(f);
+    }
     csv_formats::detect_csv(path, t)
 }
 
@@ -392,6 +409,9 @@ pub fn parse_str(path: &Path, text: &str, opts: &ReadOptions) -> Result<Annotati
         Format::Native => native::parse(path, t)?,
         Format::Labelme => labelme::parse_file(path, t)?,
         Format::LongCsv | Format::Dltdv => csv_formats::parse(path, t, format)?,
+        Format::Sleap | Format::Dlc | Format::Mot | Format::IdTracker => {
+            trackers::parse(path, t, format)?
+        }
         Format::LabelmeDir => return Err(Error::Internal("directory detected for text".into())),
     };
     finish(path, raw, opts)
