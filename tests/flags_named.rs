@@ -180,6 +180,7 @@ fn commands() -> Vec<Command> {
                 ("--frames", "3..1", None),
                 ("--roi", "0,0,999,10", None),
                 ("--fps", "-2", None),
+                ("--review", "OUT/r.txt", None),
                 o("OUT/a.txt"),
                 seed.clone(),
             ],

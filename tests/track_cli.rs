@@ -181,3 +181,37 @@ fn bad_footage_and_flags_exit_2_with_one_line() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn the_review_page_is_one_self_contained_file() {
+    let dir = scratch("track-review");
+    let out = dir.join("a.json");
+    let page = dir.join("review.html");
+    let frames = support::data("track_frames");
+    let (code, err) = run_quiet(&["track", s(&frames), "-o", s(&out), "--review", s(&page)]);
+    assert_eq!(code, 0, "{err}");
+    let html = std::fs::read_to_string(&page).unwrap();
+    // No fetch from anywhere: every frame is a data URL, no script or style is linked.
+    assert!(!html.contains("http://") && !html.contains("https://"));
+    assert!(!html.contains("src=\"") && !html.contains("href=\""));
+    assert_eq!(html.matches("data:image/jpeg;base64,").count(), 3);
+    // The annotations it edits are the ones written, and Save suggests their name.
+    let ann = read(&out);
+    assert!(html.contains("\"name\":\"a.json\""));
+    let start = html.find("id=\"data\">").unwrap() + "id=\"data\">".len();
+    let end = start + html[start..].find("</script>").unwrap();
+    let data: Value = serde_json::from_str(&html[start..end].replace("<\\/", "</")).unwrap();
+    assert_eq!(data["annotations"], ann);
+    // A page with a wrong extension is refused.
+    let (code, err) = run_quiet(&[
+        "track",
+        s(&frames),
+        "-o",
+        s(&out),
+        "--review",
+        s(&dir.join("r.png")),
+    ]);
+    assert_eq!(code, 2);
+    assert!(err.contains("--review"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -289,3 +289,50 @@ fn the_smallest_and_largest_birds_and_bright_birds_are_tracked() {
     };
     assert_eq!(tr, track(&shot, &forced));
 }
+
+#[test]
+fn a_camera_following_the_flock_gives_the_heading_from_the_shape() {
+    // The follow camera keeps the flock still in the picture: no motion to read the heading
+    // from, so it comes from the wings' axis and the V's narrow end.
+    for heading in [30.0, 200.0] {
+        let a = v_flock(9, heading, 16, "goose", (0.0, 0.0));
+        let opts = formation::export::RenderOptions {
+            width: 480,
+            height: 270,
+            min_bird_px: 24.0,
+            ..formation::export::RenderOptions::default()
+        };
+        let shot = shoot(&a, &opts, 3.0);
+        for t in &shot.truth {
+            assert_eq!(t.len(), 9);
+        }
+        let tr = track(&shot, &TrackOptions::default());
+        if std::env::var_os("FORMATION_TRACK_DUMP").is_some() {
+            for (k, f) in tr.frames.iter().enumerate() {
+                if f.birds.len() != 9 {
+                    eprintln!(
+                        "frame {k}: {:?}",
+                        f.birds
+                            .iter()
+                            .map(|b| (
+                                b.x as i64,
+                                b.y as i64,
+                                b.blob.area,
+                                (b.blob.snr * 10.0) as i64
+                            ))
+                            .collect::<Vec<_>>()
+                    );
+                }
+            }
+            let g = &shot.frames[0];
+            track_support::save_png(
+                g,
+                std::path::Path::new(&format!("/tmp/follow_{heading}.png")),
+            );
+        }
+        check(
+            &format!("follow camera, heading {heading}"),
+            &score(&shot, &tr),
+        );
+    }
+}

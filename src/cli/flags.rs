@@ -62,6 +62,7 @@ pub const FLAGS: &[(&str, &str, &[Cmd])] = &[
     // The output files (`export::write_outputs`' `outputs`, `io::OutputKind`).
     ("output", "-o", EVERY),
     ("report", "--report", &[Steady]),
+    ("review", "--review", &[Track]),
     ("track.polarity", "--polarity", &[Track]),
     ("track.every", "--every", &[Track]),
     ("track.frames", "--frames", &[Track]),

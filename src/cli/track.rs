@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use clap::Args;
 use formation::io::{write_bytes_atomic, OutputKind};
-use formation::track::{track_path, Polarity, TrackOptions};
+use formation::track::{review, track_path, Polarity, TrackOptions};
 use formation::{Error, Result};
 
 use super::Global;
@@ -20,6 +20,10 @@ pub struct TrackArgs {
     /// Output annotations (.json, the native format `formation extract` reads).
     #[arg(short = 'o', long = "output")]
     pub output: PathBuf,
+    /// Also write a review page (.html): the frames with the birds drawn, to correct them in a
+    /// browser and save the corrected annotations.
+    #[arg(long, value_name = "PAGE.html")]
+    pub review: Option<PathBuf>,
     /// Birds darker than the sky (dark), brighter (bright), or decided on the first frame (auto).
     #[arg(long, default_value = "auto", value_name = "auto|dark|bright")]
     pub polarity: String,
@@ -118,12 +122,51 @@ pub fn options(a: &TrackArgs) -> Result<TrackOptions> {
 /// Runs `formation track`.
 pub fn run(args: TrackArgs, g: Global) -> Result<()> {
     OutputKind::for_flag("-o", &args.output, &[OutputKind::Json])?;
+    if let Some(r) = &args.review {
+        OutputKind::for_flag("--review", r, &[OutputKind::Html])?;
+    }
     let opts = options(&args)?;
     formation::io::check_output_dir("-o", &args.output)?;
+    if let Some(r) = &args.review {
+        formation::io::check_output_dir("--review", r)?;
+    }
     let progress = super::progress::TermProgress::new(g.quiet);
-    let tracked = track_path(&args.input, &opts, &progress, |_, _| {})?;
+    let mut jpegs = std::collections::BTreeMap::new();
+    let mut failed: Option<Error> = None;
+    let tracked = track_path(&args.input, &opts, &progress, |k, frame| {
+        if args.review.is_none() || failed.is_some() {
+            return;
+        }
+        if jpegs.len() == review::MAX_FRAMES {
+            failed = Some(Error::parameter(
+                "review",
+                format!(
+                    "a review page holds at most {} frames; choose fewer with --every or --frames",
+                    review::MAX_FRAMES
+                ),
+            ));
+            return;
+        }
+        match review::frame_jpeg(frame) {
+            Ok(j) => {
+                jpegs.insert(k, j);
+            }
+            Err(e) => failed = Some(e),
+        }
+    })?;
+    if let Some(e) = failed {
+        return Err(e);
+    }
     let text = tracked.to_native();
     write_bytes_atomic(&args.output, text.as_bytes())?;
+    if let Some(r) = &args.review {
+        let name = args
+            .output
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "annotations.json".into());
+        write_bytes_atomic(r, review::page(&tracked, &jpegs, &name).as_bytes())?;
+    }
     if !g.quiet {
         eprintln!(
             "{}: {} frames tracked, {} tracks, wingspan {:.1} px, heading {:.1} deg",

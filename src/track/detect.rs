@@ -4,11 +4,11 @@
 //! **Sky model.** The frame is cut into square blocks (about 1/24 of the shorter side, 16 to 64
 //! px); each block's median grey (a 256-bin histogram of every second pixel of every second
 //! row) is the sky there, and the sky at a pixel is the bilinear interpolation of the block
-//! values. A gradient (sun glow, haze toward the horizon) and clouds larger than a block are
-//! followed. A bird must cover a small part of a block so as not to move its median: when the
-//! birds found are wider than a block, the sky is modelled again leaving out the pixels
-//! that stood out by a quarter of the seed threshold, and the frame searched again
-//! ([`detect_frame`]).
+//! values (extrapolated along the outermost slope in the border half blocks). A gradient (sun
+//! glow, haze toward the horizon) and clouds larger than a block are followed. A bird must cover
+//! a small part of a block so as not to move its median: when the birds found are wider than a
+//! block, the sky is modelled again leaving out the pixels that stood out by a quarter of the
+//! seed threshold, and the frame searched again ([`detect_frame`]).
 //!
 //! **Standing out.** The residual r = grey − sky; its noise σ is 1.4826 × the median absolute
 //! residual over a sample of pixels. With polarity dark the signal is −r, bright r, auto the
@@ -170,10 +170,16 @@ impl Sky {
     /// The sky along row `y` into `out` (`width` values).
     pub fn row(&self, y: usize, out: &mut [f32]) {
         let b = self.block as f32;
-        let fy = ((y as f32 + 0.5) / b - 0.5).clamp(0.0, (self.rows - 1) as f32);
-        let r0 = fy.floor() as usize;
-        let r1 = (r0 + 1).min(self.rows - 1);
-        let ty = fy - r0 as f32;
+        // Between block centres linear; beyond the outermost centres (the frame's border half
+        // blocks) the outermost slope continues, so a gradient toward the edge is followed.
+        let cell = |f: f32, n: usize| -> (usize, usize, f32) {
+            if n < 2 {
+                return (0, 0, 0.0);
+            }
+            let i = (f.floor().max(0.0) as usize).min(n - 2);
+            (i, i + 1, f - i as f32)
+        };
+        let (r0, r1, ty) = cell((y as f32 + 0.5) / b - 0.5, self.rows);
         let (a, c) = (
             &self.values[r0 * self.cols..(r0 + 1) * self.cols],
             &self.values[r1 * self.cols..(r1 + 1) * self.cols],
@@ -181,10 +187,7 @@ impl Sky {
         // The sky along this row at each block centre, then linear between them.
         let mid: Vec<f32> = a.iter().zip(c).map(|(p, q)| p + (q - p) * ty).collect();
         for (x, o) in out.iter_mut().enumerate() {
-            let fx = ((x as f32 + 0.5) / b - 0.5).clamp(0.0, (self.cols - 1) as f32);
-            let c0 = fx.floor() as usize;
-            let c1 = (c0 + 1).min(self.cols - 1);
-            let tx = fx - c0 as f32;
+            let (c0, c1, tx) = cell((x as f32 + 0.5) / b - 0.5, self.cols);
             *o = mid[c0] + (mid[c1] - mid[c0]) * tx;
         }
     }

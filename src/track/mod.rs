@@ -9,6 +9,7 @@
 //! [`Tracked::to_native`] writes the native annotation JSON that `extract` reads.
 
 pub mod detect;
+pub mod review;
 pub mod source;
 pub mod tracker;
 
@@ -428,7 +429,7 @@ impl Tracking {
 }
 
 /// The flight direction from the birds' shapes alone (no motion): across the wings' mean
-/// axis, pointing to the end of the flock where fewer birds are (a V's apex, a J's short arm).
+/// axis, pointing to the end where the flock is narrowest (a V's or a J's leader).
 fn shape_heading(birds: &[TrackedBird]) -> f64 {
     let (c, s) = birds.iter().fold((0.0, 0.0), |(c, s), b| {
         (c + (2.0 * b.blob.axis).cos(), s + (2.0 * b.blob.axis).sin())
@@ -436,15 +437,20 @@ fn shape_heading(birds: &[TrackedBird]) -> f64 {
     let wing = 0.5 * s.atan2(c);
     // Flight axis, image coordinates (x right, y down).
     let (ux, uy) = (-wing.sin(), wing.cos());
+    // Along the flight axis t, across it l: a line formation widens from its leader backward,
+    // so the front is where the birds' distance from the middle line shrinks.
     let t: Vec<f64> = birds.iter().map(|b| b.x * ux + b.y * uy).collect();
-    let mid = median(t.clone()).unwrap_or(0.0);
-    let lo = t.iter().cloned().fold(f64::INFINITY, f64::min);
-    let hi = t.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
-    let (dx, dy) = if hi - mid >= mid - lo {
-        (ux, uy)
-    } else {
-        (-ux, -uy)
-    };
+    let l: Vec<f64> = birds.iter().map(|b| b.x * uy - b.y * ux).collect();
+    let lm = median(l.clone()).unwrap_or(0.0);
+    let n = t.len().max(1) as f64;
+    let tm = t.iter().sum::<f64>() / n;
+    let wm = l.iter().map(|v| (v - lm).abs()).sum::<f64>() / n;
+    let cov: f64 = t
+        .iter()
+        .zip(&l)
+        .map(|(ti, li)| (ti - tm) * ((li - lm).abs() - wm))
+        .sum();
+    let (dx, dy) = if cov <= 0.0 { (ux, uy) } else { (-ux, -uy) };
     dx.atan2(-dy).to_degrees().rem_euclid(360.0)
 }
 
