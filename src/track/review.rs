@@ -1,5 +1,5 @@
-//! The review page of `formation track --review`: one self-contained HTML file (the frames
-//! embedded as JPEG data URLs, the annotations as JSON, the editor in plain JavaScript; no
+//! The review page that `formation track` writes on request: one self-contained HTML file (the
+//! frames embedded as JPEG data URLs, the annotations as JSON, the editor in plain JavaScript; no
 //! server, no network) where the user corrects the tracked birds and saves the corrected native
 //! JSON.
 //!
