@@ -2,7 +2,7 @@
 //! This is the only place that prints errors: one line on stderr, exit 2 for bad input or usage,
 //! 1 for the tool's own failures.
 
-mod cli;
+pub(crate) mod cli;
 
 use std::io::Write;
 use std::process::ExitCode;

@@ -159,6 +159,7 @@ def animate(
     seed: int = 0,
     path: str | _os.PathLike | None = None,
     initiation: bool = True,
+    progress: bool = False,
     **options: _Any,
 ) -> Animation:
     """The whole pipeline: extraction, steady flight, take-off, wingbeats, savings.
@@ -168,7 +169,9 @@ def animate(
     ``seconds``: length of the steady flight (None: the library's default, 20 s). ``seed``:
     equal seeds and inputs give identical motion, the same as ``formation animate --seed``.
     ``path``: a JSON or CSV file of the leader's path (the ``course.path`` option).
-    ``initiation``: fly the take-off first (False: the steady flight alone).
+    ``initiation``: fly the take-off first (False: the steady flight alone). ``progress``:
+    show the command line's progress bar on stderr (only when stderr is a terminal, so a
+    script run in a terminal shows it and a notebook does not).
 
     ``options``: any other option by its path in the library's configuration, dotted
     (``**{"steady.fps": 30, "initiate.max_turn_rate": 1.2}``) or per section
@@ -196,7 +199,7 @@ def animate(
         pairs.append(("course.path", _json.dumps(_os.fspath(path))))
     if isinstance(input, _os.PathLike):
         input = _os.fspath(input)
-    return _native.animate(input, pairs + _pairs(options))
+    return _native.animate(input, pairs + _pairs(options), bool(progress))
 
 
 def read_animation(path: str | _os.PathLike) -> Animation:

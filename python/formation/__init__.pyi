@@ -94,6 +94,7 @@ def animate(
     seed: int = 0,
     path: _Path | None = None,
     initiation: bool = True,
+    progress: bool = False,
     **options: Any,
 ) -> Animation: ...
 def read_animation(path: _Path) -> Animation: ...

@@ -427,16 +427,21 @@ impl PyAnimation {
     }
 }
 
-/// Runs the whole pipeline (see `formation.animate`).
+/// Runs the whole pipeline (see `formation.animate`); `progress`: the command line's progress
+/// bar on stderr (drawn only when stderr is a terminal).
 #[pyfunction]
 fn animate(
     py: Python<'_>,
     input: &Bound<'_, PyAny>,
     options: Vec<(String, String)>,
+    progress: bool,
 ) -> PyResult<PyAnimation> {
     let pipeline = pipeline(input)?;
     let config = config(&options)?;
-    let (anim, _report) = py.detach(|| pipeline.run(&config)).map_err(py_err)?;
+    let bar = cli_main::cli::progress::TermProgress::new(!progress);
+    let (anim, _report) = py
+        .detach(|| pipeline.run_with(&config, &bar))
+        .map_err(py_err)?;
     Ok(PyAnimation {
         inner: anim,
         config,

@@ -85,6 +85,9 @@ def test_options_by_path_and_by_section():
     np.testing.assert_array_equal(a.positions, b.positions)
     assert a.stages == [("steady", 0, 20)]
     assert "fps" in formation.default_options()["steady"]
+    # The progress bar (drawn only on a terminal) changes nothing in the motion.
+    c = formation.animate(EXAMPLE, birds=5, seconds=2, initiation=False, steady={"fps": 10}, progress=True)
+    np.testing.assert_array_equal(c.positions, a.positions)
 
 
 @pytest.mark.parametrize(
