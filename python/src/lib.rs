@@ -495,7 +495,7 @@ fn annotations_from_points(
     Ok(PyAnnotations { inner })
 }
 
-/// §4 extraction only (see `formation.extract`).
+/// The parameter extraction only (see `formation.extract`).
 #[pyfunction]
 fn extract(
     py: Python<'_>,
