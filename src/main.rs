@@ -2,7 +2,7 @@
 //! This is the only place that prints errors: one line on stderr, exit 2 for bad input or usage,
 //! 1 for the tool's own failures.
 
-mod cli;
+pub(crate) mod cli;
 
 use std::io::Write;
 use std::process::ExitCode;
@@ -10,7 +10,17 @@ use std::process::ExitCode;
 use clap::Parser;
 
 fn main() -> ExitCode {
-    let args = match cli::Cli::try_parse() {
+    ExitCode::from(run_main(std::env::args_os()))
+}
+
+/// The whole binary for the arguments `args` (the first is the program's name), giving the exit
+/// status: what `main` runs, and what the Python package's `formation` command runs.
+pub fn run_main<I, T>(args: I) -> u8
+where
+    I: IntoIterator<Item = T>,
+    T: Into<std::ffi::OsString> + Clone,
+{
+    let args = match cli::Cli::try_parse_from(args) {
         Ok(a) => a,
         Err(e) => {
             use clap::error::ErrorKind;
@@ -18,7 +28,7 @@ fn main() -> ExitCode {
                 ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
                     // On stderr, and the run fails anyway.
                     let _ = e.print();
-                    ExitCode::from(2)
+                    2
                 }
                 ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => {
                     // On stdout, as tables and --json are: a reader that goes away ends it
@@ -26,9 +36,9 @@ fn main() -> ExitCode {
                     match e.print().and_then(|()| std::io::stdout().flush()) {
                         Err(w) if w.kind() != std::io::ErrorKind::BrokenPipe => {
                             let _ = writeln!(std::io::stderr(), "error: stdout: {w}");
-                            ExitCode::from(2)
+                            2
                         }
-                        _ => ExitCode::SUCCESS,
+                        _ => 0,
                     }
                 }
                 _ => {
@@ -51,21 +61,21 @@ fn main() -> ExitCode {
                         }
                     }
                     let _ = writeln!(std::io::stderr(), "{first} (see `formation --help`)");
-                    ExitCode::from(2)
+                    2
                 }
             };
         }
     };
     cli::install_signal_cleanup();
     match cli::run(args) {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(()) => 0,
         Err(e) => {
             let _ = writeln!(
                 std::io::stderr(),
                 "error: {}",
                 formation::error::one_line(&e.to_string())
             );
-            ExitCode::from(e.exit_code())
+            e.exit_code()
         }
     }
 }

@@ -1,0 +1,258 @@
+"""formation: animate bird flocks flying in line formations (V, U, J, echelon).
+
+The Rust library does the work; this package gives it Python habits::
+
+    import formation
+    anim = formation.animate("examples_data/barnacle_geese_v.json", birds=14, seconds=10, seed=7)
+    anim.positions.shape        # (frames, birds, 3), wingspans, x east, y north, z up
+    anim.savings.mean(axis=0)   # each bird's mean saving e
+    anim.to_pandas()            # the CSV's columns, one row per frame and bird
+    anim.write("flock.glb")     # any format `formation animate -o` writes
+
+Options are the library's option paths (``steady.fps``, ``initiate.max_turn_rate``,
+``render.width``...), given as ``**{"steady.fps": 30}`` or per section as
+``steady={"fps": 30}``; ``formation.default_options()`` lists them with their defaults.
+Bad input raises ``ValueError`` (a file that cannot be read or written: ``OSError``) with the
+same one-line message as the command line, naming the option path.
+"""
+
+from __future__ import annotations
+
+import json as _json
+import os as _os
+from typing import Any as _Any
+
+import numpy as _np
+
+from . import _native
+from ._native import Animation, Annotations, Params
+
+__version__ = _native.__version__
+
+__all__ = [
+    "Animation",
+    "Annotations",
+    "Params",
+    "animate",
+    "default_options",
+    "extract",
+    "power",
+    "read_animation",
+    "read_annotations",
+    "solve",
+]
+
+_HEADINGS = {"up": "Up", "right": "Right", "down": "Down", "left": "Left"}
+
+
+def _json_default(v: _Any) -> _Any:
+    if isinstance(v, _os.PathLike):
+        return _os.fspath(v)
+    if isinstance(v, _np.generic):
+        return v.item()
+    if isinstance(v, _np.ndarray):
+        return v.tolist()
+    raise TypeError(f"{type(v).__name__} is not an option value")
+
+
+def _pairs(options: dict[str, _Any], prefix: str = "") -> list[tuple[str, str]]:
+    """(option path, JSON text) pairs; a name may be dotted or a whole section (a dict)."""
+    out = []
+    for name, value in options.items():
+        if prefix and name.startswith(prefix):
+            name = name[len(prefix) :]
+        try:
+            text = _json.dumps(value, default=_json_default, allow_nan=True)
+        except TypeError as e:
+            raise ValueError(f"{prefix}{name}: {e}") from None
+        out.append((name, text))
+    return out
+
+
+def _heading(h: _Any) -> str:
+    if isinstance(h, str):
+        word = _HEADINGS.get(h.lower())
+        if word is None:
+            raise ValueError(f"read.heading: `{h}` is not a heading; use up, right, down, left or degrees")
+        return _json.dumps(word)
+    return _json.dumps({"Degrees": float(h)})
+
+
+def default_options() -> dict:
+    """Every option of a run with its default value, as a nested dict (section → option → value).
+
+    The dotted paths into this dict (``steady.fps``) are the names ``animate`` and ``extract``
+    accept.
+    """
+    return _json.loads(_native.default_options())
+
+
+def read_annotations(
+    source: str | _os.PathLike | list,
+    *,
+    heading: str | float | None = None,
+    wingspan_px: float | None = None,
+    y_origin: str | None = None,
+    name: str = "points",
+) -> Annotations:
+    """Annotated frames of a flock, from a file or from points in memory.
+
+    ``source`` is a file or directory in any input format the command line reads (native JSON,
+    long CSV ``frame,bird,x,y``, DLTdv CSV, Labelme JSON or a directory of them), or a list of
+    frames, each an array-like of shape (birds, 2) of image pixels.
+
+    ``heading`` (the flock's flight direction in the image: ``"up"``, ``"right"``, ``"down"``,
+    ``"left"`` or degrees clockwise from image-up), ``wingspan_px`` (one wingspan in pixels) and
+    ``y_origin`` (``"top"`` or ``"bottom"``, CSV only) override what the file says (the
+    ``read.*`` options). For points, ``heading`` defaults to up, ``wingspan_px`` is required and
+    ``name`` is the source's name.
+
+    Raises ValueError for malformed input (naming the file, frame and bird) and OSError for a
+    file that cannot be read.
+    """
+    if isinstance(source, (str, _os.PathLike)):
+        options: list[tuple[str, str]] = []
+        if heading is not None:
+            options.append(("heading", _heading(heading)))
+        if wingspan_px is not None:
+            options.append(("wingspan_px", _json.dumps(float(wingspan_px))))
+        if y_origin is not None:
+            options.append(("y_origin", _json.dumps(y_origin)))
+        return _native.read_annotations(_os.fspath(source), options)
+    if wingspan_px is None:
+        raise ValueError("read.wingspan_px: points in memory need the wingspan in pixels")
+    if y_origin is not None:
+        raise ValueError("read.y_origin: only for CSV files; points are image pixels, y down")
+    frames = []
+    for k, f in enumerate(source):
+        a = _np.asarray(f, dtype=_np.float64)
+        if a.ndim != 2 or a.shape[1] != 2:
+            raise ValueError(f"frame {k}: expected an array of shape (birds, 2), got {a.shape}")
+        frames.append(_np.ascontiguousarray(a).ravel())
+    return _native.annotations_from_points(
+        name, _heading("up" if heading is None else heading), float(wingspan_px), frames
+    )
+
+
+def extract(
+    annotations: Annotations | str | _os.PathLike, *, seed: int = 0, **options: _Any
+) -> Params:
+    """Formation parameters of annotated footage (RANSAC over every frame).
+
+    ``annotations`` is an ``Annotations`` object or a path (annotations in any format, or a
+    params file, which is read and checked). ``options`` are option paths of the ``extract``
+    and ``read`` sections (``**{"extract.iterations": 2000}`` or ``extract={...}``). The same
+    seed gives the same parameters as ``formation extract --seed``.
+
+    Returns ``Params``: ``.birds``, ``.frames`` (one dict per frame), ``.summary``,
+    ``.to_dict()``, ``.to_json()``. Raises ValueError for bad input or options.
+    """
+    if isinstance(annotations, _os.PathLike):
+        annotations = _os.fspath(annotations)
+    return _native.extract(annotations, [("seed", str(int(seed)))] + _pairs(options))
+
+
+def animate(
+    input: Annotations | Params | str | _os.PathLike,
+    birds: int = 14,
+    seconds: float | None = None,
+    seed: int = 0,
+    path: str | _os.PathLike | None = None,
+    initiation: bool = True,
+    progress: bool = False,
+    **options: _Any,
+) -> Animation:
+    """The whole pipeline: extraction, steady flight, take-off, wingbeats, savings.
+
+    ``input``: annotations (an ``Annotations`` object or a file in any input format), or
+    formation parameters (a ``Params`` object or a params file). ``birds``: flock size.
+    ``seconds``: length of the steady flight (None: the library's default, 20 s). ``seed``:
+    equal seeds and inputs give identical motion, the same as ``formation animate --seed``.
+    ``path``: a JSON or CSV file of the leader's path (the ``course.path`` option).
+    ``initiation``: fly the take-off first (False: the steady flight alone). ``progress``:
+    show the command line's progress bar on stderr (only when stderr is a terminal, so a
+    script run in a terminal shows it and a notebook does not).
+
+    ``options``: any other option by its path in the library's configuration, dotted
+    (``**{"steady.fps": 30, "initiate.max_turn_rate": 1.2}``) or per section
+    (``steady={"fps": 30}``); ``formation.default_options()`` lists them all. ``render.*``
+    options are kept for ``Animation.write``.
+
+    Returns an ``Animation`` whose arrays (float64) are ``positions`` (frames × birds × 3),
+    ``headings``, ``banks``, ``pitches``, ``wing_phase``, ``speeds``, ``savings`` and ``xi``
+    (frames × birds) and ``times`` (frames); ``to_pandas()`` and ``write(path)`` give the CSV
+    table and every output format. The GIL is released while it runs.
+
+    Raises ValueError (with the command line's one-line message, naming the option path, file,
+    frame or bird) for bad input, OSError for unreadable files.
+    """
+    if isinstance(birds, bool) or not isinstance(birds, (int, _np.integer)):
+        raise ValueError(f"steady.birds: expected a whole number of birds, got {birds!r}")
+    pairs = [
+        ("seed", _json.dumps(int(seed))),
+        ("initiation", _json.dumps(bool(initiation))),
+        ("steady.birds", _json.dumps(int(birds))),
+    ]
+    if seconds is not None:
+        pairs.append(("seconds", _json.dumps(float(seconds))))
+    if path is not None:
+        pairs.append(("course.path", _json.dumps(_os.fspath(path))))
+    if isinstance(input, _os.PathLike):
+        input = _os.fspath(input)
+    return _native.animate(input, pairs + _pairs(options), bool(progress))
+
+
+def read_animation(path: str | _os.PathLike) -> Animation:
+    """An animation JSON file written by ``formation animate -o flock.json`` (or by
+    ``Animation.write``), as an ``Animation``."""
+    return _native.read_animation(_os.fspath(path))
+
+
+def power(x, y, z=None, core_radius: float | None = None, **options: _Any):
+    """Hummel's power reduction of a shape: ``(e, xi, E)``.
+
+    ``x`` (lateral, right of the flight direction) and ``y`` (distance behind the leader) are
+    array-likes of wingspans, one value per bird. ``e[i]`` is bird i's saving (the fraction of
+    its solo induced power the others save it), ``xi = e / E`` and ``E = e.sum()``.
+    ``core_radius`` is the vortex core radius in wingspans (the ``aero.core_radius`` option);
+    ``options`` are other options of the aerodynamic model by name. ``z`` (heights) must be
+    None or all zero: the model is planar (the library places every bird in the wing plane).
+
+    Raises ValueError naming the birds when two birds' wings overlap, or for non-finite
+    values or fewer than two birds.
+    """
+    x = _np.asarray(x, dtype=_np.float64).ravel()
+    y = _np.asarray(y, dtype=_np.float64).ravel()
+    if z is not None:
+        z = _np.asarray(z, dtype=_np.float64).ravel()
+        if z.shape != x.shape:
+            raise ValueError(f"z: {z.size} values for {x.size} birds in x")
+        if _np.any(z != 0):
+            raise ValueError(
+                "z: the aerodynamic model is planar (all birds in one wing plane); give z=None or zeros"
+            )
+    if core_radius is not None:
+        options = {"core_radius": core_radius, **options}
+    return _native.power(x.tolist(), y.tolist(), _pairs(options, "aero."))
+
+
+def solve(x, xi, y=None, *, tolerance: float | None = None, patience: int | None = None,
+          core_radius: float | None = None) -> dict:
+    """Longitudinal positions y that give the birds at lateral positions ``x`` the relative
+    savings ``xi`` (renormalised to sum to 1), by Newton's method on Hummel's model.
+
+    ``y``: a start (else the library's own starts). ``tolerance``: converged means
+    ‖ξ − ξ̂‖₂ ≤ tolerance (default 1e-9); ``patience``: Newton steps per attempt.
+
+    Returns a dict: ``y`` (front-most bird at 0), ``xi`` achieved, ``target``, ``residual``,
+    ``converged`` (not converging is not an error), ``total`` (E), ``evaluations``,
+    ``termination``. Raises ValueError for unreachable targets (naming the birds), collisions
+    and bad input. The GIL is released while it runs.
+    """
+    x = _np.asarray(x, dtype=_np.float64).ravel().tolist()
+    xi = _np.asarray(xi, dtype=_np.float64).ravel().tolist()
+    if y is not None:
+        y = _np.asarray(y, dtype=_np.float64).ravel().tolist()
+    aero = [] if core_radius is None else [("core_radius", _json.dumps(float(core_radius)))]
+    return _native.solve(x, xi, y, tolerance, patience, aero)
+
