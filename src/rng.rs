@@ -35,6 +35,8 @@ pub enum Stream {
     SkeinSizes,
     /// Skeins: where the formations fly relative to one another.
     SkeinLayout,
+    /// Steady flight: each bird's position-keeping motion about its slot.
+    SteadyJostle,
 }
 
 impl Stream {
@@ -51,6 +53,7 @@ impl Stream {
             Stream::SteadyHeight => "steady.height",
             Stream::SkeinSizes => "skein/sizes",
             Stream::SkeinLayout => "skein/layout",
+            Stream::SteadyJostle => "steady.jostle",
         }
     }
 }

@@ -91,6 +91,7 @@ fn commands() -> Vec<Command> {
         ("--c2", "3", None),
         ("--wingspan-m", "0", None),
         ("--max-jump", "0", None),
+        ("--jostle", "-1", None),
         ("--formations", "0", None),
         ("--formation-size", "1", None),
         ("--clearance", "-1", None),
@@ -154,7 +155,12 @@ fn commands() -> Vec<Command> {
             cases: cat(vec![
                 read.clone(),
                 fit.clone(),
-                vec![("--wingspan-m", "0", None), o("OUT/p.txt"), seed.clone()],
+                vec![
+                    ("--wingspan-m", "0", None),
+                    ("--footage-fps", "0", None),
+                    o("OUT/p.txt"),
+                    seed.clone(),
+                ],
             ]),
         },
         Command {
@@ -163,7 +169,12 @@ fn commands() -> Vec<Command> {
             cases: cat(vec![
                 read.clone(),
                 fit.clone(),
-                vec![("--wingspan-m", "-1", None), o("OUT/r.txt"), seed.clone()],
+                vec![
+                    ("--wingspan-m", "-1", None),
+                    ("--footage-fps", "nan", None),
+                    o("OUT/r.txt"),
+                    seed.clone(),
+                ],
             ]),
         },
         Command {
@@ -251,6 +262,7 @@ fn commands() -> Vec<Command> {
                 "OUT/a.json",
             ]),
             cases: cat(vec![
+                vec![("--footage-fps", "-5", None)],
                 read.clone(),
                 steady_flags.clone(),
                 course,

@@ -136,6 +136,7 @@ pub(crate) fn parse(path: &Path, text: &str, format: Format) -> Result<RawAnnota
         parse_long(path, &mut rdr, &hdr)?
     };
     Ok(RawAnnotations {
+        fps: None,
         format,
         source: m.source,
         heading: m.heading,

@@ -134,6 +134,7 @@ pub(crate) fn parse_file(path: &Path, text: &str) -> Result<RawAnnotations> {
         ));
     }
     Ok(RawAnnotations {
+        fps: None,
         format: Format::Labelme,
         source: None,
         heading: f.heading,
@@ -263,6 +264,7 @@ pub(crate) fn read_dir(dir: &Path) -> Result<RawAnnotations> {
         ));
     }
     Ok(RawAnnotations {
+        fps: None,
         format: Format::LabelmeDir,
         source: dir.file_name().map(|n| n.to_string_lossy().into_owned()),
         heading,

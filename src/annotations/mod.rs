@@ -197,6 +197,10 @@ pub struct Annotations {
     /// True when pixel y grew upward as read (DLTdv, `read.y_origin` bottom).
     #[serde(default)]
     pub y_up: bool,
+    /// Frames per second of the footage when the file gives it (native JSON's top-level `fps`):
+    /// frame times are frame index / fps.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fps: Option<f64>,
     /// Frames in file order.
     pub frames: Vec<AnnotatedFrame>,
 }
@@ -231,6 +235,7 @@ impl Annotations {
             source: Some(source.to_string()),
             heading: Some(heading),
             wingspan_px: Some(wingspan_px),
+            fps: None,
             y_up: false,
             is_csv: false,
             frames: frames
@@ -298,6 +303,8 @@ pub(crate) struct RawAnnotations {
     pub source: Option<String>,
     pub heading: Option<Heading>,
     pub wingspan_px: Option<f64>,
+    /// Frames per second of the footage (native JSON's top-level `fps`).
+    pub fps: Option<f64>,
     /// Whether pixel y grows upward in the file (before any `read.y_origin`).
     pub y_up: bool,
     /// Whether `read.y_origin` applies (CSV formats).
@@ -600,6 +607,7 @@ fn finish(path: &Path, raw: RawAnnotations, opts: &ReadOptions) -> Result<Annota
         format: raw.format,
         ids_given,
         y_up,
+        fps: raw.fps,
         frames,
     })
 }

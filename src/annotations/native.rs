@@ -185,6 +185,21 @@ pub(crate) fn parse(path: &Path, text: &str) -> Result<RawAnnotations> {
         None | Some(Value::Null) => None,
         Some(w) => Some(number(path, "wingspan_px", w)?),
     };
+    let fps = match obj.get("fps") {
+        None | Some(Value::Null) => None,
+        Some(f) => {
+            let f = number(path, "fps", f)?;
+            if !(f.is_finite() && f > 0.0 && f <= 100_000.0) {
+                return Err(Error::format(
+                    path,
+                    format!(
+                        "fps: {f}: must be a positive number of frames per second, at most 100000"
+                    ),
+                ));
+            }
+            Some(f)
+        }
+    };
     let frames_v = obj
         .get("frames")
         .and_then(|f| f.as_array())
@@ -275,6 +290,7 @@ pub(crate) fn parse(path: &Path, text: &str) -> Result<RawAnnotations> {
         source,
         heading,
         wingspan_px,
+        fps,
         y_up: false,
         is_csv: false,
         frames,

@@ -135,6 +135,7 @@ impl Frames {
             return Err(Error::format(path, "too many marks"));
         }
         Ok(RawAnnotations {
+            fps: None,
             format,
             source: None,
             heading: None,

@@ -57,6 +57,8 @@ pub struct AnimateArgs {
     #[command(flatten)]
     pub read: ReadArgs,
     #[command(flatten)]
+    pub timing: super::extract::TimingArgs,
+    #[command(flatten)]
     pub steady: SteadyFlags,
     #[command(flatten)]
     pub path: super::course::PathFlags,
@@ -77,7 +79,10 @@ pub fn run(args: AnimateArgs, g: Global) -> Result<()> {
         seconds: Some(args.seconds),
         initiation: !args.no_initiation,
         read: args.read.options(),
-        extract: ExtractOptions::default(),
+        extract: ExtractOptions {
+            footage_fps: args.timing.footage_fps,
+            ..ExtractOptions::default()
+        },
         steady: args.steady.options(args.birds),
         skein: args.skein.options(),
         ..Config::default()

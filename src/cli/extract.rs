@@ -56,6 +56,16 @@ pub struct SizeArgs {
     pub wingspan_m: Option<f64>,
 }
 
+/// The footage's timing (shared by `extract`, `report` and `animate`).
+#[derive(Debug, Args, Clone)]
+pub struct TimingArgs {
+    /// Frames per second of the footage: frame times are frame index / F, for the birds'
+    /// position-keeping statistics (default: the annotations' top-level "fps"; without either,
+    /// the steady flight uses the field-data default).
+    #[arg(long = "footage-fps", value_name = "F", allow_hyphen_values = true)]
+    pub footage_fps: Option<f64>,
+}
+
 impl ReadArgs {
     pub fn options(&self) -> ReadOptions {
         ReadOptions {
@@ -104,6 +114,8 @@ pub struct ExtractionArgs {
     pub fit: FitArgs,
     #[command(flatten)]
     pub size: SizeArgs,
+    #[command(flatten)]
+    pub timing: TimingArgs,
 }
 
 impl ExtractionArgs {
@@ -111,6 +123,7 @@ impl ExtractionArgs {
     pub fn options(&self) -> ExtractOptions {
         ExtractOptions {
             wingspan_m: self.size.wingspan_m,
+            footage_fps: self.timing.footage_fps,
             ..self.fit.options()
         }
     }

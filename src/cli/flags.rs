@@ -89,6 +89,12 @@ pub const FLAGS: &[(&str, &str, &[Cmd])] = &[
     ("steady.keys.c2", "--c2", STEADY),
     ("steady.wingspan_m", "--wingspan-m", STEADY),
     ("steady.keys.max_jump", "--max-jump", STEADY),
+    ("steady.jostle.scale", "--jostle", STEADY),
+    (
+        "extract.footage_fps",
+        "--footage-fps",
+        &[Extract, Report, Animate],
+    ),
     ("steady.loop", "--loop", STEADY),
     ("course.path", "--path", SCENE_COURSE),
     ("course.units", "--path-units", SCENE_COURSE),

@@ -7,7 +7,7 @@ use clap::{Args, ValueEnum};
 use formation::animation::Animation;
 use formation::extract::params::FormationParams;
 use formation::io::{write_json_atomic, OutputKind};
-use formation::keyshape::{KeyOptions, SteadyOptions};
+use formation::keyshape::{JostleOptions, KeyOptions, SteadyOptions};
 use formation::pipeline::{flock_steady_stage, Config, SteadyOutcome};
 use formation::plot::power::{PowerChart, PowerMetric, PowerOf};
 use formation::plot::xi::XiChart;
@@ -83,6 +83,11 @@ pub struct SteadyFlags {
     /// Largest move of a bird between consecutive key shapes, wingspans.
     #[arg(long = "max-jump", default_value_t = KeyOptions::default().max_jump, allow_negative_numbers = true)]
     pub max_jump: f64,
+    /// Scale of each bird's small, frequent moves about its slot: 1 = as measured in the
+    /// footage (or the field-data default without footage timing), 0 = key-shape interpolation
+    /// only (the default for now); in [0, 10].
+    #[arg(long, value_name = "S", default_value_t = JostleOptions::default().scale, allow_negative_numbers = true)]
+    pub jostle: f64,
     /// A seamless cycle: the last key shape is the first and the wingbeats make whole cycles, so
     /// the GIF, the glTF clip or a game's background flock loops without a jump (in the flock's
     /// moving frame; in the world on a closed --path). No take-off.
@@ -106,6 +111,10 @@ impl SteadyFlags {
                 key_every_s: self.key_every,
                 max_jump: self.max_jump,
                 ..KeyOptions::default()
+            },
+            jostle: JostleOptions {
+                scale: self.jostle,
+                ..JostleOptions::default()
             },
             looped: self.looped,
             ..SteadyOptions::default()

@@ -40,6 +40,7 @@
 
 pub mod checks;
 pub mod geometry;
+pub mod motion;
 pub mod params;
 pub mod ransac;
 
@@ -92,6 +93,9 @@ pub struct ExtractOptions {
     pub kind: Option<ShapeKind>,
     /// Wingspan of one bird, metres, when known: the wingtip spacings are also given in metres.
     pub wingspan_m: Option<f64>,
+    /// Frames per second of the footage (overrides the annotations' `fps`): frame times for
+    /// the position-keeping statistics.
+    pub footage_fps: Option<f64>,
 }
 
 impl Default for ExtractOptions {
@@ -103,6 +107,7 @@ impl Default for ExtractOptions {
             j_offset: 0.5,
             kind: None,
             wingspan_m: None,
+            footage_fps: None,
         }
     }
 }
@@ -142,6 +147,16 @@ impl ExtractOptions {
                     format!(
                         "must be a positive number of metres, at most {}, got {m}",
                         crate::limits::MAX_WINGSPAN_M
+                    ),
+                ));
+            }
+        }
+        if let Some(f) = self.footage_fps {
+            if !(f.is_finite() && f > 0.0 && f <= 100_000.0) {
+                return Err(Error::parameter(
+                    "extract.footage_fps",
+                    format!(
+                        "must be a positive number of frames per second, at most 100000, got {f}"
                     ),
                 ));
             }
@@ -230,7 +245,12 @@ pub fn extract_with_report(
         birds: ann.bird_count(),
         frames,
         summary: None,
+        motion: None,
     };
+    params.motion = opts
+        .footage_fps
+        .or(ann.fps)
+        .and_then(|fps| motion::footage_keeping(&params.frames, fps));
     let warnings = checks::check(ann, &params, &reports, opts, rng);
     params.summary = Some(Box::new(ParamsSummary {
         wingspan_m: opts.wingspan_m,

@@ -24,6 +24,10 @@ pub struct FormationParams {
     /// absent in files written before it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub summary: Option<Box<ParamsSummary>>,
+    /// The birds' position keeping measured in the footage (needs frame times); absent when
+    /// the footage has no timing (the steady flight then uses the field-data default).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub motion: Option<super::motion::PositionKeeping>,
 }
 
 /// What `extract` reports about the whole movie besides the per-frame parameters.

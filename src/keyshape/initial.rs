@@ -586,6 +586,7 @@ mod tests {
             birds: 5,
             frames: vec![f],
             summary: None,
+            motion: None,
         };
         let c = correspondence(&p.frames[0], 5).unwrap();
         let s = initial_shapes(&p, &c, &mut seeded(0), &InitialOptions::default());

@@ -4,6 +4,7 @@
 pub mod heights;
 pub mod initial;
 pub mod interpolate;
+pub mod jostle;
 pub mod keys;
 pub mod lateral;
 pub mod ranges;
@@ -13,6 +14,7 @@ pub mod steady;
 
 pub use heights::HeightOptions;
 pub use initial::InitialOptions;
+pub use jostle::JostleOptions;
 pub use keys::KeyOptions;
 pub use lateral::LateralOptions;
 pub use solve::{solve, SolveOptions, SolveReport};

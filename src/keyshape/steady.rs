@@ -32,6 +32,9 @@ use crate::keyshape::initial::{
     Correspondence, InitialOptions,
 };
 use crate::keyshape::interpolate::Track;
+use crate::keyshape::jostle::{
+    keeping_for, key_spread, nearest, residual_keeping, slow_drift, Jostle, JostleOptions,
+};
 use crate::keyshape::keys::{
     key_shapes, KeyContext, KeyOptions, KeyPlan, KeyShape, KeyStats, LateralKey, Structure,
 };
@@ -68,6 +71,9 @@ pub struct SteadyOptions {
     pub heights: HeightOptions,
     /// The aerodynamic model's vortex core and collision distance.
     pub aero: AeroOptions,
+    /// Each bird's position-keeping motion about its slot (`keyshape::jostle`); none in a
+    /// loop.
+    pub jostle: JostleOptions,
     /// A seamless cycle: the last key shape is the first, placed one frame after the last
     /// frame, so the frame after the last is the first again (in the flock's moving frame).
     #[serde(rename = "loop")]
@@ -88,6 +94,7 @@ impl Default for SteadyOptions {
             lateral: LateralOptions::default(),
             heights: HeightOptions::default(),
             aero: AeroOptions::default(),
+            jostle: JostleOptions::default(),
             looped: false,
         }
     }
@@ -147,6 +154,7 @@ impl SteadyOptions {
         self.lateral.validate()?;
         self.heights.validate()?;
         self.aero.validate()?;
+        self.jostle.validate()?;
         let seconds = self.frames as f64 / self.fps;
         if self.looped && seconds < self.keys.key_every_s {
             return Err(p(
@@ -490,7 +498,13 @@ pub fn steady_flight_in(
         total,
         feasible: feasible.clone(),
     };
-    let drift = opts.lateral.drift_for(params);
+    let keeping = keeping_for(params);
+    let jostling = !opts.looped && opts.jostle.scale > 0.0;
+    let drift = match opts.lateral.drift {
+        // The footage's gap variation, less the part the birds' position keeping makes.
+        None if jostling => slow_drift(opts.lateral.drift_for(params), &keeping, opts.jostle.scale),
+        _ => opts.lateral.drift_for(params),
+    };
     // Each key's feasible ranges are the initial shapes' ξ at its own lateral positions (as
     // step 2 does at the drawn ones). A drift that leaves the flock no saving in total, or at
     // which every initial shape collides, is not taken.
@@ -551,6 +565,20 @@ pub fn steady_flight_in(
         &mut scope.stream(opts.seed, Stream::SteadyHeight),
     );
 
+    // Each bird's position keeping about its slot (not in a loop: the motion does not cycle).
+    let jostle = if !jostling {
+        None
+    } else {
+        let xs: Vec<&[f64]> = keys.iter().map(|k| k.x.as_slice()).collect();
+        let ys: Vec<&[f64]> = keys.iter().map(|k| k.y.as_slice()).collect();
+        Jostle::draw(
+            n,
+            &residual_keeping(&keeping, key_spread(&xs, &ys), n),
+            &opts.jostle,
+            &mut scope.stream(opts.seed, Stream::SteadyJostle),
+        )
+    };
+
     // Step 4.
     progress.start("steady: frames", opts.frames as u64);
     let times: Vec<f64> = key_frames.iter().map(|&f| f as f64 / opts.fps).collect();
@@ -582,16 +610,32 @@ pub fn steady_flight_in(
             speed: Vec::with_capacity(n),
             ..Frame::default()
         };
+        // The key-shape placement, then each bird's position keeping about it.
         let mut ys = Vec::with_capacity(n);
+        let (mut vxs, mut vys) = (Vec::with_capacity(n), Vec::with_capacity(n));
         for [ty, tx, tz] in &tracks {
             let (y, dy) = ty.eval(t);
             let (xl, dx) = tx.eval(t);
             ys.push(y);
             fr.x.push(xl);
-            fr.y.push(lead_y - y);
             fr.z.push(tz.eval(t).0);
+            vxs.push(dx);
+            vys.push(dy);
+        }
+        if let Some(j) = &jostle {
+            let near = nearest(&fr.x, &ys, &vxs, &vys);
+            for (i, &(d, rate)) in near.iter().enumerate() {
+                let dev = j.at(i, t, d, rate);
+                fr.x[i] += dev.x;
+                ys[i] += dev.y;
+                vxs[i] += dev.vx;
+                vys[i] += dev.vy;
+            }
+        }
+        for i in 0..n {
+            fr.y.push(lead_y - ys[i]);
             // World velocity (dx/dt, speed − dy/dt): the flock frame moves at `speed` along +y.
-            let (vx, vy) = (dx, opts.speed - dy);
+            let (vx, vy) = (vxs[i], opts.speed - vys[i]);
             fr.heading.push(vx.atan2(vy));
             fr.speed.push(vx.hypot(vy));
         }

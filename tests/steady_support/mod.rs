@@ -118,6 +118,7 @@ pub fn movie(
         birds: n_hat,
         frames: out,
         summary: None,
+        motion: None,
     }
 }
 
