@@ -64,12 +64,59 @@ impl PlotArgs {
 
 /// Runs `formation plot`.
 pub fn run(args: PlotArgs, g: Global) -> Result<()> {
-    match args.kind {
+    use std::path::PathBuf;
+    let (what, input, output): (String, PathBuf, PathBuf) = match &args.kind {
+        PlotKind::Power(a) => (
+            match (a.key, a.frame) {
+                (Some(k), _) => {
+                    format!("each bird's saving in key shape {k}, with its feasible range")
+                }
+                (None, Some(f)) => {
+                    format!("each bird's saving in frame {f}, with its feasible range")
+                }
+                _ => "each bird's saving, with its feasible range".into(),
+            },
+            a.input.clone(),
+            a.output.clone(),
+        ),
+        PlotKind::Xi(a) => (
+            "ξ of every bird over time".into(),
+            a.input.clone(),
+            a.output.clone(),
+        ),
+        PlotKind::Shape(a) => (
+            match a.frame {
+                Some(f) => format!("the birds, fitted curve, leader and outliers of frame {f}"),
+                None => "the birds, fitted curve, leader and outliers of a frame".into(),
+            },
+            a.input.clone(),
+            a.output.clone(),
+        ),
+        PlotKind::Paths(a) => (
+            "the take-off's trajectories from above".into(),
+            a.input.clone(),
+            a.output.clone(),
+        ),
+        PlotKind::Wingbeat(a) => (
+            format!("joint angles over one wingbeat of the {}", a.species),
+            PathBuf::from(format!("the {} preset", a.species)),
+            a.output.clone(),
+        ),
+        PlotKind::Savings(a) => (
+            "each bird's saving against its rank, and the flock's saving over time".into(),
+            a.input.clone(),
+            a.output.clone(),
+        ),
+    };
+    let kind = match args.kind {
         PlotKind::Power(a) => super::steady::run_plot_power(a, g),
         PlotKind::Xi(a) => super::steady::run_plot_xi(a, g),
         PlotKind::Shape(a) => super::extract::run_plot_shape(a, g),
         PlotKind::Paths(a) => super::initiate::run_plot_paths(a, g),
         PlotKind::Wingbeat(a) => super::wingbeat::run_plot_wingbeat(a, g),
         PlotKind::Savings(a) => run_plot_savings(a),
-    }
+    };
+    kind?;
+    super::summary::chart(g, "plot", &what, &input, &output);
+    Ok(())
 }

@@ -203,5 +203,7 @@ pub fn run(args: RenderArgs, g: Global) -> Result<()> {
     formation::export::sample::check_times(&anim, &args.animation)?;
     // `--seed` does not apply: rendering is deterministic, and the clouds take the animation's seed.
     let _ = g.seed;
-    write_outputs(&anim, &args.output, &opts, &TermProgress::new(g.quiet))
+    write_outputs(&anim, &args.output, &opts, &TermProgress::new(g.quiet))?;
+    super::summary::render(g, &anim, &args.animation, &args.output);
+    Ok(())
 }

@@ -58,5 +58,20 @@ pub fn run(args: ReportArgs, g: Global) -> Result<()> {
         threshold,
         animation: animation.as_ref(),
     })?;
-    write_bytes_atomic(&args.output, page.as_bytes())
+    write_bytes_atomic(&args.output, page.as_bytes())?;
+    let what = match (&params, &animation) {
+        (Some(p), _) => format!(
+            "a page on {} annotated frames (shape {}, fits, spacing, savings)",
+            p.frames.len(),
+            super::summary::dominant(p)
+        ),
+        (None, Some(a)) => format!(
+            "a page on an animation of {} birds, {} frames (savings, take-off, steady flight)",
+            a.birds,
+            a.frames.len()
+        ),
+        (None, None) => "a page".to_string(),
+    };
+    super::summary::chart(g, "report", &what, &args.input, &args.output);
+    Ok(())
 }

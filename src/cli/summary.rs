@@ -147,3 +147,71 @@ pub fn animate(
     }
     defer(text, outputs);
 }
+
+/// `solve`'s summary: converged or not, the residual, the evaluations, the flock's total E.
+pub fn solve(
+    g: super::Global,
+    birds: usize,
+    rep: &formation::keyshape::solve::SolveReport,
+    tolerance: f64,
+    output: &std::path::Path,
+) {
+    if g.quiet {
+        return;
+    }
+    defer(
+        format!(
+            "solve: {birds} birds, {} (residual ‖ξ − ξ̂‖ = {:.2e}, tolerance {:.1e}) after {} evaluations; E = {:.4}",
+            if rep.converged { "converged" } else { "NOT converged" },
+            rep.residual,
+            tolerance,
+            rep.evaluations,
+            rep.total
+        ),
+        &[output.to_path_buf()],
+    );
+}
+
+/// `render`'s summary: what was rendered, from which file.
+pub fn render(g: super::Global, anim: &Animation, input: &std::path::Path, outputs: &[PathBuf]) {
+    if g.quiet {
+        return;
+    }
+    let frames = anim.frames.len();
+    let stages: Vec<&str> = anim.stages.iter().map(|s| s.name.as_str()).collect();
+    defer(
+        format!(
+            "render: {} birds, {frames} frames ({:.1} s at {} fps; {}) from {}",
+            anim.birds,
+            frames as f64 / anim.fps,
+            anim.fps,
+            if stages.is_empty() {
+                "no stages".to_string()
+            } else {
+                stages.join(" + ")
+            },
+            super::stdout::file_name(input)
+        ),
+        outputs,
+    );
+}
+
+/// A chart's or a page's summary: `what` says what it shows.
+pub fn chart(
+    g: super::Global,
+    command: &str,
+    what: &str,
+    input: &std::path::Path,
+    output: &std::path::Path,
+) {
+    if g.quiet {
+        return;
+    }
+    defer(
+        format!(
+            "{command}: {what}, from {}",
+            super::stdout::file_name(input)
+        ),
+        &[output.to_path_buf()],
+    );
+}
