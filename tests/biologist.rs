@@ -784,3 +784,66 @@ fn warnings_fire_on_reversed_and_turned_headings_and_never_on_true_ones() {
     }
     assert_eq!(checked, 36);
 }
+
+/// The cranes' footage read with the default heading (the user forgot `--heading 300`): about
+/// half of every frame's birds are off the fitted line, and the warning names the heading that
+/// fits; read the right way, and for every other bundled footage, no warning.
+#[test]
+fn a_forgotten_heading_is_named_with_the_heading_that_fits() {
+    let dir = scratch("forgotten-heading");
+    let out_path = dir.join("c.json");
+    let o = s(&out_path);
+    let cranes = example_arg("cranes_v_dltdv.csv");
+    let out = run(&["extract", &cranes, "--wingspan-px", "22", "-o", o, "-q"]);
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    let err = stderr(&out);
+    let warnings: Vec<&str> = err.lines().filter(|l| l.starts_with("warning:")).collect();
+    assert_eq!(warnings.len(), 1, "{err}");
+    assert!(
+        warnings[0].contains("600 of 1228 marks are off the fitted shape")
+            && warnings[0].ends_with("the heading (up) is probably wrong; give --heading 300"),
+        "{err}"
+    );
+    // The same through animate (the warning the user sees before the GIF is written).
+    let gif = dir.join("a.gif");
+    let out = run(&[
+        "animate",
+        &cranes,
+        "--wingspan-px",
+        "22",
+        "--birds",
+        "9",
+        "--seconds",
+        "2",
+        "--no-initiation",
+        "-o",
+        s(&gif),
+        "-q",
+    ]);
+    assert!(
+        stderr(&out).contains("give --heading 300"),
+        "{}",
+        stderr(&out)
+    );
+    // Read the right way, and the other footage: no warning.
+    let runs: [Vec<String>; 4] = [
+        vec![
+            cranes.clone(),
+            "--wingspan-px".into(),
+            "22".into(),
+            "--heading".into(),
+            "300".into(),
+        ],
+        vec![example_arg("barnacle_geese_v.json")],
+        vec![example_arg("snow_geese_j.csv")],
+        vec![example_arg("pelicans_u_labelme")],
+    ];
+    for args in runs {
+        let mut a: Vec<&str> = vec!["extract"];
+        a.extend(args.iter().map(String::as_str));
+        a.extend(["-o", o, "-q"]);
+        let out = run(&a);
+        assert_eq!(code(&out), 0, "{a:?}: {}", stderr(&out));
+        assert!(!stderr(&out).contains("warning"), "{a:?}: {}", stderr(&out));
+    }
+}

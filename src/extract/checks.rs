@@ -10,7 +10,12 @@
 //!   better than as given: the criterion S of the module [`super`] drops by more than ln n
 //!   (the price of one parameter) in most frames (at most [`MAX_CHECKED_FRAMES`], evenly spaced, are refitted).
 //!   Typical sign: the leader at a wingtip and the other birds ahead of its arms.
-//! - **Heading**: the same with the flight direction turned 90° either way.
+//! - **Heading**: the same with the flight direction turned 90° either way; and, when many birds
+//!   of most frames are off the fitted shape ([`MOSTLY_OUTLIERS`]), the flight direction that
+//!   fits best is searched in steps of [`AXIS_STEP_DEG`] (then 5°) over at most
+//!   [`AXIS_CHECKED_FRAMES`] frames: a turn of at least [`AXIS_MIN_TURN_DEG`] that fits far better
+//!   in most of them is named with the heading to give; otherwise the warning says that the
+//!   shape leaves most birds out and what to check.
 //! - **Scale**: the median distance from a bird to its nearest neighbour is outside
 //!   [`PLAUSIBLE_NEIGHBOUR`] wingspans (real formations keep about 0.8–2.5, see
 //!   `docs/formats.md`); the wingspan in pixels is probably wrong.
@@ -28,6 +33,21 @@ use crate::annotations::{AnnotatedFrame, Annotations, Format};
 /// Most frames the orientation checks refit (evenly spaced): each costs three more fits, and
 /// a majority over 30 frames is as clear as over 1000.
 pub const MAX_CHECKED_FRAMES: usize = 30;
+
+/// A frame is suspicious when more than this fraction of its birds are off the fitted shape (a
+/// real formation with a few stragglers stays well below; a wrong flight direction leaves about
+/// half of a V out).
+pub const MOSTLY_OUTLIERS: f64 = 0.4;
+
+/// Step of the search for the flight direction that fits, degrees.
+pub const AXIS_STEP_DEG: f64 = 15.0;
+
+/// Smallest turn of the flight direction that the search reports, degrees (smaller ones are
+/// within what the fit absorbs).
+pub const AXIS_MIN_TURN_DEG: f64 = 10.0;
+
+/// Most frames the flight-direction search refits (evenly spaced): each costs 26 fits.
+pub const AXIS_CHECKED_FRAMES: usize = 6;
 
 /// Fewest annotated frames without a warning.
 pub const MIN_FRAMES: usize = 3;
@@ -188,6 +208,9 @@ pub fn check(
             ),
         });
     }
+    if out.is_empty() {
+        out.extend(axis_check(ann, params, reports, opts, rng));
+    }
     // Scale: median nearest-neighbour distance over every bird of every frame.
     let mut nn: Vec<f64> = Vec::new();
     for f in &params.frames {
@@ -235,6 +258,106 @@ pub fn check(
         });
     }
     out
+}
+
+/// The warning when most birds of most frames are off the fitted shape: the flight direction
+/// that fits best (searched over whole turns), or what else to check.
+fn axis_check(
+    ann: &Annotations,
+    params: &FormationParams,
+    reports: &[FrameReport],
+    opts: &ExtractOptions,
+    rng: &mut impl Rng,
+) -> Option<Warning> {
+    let n = params.frames.len();
+    let mostly = params
+        .frames
+        .iter()
+        .filter(|f| f.outliers.len() as f64 > MOSTLY_OUTLIERS * f.order.len() as f64)
+        .count();
+    if n == 0 || 2 * mostly <= n {
+        return None;
+    }
+    let marks: usize = params.frames.iter().map(|f| f.outliers.len()).sum();
+    let all: usize = params.frames.iter().map(|f| f.order.len()).sum();
+    let path = ann.path.display();
+    let heading = ann.frames.first().map_or(0.0, |f| f.heading_deg);
+    let step = ann.frames.len().div_ceil(AXIS_CHECKED_FRAMES).max(1);
+    let frames: Vec<(&AnnotatedFrame, f64)> = ann
+        .frames
+        .iter()
+        .zip(reports)
+        .step_by(step)
+        .filter_map(|(f, r)| best_score(r).map(|s| (f, s)))
+        .collect();
+    // (wins, total improvement) of turning the flight direction by `turn`.
+    let mut score_of = |turn: f64| -> (usize, f64) {
+        let mut wins = 0;
+        let mut gain = 0.0;
+        for &(f, s0) in &frames {
+            let pts = reoriented(f, false, turn);
+            let alt = super::choose_model(&pts, opts, rng)
+                .and_then(|(_, s)| s.iter().map(|s| s.1).min_by(f64::total_cmp));
+            if let Some(a) = alt {
+                if a < s0 - (f.birds.len() as f64).ln() {
+                    wins += 1;
+                }
+                gain += s0 - a;
+            }
+        }
+        (wins, gain)
+    };
+    let better = |a: (usize, f64), b: (usize, f64)| a.0 > b.0 || (a.0 == b.0 && a.1 > b.1);
+    let mut best: Option<(f64, (usize, f64))> = None;
+    let steps = (360.0 / AXIS_STEP_DEG).round() as usize;
+    for k in 1..steps {
+        let turn = k as f64 * AXIS_STEP_DEG;
+        let sc = score_of(turn);
+        if best.is_none_or(|(_, b)| better(sc, b)) {
+            best = Some((turn, sc));
+        }
+    }
+    if let Some((coarse, _)) = best {
+        for d in [-10.0, -5.0, 5.0, 10.0] {
+            let turn = coarse + d;
+            let sc = score_of(turn);
+            if best.is_none_or(|(_, b)| better(sc, b)) {
+                best = Some((turn, sc));
+            }
+        }
+    }
+    let lead = format!(
+        "{path}: {marks} of {all} marks are off the fitted shape (more than {:.0} % of the birds in {mostly} of {n} frames)",
+        100.0 * MOSTLY_OUTLIERS
+    );
+    let signed = |t: f64| {
+        let t = t.rem_euclid(360.0);
+        if t > 180.0 {
+            t - 360.0
+        } else {
+            t
+        }
+    };
+    let message = match best {
+        Some((turn, (wins, _)))
+            if 2 * wins > frames.len() && signed(turn).abs() >= AXIS_MIN_TURN_DEG =>
+        {
+            format!(
+                "{lead}, and they fit far better with the flight direction turned {:+}° in {wins} of {} frames checked: the heading ({}) is probably wrong; give read.heading {}",
+                signed(turn),
+                frames.len(),
+                heading_word(heading),
+                heading_word(heading + turn)
+            )
+        }
+        _ => format!(
+            "{lead}: check the heading (read.heading), the scale (read.wingspan_px), and whether the frames hold one formation"
+        ),
+    };
+    Some(Warning {
+        kind: WarningKind::Heading,
+        message,
+    })
 }
 
 #[cfg(test)]
