@@ -313,7 +313,7 @@ fn axis_check(
     for k in 1..steps {
         let turn = k as f64 * AXIS_STEP_DEG;
         let sc = score_of(turn);
-        if best.is_none_or(|(_, b)| better(sc, b)) {
+        if best.map_or(true, |(_, b)| better(sc, b)) {
             best = Some((turn, sc));
         }
     }
@@ -321,7 +321,7 @@ fn axis_check(
         for d in [-10.0, -5.0, 5.0, 10.0] {
             let turn = coarse + d;
             let sc = score_of(turn);
-            if best.is_none_or(|(_, b)| better(sc, b)) {
+            if best.map_or(true, |(_, b)| better(sc, b)) {
                 best = Some((turn, sc));
             }
         }
