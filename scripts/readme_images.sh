@@ -17,7 +17,7 @@ $B plot shape "$T/geese.json" --frame 0 -o "$I/usage-fit.png"
 $B animate "$T/geese.json" --birds 14 -o "$T/flock.json" -o "$T/frames/" --picture-fps 1 --quiet
 n=$(ls "$T/frames" | wc -l)
 echo "$n frames at 1 fps"
-cp "$T/frames/frame_00006.png" "$I/usage-initiation.png"
+cp "$T/frames/frame_00002.png" "$I/usage-initiation.png"
 # docs/initiation.md: the README job's ground take-off, two frames (2 s and 6 s) and its paths.
 cp "$T/frames/frame_00002.png" docs/takeoff-ground-2s.png
 cp "$T/frames/frame_00006.png" docs/takeoff-ground-6s.png

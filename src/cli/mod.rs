@@ -29,7 +29,7 @@ mod wingbeat;
 pub struct Cli {
     #[command(subcommand)]
     command: Command,
-    /// Hide progress bars.
+    /// Hide progress bars and the summary each command prints when it is done.
     #[arg(long, short = 'q', global = true)]
     quiet: bool,
     /// Seed of every random draw; equal seeds and inputs give byte-identical outputs.
@@ -66,7 +66,8 @@ enum Command {
     Initiate(Box<initiate::InitiateArgs>),
     /// The whole chain: annotations or params → extract → steady → initiate → outputs.
     Animate(Box<animate::AnimateArgs>),
-    /// Render or export an animation file (GIF, PNG frames, glTF, CSV, JSON).
+    /// Render or export an animation file (GIF, PNG frames, MP4, WebM, glTF .glb, USD .usda,
+    /// CSV, JSON).
     Render(render::RenderArgs),
     /// Charts: power, xi, shape, paths, wingbeat, savings.
     Plot(plot::PlotArgs),

@@ -1,4 +1,4 @@
-//! `formation power SHAPE [--json]`: e_i, ξ_i and E of a shape (SPEC §4.3).
+//! `formation power SHAPE [--json]`: e_i, ξ_i and E of a shape (docs/formats.md).
 
 use std::path::PathBuf;
 

@@ -13,7 +13,7 @@ use super::Global;
 /// Arguments of `formation render`.
 #[derive(Debug, Args)]
 pub struct RenderArgs {
-    /// An animation file (SPEC §4.4).
+    /// An animation file (docs/formats.md).
     pub animation: PathBuf,
     /// Outputs by extension: .gif, DIR/ (numbered PNG frames), .mp4, .webm (through ffmpeg),
     /// .glb, .usda, .csv, .json; may be repeated.

@@ -260,7 +260,7 @@ impl From<MetricArg> for PowerMetric {
 /// Arguments of `formation plot power`.
 #[derive(Debug, Args)]
 pub struct PlotPowerArgs {
-    /// A shape file (SPEC §4.3) or an animation file.
+    /// A shape file (docs/formats.md) or an animation file.
     pub input: PathBuf,
     /// Output chart (.png or .svg).
     #[arg(short = 'o', long = "output")]
