@@ -136,6 +136,55 @@ impl ShapeKind {
     }
 }
 
+impl std::fmt::Display for ShapeKind {
+    /// `V`, `U`, `J` or `line`, as the summaries print them.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            ShapeKind::V => "V",
+            ShapeKind::U => "U",
+            ShapeKind::J => "J",
+            ShapeKind::Line => "line",
+        })
+    }
+}
+
+impl std::fmt::Display for Bird {
+    /// `(x, y)` in wingspans, to the given precision (default 2 decimals).
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let p = f.precision().unwrap_or(2);
+        write!(f, "({:.p$}, {:.p$})", self.x, self.y)
+    }
+}
+
+impl std::fmt::Display for Shape {
+    /// `3 birds, 1.60 wide, 0.80 deep (wingspans): (-0.80, 0.80), (0.00, 0.00), (0.80, 0.80)`;
+    /// the precision applies to every number (`{:.3}`).
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let p = f.precision().unwrap_or(2);
+        let extent = |v: Vec<f64>| {
+            let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
+            let hi = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            if v.is_empty() {
+                0.0
+            } else {
+                hi - lo
+            }
+        };
+        write!(
+            f,
+            "{} bird{}, {:.p$} wide, {:.p$} deep (wingspans)",
+            self.birds.len(),
+            if self.birds.len() == 1 { "" } else { "s" },
+            extent(self.xs()),
+            extent(self.ys())
+        )?;
+        for (i, b) in self.birds.iter().enumerate() {
+            write!(f, "{}{b:.p$}", if i == 0 { ": " } else { ", " })?;
+        }
+        Ok(())
+    }
+}
+
 impl FromStr for ShapeKind {
     type Err = String;
     fn from_str(s: &str) -> std::result::Result<Self, Self::Err> {
@@ -146,5 +195,48 @@ impl FromStr for ShapeKind {
             "line" | "echelon" => Ok(ShapeKind::Line),
             _ => Err(format!("`{s}` is not a shape kind; use v, u, j or line")),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn shapes_print_their_birds() {
+        let s = super::Shape::from_xy(&[-0.8, 0.0, 0.8], &[0.8, 0.0, 0.8]);
+        assert_eq!(
+            s.to_string(),
+            "3 birds, 1.60 wide, 0.80 deep (wingspans): (-0.80, 0.80), (0.00, 0.00), (0.80, 0.80)"
+        );
+        assert_eq!(format!("{:.1}", s.birds[0]), "(-0.8, 0.8)");
+        assert_eq!(super::ShapeKind::Line.to_string(), "line");
+        assert_eq!(
+            super::Shape::default().to_string(),
+            "0 birds, 0.00 wide, 0.00 deep (wingspans)"
+        );
+    }
+
+    #[test]
+    fn fitted_curves_print_as_equations() {
+        use crate::extract::params::{LineCoef, ShapeModel};
+        let v = ShapeModel::V {
+            left: LineCoef {
+                intercept: 0.12,
+                slope: -0.83,
+            },
+            right: LineCoef {
+                intercept: 0.1,
+                slope: 0.79,
+            },
+        };
+        assert_eq!(
+            v.to_string(),
+            "V: y = 0.12 - 0.83·x (x < 0), y = 0.10 + 0.79·x (x ≥ 0)"
+        );
+        let u = ShapeModel::U {
+            a: 0.2,
+            b: -0.01,
+            c: 0.5,
+        };
+        assert_eq!(format!("{u:.1}"), "U: y = 0.2·x² - 0.0·x + 0.5");
     }
 }

@@ -170,6 +170,34 @@ impl ShapeModel {
     }
 }
 
+impl std::fmt::Display for ShapeModel {
+    /// The fitted curve as an equation in the formation frame (wingspans, y behind the leader):
+    /// `V: y = 0.12 - 0.83·x (x < 0), y = 0.10 + 0.79·x (x ≥ 0)`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let p = f.precision().unwrap_or(2);
+        let line = |c: f64, m: f64| {
+            let sign = if m < 0.0 { '-' } else { '+' };
+            format!("y = {c:.p$} {sign} {:.p$}·x", m.abs())
+        };
+        let para = |a: f64, b: f64, c: f64| {
+            let sb = if b < 0.0 { '-' } else { '+' };
+            let sc = if c < 0.0 { '-' } else { '+' };
+            format!("y = {a:.p$}·x² {sb} {:.p$}·x {sc} {:.p$}", b.abs(), c.abs())
+        };
+        match *self {
+            ShapeModel::V { left, right } => write!(
+                f,
+                "V: {} (x < 0), {} (x ≥ 0)",
+                line(left.intercept, left.slope),
+                line(right.intercept, right.slope)
+            ),
+            ShapeModel::Line { intercept, slope } => write!(f, "line: {}", line(intercept, slope)),
+            ShapeModel::U { a, b, c } => write!(f, "U: {}", para(a, b, c)),
+            ShapeModel::J { a, b, c } => write!(f, "J: {}", para(a, b, c)),
+        }
+    }
+}
+
 impl FormationParams {
     /// How many frames were fitted by each kind (`"v"`, `"line"`, …), most frequent first
     /// (ties in order of first appearance).
