@@ -11,6 +11,7 @@ pub mod paths;
 pub mod power;
 pub mod savings;
 pub mod shape;
+pub mod text;
 pub mod wingbeat;
 pub mod xi;
 
@@ -207,7 +208,10 @@ pub fn render<C: Chart>(chart: &C, kind: OutputKind) -> Result<Vec<u8>> {
         OutputKind::Png => {
             let mut buf = vec![0u8; (w as usize) * (h as usize) * 3];
             {
-                let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
+                let bitmap = BitMapBackend::with_buffer(&mut buf, (w, h));
+                let root = text::GlyphText::new(bitmap, FONT)
+                    .ok_or_else(|| Error::Internal("the bundled font does not load".into()))?
+                    .into_drawing_area();
                 root.fill(&WHITE).map_err(|e| draw_err(e.to_string()))?;
                 chart.draw(&root).map_err(|e| draw_err(e.to_string()))?;
                 root.present().map_err(|e| draw_err(e.to_string()))?;
