@@ -351,3 +351,31 @@ impl FormationParams {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn fitted_curves_print_as_equations() {
+        use super::{LineCoef, ShapeModel};
+        let v = ShapeModel::V {
+            left: LineCoef {
+                intercept: 0.12,
+                slope: -0.83,
+            },
+            right: LineCoef {
+                intercept: 0.1,
+                slope: 0.79,
+            },
+        };
+        assert_eq!(
+            v.to_string(),
+            "V: y = 0.12 - 0.83·x (x < 0), y = 0.10 + 0.79·x (x ≥ 0)"
+        );
+        let u = ShapeModel::U {
+            a: 0.2,
+            b: -0.01,
+            c: 0.5,
+        };
+        assert_eq!(format!("{u:.1}"), "U: y = 0.2·x² - 0.0·x + 0.5");
+    }
+}
