@@ -8,9 +8,10 @@
 //!   framed whole down to [`FLOCK_MIN_BIRD_PX`] (if the minimum asked for is larger), so that
 //!   every formation is in the picture; only a flock that would be drawn smaller still is cut to
 //!   its leading formations.
-//! - **ground**: a fixed observer standing under the flock's course, looking up at
-//!   [`GroundParams::elevation_deg`] towards the oncoming flock with a perspective lens; the
-//!   flock approaches low over the horizon, grows and passes over the top of the picture.
+//! - **ground**: an observer standing on the ground beside the flock's course
+//!   ([`GroundParams::distance`] to the right of it where the flock passes), who turns and
+//!   zooms a perspective lens to keep the flock in the picture from the take-off on the field,
+//!   low over the horizon, to the pass overhead and away.
 //! - **fixed**: a given rectangle of the world (`render.camera` = fixed with `[x0, y0, x1, y1]`, wingspans), top-down.
 //!
 //! The follow path is computed offline over all output frames. The centre (the flock's bounding
@@ -256,14 +257,13 @@ impl View {
 /// The ground observer.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GroundParams {
-    /// Height of the flock above the observer where it passes over, wingspans (the animation's
-    /// `z` is taken relative to the flock's median height then).
+    /// How far to the right of the flock's course the observer stands, at the pass point,
+    /// wingspans.
     pub distance: f64,
-    /// Elevation of the viewing direction above the horizon, degrees.
-    pub elevation_deg: f64,
-    /// Vertical field of view, degrees.
+    /// Widest vertical field of view the camera opens to, degrees (it zooms in from there to
+    /// keep the flock large).
     pub fov_deg: f64,
-    /// When the flock passes over the observer, as a fraction of the picture's duration.
+    /// When the flock passes the observer, as a fraction of the picture's duration.
     pub pass_at: f64,
 }
 
@@ -271,7 +271,6 @@ impl Default for GroundParams {
     fn default() -> Self {
         GroundParams {
             distance: 25.0,
-            elevation_deg: 60.0,
             fov_deg: 60.0,
             pass_at: 0.7,
         }
@@ -383,40 +382,157 @@ pub fn track(
                 n
             ]
         }
-        CameraKind::Ground => vec![View::Ground(ground_eye(states, height, &p.ground)); n],
+        CameraKind::Ground => ground(states, fps, width, height, p),
         CameraKind::Follow => follow(states, fps, width, height, p),
     }
 }
 
-/// The ground observer for these frames: under the flock's centre at the pass time, `distance`
-/// below the flock's median height then, looking up towards where the flock comes from.
-pub fn ground_eye(states: &[Vec<BirdState>], height: usize, g: &GroundParams) -> Eye {
+/// Height of the ground observer's eye above the lowest point any bird reaches (the ground for
+/// a take-off from a field), wingspans: about a standing person's eye for a goose's span.
+pub const EYE_HEIGHT: f64 = 1.2;
+
+/// Narrowest vertical field of view the ground camera zooms in to, degrees (a long lens).
+pub const GROUND_MIN_FOV_DEG: f64 = 3.0;
+
+/// Highest elevation the ground camera tilts up to, degrees (short of the zenith, where the
+/// image's up direction is undefined).
+pub const GROUND_MAX_ELEVATION_DEG: f64 = 80.0;
+
+/// Share of the picture's shorter side the ground camera fills with the flock.
+const GROUND_FILL: f64 = 0.7;
+
+/// Where the ground observer stands: `distance` to the right of the flock's course at the pass
+/// time (its centre then, across its mean heading), its eye [`EYE_HEIGHT`] above the lowest
+/// point any bird reaches in `states`.
+pub fn ground_position(states: &[Vec<BirdState>], g: &GroundParams) -> [f64; 3] {
     let k = ((states.len() - 1) as f64 * g.pass_at.clamp(0.0, 1.0)).round() as usize;
     let s = &states[k];
     let m = s.len().max(1) as f64;
     let (x, y) = s.iter().fold((0.0, 0.0), |(a, b), q| (a + q.x, b + q.y));
-    let mut zs: Vec<f64> = s.iter().map(|q| q.z).collect();
-    zs.sort_by(f64::total_cmp);
-    let z = zs.get(zs.len() / 2).copied().unwrap_or(0.0);
-    // Mean heading (circular) of the flock there.
     let (hs, hc) = s.iter().fold((0.0, 0.0), |(a, b), q| {
         (a + q.heading.sin(), b + q.heading.cos())
     });
-    let (hs, hc) = if hs.hypot(hc) < 1e-9 {
-        (0.0, 1.0)
+    let h = if hs.hypot(hc) < 1e-9 {
+        0.0
     } else {
-        (hs, hc)
+        hs.atan2(hc)
     };
-    let h = hs.atan2(hc);
-    let el = g.elevation_deg.clamp(5.0, 85.0).to_radians();
-    // Face the oncoming flock: opposite its heading, tilted up.
-    let forward = [-h.sin() * el.cos(), -h.cos() * el.cos(), el.sin()];
-    Eye::looking(
-        [x / m, y / m, z - g.distance],
-        forward,
-        g.fov_deg.clamp(10.0, 150.0),
-        height,
-    )
+    let floor = states
+        .iter()
+        .flatten()
+        .map(|q| q.z)
+        .fold(f64::INFINITY, f64::min);
+    let floor = if floor.is_finite() { floor } else { 0.0 };
+    [
+        x / m + g.distance * h.cos(),
+        y / m - g.distance * h.sin(),
+        floor + EYE_HEIGHT,
+    ]
+}
+
+/// The ground camera: an observer standing beside the course ([`ground_position`]) who turns
+/// and zooms to keep the flock in the picture, as a camera operator would. Each frame aims at
+/// the flock's centre and needs the vertical field of view that shows every bird within
+/// [`GROUND_FILL`] of the shorter side (between [`GROUND_MIN_FOV_DEG`] and `fov_deg`). The aim is
+/// smoothed by a Gaussian of `smoothing_s` (on unit vectors), the zoom like the follow camera's
+/// (a maximum filter, then a Gaussian in log tan(fov/2)), so the flock is never cut off by the
+/// zoom; the elevation is capped at [`GROUND_MAX_ELEVATION_DEG`].
+fn ground(
+    states: &[Vec<BirdState>],
+    fps: f64,
+    width: usize,
+    height: usize,
+    p: &CameraParams,
+) -> Vec<View> {
+    let n = states.len();
+    let g = &p.ground;
+    let eye = ground_position(states, g);
+    let sigma = (p.smoothing_s * fps).max(0.5);
+    let half = ((2.0 * sigma).ceil() as usize).min(n.max(1));
+    let kernel = gaussian(sigma, half);
+    // Aim (unit vectors) and the angular radius of the flock around it, per frame.
+    let (aims, radii): (Vec<[f64; 3]>, Vec<f64>) = states
+        .iter()
+        .map(|s| {
+            let m = s.len().max(1) as f64;
+            let c = s
+                .iter()
+                .fold([0.0; 3], |a, q| [a[0] + q.x, a[1] + q.y, a[2] + q.z])
+                .map(|v| v / m);
+            let aim = unit([c[0] - eye[0], c[1] - eye[1], c[2] - eye[2]]);
+            let r = s
+                .iter()
+                .map(|q| {
+                    let d = unit([q.x - eye[0], q.y - eye[1], q.z - eye[2]]);
+                    dot(d, aim).clamp(-1.0, 1.0).acos()
+                })
+                .fold(0.0, f64::max);
+            (aim, r)
+        })
+        .unzip();
+    let at = |i: isize| i.clamp(0, n as isize - 1) as usize;
+    let max_el = GROUND_MAX_ELEVATION_DEG.to_radians();
+    let smoothed: Vec<[f64; 3]> = (0..n as isize)
+        .map(|i| {
+            let mut a = [0.0; 3];
+            for (k, w) in kernel.iter().enumerate() {
+                let v = aims[at(i + k as isize - half as isize)];
+                for d in 0..3 {
+                    a[d] += w * v[d];
+                }
+            }
+            let a = unit(a);
+            // Cap the elevation (keep the azimuth).
+            let el = a[2].clamp(-1.0, 1.0).asin();
+            if el > max_el {
+                let hz = a[0].hypot(a[1]).max(1e-12);
+                [
+                    a[0] / hz * max_el.cos(),
+                    a[1] / hz * max_el.cos(),
+                    max_el.sin(),
+                ]
+            } else {
+                a
+            }
+        })
+        .collect();
+    // Zoom: the half-angle of the shorter side that holds every bird around the smoothed aim.
+    let (w, h) = (width as f64, height as f64);
+    let short_over_h = w.min(h) / h;
+    let widest = (0.5 * g.fov_deg.clamp(10.0, 150.0)).to_radians().tan();
+    let narrowest = (0.5 * GROUND_MIN_FOV_DEG).to_radians().tan();
+    let log_need: Vec<f64> = (0..n)
+        .map(|i| {
+            let spread = states[i]
+                .iter()
+                .map(|q| {
+                    let d = unit([q.x - eye[0], q.y - eye[1], q.z - eye[2]]);
+                    dot(d, smoothed[i]).clamp(-1.0, 1.0).acos()
+                })
+                .fold(radii[i], f64::max);
+            // tan of the vertical half-angle whose shorter side shows `spread` at GROUND_FILL.
+            let t = (spread.min(1.5)).tan() / GROUND_FILL / short_over_h;
+            t.clamp(narrowest, widest).ln()
+        })
+        .collect();
+    let dilated: Vec<f64> = (0..n as isize)
+        .map(|i| {
+            (-(half as isize)..=half as isize)
+                .map(|d| log_need[at(i + d)])
+                .fold(f64::MIN, f64::max)
+        })
+        .collect();
+    (0..n as isize)
+        .map(|i| {
+            let t: f64 = kernel
+                .iter()
+                .enumerate()
+                .map(|(k, wk)| wk * dilated[at(i + k as isize - half as isize)])
+                .sum();
+            let fov = 2.0 * t.exp().clamp(narrowest, widest).atan().to_degrees();
+            View::Ground(Eye::looking(eye, smoothed[i as usize], fov, height))
+        })
+        .collect()
 }
 
 fn follow(

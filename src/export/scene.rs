@@ -104,6 +104,9 @@ pub struct Style {
     pub cloud_zoom: f64,
     /// Colour of the sun glow.
     pub sun_colour: [u8; 3],
+    /// Colour of the ground below the horizon (ground camera), seen through haze that fades it
+    /// into the horizon's sky colour within a few degrees.
+    pub ground: [u8; 3],
 }
 
 /// One procedural cloud layer.
@@ -160,6 +163,8 @@ impl Default for Style {
             cloud_px: 16.0,
             cloud_zoom: 0.25,
             sun_colour: [255, 242, 210],
+            // A grass field in summer light, muted by distance.
+            ground: [104, 122, 84],
         }
     }
 }
@@ -183,6 +188,9 @@ impl Style {
         [0, 1, 2].map(|k| a[k] as f32 + (b[k] as f32 - a[k] as f32) * w)
     }
 }
+
+/// Angle below the horizon over which the ground's haze fades, radians (about 2°).
+const GROUND_HAZE_RAD: f64 = 0.035;
 
 /// Background sample spacing, pixels.
 pub const GRID: usize = 8;
@@ -367,6 +375,12 @@ impl Backdrop {
             View::Ground(e) => {
                 let d = e.ray(col, row, self.width, self.height);
                 let el = (d[2] / (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()).clamp(-1.0, 1.0);
+                if el < 0.0 {
+                    // Below the horizon: the ground, hazy towards the horizon (a few degrees).
+                    let haze = (el / GROUND_HAZE_RAD).exp() as f32;
+                    let (g, b) = (st.ground, st.sky_bottom);
+                    return [0, 1, 2].map(|k| g[k] as f32 + (b[k] as f32 - g[k] as f32) * haze);
+                }
                 1.0 - (el.asin() / std::f64::consts::FRAC_PI_2).max(0.0) as f32
             }
         };
