@@ -401,7 +401,11 @@ fn csv_columns_match_the_json_in_every_frame() {
         "{err}"
     );
     assert!(
-        first.contains("flock saving ") && first.contains(" % of induced power in steady flight")
+        first.contains("flock saving ")
+            && first.contains(" % of induced power (")
+            && first.contains(" % of total power) in steady flight by Hummel's model")
+            && first.contains("(models applied to measured spacings: 14–36 %)"),
+        "{first}"
     );
     assert!(
         err.contains("flock.json (") && err.contains("flock.csv ("),
@@ -412,13 +416,14 @@ fn csv_columns_match_the_json_in_every_frame() {
     let mut lines = text.lines();
     assert_eq!(
         lines.next().unwrap(),
-        "frame,t,bird,x,y,z,heading,speed,e,xi,stage,formation,rank,leader,lateral,behind,wing_phase,bank"
+        "frame,t,bird,x,y,z,heading,speed,e,xi,stage,formation,rank,leader,lateral,behind,wing_phase,bank,saving_total"
     );
     let leaders = a.leaders();
+    let curve = formation::aero::flight::animation_curve(a.species.as_deref(), a.wingspan_m);
     let mut rows = 0;
     for line in lines {
         let c: Vec<&str> = line.split(',').collect();
-        assert_eq!(c.len(), 18, "{line}");
+        assert_eq!(c.len(), 19, "{line}");
         let (k, b): (usize, usize) = (c[0].parse().unwrap(), c[2].parse().unwrap());
         let f = &a.frames[k];
         let num = |i: usize| c[i].parse::<f64>().unwrap_or_else(|_| panic!("{line}"));
@@ -442,6 +447,20 @@ fn csv_columns_match_the_json_in_every_frame() {
         assert!((num(14) - lateral).abs() < 1e-12 && (num(15) - behind).abs() < 1e-12);
         assert_eq!(num(16), f.wing_phase.as_ref().unwrap()[b]);
         assert_eq!(num(17), f.bank.as_ref().map_or(0.0, |v| v[b]));
+        // The saving of total power: e times the induced share of the power curve at the bird's
+        // airspeed, a fraction between 0 and 1 of e.
+        let e = num(8);
+        let ratio = num(18) / e;
+        if e.abs() > 1e-9 {
+            assert!(ratio > 0.05 && ratio < 1.0, "{line}");
+        }
+        if f.speed[b] * a.wingspan_m > 0.5 {
+            let share = curve.induced_share(f.speed[b] * a.wingspan_m);
+            assert!(
+                (num(18) - e * share).abs() <= 1e-12 * e.abs().max(1.0),
+                "{line}"
+            );
+        }
         rows += 1;
     }
     assert_eq!(rows, a.frames.len() * a.birds);
@@ -480,7 +499,7 @@ fn charts_draw_the_leader_the_ranges_and_the_stages_they_claim() {
         assert!(!text.contains("#FDE725"), "{chart}");
     }
     let sav = svg(&["plot", "savings", j, "-o", &out("s.svg")]);
-    assert!(sav.contains("field studies, geese: flock saves 14–36 % of induced power"));
+    assert!(sav.contains("models applied to measured spacings of geese: 14–36 % of induced power"));
     assert!(sav.contains("take-off ("));
     assert!(sav.contains("(take-off and steady flight)"));
     // Feasible ranges are recorded in animate's output and drawn.

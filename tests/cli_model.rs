@@ -36,6 +36,65 @@ fn power_table_and_json() {
 }
 
 #[test]
+fn power_reports_savings_of_total_power_from_the_power_curve() {
+    let shape = example("v9_shape.json");
+    let json = |extra: &[&str]| -> serde_json::Value {
+        let mut args = vec!["power", shape.as_str(), "--json"];
+        args.extend_from_slice(extra);
+        let (code, out, err) = run(&args);
+        assert_eq!(code, 0, "{err}");
+        serde_json::from_str(&out).unwrap()
+    };
+    let v = json(&[]);
+    let f = &v["flight"];
+    let share = f["induced_share"].as_f64().unwrap();
+    // The library's curve for the same bird and speed gives the same share.
+    let curve = formation::aero::flight::PowerCurve::new(formation::aero::flight::Morphology::of(
+        formation::animation::wing::Species::Goose,
+    ));
+    assert_eq!(f["speed_ms"].as_f64().unwrap(), curve.minimum_power_speed());
+    assert!((share - curve.induced_share(curve.minimum_power_speed())).abs() < 1e-15);
+    assert!(share > 0.2 && share < 0.6, "{share}");
+    for b in v["birds"].as_array().unwrap() {
+        let (s, t) = (
+            b["saving"].as_f64().unwrap(),
+            b["saving_total"].as_f64().unwrap(),
+        );
+        assert!((t - s * share).abs() <= 1e-15 * s.abs().max(1.0));
+    }
+    let flock = v["flock_saving"].as_f64().unwrap();
+    assert!((v["flock_saving_total"].as_f64().unwrap() - flock * share).abs() < 1e-15);
+    // Faster flight: less of the power is induced, so the same positions save less of the total.
+    let fast = json(&["--speed-ms", "25"]);
+    assert!(fast["flight"]["induced_share"].as_f64().unwrap() < share);
+    // A heavier bird of the same span: more of its power is induced at the same speed.
+    let heavy = json(&["--mass-kg", "4", "--speed-ms", "16"]);
+    let light = json(&["--mass-kg", "2", "--speed-ms", "16"]);
+    assert!(
+        heavy["flight"]["induced_share"].as_f64().unwrap()
+            > light["flight"]["induced_share"].as_f64().unwrap()
+    );
+    // The table says which model, core and bird gave the numbers.
+    let (_, out, _) = run(&["power", &shape, "--species", "crane"]);
+    assert!(
+        out.contains("of total power") && out.contains("core 0.04") && out.contains("crane"),
+        "{out}"
+    );
+    // Bad values exit 2 with one line naming the flag.
+    for (flag, value) in [
+        ("--mass-kg", "0"),
+        ("--speed-ms", "-3"),
+        ("--species", "owl"),
+        ("--core-radius", "nan"),
+        ("--wingspan-m", "-1"),
+    ] {
+        let (code, out, err) = run(&["power", &shape, flag, value]);
+        assert!(out.is_empty());
+        assert_usage_text(&format!("{flag} {value}"), code, &err, &[flag]);
+    }
+}
+
+#[test]
 fn solve_writes_a_shape_that_power_reads_back() {
     let dir = scratch("solve");
     let out = dir.join("u.json");

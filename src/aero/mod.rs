@@ -55,6 +55,7 @@
 use serde::{Deserialize, Serialize};
 
 mod field;
+pub mod flight;
 mod tree;
 pub use field::{ApproxField, Field};
 pub use tree::TreeOptions;

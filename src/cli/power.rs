@@ -13,19 +13,113 @@ use super::Global;
 pub struct PowerArgs {
     /// Shape file: {"birds": [{"x": .., "y": ..}, ...]} in the formation frame, wingspans.
     pub shape: PathBuf,
-    /// Print JSON ({"total": E, "flock_saving": E/N, "birds": [{"x","y","e","xi","saving"}]})
-    /// instead of a table.
+    /// Print JSON ({"total": E, "flock_saving": E/N, "flock_saving_total", "flight": {..},
+    /// "birds": [{"x","y","e","xi","saving","saving_total"}]}) instead of a table.
     #[arg(long)]
     pub json: bool,
     /// Vortex core radius of Hummel's model, wingspans (docs/model.md).
     #[arg(long, allow_negative_numbers = true, default_value_t = formation::aero::AeroOptions::default().core_radius)]
     pub core_radius: f64,
+    #[command(flatten)]
+    pub flight: FlightArgs,
+}
+
+/// The bird whose power curve turns savings of induced power into savings of total power.
+#[derive(Debug, Args, Clone)]
+pub struct FlightArgs {
+    /// Species whose typical size sets the power curve (goose, crane or pelican; docs/model.md).
+    #[arg(long, value_name = "NAME", default_value = "goose")]
+    pub species: String,
+    /// Body mass, kg (default: the species' typical mass, scaled to --wingspan-m).
+    #[arg(long = "mass-kg", value_name = "KG", allow_negative_numbers = true)]
+    pub mass_kg: Option<f64>,
+    /// Airspeed, m/s (default: the bird's minimum-power speed).
+    #[arg(long = "speed-ms", value_name = "M/S", allow_negative_numbers = true)]
+    pub speed_ms: Option<f64>,
+    /// Wingspan, m (default: the species' typical span).
+    #[arg(long = "wingspan-m", value_name = "M", allow_negative_numbers = true)]
+    pub wingspan_m: Option<f64>,
+}
+
+/// The power curve and airspeed the flags give.
+pub struct Flight {
+    pub species: formation::animation::wing::Species,
+    pub curve: aero::flight::PowerCurve,
+    pub speed_ms: f64,
+}
+
+impl Flight {
+    /// Share of total power that is induced power at the airspeed.
+    pub fn induced_share(&self) -> f64 {
+        self.curve.induced_share(self.speed_ms)
+    }
+}
+
+impl FlightArgs {
+    /// Checks the flags and builds the curve; errors name the flag.
+    pub fn flight(&self) -> Result<Flight> {
+        let species: formation::animation::wing::Species = self
+            .species
+            .parse()
+            .map_err(|e: Error| reflag(e, "--species"))?;
+        let preset = aero::flight::Morphology::of(species);
+        let mut bird = match self.wingspan_m {
+            Some(b) => {
+                if !(b.is_finite() && b > 0.0 && b <= 100.0) {
+                    return Err(Error::parameter(
+                        "--wingspan-m",
+                        format!("{b}: must be in (0, 100] metres"),
+                    ));
+                }
+                preset.scaled_to(b)
+            }
+            None => preset,
+        };
+        if let Some(m) = self.mass_kg {
+            bird.mass_kg = m;
+        }
+        bird.validate().map_err(|e| reflag(e, "--mass-kg"))?;
+        let curve = aero::flight::PowerCurve::new(bird);
+        let speed_ms = match self.speed_ms {
+            Some(v) => {
+                aero::flight::validate_speed(v).map_err(|e| reflag(e, "--speed-ms"))?;
+                v
+            }
+            None => curve.minimum_power_speed(),
+        };
+        Ok(Flight {
+            species,
+            curve,
+            speed_ms,
+        })
+    }
+}
+
+/// Renames a parameter error to the flag it came from.
+fn reflag(e: Error, flag: &str) -> Error {
+    match e {
+        Error::Parameter { message, .. } => Error::parameter(flag, message),
+        other => other,
+    }
+}
+
+#[derive(Serialize)]
+struct FlightJson {
+    species: String,
+    mass_kg: f64,
+    wingspan_m: f64,
+    wing_area_m2: f64,
+    speed_ms: f64,
+    induced_share: f64,
+    method: &'static str,
 }
 
 #[derive(Serialize)]
 struct PowerJson {
     total: f64,
     flock_saving: f64,
+    flock_saving_total: f64,
+    flight: FlightJson,
     birds: Vec<BirdJson>,
 }
 
@@ -36,6 +130,7 @@ struct BirdJson {
     e: f64,
     xi: f64,
     saving: f64,
+    saving_total: f64,
 }
 
 /// Runs `formation power`.
@@ -61,6 +156,8 @@ pub fn run(args: PowerArgs, _g: Global) -> Result<()> {
     let shape: Shape = formation::io::parse_json(&args.shape, &text)?;
     shape.validate(&args.shape, 2)?;
     let (x, y) = (shape.xs(), shape.ys());
+    let flight = args.flight.flight()?;
+    let share = flight.induced_share();
     let model = aero::AeroOptions {
         core_radius: args.core_radius,
         ..aero::AeroOptions::default()
@@ -78,6 +175,16 @@ pub fn run(args: PowerArgs, _g: Global) -> Result<()> {
         let doc = PowerJson {
             total: pr.total,
             flock_saving,
+            flock_saving_total: flock_saving * share,
+            flight: FlightJson {
+                species: flight.species.to_string(),
+                mass_kg: flight.curve.bird.mass_kg,
+                wingspan_m: flight.curve.bird.span_m,
+                wing_area_m2: flight.curve.bird.wing_area_m2,
+                speed_ms: flight.speed_ms,
+                induced_share: share,
+                method: "Pennycuick 2008",
+            },
             birds: shape
                 .birds
                 .iter()
@@ -88,6 +195,7 @@ pub fn run(args: PowerArgs, _g: Global) -> Result<()> {
                     e,
                     xi,
                     saving: e,
+                    saving_total: e * share,
                 })
                 .collect(),
         };
@@ -96,30 +204,42 @@ pub fn run(args: PowerArgs, _g: Global) -> Result<()> {
     } else {
         let leader = shape.leader().unwrap_or(0);
         out.push_str(&format!(
-            "{:>5} {:>10} {:>10} {:>9} {:>9}\n",
-            "bird", "x", "y", "saving", "xi"
+            "{:>5} {:>10} {:>10} {:>9} {:>9} {:>9}\n",
+            "bird", "x", "y", "induced", "total", "xi"
         ));
         for (i, b) in shape.birds.iter().enumerate() {
             out.push_str(&format!(
-                "{:>5} {:>10.4} {:>10.4} {:>8.2}% {:>9.5}{}\n",
+                "{:>5} {:>10.4} {:>10.4} {:>8.2}% {:>8.2}% {:>9.5}{}\n",
                 i,
                 b.x,
                 b.y,
                 100.0 * pr.e[i],
+                100.0 * pr.e[i] * share,
                 pr.xi[i],
                 if i == leader { "  leader" } else { "" }
             ));
         }
         out.push_str(&format!(
-            "flock saving {:.2}% (mean over {} birds; E = {:.6})\n",
+            "flock saving {:.2}% of induced power, {:.2}% of total power (mean over {} birds; E = {:.6})\n",
             100.0 * flock_saving,
+            100.0 * flock_saving * share,
             shape.len(),
             pr.total
         ));
+        let bird = &flight.curve.bird;
+        out.push_str(&format!(
+            "model: Hummel's horseshoe wake, core {} wingspans; power curve after Pennycuick (2008) for a {} of {:.2} kg, {:.2} m span at {:.1} m/s: induced power is {:.0}% of the total\n",
+            args.core_radius,
+            flight.species,
+            bird.mass_kg,
+            bird.span_m,
+            flight.speed_ms,
+            100.0 * share
+        ));
         out.push_str(
-            "saving = e, the share of a bird's solo induced power (the power that holds it up) that the\n\
-             others save it (negative: it flies in downwash); total power falls by about C × saving,\n\
-             C = induced / total power (0.3-0.5 in cruise); x, y in wingspans, y behind the leader\n",
+            "induced = e, the share of a bird's solo induced power (the power that holds it up) that the\n\
+             others save it (negative: it flies in downwash); total = e × induced share, the share of its\n\
+             mechanical power; model estimates, not measurements; x, y in wingspans, y behind the leader\n",
         );
     }
     super::stdout::print(&out)

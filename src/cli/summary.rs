@@ -104,8 +104,11 @@ pub fn animation_text(what: &str, anim: &Animation, params: Option<&FormationPar
         parts.push(format!("steady flight {t:.1} s"));
     }
     if let Some(e) = s.steady_saving {
+        let total = formation::aero::flight::steady_saving_total(anim).map_or(String::new(), |t| {
+            format!(" ({:.1} % of total power)", 100.0 * t)
+        });
         parts.push(format!(
-            "flock saving {:.1} % of induced power in steady flight (field studies: 14–36 %)",
+            "flock saving {:.1} % of induced power{total} in steady flight by Hummel's model (models applied to measured spacings: 14–36 %)",
             100.0 * e
         ));
     }

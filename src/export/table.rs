@@ -11,6 +11,7 @@
 //! | `lateral`, `behind` | formation frame relative to the leader's heading, wingspans |
 //! | `wing_phase` | radians in [0, 2π), 0 = start of the downstroke |
 //! | `bank` | radians, right wing down positive (0 when the file carries none: level) |
+//! | `saving_total` | `e` as a fraction of the bird's total mechanical power: `e` × the induced share of its power curve at its airspeed (empty where `e` is) |
 //!
 //! `e` (the saving), `xi` and `wing_phase` are numbers in every frame of a file written by this
 //! tool; they are empty only for a hand-made animation file without them. Numbers use the
@@ -22,7 +23,7 @@ use crate::animation::Animation;
 
 /// The header line, without newline.
 pub const CSV_HEADER: &str =
-    "frame,t,bird,x,y,z,heading,speed,e,xi,stage,formation,rank,leader,lateral,behind,wing_phase,bank";
+    "frame,t,bird,x,y,z,heading,speed,e,xi,stage,formation,rank,leader,lateral,behind,wing_phase,bank,saving_total";
 
 /// The stage word of every frame (`none` outside every stage).
 fn stage_words(anim: &Animation) -> Vec<&str> {
@@ -41,6 +42,7 @@ pub fn write_csv<W: Write>(anim: &Animation, w: &mut W) -> std::io::Result<()> {
     let stages = stage_words(anim);
     let of = anim.formation_of_birds();
     let leaders = anim.leaders();
+    let curve = crate::aero::flight::animation_curve(anim.species.as_deref(), anim.wingspan_m);
     for (k, f) in anim.frames.iter().enumerate() {
         let rel = anim.relative_with(k, &of, &leaders);
         for (b, r) in rel.iter().enumerate() {
@@ -55,9 +57,16 @@ pub fn write_csv<W: Write>(anim: &Animation, w: &mut W) -> std::io::Result<()> {
                 .and_then(|a| a.get(b))
                 .copied()
                 .unwrap_or(0.0);
+            let total = match f.e.as_ref().and_then(|a| a.get(b)) {
+                Some(e) => {
+                    let v = crate::aero::flight::airspeed_ms(&curve, v(&f.speed), anim.wingspan_m);
+                    format!("{}", e * curve.induced_share(v))
+                }
+                None => String::new(),
+            };
             writeln!(
                 w,
-                "{k},{},{b},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{bank}",
+                "{k},{},{b},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{bank},{total}",
                 f.t,
                 v(&f.x),
                 v(&f.y),

@@ -27,7 +27,9 @@ const fn r(source: &'static str, species: &'static str, lo: f64, hi: f64) -> Fie
 }
 
 /// Induced-power saving of the flock in formation flight, fraction (the same quantity as the
-/// tool's mean `e`).
+/// tool's mean `e`): model estimates, not measurements. Each study measured wingtip spacings and
+/// turned them into a saving with a lifting-line model (Hainsworth 1987 used Lissaman &
+/// Shollenberger's).
 pub const FLOCK_SAVING: &[FieldRange] = &[
     r(
         "Cutts & Speakman 1994",

@@ -57,7 +57,8 @@ impl SavingsChart {
     }
 }
 
-/// Shades the field studies' span of flock savings across `x`.
+/// Shades the span of flock savings that field studies estimated by applying lifting-line models
+/// to the spacings they measured (not measured savings) across `x`.
 fn band<DB: DrawingBackend>(
     chart: &mut ChartContext<
         '_,
@@ -73,7 +74,7 @@ fn band<DB: DrawingBackend>(
             [(x.0, 100.0 * lo), (x.1, 100.0 * hi)],
             c.mix(0.18).filled(),
         )))?
-        .label("field studies, geese: flock saves 14–36 % of induced power")
+        .label("models applied to measured spacings of geese: 14–36 % of induced power")
         .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 14, y + 5)], c.mix(0.4).filled()));
     Ok(())
 }

@@ -97,7 +97,7 @@ pub fn build(s: &Subject<'_>) -> Result<String> {
     }
     field_section(&mut page, s.params, s.animation);
     page.h2("notes", "How these numbers are defined");
-    page.p("Lengths are in wingspans unless marked m. The formation frame puts each formation's leader at the origin: lateral is to the right of its flight direction, behind is along it. Angles are measured from the flight axis behind the leader (90° = line abreast); the apex angle is the sum of both arms' angles. Wingtip spacing is the lateral distance between lateral neighbours minus one wingspan (negative: wingtips overlap). Savings are fractions of a bird's solo induced power saved by the others' upwash (Hummel's horseshoe-vortex model, as in Klotsman & Tal §5); field studies measured flocks of live birds, so their ranges are a comparison, not a target. docs/formats.md in the tool's documentation defines every field.");
+    page.p("Lengths are in wingspans unless marked m. The formation frame puts each formation's leader at the origin: lateral is to the right of its flight direction, behind is along it. Angles are measured from the flight axis behind the leader (90° = line abreast); the apex angle is the sum of both arms' angles. Wingtip spacing is the lateral distance between lateral neighbours minus one wingspan (negative: wingtips overlap). Savings are fractions of a bird's solo induced power saved by the others' upwash (Hummel's horseshoe-vortex model with a vortex core of 0.04 wingspans, as in Klotsman & Tal §5); \"of total power\" multiplies them by the share of induced power in the bird's power curve (Pennycuick's method). All savings on this page are model estimates. The field studies' savings are model estimates too (lifting-line models applied to the spacings they measured); the only measured effect, a 11–15 % lower heart rate of pelicans in formation, is not a power saving. Their ranges are a comparison, not a target. docs/formats.md in the tool's documentation defines every field.");
     let title = format!("formation report: {name}");
     let mut out = String::new();
     let _ = write!(
@@ -238,7 +238,7 @@ fn params_sections(page: &mut Page, p: &FormationParams, s: &Subject<'_>) -> Res
         };
         page.chart(
             "footage-savings",
-            "Each annotated bird's mean saving against its mean rank (0 = front), and the flock's saving per frame; the field studies' flock savings shaded.",
+            "Each annotated bird's mean saving against its mean rank (0 = front), and the flock's saving per frame; the range that field studies estimated with models from measured spacings shaded.",
             &chart,
         )?;
         bird_tables(page, &st.birds);
@@ -264,14 +264,23 @@ fn animation_sections(page: &mut Page, a: &Animation, s: &Subject<'_>) -> Result
         rows.push(vec!["steady flight".into(), format!("{t:.1} s")]);
     }
     if let Some(e) = st.steady_saving {
-        rows.push(vec!["flock saving in steady flight".into(), pct(e)]);
+        rows.push(vec![
+            "flock saving in steady flight (of induced power, Hummel's model)".into(),
+            pct(e),
+        ]);
+    }
+    if let Some(t) = crate::aero::flight::steady_saving_total(a) {
+        rows.push(vec![
+            "flock saving in steady flight (of total power, Pennycuick's power curve)".into(),
+            pct(t),
+        ]);
     }
     page.table(&["quantity", "value"], &rows);
     if !st.birds.is_empty() {
         let c = crate::plot::savings::SavingsChart::from_animation(a, s.origin)?;
         page.chart(
             "savings",
-            "Each bird's mean saving in steady flight against its rank (the leader in red), and the flock's saving over time through the take-off; field studies' flock savings shaded.",
+            "Each bird's mean saving in steady flight against its rank (the leader in red), and the flock's saving over time through the take-off; the range that field studies estimated with models from measured spacings shaded.",
             &c,
         )?;
         bird_tables(page, &st.birds);
@@ -466,7 +475,7 @@ fn field_section(page: &mut Page, p: Option<&FormationParams>, a: Option<&Animat
         .map_or("–".into(), pct);
     for f in field::FLOCK_SAVING {
         rows.push(vec![
-            "flock's induced-power saving".into(),
+            "flock's induced-power saving (a model applied to measured spacings)".into(),
             format!("{}, {}", f.source, f.species),
             pct(f.lo),
             ours_saving.clone(),
