@@ -274,11 +274,39 @@ pub fn summary_table(
     if let Some(sum) = &p.summary {
         s.push_str(&overall_text(&sum.geometry, sum.wingspan_m.is_some()));
     }
+    if let Some(ci) = &p.ci {
+        s.push_str(&ci_text(ci));
+    }
     s.push_str("angles from the flight axis behind the leader (90° = line abreast); depth = farthest inlier behind the leader; WTS = mean wingtip spacing of lateral neighbours (μ_x − 1), wingspans\n");
     if let Some(o) = out {
         let _ = writeln!(s, "wrote {}", o.display());
     }
     s
+}
+
+/// The line of 95 % bootstrap intervals.
+pub fn ci_text(ci: &formation::extract::bootstrap::Intervals) -> String {
+    let r = |v: Option<[f64; 2]>, prec: usize, unit: &str| {
+        v.map(|[lo, hi]| format!("{lo:.prec$} to {hi:.prec$}{unit}"))
+    };
+    let parts: Vec<String> = [
+        r(ci.apex_deg, 1, "°").map(|t| format!("apex angle {t}")),
+        r(ci.lateral, 2, "")
+            .zip(r(ci.behind, 2, " wingspans"))
+            .map(|(a, b)| format!("nearest bird ahead {a} to the side and {b} in front")),
+        r(ci.depth, 2, " wingspans").map(|t| format!("depth {t}")),
+        r(ci.wts, 3, " wingspans").map(|t| format!("mean wingtip spacing {t}")),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    if parts.is_empty() {
+        return String::new();
+    }
+    format!(
+        "95 % intervals of the medians (bootstrap over frames and birds): {}\n",
+        parts.join("; ")
+    )
 }
 
 /// `54.1 (27.0+27.1)`, `61.0 (right)` for one arm, `-` for none.

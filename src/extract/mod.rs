@@ -38,6 +38,7 @@
 //! |r| ≤ T are inliers; μ_y, σ_y are the mean and sample standard deviation of the inliers'
 //! vertical deviations dy = y − curve(x) (the paper's y-deviations).
 
+pub mod bootstrap;
 pub mod checks;
 pub mod geometry;
 pub mod motion;
@@ -246,7 +247,9 @@ pub fn extract_with_report(
         frames,
         summary: None,
         motion: None,
+        ci: None,
     };
+    params.ci = Some(Box::new(bootstrap::intervals(&params.frames)));
     params.motion = opts
         .footage_fps
         .or(ann.fps)

@@ -28,6 +28,10 @@ pub struct FormationParams {
     /// the footage has no timing (the steady flight then uses the field-data default).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub motion: Option<super::motion::PositionKeeping>,
+    /// 95 % bootstrap intervals of the apex angle, the nearest bird ahead, the depth and the
+    /// wingtip spacing; absent in files written before them.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ci: Option<Box<super::bootstrap::Intervals>>,
 }
 
 /// What `extract` reports about the whole movie besides the per-frame parameters.

@@ -587,6 +587,7 @@ mod tests {
             frames: vec![f],
             summary: None,
             motion: None,
+            ci: None,
         };
         let c = correspondence(&p.frames[0], 5).unwrap();
         let s = initial_shapes(&p, &c, &mut seeded(0), &InitialOptions::default());

@@ -119,6 +119,7 @@ pub fn movie(
         frames: out,
         summary: None,
         motion: None,
+        ci: None,
     }
 }
 
