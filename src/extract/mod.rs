@@ -44,6 +44,7 @@ pub mod geometry;
 pub mod motion;
 pub mod params;
 pub mod ransac;
+pub mod screen;
 
 use rand::Rng;
 use serde::{Deserialize, Serialize};

@@ -376,14 +376,16 @@ pub fn steady_flight_in(
 
     // Step 1.
     let corr: Correspondence = correspondence(first, n)?;
-    let (lo_mu, hi_mu) = params
-        .frames
+    // The spacing is drawn from the frames that look like the others (an odd frame, e.g. a
+    // half-tracked one, would widen every generated flock; `extract` warns about it).
+    let spacing_frames = crate::extract::screen::spacing_frames(params);
+    let (lo_mu, hi_mu) = spacing_frames
         .iter()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), f| {
             (a.min(f.mu_x), b.max(f.mu_x))
         });
     let sigma_bar =
-        params.frames.iter().map(|f| f.sigma_x).sum::<f64>() / params.frames.len() as f64;
+        spacing_frames.iter().map(|f| f.sigma_x).sum::<f64>() / spacing_frames.len().max(1) as f64;
     let u: f64 = rng.random();
     let mean_gap = (lo_mu + u * (hi_mu - lo_mu)).max(init_opts.min_gap);
     let gaps = lateral_gaps(rng, mean_gap, sigma_bar, n - 1, init_opts);
