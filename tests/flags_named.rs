@@ -92,6 +92,9 @@ fn commands() -> Vec<Command> {
         ("--wingspan-m", "0", None),
         ("--max-jump", "0", None),
         ("--jostle", "-1", None),
+        ("--core-radius", "nan", None),
+        ("--mass-kg", "0", None),
+        ("--speed-ms", "-3", None),
         ("--formations", "0", None),
         ("--formation-size", "1", None),
         ("--clearance", "-1", None),
@@ -199,7 +202,14 @@ fn commands() -> Vec<Command> {
         Command {
             name: &["power"],
             base: strings(&["power", &shape]),
-            cases: vec![("--core-radius", "nan", None), seed.clone()],
+            cases: vec![
+                ("--core-radius", "nan", None),
+                ("--mass-kg", "0", None),
+                ("--speed-ms", "-3", None),
+                ("--species", "owl", None),
+                ("--wingspan-m", "0", None),
+                seed.clone(),
+            ],
         },
         Command {
             name: &["solve"],

@@ -1795,6 +1795,8 @@ pub fn hand_over(
     }
     let mut out = Animation::new(opts.seed, fps, steady.wingspan_m, n);
     out.species = steady.species.clone();
+    out.flight = steady.flight;
+    out.savings_model = steady.savings_model.clone();
     out.stages.push(Stage {
         name: "initiation".into(),
         start: 0,

@@ -74,6 +74,9 @@ pub struct SteadyOptions {
     /// Each bird's position-keeping motion about its slot (`keyshape::jostle`); none in a
     /// loop.
     pub jostle: JostleOptions,
+    /// The birds' mass and airspeed for their power curve (savings of total power), recorded in
+    /// the animation.
+    pub flight: crate::animation::FlightSettings,
     /// A seamless cycle: the last key shape is the first, placed one frame after the last
     /// frame, so the frame after the last is the first again (in the flock's moving frame).
     #[serde(rename = "loop")]
@@ -95,6 +98,7 @@ impl Default for SteadyOptions {
             heights: HeightOptions::default(),
             aero: AeroOptions::default(),
             jostle: JostleOptions::default(),
+            flight: crate::animation::FlightSettings::default(),
             looped: false,
         }
     }
@@ -155,6 +159,7 @@ impl SteadyOptions {
         self.heights.validate()?;
         self.aero.validate()?;
         self.jostle.validate()?;
+        crate::aero::flight::validate_settings(&self.flight)?;
         let seconds = self.frames as f64 / self.fps;
         if self.looped && seconds < self.keys.key_every_s {
             return Err(p(
@@ -662,6 +667,11 @@ pub fn steady_flight_in(
     progress.finish();
 
     let mut anim = Animation::new(opts.seed, opts.fps, opts.wingspan_m, n);
+    anim.flight = (!opts.flight.is_empty()).then_some(opts.flight);
+    anim.savings_model = Some(crate::animation::SavingsModel {
+        wake: "planar".into(),
+        core_radius: opts.aero.core_radius,
+    });
     anim.stages.push(Stage {
         name: "steady".into(),
         start: 0,

@@ -269,6 +269,26 @@ fn animation_sections(page: &mut Page, a: &Animation, s: &Subject<'_>) -> Result
             pct(e),
         ]);
     }
+    if let Some(m) = &a.savings_model {
+        rows.push(vec!["savings model".into(), m.to_string()]);
+    }
+    {
+        let c = crate::aero::flight::curve_of(a);
+        let b = &c.bird;
+        let speed = a
+            .flight
+            .and_then(|f| f.speed_ms)
+            .map_or("each bird's own airspeed".to_string(), |v| {
+                format!("{v} m/s")
+            });
+        rows.push(vec![
+            "power curve (Pennycuick 2008)".into(),
+            format!(
+                "{:.2} kg, {:.2} m span, {:.3} m² wings; {speed}",
+                b.mass_kg, b.span_m, b.wing_area_m2
+            ),
+        ]);
+    }
     if let Some(t) = crate::aero::flight::steady_saving_total(a) {
         rows.push(vec![
             "flock saving in steady flight (of total power, Pennycuick's power curve)".into(),

@@ -547,6 +547,8 @@ fn join(anims: &[Animation], reports: &[FormationReport]) -> Result<Animation> {
     }
     let mut out = Animation::new(first.seed, first.fps, first.wingspan_m, n);
     out.species = first.species.clone();
+    out.flight = first.flight;
+    out.savings_model = first.savings_model.clone();
     out.wingbeat = first.wingbeat.clone();
     out.stages = first.stages.clone();
     let steady_start = first.stage("steady").map(|s: &Stage| s.start);
