@@ -1,4 +1,4 @@
-//! The animation file (SPEC §4.4), the plain data type that `steady`, `initiate` and `animate`
+//! The animation file (docs/formats.md §4.4), the plain data type that `steady`, `initiate` and `animate`
 //! write and `render` reads. World frame: `x` east, `y` north, `z` up, lengths in wingspans, the
 //! cruise heading is +y; headings in radians clockwise from +y; speeds in wingspans per second.
 
@@ -46,7 +46,7 @@ pub struct Animation {
     /// shapes. Absent when the whole flock is one formation (then `key_shapes` describe it).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub formations: Option<Vec<FormationRecord>>,
-    /// The steady flight cycles seamlessly (issue 19, `steady.loop`): the frame after the last
+    /// The steady flight cycles seamlessly (`steady.loop`): the frame after the last
     /// would be the first again, in the flock's moving frame (in the world too on a closed path).
     #[serde(default, skip_serializing_if = "std::ops::Not::not", rename = "loop")]
     pub looped: bool,
@@ -84,7 +84,7 @@ impl std::fmt::Display for SavingsModel {
 }
 
 /// What the power curve of an animation's birds is computed from besides the species and the
-/// wingspan (`steady.flight`; `--mass-kg`, `--speed-ms`).
+/// wingspan (`steady.flight`).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct FlightSettings {
@@ -103,7 +103,7 @@ impl FlightSettings {
     }
 }
 
-/// The path an animation follows (issue 19).
+/// The path an animation follows.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PathRecord {
     /// The file it was read from.

@@ -1,7 +1,7 @@
 //! §5 step 2: Hummel's power-reduction model, as printed in Klotsman & Tal (after Hummel 1983),
 //! defined for every lateral distance: overlapping wingtips, line astern, and a vortex core.
 //!
-//! Takes lateral and longitudinal distances between birds in wingspans (SPEC §2–3) and gives the
+//! Takes lateral and longitudinal distances between birds in wingspans (docs/formats.md §2–3) and gives the
 //! pair function g(x, y), its partial derivatives, each bird's saving e_i, the total E and the
 //! relative values ξ_i = e_i / E. Pure functions; the drag ratio C of eq. (1) is dropped.
 //!

@@ -1,4 +1,4 @@
-//! `formation steady`, `formation plot power` and `formation plot xi` (issue 4): flags into
+//! `formation steady`, `formation plot power` and `formation plot xi`: flags into
 //! [`SteadyOptions`], the library's Algorithm 1, and the animation written as JSON or long CSV.
 
 use std::path::{Path, PathBuf};

@@ -1,5 +1,5 @@
 //! The one-paragraph summary that `animate`, `steady` and `initiate` print on stderr after
-//! their outputs are committed (issue 16): the shape learnt, the formations, the take-off time,
+//! their outputs are committed: the shape learnt, the formations, the take-off time,
 //! the flock's saving and the files written with their sizes. `--quiet` hides it.
 
 use std::path::PathBuf;

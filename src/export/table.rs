@@ -1,6 +1,7 @@
-//! CSV export in SPEC §4.4's long format, one row per frame and bird: first exactly the SPEC's
-//! columns `frame,t,bird,x,y,z,heading,speed,e,xi` (world frame, wingspans, radians, wingspans
-//! per second, seconds), then the analysis columns of issue 16 (never renamed, only added to):
+//! CSV export in the long format of docs/formats.md §4.4, one row per frame and bird: first
+//! exactly the ten fixed columns `frame,t,bird,x,y,z,heading,speed,e,xi` (world frame,
+//! wingspans, radians, wingspans per second, seconds), then the analysis columns (never
+//! renamed, only added to):
 //!
 //! | column | meaning |
 //! |---|---|

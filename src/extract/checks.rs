@@ -1,4 +1,4 @@
-//! Warnings instead of silent wrong answers (issue 16): suspicious annotations that extract
+//! Warnings instead of silent wrong answers: suspicious annotations that extract
 //! without error but probably do not say what the user meant.
 //!
 //! Takes the [`Annotations`], the extracted [`FormationParams`] and each frame's model-selection

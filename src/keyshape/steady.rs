@@ -1,5 +1,5 @@
 //! §5 Algorithm 1, the whole steady flight: from the formation parameters of an N̂-bird movie
-//! (SPEC §4.2) to an F-frame animation of N birds (SPEC §4.4) whose key shapes keep the movie's
+//! (docs/formats.md §4.2) to an F-frame animation of N birds (docs/formats.md §4.4) whose key shapes keep the movie's
 //! energy-savings pattern. Lengths in wingspans, times in seconds, speeds in wingspans per second.
 //!
 //! 1. [`initial`](crate::keyshape::initial): correspondence and one N-bird shape per movie frame.
@@ -12,7 +12,7 @@
 //! The lateral positions are drawn once: gaps from N(d̄, σ̄_x) with
 //! d̄ uniform in the movie's range of mean gaps [min_f μ_xf, max_f μ_xf] and σ̄_x the mean of σ_xf,
 //! redrawn only at or below a body's width (`min_gap`; overlapping wingtips are kept); each gap
-//! then drifts slowly around its drawn value from key to key (`lateral_drift`, issue 19), so
+//! then drifts slowly around its drawn value from key to key (`lateral_drift`), so
 //! every key shape has its own x. Munk's theorem fixes E = Σ_{i≠j} g(|x_i − x_j|, 0) of each
 //! key shape (`aero::munk_total`), which makes eq. (3) exact instead of an estimate from a
 //! constant-gap flock. Heights differ slightly between birds (`height_spread`,
@@ -65,9 +65,9 @@ pub struct SteadyOptions {
     pub keys: KeyOptions,
     /// Step 1: the lateral gaps' physical bound and the initial shapes' redraws.
     pub initial: InitialOptions,
-    /// The lateral positions' slow drift between key shapes (issue 19).
+    /// The lateral positions' slow drift between key shapes.
     pub lateral: LateralOptions,
-    /// Small per-bird altitude differences (issue 19).
+    /// Small per-bird altitude differences.
     pub heights: HeightOptions,
     /// The aerodynamic model's vortex core and collision distance.
     pub aero: AeroOptions,
@@ -299,7 +299,7 @@ const DEPTH_SCALE_LIMIT: f64 = 3.0;
 
 /// The factor on the U and J curves' rank scale ([`side_scales`]) that gives the initial shapes,
 /// at the key shapes' lateral positions `x`, the footage's median longitudinal distance to the
-/// nearest bird ahead (issue 12). The plain rank scale keeps each bird's step behind its
+/// nearest bird ahead. The plain rank scale keeps each bird's step behind its
 /// neighbour at the same relative place on the arm, but a median of the few steps of a small
 /// flock, or of the many of a large one, is not the footage's median of its own count (a
 /// parabola's steps grow along the arm), and the noise of the deviations adds to it. The

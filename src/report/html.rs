@@ -405,7 +405,7 @@ fn bird_tables(page: &mut Page, birds: &[BirdStats]) {
     // (by mean distance behind the leader), pooled over formations.
     // Place k on an arm: 1 + the birds of the same formation and arm ahead of it, counted by
     // sorting each arm once (counting them for every bird was quadratic: 100 000 birds took
-    // seconds, issue 17).
+    // seconds).
     let mut arm: Vec<usize> = (0..birds.len()).filter(|&i| !birds[i].leader).collect();
     let side = |b: &BirdStats| (b.formation, b.lateral >= 0.0);
     arm.sort_by(|&i, &j| {
