@@ -83,7 +83,7 @@ const A: f64 = VORTEX_SPAN;
 
 /// Pairs at least this far apart laterally (wingspans) are evaluated, inside the shape-level
 /// sums ([`AeroOptions::power_unchecked`] and the Jacobian), by the far-field expansion of
-/// [`far_pair`] instead of the closed form: relative error below 3·10⁻⁸, absolute below 10⁻¹²
+/// `far_pair` instead of the closed form: relative error below 3·10⁻⁸, absolute below 10⁻¹²
 /// (tested), and about a fifth of the cost, which is what makes flocks of thousands of birds fast.
 pub const FAR_FIELD: f64 = 60.0;
 /// Flocks of at least this many birds are summed by [`Field`] in [`AeroOptions::power_unchecked`]
