@@ -134,3 +134,97 @@ fn no_import_cycles_between_top_level_modules() {
         }
     }
 }
+
+#[test]
+fn no_import_cycles_between_the_files_of_a_module() {
+    // Inside each directory module (src/aero/, src/extract/, ...), the sibling files import one
+    // another in one direction only (the parent mod.rs is left out: it gathers its children).
+    let mut cycles = Vec::new();
+    for entry in std::fs::read_dir(src()).unwrap() {
+        let dir = entry.unwrap().path();
+        if !dir.is_dir() {
+            continue;
+        }
+        let module = dir.file_name().unwrap().to_string_lossy().into_owned();
+        let mut files: BTreeMap<String, String> = BTreeMap::new();
+        for f in std::fs::read_dir(&dir).unwrap() {
+            let p = f.unwrap().path();
+            let name = p.file_stem().unwrap().to_string_lossy().into_owned();
+            if p.extension().is_some_and(|e| e == "rs") && name != "mod" {
+                // Code outside the file's unit tests.
+                let text = std::fs::read_to_string(&p).unwrap();
+                let code = text.split("#[cfg(test)]").next().unwrap_or("").to_string();
+                files.insert(name, code);
+            }
+        }
+        let mut deps: BTreeMap<&str, BTreeSet<&str>> = BTreeMap::new();
+        for (name, code) in &files {
+            for line in code.lines() {
+                let line = line.split("//").next().unwrap();
+                for prefix in ["super::".to_string(), format!("crate::{module}::")] {
+                    for (i, _) in line.match_indices(prefix.as_str()) {
+                        let rest = &line[i + prefix.len()..];
+                        let mut names: Vec<&str> = Vec::new();
+                        if let Some(group) = rest.strip_prefix('{') {
+                            names.extend(
+                                group
+                                    .split('}')
+                                    .next()
+                                    .unwrap()
+                                    .split(',')
+                                    .map(|s| s.trim().split("::").next().unwrap().trim()),
+                            );
+                        } else {
+                            names.push(
+                                rest.split(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
+                                    .next()
+                                    .unwrap(),
+                            );
+                        }
+                        for n in names {
+                            if let Some((k, _)) = files.get_key_value(n) {
+                                if k != name {
+                                    deps.entry(name.as_str()).or_default().insert(k.as_str());
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        let reaches = |from: &str, to: &str| {
+            let mut seen = BTreeSet::new();
+            let mut stack = vec![from];
+            while let Some(x) = stack.pop() {
+                for d in deps.get(x).into_iter().flatten() {
+                    if *d == to {
+                        return true;
+                    }
+                    if seen.insert(*d) {
+                        stack.push(d);
+                    }
+                }
+            }
+            false
+        };
+        for (m, ds) in &deps {
+            for d in ds {
+                if m < d && reaches(d, m) {
+                    cycles.push(format!("{module}: {m} <-> {d}"));
+                }
+            }
+        }
+    }
+    // Known: the steady flight's orchestrator and three of its steps still share options and a
+    // helper both ways (keyshape: steady <-> heights, keys, lateral). No new cycle may appear.
+    let known = [
+        "keyshape: heights <-> steady",
+        "keyshape: keys <-> steady",
+        "keyshape: lateral <-> steady",
+    ];
+    cycles.retain(|c| !known.contains(&c.as_str()));
+    assert!(
+        cycles.is_empty(),
+        "import cycles inside modules: {cycles:?}"
+    );
+}

@@ -54,6 +54,7 @@
 
 use serde::{Deserialize, Serialize};
 
+mod far;
 mod field;
 pub mod flight;
 mod tree;

@@ -19,8 +19,7 @@
 //!
 //! Deterministic: one sequential traversal in a fixed order; the same bits on every run.
 
-use super::field::{far_odd_smooth, far_slope};
-use super::field::{parallel, PARALLEL_MIN};
+use super::far::{far_odd_smooth, far_slope, parallel, PARALLEL_MIN};
 use super::FAR_FIELD;
 
 /// Which far-pair function [`FarTree::sum`] adds up (units of 2/π²).

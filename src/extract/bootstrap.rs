@@ -11,7 +11,6 @@
 //! always gives the same intervals (and the extraction's own random stream is untouched).
 
 use rand::Rng;
-use serde::{Deserialize, Serialize};
 
 use super::geometry::FrameGeometry;
 use super::params::FrameParams;
@@ -25,27 +24,7 @@ const SEED: u64 = 0x626f_6f74_7374_7270;
 /// Fewest frames an interval is computed from (fewer: no interval).
 pub const MIN_FRAMES: usize = 3;
 
-/// 95 % intervals, `[lo, hi]`; a quantity the footage does not have (an apex without a V, too
-/// few frames) is absent.
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
-pub struct Intervals {
-    /// Apex angle, degrees (median over the frames with two arms).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub apex_deg: Option<[f64; 2]>,
-    /// Lateral offset of each bird from its nearest bird ahead, wingspans (median over every
-    /// bird of every frame).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub lateral: Option<[f64; 2]>,
-    /// Distance behind its nearest bird ahead, wingspans.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub behind: Option<[f64; 2]>,
-    /// Depth (farthest inlier behind the leader), wingspans (median over the frames).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub depth: Option<[f64; 2]>,
-    /// Mean wingtip spacing (μ_x − 1), wingspans (median over the frames).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub wts: Option<[f64; 2]>,
-}
+pub use super::params::Intervals;
 
 /// Each inlier bird's offset from its nearest bird ahead in one frame: (|lateral|, behind),
 /// wingspans. The bird ahead is the nearest (Euclidean) inlier with a smaller distance behind the

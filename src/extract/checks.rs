@@ -24,7 +24,6 @@
 //! - **Three birds**: frames of 3 birds fit a V and a parabola exactly; they are taken as a V.
 
 use rand::Rng;
-use serde::{Deserialize, Serialize};
 
 use super::params::FormationParams;
 use super::{ExtractOptions, FrameReport};
@@ -59,32 +58,7 @@ pub const PLAUSIBLE_NEIGHBOUR: (f64, f64) = (0.4, 5.0);
 /// 0.8 lateral and 0.5–1.2 behind, so 1–1.5 apart); used to suggest a scale.
 pub const TYPICAL_NEIGHBOUR: f64 = 1.2;
 
-/// What kind of suspicion a [`Warning`] is.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum WarningKind {
-    /// The formation opens forward (y axis or heading reversed).
-    OpensForward,
-    /// The formation fits far better with the heading turned 90°.
-    Heading,
-    /// Birds implausibly close or far for the given wingspan in pixels.
-    Scale,
-    /// Fewer than [`MIN_FRAMES`] frames.
-    FewFrames,
-    /// Frames of exactly 3 birds (V and U indistinguishable).
-    ThreeBirds,
-    /// Frames unlike the others (gaps, scatter or birds off the shape), left out of the spacing.
-    OddFrame,
-}
-
-/// One warning: its kind and a one-line message naming the option that fixes it.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Warning {
-    /// What kind of suspicion.
-    pub kind: WarningKind,
-    /// One line: the file, what looks wrong, the likely cause, the option that fixes it.
-    pub message: String,
-}
+pub use super::params::{Warning, WarningKind};
 
 /// `deg` as the annotation format writes it: `up`, `right`, `down`, `left` or degrees.
 pub fn heading_word(deg: f64) -> String {

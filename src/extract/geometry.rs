@@ -18,96 +18,10 @@
 //!   averaged over the frame's neighbour pairs, i.e. μ_x − 1; negative when wingtips overlap.
 //!   Metres when the wingspan in metres is known.
 
-use serde::{Deserialize, Serialize};
-
 use super::params::FrameParams;
 use super::ransac::{Line, Model};
 
-/// Geometry of one extracted frame.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct FrameGeometry {
-    /// Angle of the left arm from the flight axis behind the leader, degrees; `None` without a
-    /// bird left of the leader.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub arm_left_deg: Option<f64>,
-    /// Angle of the right arm, degrees; `None` without a bird right of the leader.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub arm_right_deg: Option<f64>,
-    /// Apex angle, left + right arm, degrees; `None` unless both arms exist.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub apex_deg: Option<f64>,
-    /// Farthest inlier behind the leader, wingspans.
-    pub depth: f64,
-    /// Lateral extent of the inliers, wingspans.
-    pub width: f64,
-    /// Mean wingtip spacing of lateral neighbours (μ_x − 1), wingspans.
-    pub wingtip_spacing: f64,
-    /// The same in metres, when the wingspan in metres is known.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub wingtip_spacing_m: Option<f64>,
-}
-
-/// Median, mean and range of one quantity over the frames that have it.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct Stat {
-    /// Frames that have the quantity.
-    pub frames: usize,
-    /// Median.
-    pub median: f64,
-    /// Mean.
-    pub mean: f64,
-    /// Smallest value.
-    pub min: f64,
-    /// Largest value.
-    pub max: f64,
-}
-
-impl Stat {
-    /// The statistics of `v`; `None` when empty.
-    pub fn of(v: &[f64]) -> Option<Stat> {
-        if v.is_empty() {
-            return None;
-        }
-        let mut s = v.to_vec();
-        s.sort_by(f64::total_cmp);
-        let n = s.len();
-        let median = if n % 2 == 1 {
-            s[n / 2]
-        } else {
-            (s[n / 2 - 1] + s[n / 2]) / 2.0
-        };
-        Some(Stat {
-            frames: n,
-            median,
-            mean: s.iter().sum::<f64>() / n as f64,
-            min: s[0],
-            max: s[n - 1],
-        })
-    }
-}
-
-/// The movie's geometry over all frames.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct GeometrySummary {
-    /// Apex angle, degrees (frames with two arms).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub apex_deg: Option<Stat>,
-    /// Left arm angle, degrees.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub arm_left_deg: Option<Stat>,
-    /// Right arm angle, degrees.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub arm_right_deg: Option<Stat>,
-    /// Depth, wingspans.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub depth: Option<Stat>,
-    /// Mean wingtip spacing, wingspans.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub wingtip_spacing: Option<Stat>,
-    /// Mean wingtip spacing, metres, when the wingspan in metres is known.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub wingtip_spacing_m: Option<Stat>,
-}
+pub use super::params::{FrameGeometry, GeometrySummary, Stat};
 
 /// Angle of an arm of slope `s` (dy/dx) from the flight axis behind the leader, degrees; `left`
 /// for an arm at x < 0.

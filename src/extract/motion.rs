@@ -10,7 +10,6 @@
 //! them with a smooth stationary process per bird whose correlation time is fitted here to the
 //! 0.5 s move and the spread.
 
-use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
 /// The short lag of the move statistics, seconds.
@@ -20,46 +19,7 @@ pub const LONG_LAG_S: f64 = 3.0;
 /// Median of |N(0, 1)|: the median absolute value of a zero-mean Gaussian is this times its sd.
 const HALF_NORMAL_MEDIAN: f64 = 0.674_489_750_196_081_7;
 
-/// One axis of position keeping, wingspans.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct AxisKeeping {
-    /// Median of a bird's move over 0.5 s.
-    pub move_median: f64,
-    /// 90th percentile of a bird's move over 0.5 s.
-    pub move_p90: f64,
-    /// Median of a bird's move over 3 s (`None` when the footage is shorter).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub move_long_median: Option<f64>,
-    /// Per-bird standard deviation about its mean slot, median over the birds.
-    pub spread: f64,
-    /// Correlation time ℓ of the fitted process, seconds: its autocorrelation is
-    /// exp(−τ²/(2ℓ²)).
-    pub time_scale: f64,
-}
-
-/// Where the position-keeping statistics came from.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum KeepingSource {
-    /// Measured in the footage.
-    Footage,
-    /// The field-data default (wild white-fronted geese).
-    FieldData,
-}
-
-/// The footage's position keeping (the params' `"motion"`).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct PositionKeeping {
-    /// Measured or default.
-    pub source: KeepingSource,
-    /// Frames per second of the footage used for the frame times.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub fps: Option<f64>,
-    /// Across the flight direction.
-    pub lateral: AxisKeeping,
-    /// Along the flight direction.
-    pub fore_aft: AxisKeeping,
-}
+pub use super::params::{AxisKeeping, KeepingSource, PositionKeeping};
 
 impl AxisKeeping {
     /// An axis from its 0.5 s move median and spread, with the fitted correlation time.

@@ -27,11 +27,11 @@ pub struct FormationParams {
     /// The birds' position keeping measured in the footage (needs frame times); absent when
     /// the footage has no timing (the steady flight then uses the field-data default).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub motion: Option<super::motion::PositionKeeping>,
+    pub motion: Option<PositionKeeping>,
     /// 95 % bootstrap intervals of the apex angle, the nearest bird ahead, the depth and the
     /// wingtip spacing; absent in files written before them.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub ci: Option<Box<super::bootstrap::Intervals>>,
+    pub ci: Option<Box<Intervals>>,
 }
 
 /// What `extract` reports about the whole movie besides the per-frame parameters.
@@ -41,10 +41,10 @@ pub struct ParamsSummary {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub wingspan_m: Option<f64>,
     /// Apex angle, arm angles, depth and wingtip spacing over the frames.
-    pub geometry: super::geometry::GeometrySummary,
+    pub geometry: GeometrySummary,
     /// Suspicious input found while extracting (empty when none).
     #[serde(default)]
-    pub warnings: Vec<super::checks::Warning>,
+    pub warnings: Vec<Warning>,
 }
 
 /// §4 steps 1 and 2 for one frame.
@@ -77,7 +77,7 @@ pub struct FrameParams {
     /// Apex angle per arm, depth, width and wingtip spacing; absent in files
     /// written before it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub geometry: Option<super::geometry::FrameGeometry>,
+    pub geometry: Option<FrameGeometry>,
 }
 
 /// A marked bird in the formation frame.
@@ -354,6 +354,185 @@ impl FormationParams {
         }
         Ok(())
     }
+}
+
+// The types the extraction's summary and checks fill in live here, with the file they are part
+// of, so that `geometry` and `checks` depend on this module and not the other way round.
+
+/// Geometry of one extracted frame.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct FrameGeometry {
+    /// Angle of the left arm from the flight axis behind the leader, degrees; `None` without a
+    /// bird left of the leader.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub arm_left_deg: Option<f64>,
+    /// Angle of the right arm, degrees; `None` without a bird right of the leader.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub arm_right_deg: Option<f64>,
+    /// Apex angle, left + right arm, degrees; `None` unless both arms exist.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub apex_deg: Option<f64>,
+    /// Farthest inlier behind the leader, wingspans.
+    pub depth: f64,
+    /// Lateral extent of the inliers, wingspans.
+    pub width: f64,
+    /// Mean wingtip spacing of lateral neighbours (μ_x − 1), wingspans.
+    pub wingtip_spacing: f64,
+    /// The same in metres, when the wingspan in metres is known.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub wingtip_spacing_m: Option<f64>,
+}
+
+/// Median, mean and range of one quantity over the frames that have it.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Stat {
+    /// Frames that have the quantity.
+    pub frames: usize,
+    /// Median.
+    pub median: f64,
+    /// Mean.
+    pub mean: f64,
+    /// Smallest value.
+    pub min: f64,
+    /// Largest value.
+    pub max: f64,
+}
+
+impl Stat {
+    /// The statistics of `v`; `None` when empty.
+    pub fn of(v: &[f64]) -> Option<Stat> {
+        if v.is_empty() {
+            return None;
+        }
+        let mut s = v.to_vec();
+        s.sort_by(f64::total_cmp);
+        let n = s.len();
+        let median = if n % 2 == 1 {
+            s[n / 2]
+        } else {
+            (s[n / 2 - 1] + s[n / 2]) / 2.0
+        };
+        Some(Stat {
+            frames: n,
+            median,
+            mean: s.iter().sum::<f64>() / n as f64,
+            min: s[0],
+            max: s[n - 1],
+        })
+    }
+}
+
+/// The movie's geometry over all frames.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct GeometrySummary {
+    /// Apex angle, degrees (frames with two arms).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub apex_deg: Option<Stat>,
+    /// Left arm angle, degrees.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub arm_left_deg: Option<Stat>,
+    /// Right arm angle, degrees.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub arm_right_deg: Option<Stat>,
+    /// Depth, wingspans.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub depth: Option<Stat>,
+    /// Mean wingtip spacing, wingspans.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub wingtip_spacing: Option<Stat>,
+    /// Mean wingtip spacing, metres, when the wingspan in metres is known.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub wingtip_spacing_m: Option<Stat>,
+}
+
+/// What kind of suspicion a [`Warning`] is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum WarningKind {
+    /// The formation opens forward (y axis or heading reversed).
+    OpensForward,
+    /// The formation fits far better with the heading turned 90°.
+    Heading,
+    /// Birds implausibly close or far for the given wingspan in pixels.
+    Scale,
+    /// Fewer than `extract::checks::MIN_FRAMES` frames.
+    FewFrames,
+    /// Frames of exactly 3 birds (V and U indistinguishable).
+    ThreeBirds,
+    /// Frames unlike the others (gaps, scatter or birds off the shape), left out of the spacing.
+    OddFrame,
+}
+
+/// One warning: its kind and a one-line message naming the option that fixes it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Warning {
+    /// What kind of suspicion.
+    pub kind: WarningKind,
+    /// One line: the file, what looks wrong, the likely cause, the option that fixes it.
+    pub message: String,
+}
+
+/// One axis of position keeping, wingspans.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct AxisKeeping {
+    /// Median of a bird's move over 0.5 s.
+    pub move_median: f64,
+    /// 90th percentile of a bird's move over 0.5 s.
+    pub move_p90: f64,
+    /// Median of a bird's move over 3 s (`None` when the footage is shorter).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub move_long_median: Option<f64>,
+    /// Per-bird standard deviation about its mean slot, median over the birds.
+    pub spread: f64,
+    /// Correlation time ℓ of the fitted process, seconds: its autocorrelation is
+    /// exp(−τ²/(2ℓ²)).
+    pub time_scale: f64,
+}
+
+/// Where the position-keeping statistics came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum KeepingSource {
+    /// Measured in the footage.
+    Footage,
+    /// The field-data default (wild white-fronted geese).
+    FieldData,
+}
+
+/// The footage's position keeping (the params' `"motion"`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct PositionKeeping {
+    /// Measured or default.
+    pub source: KeepingSource,
+    /// Frames per second of the footage used for the frame times.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fps: Option<f64>,
+    /// Across the flight direction.
+    pub lateral: AxisKeeping,
+    /// Along the flight direction.
+    pub fore_aft: AxisKeeping,
+}
+
+/// 95 % intervals, `[lo, hi]`; a quantity the footage does not have (an apex without a V, too
+/// few frames) is absent.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct Intervals {
+    /// Apex angle, degrees (median over the frames with two arms).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub apex_deg: Option<[f64; 2]>,
+    /// Lateral offset of each bird from its nearest bird ahead, wingspans (median over every
+    /// bird of every frame).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lateral: Option<[f64; 2]>,
+    /// Distance behind its nearest bird ahead, wingspans.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub behind: Option<[f64; 2]>,
+    /// Depth (farthest inlier behind the leader), wingspans (median over the frames).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub depth: Option<[f64; 2]>,
+    /// Mean wingtip spacing (μ_x − 1), wingspans (median over the frames).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub wts: Option<[f64; 2]>,
 }
 
 #[cfg(test)]
