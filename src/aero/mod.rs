@@ -57,8 +57,10 @@ use serde::{Deserialize, Serialize};
 mod field;
 pub mod flight;
 mod tree;
+mod wake3d;
 pub use field::{ApproxField, Field};
 pub use tree::TreeOptions;
+pub use wake3d::Wake;
 
 use crate::animation::Animation;
 use crate::error::{Error, Result};
@@ -104,6 +106,12 @@ pub struct AeroOptions {
     /// [`COLLISION_SPAN`] apart laterally and less than this apart fore and aft have wings that
     /// overlap side by side. Coincident birds always collide.
     pub collision_chord: f64,
+    /// Which wake gives the savings of shapes whose birds fly at different heights
+    /// ([`AeroOptions::power_reduction_3d`]): [`Wake::Planar`] (the default, heights ignored) or
+    /// [`Wake::ThreeD`]. Functions without heights (g, the key-shape solve's sums, the frames'
+    /// savings) are planar whatever it says. Left out of serialised options when planar.
+    #[serde(skip_serializing_if = "Wake::is_planar")]
+    pub wake: Wake,
 }
 
 impl Default for AeroOptions {
@@ -111,6 +119,7 @@ impl Default for AeroOptions {
         AeroOptions {
             core_radius: DEFAULT_CORE_RADIUS,
             collision_chord: DEFAULT_COLLISION_CHORD,
+            wake: Wake::Planar,
         }
     }
 }
@@ -765,6 +774,7 @@ mod tests {
     const IDEAL: AeroOptions = AeroOptions {
         core_radius: 0.0,
         collision_chord: DEFAULT_COLLISION_CHORD,
+        wake: Wake::Planar,
     };
 
     /// The formula exactly as printed, with absolute values inside the logarithms, evaluated

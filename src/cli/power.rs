@@ -6,6 +6,7 @@ use clap::Args;
 use formation::{aero, Error, Result, Shape};
 use serde::Serialize;
 
+use super::wake::WakeArg;
 use super::Global;
 
 /// Arguments of `formation power`.
@@ -20,6 +21,10 @@ pub struct PowerArgs {
     /// Vortex core radius of Hummel's model, wingspans (docs/model.md).
     #[arg(long, allow_negative_numbers = true, default_value_t = formation::aero::AeroOptions::default().core_radius)]
     pub core_radius: f64,
+    /// Wake model: planar (Hummel's, heights ignored) or 3d (uses each bird's "z", wingspans,
+    /// up; docs/model.md).
+    #[arg(long, value_enum, default_value_t = WakeArg::Planar)]
+    pub wake: WakeArg,
     #[command(flatten)]
     pub flight: FlightArgs,
 }
@@ -127,10 +132,17 @@ struct PowerJson {
 struct BirdJson {
     x: f64,
     y: f64,
+    #[serde(skip_serializing_if = "is_zero")]
+    z: f64,
     e: f64,
     xi: f64,
     saving: f64,
     saving_total: f64,
+}
+
+/// True for 0: a height left out of the JSON (planar shapes print as before).
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
 }
 
 /// Runs `formation power`.
@@ -155,11 +167,12 @@ pub fn run(args: PowerArgs, _g: Global) -> Result<()> {
     }
     let shape: Shape = formation::io::parse_json(&args.shape, &text)?;
     shape.validate(&args.shape, 2)?;
-    let (x, y) = (shape.xs(), shape.ys());
+    let (x, y, z) = (shape.xs(), shape.ys(), shape.zs());
     let flight = args.flight.flight()?;
     let share = flight.induced_share();
     let model = aero::AeroOptions {
         core_radius: args.core_radius,
+        wake: args.wake.into(),
         ..aero::AeroOptions::default()
     };
     model.validate().map_err(|e| match e {
@@ -167,7 +180,7 @@ pub fn run(args: PowerArgs, _g: Global) -> Result<()> {
         other => other,
     })?;
     let pr = model
-        .power_reduction(&x, &y)
+        .power_reduction_3d(&x, &y, &z)
         .map_err(|e| in_file(&args.shape, e))?;
     let flock_saving = pr.total / shape.len() as f64;
     let mut out = String::new();
@@ -192,6 +205,7 @@ pub fn run(args: PowerArgs, _g: Global) -> Result<()> {
                 .map(|(b, (&e, &xi))| BirdJson {
                     x: b.x,
                     y: b.y,
+                    z: b.z,
                     e,
                     xi,
                     saving: e,
@@ -228,7 +242,12 @@ pub fn run(args: PowerArgs, _g: Global) -> Result<()> {
         ));
         let bird = &flight.curve.bird;
         out.push_str(&format!(
-            "model: Hummel's horseshoe wake, core {} wingspans; power curve after Pennycuick (2008) for a {} of {:.2} kg, {:.2} m span at {:.1} m/s: induced power is {:.0}% of the total\n",
+            "model: Hummel's horseshoe wake{}, core {} wingspans; power curve after Pennycuick (2008) for a {} of {:.2} kg, {:.2} m span at {:.1} m/s: induced power is {:.0}% of the total\n",
+            if model.wake == aero::Wake::ThreeD {
+                " in 3-D (each bird's height z)"
+            } else {
+                ""
+            },
             args.core_radius,
             flight.species,
             bird.mass_kg,
