@@ -199,7 +199,11 @@ fn commands() -> Vec<Command> {
         Command {
             name: &["power"],
             base: strings(&["power", &shape]),
-            cases: vec![("--core-radius", "nan", None), seed.clone()],
+            cases: vec![
+                ("--core-radius", "nan", None),
+                ("--wake", "sideways", None),
+                seed.clone(),
+            ],
         },
         Command {
             name: &["solve"],
@@ -207,6 +211,7 @@ fn commands() -> Vec<Command> {
             cases: vec![
                 ("--tolerance", "-1", None),
                 ("--core-radius", "nan", None),
+                ("--wake", "sideways", None),
                 o("OUT/s.txt"),
                 seed.clone(),
             ],
