@@ -48,6 +48,10 @@
 //! (π²/2)·∂g/∂y = Σ/Y² + Σ_c w_c(1/r̃_c − 1/r_c), even in y and positive: g increases with y on
 //! each side of a collision, so e(y) is the gradient of a convex potential.
 //!
+//! **Heights.** `wake3d` extends g to birds at different heights, g₃(x, y, z) with
+//! g₃(x, y, 0) = g(x, y) ([`AeroOptions::g3`], [`AeroOptions::power_reduction_3d`], chosen by
+//! [`AeroOptions::wake`]); everything else in this module is planar.
+//!
 //! Symbols → code: x → `x` (lateral distance), y → `y` (how far the affected bird is behind
 //! the other), a → [`VORTEX_SPAN`], δ → [`AeroOptions::core_radius`], e_i →
 //! [`PowerReduction::e`], ξ_i → [`PowerReduction::xi`], E → [`PowerReduction::total`].
