@@ -352,6 +352,34 @@ fn continuous_in_height_including_the_plane_and_the_branch_switch() {
 }
 
 #[test]
+fn side_by_side_at_different_heights() {
+    // Abreast (y = 0) the bound vortex induces nothing off its plane, and g3 tends to the planar
+    // g(x, 0) as z → 0, also for tiny heights whose square underflows.
+    for core in [0.0, 0.04] {
+        let o = three_d(core);
+        for &x in &[0.85, 1.0, 1.5, 4.0] {
+            let g0 = o.g(x, 0.0);
+            for &z in &[1e-300, 1e-150, 1e-20, 1e-8] {
+                let g = o.g3(x, 0.0, z);
+                assert!((g - g0).abs() < 1e-6, "δ={core} x={x} z={z}: {g} vs {g0}");
+            }
+            for &y in &[1e-200, -1e-200] {
+                let g = o.g3(x, y, 1e-200);
+                assert!(g.is_finite(), "δ={core} x={x} y={y}: {g}");
+            }
+        }
+        // Overlapping wingtips abreast are a collision in the plane, finite off it: the mean
+        // of the two shares (Munk).
+        for &x in &[0.2, 0.5, 0.7] {
+            for &z in &[1e-250, 0.01, 0.3] {
+                let g = o.g3(x, 0.0, z);
+                assert!((g - o.g3_0(x, z)).abs() < 1e-12, "δ={core} x={x} z={z}");
+            }
+        }
+    }
+}
+
+#[test]
 fn a_height_difference_costs_the_follower_on_the_vortex_line() {
     // On the line where the follower's wingtip meets the other's trailing vortex (x = a), height
     // detunes the upwash peak: the saving falls with |z| over the first half wingspan, with the

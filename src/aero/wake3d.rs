@@ -158,8 +158,15 @@ impl AeroOptions {
         } else {
             0.0
         };
-        // The bound vortex's share of the front bird, |y|/b²·Σ_c w R_c (1/|y| at y = z = 0).
-        let over = if b2 > 0.0 { yy / b2 } else { 1.0 / yy };
+        // The bound vortex's share of the front bird is |y|/b²·Σ_c w R_c; |y|/b² is scaled so
+        // that b² cannot underflow (exactly 1/|y| at z = 0, as in the planar model).
+        let m = yy.max(z.abs());
+        let over = if m > 0.0 {
+            let (u, v) = (yy / m, z.abs() / m);
+            u / (m * (u * u + v * v))
+        } else {
+            1.0 / yy
+        };
         let bound = if small {
             (if k > 0.0 { k * over } else { 0.0 }) + yy * bracket
         } else {
