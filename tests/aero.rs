@@ -13,6 +13,7 @@ const IDEAL: AeroOptions = AeroOptions {
     core_radius: 0.0,
     collision_chord: aero::DEFAULT_COLLISION_CHORD,
     wake: aero::Wake::Planar,
+    wake_descent: 0.0,
 };
 
 fn cored() -> AeroOptions {

@@ -202,6 +202,7 @@ fn commands() -> Vec<Command> {
             cases: vec![
                 ("--core-radius", "nan", None),
                 ("--wake", "sideways", None),
+                ("--wake-descent", "nan", None),
                 seed.clone(),
             ],
         },

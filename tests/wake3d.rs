@@ -101,6 +101,20 @@ fn upwash(p: V3) -> f64 {
     segs.iter().map(|&(a, b)| segment(p, a, b)[2]).sum()
 }
 
+/// Vertical velocity at `p` of bird j's horseshoe whose trailing vortices sink at slope `sigma`
+/// (the segments from the wingtips run along (0, cos β, −sin β), tan β = σ).
+fn upwash_descending(p: V3, sigma: f64) -> f64 {
+    const FAR: f64 = 1e7;
+    let cb = 1.0 / (1.0 + sigma * sigma).sqrt();
+    let (fy, fz) = (FAR * cb, -FAR * sigma * cb);
+    let segs = [
+        ([S, fy, fz], [S, 0.0, 0.0]),
+        ([S, 0.0, 0.0], [-S, 0.0, 0.0]),
+        ([-S, 0.0, 0.0], [-S, fy, fz]),
+    ];
+    segs.iter().map(|&(a, b)| segment(p, a, b)[2]).sum()
+}
+
 /// Adaptive Simpson quadrature of `f` over [a, b] to absolute tolerance `tol`.
 fn simpson(f: &dyn Fn(f64) -> f64, a: f64, b: f64, tol: f64) -> f64 {
     /// One panel [a, b] with f at a, the midpoint and b, and its Simpson value `whole`.
@@ -195,6 +209,99 @@ fn cored_trailing(c: f64, y: f64, z: f64, core: f64) -> f64 {
     let e = (-h2 / (core * core)).exp();
     let rho2 = h2 + core * core * e;
     c * (1.0 - e) / rho2 * (1.0 + y / (rho2 + y * y).sqrt())
+}
+
+#[test]
+fn descending_wake_matches_numerical_biot_savart() {
+    let mut rng = Rng(17);
+    let mut checked = 0;
+    while checked < 200 {
+        let sigma = rng.range(0.0, aero::MAX_WAKE_DESCENT);
+        let o = AeroOptions {
+            core_radius: 0.0,
+            wake: Wake::ThreeD,
+            wake_descent: sigma,
+            ..AeroOptions::default()
+        };
+        let (x, y, z) = (
+            rng.range(-3.0, 3.0),
+            rng.range(-4.0, 4.0),
+            rng.range(-1.0, 1.0),
+        );
+        // Height above the sunk trailing vortex: stay off the ideal vortices' lines.
+        let cb = 1.0 / (1.0 + sigma * sigma).sqrt();
+        let above = (y * sigma + z) * cb;
+        let near_line = [x.abs() - A, x.abs(), x.abs() - 2.0 * S]
+            .iter()
+            .any(|d| d.abs() < 0.03);
+        if (above.abs() < 0.03 && (near_line || y.abs() < 0.1)) || (z.abs() < 0.03 && y.abs() < 0.1)
+        {
+            continue;
+        }
+        let (lo, hi) = (x - S, x + S);
+        let mut cuts = vec![lo, hi];
+        for c in [-S, 0.0, S] {
+            if lo < c && c < hi {
+                cuts.push(c);
+            }
+        }
+        cuts.sort_by(f64::total_cmp);
+        let f = |xi: f64| upwash_descending([xi, y, z], sigma);
+        let want = TWO_OVER_PI2
+            * cuts
+                .windows(2)
+                .map(|w| simpson(&f, w[0], w[1], 1e-11))
+                .sum::<f64>();
+        let got = o.g3(x, y, z);
+        assert!(
+            (got - want).abs() < 1e-6,
+            "σ={sigma} x={x} y={y} z={z}: g3 {got}, Biot–Savart {want}"
+        );
+        checked += 1;
+    }
+}
+
+#[test]
+fn descending_wake_in_shapes_and_its_limits() {
+    let level = three_d(0.04);
+    let sunk = AeroOptions {
+        wake_descent: 0.01,
+        ..level
+    };
+    // A follower level with the leader sits above the sunk vortex: it saves less than with a
+    // level wake; one that sits where the vortex has sunk to saves about the level peak.
+    let (x, y) = (0.77, 1.24);
+    assert!(sunk.g3(x, y, 0.0) < level.g3(x, y, 0.0));
+    assert!((sunk.g3(x, y, -0.01 * y) - level.g3(x, y, 0.0)).abs() < 0.01);
+    // Ahead of the other bird the trailing vortices barely matter.
+    assert!((sunk.g3(x, -1.0, 0.0) - level.g3(x, -1.0, 0.0)).abs() < 1e-3);
+    let mut rng = Rng(3);
+    for _ in 0..20 {
+        let n = 6;
+        let (x, y, z) = flock(&mut rng, n);
+        let e = sunk.power_reduction_3d(&x, &y, &z).unwrap();
+        for i in 0..n {
+            let sum: f64 = (0..n)
+                .filter(|&j| j != i)
+                .map(|j| sunk.g3(x[i] - x[j], y[i] - y[j], z[i] - z[j]))
+                .sum();
+            assert!((sum - e.e[i]).abs() < 1e-12 * sum.abs().max(1.0));
+        }
+    }
+    for (bad, wake) in [
+        (-0.01, Wake::ThreeD),
+        (f64::NAN, Wake::ThreeD),
+        (0.5, Wake::ThreeD),
+        (0.01, Wake::Planar),
+    ] {
+        let o = AeroOptions {
+            wake,
+            wake_descent: bad,
+            ..AeroOptions::default()
+        };
+        let err = o.validate().unwrap_err().to_string();
+        assert!(err.contains("aero.wake_descent"), "{err}");
+    }
 }
 
 #[test]
@@ -563,6 +670,14 @@ fn power_with_the_3d_wake_uses_heights() {
     let out = run(&["power", s(&high), "--wake", "3d"]);
     assert_eq!(code(&out), 0);
     assert!(stdout(&out).contains("in 3-D"), "{}", stdout(&out));
+    // A sinking wake changes the followers' savings; it needs the 3-D wake.
+    let sunk = power_json(&high, &["--wake", "3d", "--wake-descent", "0.01"]);
+    assert!(savings(&sunk)
+        .iter()
+        .zip(savings(&three_high))
+        .any(|(a, b)| (a - b).abs() > 1e-3));
+    let out = run(&["power", s(&high), "--wake-descent", "0.01"]);
+    assert_usage_error(&out, &["--wake-descent", "--wake 3d"]);
 }
 
 #[test]

@@ -116,6 +116,20 @@ pub struct AeroOptions {
     /// savings) are planar whatever it says. Left out of serialised options when planar.
     #[serde(skip_serializing_if = "Wake::is_planar")]
     pub wake: Wake,
+    /// Slope at which the 3-D wake's trailing vortices sink behind the bird, wingspans of descent
+    /// per wingspan downstream (≥ 0, at most [`MAX_WAKE_DESCENT`]; 0, the default, keeps them
+    /// level). Only [`Wake::ThreeD`] uses it. Left out of serialised options when 0.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub wake_descent: f64,
+}
+
+/// Largest accepted [`AeroOptions::wake_descent`]: a slope of 0.2, far beyond a bird's wake
+/// (about 0.01).
+pub const MAX_WAKE_DESCENT: f64 = 0.2;
+
+/// True for 0: an option left out of serialised options.
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
 }
 
 impl Default for AeroOptions {
@@ -124,6 +138,7 @@ impl Default for AeroOptions {
             core_radius: DEFAULT_CORE_RADIUS,
             collision_chord: DEFAULT_COLLISION_CHORD,
             wake: Wake::Planar,
+            wake_descent: 0.0,
         }
     }
 }
@@ -224,6 +239,27 @@ impl AeroOptions {
                 format!(
                     "{}: the collision distance must be a number of wingspans in [0, 1] (default {DEFAULT_COLLISION_CHORD})",
                     self.collision_chord
+                ),
+            ));
+        }
+        if !(self.wake_descent.is_finite()
+            && self.wake_descent >= 0.0
+            && self.wake_descent <= MAX_WAKE_DESCENT)
+        {
+            return Err(Error::parameter(
+                "aero.wake_descent",
+                format!(
+                    "{}: the wake's descent must be a slope in [0, {MAX_WAKE_DESCENT}] (wingspans per wingspan; default 0)",
+                    self.wake_descent
+                ),
+            ));
+        }
+        if self.wake_descent != 0.0 && self.wake == Wake::Planar {
+            return Err(Error::parameter(
+                "aero.wake_descent",
+                format!(
+                    "{}: only the 3-D wake descends; choose the wake \"3d\" or a descent of 0",
+                    self.wake_descent
                 ),
             ));
         }
@@ -779,6 +815,7 @@ mod tests {
         core_radius: 0.0,
         collision_chord: DEFAULT_COLLISION_CHORD,
         wake: Wake::Planar,
+        wake_descent: 0.0,
     };
 
     /// The formula exactly as printed, with absolute values inside the logarithms, evaluated

@@ -6,7 +6,8 @@
 //!
 //! **What g₃ is.** The same horseshoe as [`AeroOptions::g`] (bound vortex of span a = π/4
 //! wingspans, two straight trailing vortices from its ends, parallel to the flight direction and
-//! level: they neither descend nor follow the wingbeat), but bird i's bound vortex lies z
+//! level unless [`AeroOptions::wake_descent`] makes them sink; they do not follow the wingbeat),
+//! but bird i's bound vortex lies z
 //! wingspans **above** bird j's plane (up positive). g₃ is the vertical velocity that j's
 //! horseshoe induces along i's bound vortex, integrated along i's span, over the solo induced
 //! drag of an elliptic wing of the same lift: the fraction of i's solo induced power that j
@@ -43,6 +44,11 @@
 //! planar one (two wings overlapping side by side collide at any height: the wingbeat's vertical
 //! sweep is larger than the height differences of real flocks). The key-shape solve works in the
 //! plane (z = 0), where both wakes agree, so it keeps using the planar sums whatever the wake.
+//!
+//! **A sinking wake** (slope σ = tan β > 0): the trailing vortices' share is the level one, times
+//! cos β, evaluated at the offsets along and across the tilted vortex, y′ = y cos β − z sin β and
+//! z′ = y sin β + z cos β; the bound vortex's share is unchanged. Munk's theorem then fails, so
+//! both birds of each pair are evaluated.
 //!
 //! Symbols → code: z → `z` (how far the affected bird is above the other, wingspans), the
 //! choice of wake → [`Wake`] in [`AeroOptions::wake`].
@@ -130,7 +136,16 @@ impl AeroOptions {
 
     /// (Ã, D(|y|)) of a pair at lateral distance `x`, fore-aft `y` and vertical `z`, in units of
     /// 2/π²: Ã = (π²/2)·g₃(x, 0, z), D = (π²/2)·g₃(x, −|y|, z) (the front bird's share).
+    #[inline]
     fn pair3(&self, x: f64, y: f64, z: f64) -> (f64, f64) {
+        let (a_term, log_term, bound) = self.parts3(x, y, z);
+        (a_term, log_term + bound)
+    }
+
+    /// The three pieces of [`AeroOptions::pair3`], units of 2/π²: Ã, the trailing vortices'
+    /// share of the front bird −Σ_c w_c ln(R̃_c + |y|), and the bound vortex's
+    /// |y|/(y² + z²)·Σ_c w_c R_c.
+    fn parts3(&self, x: f64, y: f64, z: f64) -> (f64, f64, f64) {
         let x = x.abs();
         let yy = y.abs();
         let y2 = yy * yy;
@@ -208,17 +223,39 @@ impl AeroOptions {
         } else {
             0.5 * ((q0 / qp) * (q0 / qm)).ln()
         };
-        (a_term, log_term + bound)
+        (a_term, log_term, bound)
+    }
+
+    /// What bird i saves thanks to bird j (units of 2/π²) when j's trailing vortices sink at
+    /// slope σ = [`AeroOptions::wake_descent`] (direction (0, cos β, −sin β), tan β = σ): the
+    /// trailing vortices' share is the level one, times cos β, at the offsets along and across
+    /// the tilted vortices, y′ = y cos β − z sin β and z′ = y sin β + z cos β (R_c is the same
+    /// in both frames); the bound vortex's share is unchanged. Munk's theorem does not hold for
+    /// a tilted wake, so both birds of a pair are evaluated.
+    fn descending(&self, x: f64, y: f64, z: f64) -> f64 {
+        let sigma = self.wake_descent;
+        let cb = 1.0 / (1.0 + sigma * sigma).sqrt();
+        let sb = sigma * cb;
+        let (yt, zt) = (y * cb - z * sb, y * sb + z * cb);
+        let (a_t, log_t, _) = self.parts3(x, yt, zt);
+        // −Σ w ln(R̃ − y′) = 2Ã(z′) − (−Σ w ln(R̃ + y′)) behind, since R̃² − y′² = ρ².
+        let trailing = if yt > 0.0 { 2.0 * a_t - log_t } else { log_t };
+        let (_, _, bound) = self.parts3(x, y, z);
+        cb * trailing + if y > 0.0 { -bound } else { bound }
     }
 
     /// g₃(x, y, z): the fraction of its solo induced power that a bird saves thanks to one
     /// other bird at lateral distance `x` (wingspans, any sign) when it flies `y` wingspans
     /// behind it (negative: ahead) and `z` wingspans above it (negative: below). Even in x and
-    /// in z; equal to [`AeroOptions::g`] at z = 0. Ignores [`AeroOptions::wake`]. NaN for
-    /// non-finite input; infinite where the planar g is (z = 0 only).
+    /// in z; equal to [`AeroOptions::g`] at z = 0. Ignores [`AeroOptions::wake`]; with a
+    /// [`AeroOptions::wake_descent`] the trailing vortices sink (then g₃ is no longer even in z,
+    /// nor equal to g at z = 0). NaN for non-finite input; infinite where the planar g is.
     pub fn g3(&self, x: f64, y: f64, z: f64) -> f64 {
         if !(x.is_finite() && y.is_finite() && z.is_finite()) {
             return f64::NAN;
+        }
+        if self.wake_descent != 0.0 {
+            return TWO_OVER_PI2 * self.descending(x, y, z);
         }
         let (a_term, d_term) = self.pair3(x, y, z);
         let scaled = if y > 0.0 {
@@ -230,7 +267,7 @@ impl AeroOptions {
     }
 
     /// g₃(x, 0, z): half of what two birds `x` apart laterally and `z` apart vertically save
-    /// together, whatever their stagger (Munk's theorem).
+    /// together, whatever their stagger (Munk's theorem; level vortices, the descent ignored).
     pub fn g3_0(&self, x: f64, z: f64) -> f64 {
         if !(x.is_finite() && z.is_finite()) {
             return f64::NAN;
@@ -276,13 +313,27 @@ impl AeroOptions {
     /// e_i without validation (the caller guarantees N ≥ 2, matching lengths, finite values,
     /// no collision). [`Wake::Planar`]: [`AeroOptions::power_unchecked`] (z ignored, with its
     /// fast paths). [`Wake::ThreeD`]: the direct sum over pairs of g₃, one evaluation per pair
-    /// serving both birds (the front bird gets D, the one behind 2Ã − D).
+    /// serving both birds (the front bird gets D, the one behind 2Ã − D); with a
+    /// [`AeroOptions::wake_descent`], both birds of each pair evaluated.
     pub fn power_unchecked_3d(&self, x: &[f64], y: &[f64], z: &[f64]) -> Vec<f64> {
         if self.wake == Wake::Planar {
             return self.power_unchecked(x, y);
         }
         let n = x.len();
         let mut e = vec![0.0; n];
+        if self.wake_descent != 0.0 {
+            for i in 0..n {
+                for j in (i + 1)..n {
+                    let (dx, dy, dz) = (x[i] - x[j], y[i] - y[j], z[i] - z[j]);
+                    e[i] += self.descending(dx, dy, dz);
+                    e[j] += self.descending(-dx, -dy, -dz);
+                }
+            }
+            for v in e.iter_mut() {
+                *v *= TWO_OVER_PI2;
+            }
+            return e;
+        }
         for i in 0..n {
             for j in (i + 1)..n {
                 let dy = y[i] - y[j];
@@ -304,8 +355,9 @@ impl AeroOptions {
     }
 
     /// E from lateral positions and heights (Munk's theorem at every height): Σ over pairs of
-    /// 2·g₃(|Δx|, 0, Δz). With [`Wake::Planar`], [`AeroOptions::munk_total_unchecked`]. No
-    /// validation.
+    /// 2·g₃(|Δx|, 0, Δz), for level vortices ([`AeroOptions::wake_descent`] is ignored: a
+    /// sinking wake's total depends on the stagger). With [`Wake::Planar`],
+    /// [`AeroOptions::munk_total_unchecked`]. No validation.
     pub fn munk_total_3d_unchecked(&self, x: &[f64], z: &[f64]) -> f64 {
         if self.wake == Wake::Planar {
             return self.munk_total_unchecked(x);

@@ -25,6 +25,15 @@ pub struct PowerArgs {
     /// up; docs/model.md).
     #[arg(long, value_enum, default_value_t = WakeArg::Planar)]
     pub wake: WakeArg,
+    /// With --wake 3d: slope at which the trailing vortices sink behind each bird, wingspans per
+    /// wingspan (0 = level; about 0.01 for a goose; docs/model.md).
+    #[arg(
+        long,
+        value_name = "SLOPE",
+        allow_negative_numbers = true,
+        default_value_t = 0.0
+    )]
+    pub wake_descent: f64,
     #[command(flatten)]
     pub flight: FlightArgs,
 }
@@ -173,9 +182,14 @@ pub fn run(args: PowerArgs, _g: Global) -> Result<()> {
     let model = aero::AeroOptions {
         core_radius: args.core_radius,
         wake: args.wake.into(),
+        wake_descent: args.wake_descent,
         ..aero::AeroOptions::default()
     };
     model.validate().map_err(|e| match e {
+        Error::Parameter { name, message } if name == "aero.wake_descent" => Error::parameter(
+            "--wake-descent",
+            message.replace("the wake \"3d\"", "--wake 3d"),
+        ),
         Error::Parameter { message, .. } => Error::parameter("--core-radius", message),
         other => other,
     })?;
@@ -243,10 +257,15 @@ pub fn run(args: PowerArgs, _g: Global) -> Result<()> {
         let bird = &flight.curve.bird;
         out.push_str(&format!(
             "model: Hummel's horseshoe wake{}, core {} wingspans; power curve after Pennycuick (2008) for a {} of {:.2} kg, {:.2} m span at {:.1} m/s: induced power is {:.0}% of the total\n",
-            if model.wake == aero::Wake::ThreeD {
-                " in 3-D (each bird's height z)"
-            } else {
-                ""
+            match model.wake {
+                aero::Wake::Planar => String::new(),
+                aero::Wake::ThreeD if model.wake_descent == 0.0 => {
+                    " in 3-D (each bird's height z)".to_string()
+                }
+                aero::Wake::ThreeD => format!(
+                    " in 3-D (each bird's height z; trailing vortices sinking {} wingspans per wingspan)",
+                    model.wake_descent
+                ),
             },
             args.core_radius,
             flight.species,
