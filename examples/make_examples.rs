@@ -1,4 +1,4 @@
-//! Writes the example flocks in `examples_data/` (issue 3) from [`formation::annotations::synth`]:
+//! Writes the example flocks in `examples_data/` from [`formation::annotations::synth`]:
 //! synthetic annotations shaped like the three flocks of Klotsman & Tal (9 barnacle geese in a V,
 //! 16 snow geese in a J, 41 cranes in a V with outliers) plus a small Labelme directory, each in a
 //! different input format. Deterministic: run `cargo run --example make_examples` to regenerate

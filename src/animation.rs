@@ -1,4 +1,4 @@
-//! The animation file (SPEC §4.4), the plain data type that `steady`, `initiate` and `animate`
+//! The animation file (docs/formats.md §4.4), the plain data type that `steady`, `initiate` and `animate`
 //! write and `render` reads. World frame: `x` east, `y` north, `z` up, lengths in wingspans, the
 //! cruise heading is +y; headings in radians clockwise from +y; speeds in wingspans per second.
 
@@ -46,18 +46,64 @@ pub struct Animation {
     /// shapes. Absent when the whole flock is one formation (then `key_shapes` describe it).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub formations: Option<Vec<FormationRecord>>,
-    /// The steady flight cycles seamlessly (issue 19, `steady.loop`): the frame after the last
+    /// The steady flight cycles seamlessly (`steady.loop`): the frame after the last
     /// would be the first again, in the flock's moving frame (in the world too on a closed path).
     #[serde(default, skip_serializing_if = "std::ops::Not::not", rename = "loop")]
     pub looped: bool,
     /// The path the flock follows (world frame), when it was given one.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub path: Option<PathRecord>,
+    /// The bird's mass and airspeed for its power curve (savings of total power), when given;
+    /// absent: the species' typical bird at each bird's own speed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub flight: Option<FlightSettings>,
+    /// The wake model the savings (`e`, `xi`) were computed with, when recorded.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub savings_model: Option<SavingsModel>,
     /// One entry per frame.
     pub frames: Vec<Frame>,
 }
 
-/// The path an animation follows (issue 19).
+/// The model behind an animation's savings.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SavingsModel {
+    /// `"planar"` (Hummel's horseshoe wakes in the plane) or `"3d"`.
+    pub wake: String,
+    /// Vortex core radius, wingspans.
+    pub core_radius: f64,
+}
+
+impl std::fmt::Display for SavingsModel {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "Hummel's model, {} wake, core {} wingspans",
+            self.wake, self.core_radius
+        )
+    }
+}
+
+/// What the power curve of an animation's birds is computed from besides the species and the
+/// wingspan (`steady.flight`).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct FlightSettings {
+    /// Body mass, kg (default: the species' typical mass scaled to the wingspan).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mass_kg: Option<f64>,
+    /// Airspeed, m/s, for every bird (default: each bird's own speed).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub speed_ms: Option<f64>,
+}
+
+impl FlightSettings {
+    /// Whether nothing is set.
+    pub fn is_empty(&self) -> bool {
+        self.mass_kg.is_none() && self.speed_ms.is_none()
+    }
+}
+
+/// The path an animation follows.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PathRecord {
     /// The file it was read from.
@@ -245,6 +291,8 @@ impl Animation {
             formations: None,
             looped: false,
             path: None,
+            flight: None,
+            savings_model: None,
             frames: Vec::new(),
         }
     }
@@ -519,6 +567,8 @@ impl Animation {
         let pick_opt = |v: &Option<Vec<f64>>| v.as_ref().map(pick);
         let mut a = Animation::new(self.seed, self.fps, self.wingspan_m, fm.birds.len());
         a.species = self.species.clone();
+        a.flight = self.flight;
+        a.savings_model = self.savings_model.clone();
         a.wingbeat = self.wingbeat.clone();
         a.stages = self.stages.clone();
         a.key_shapes = fm.key_shapes.clone();

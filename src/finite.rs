@@ -1,4 +1,4 @@
-//! No NaN or infinity in an output file (issue 8). `serde_json` silently writes a non-finite
+//! No NaN or infinity in an output file. `serde_json` silently writes a non-finite
 //! number as `null`, and CSV/glTF would carry `NaN`/`inf`; every writer therefore checks first.
 //! [`check_serialize`] walks any `Serialize` value the way a serializer would and reports the
 //! first non-finite number by its path (`frames[12].x[3]`), which the writers turn into

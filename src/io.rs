@@ -15,7 +15,7 @@ use crate::error::{Error, Result};
 /// the largest animation file `formation` writes (10⁷ bird-frames of pretty JSON: 1.97 GB for
 /// 100 birds × 100 000 frames, 2.9 GB for 100 000 birds × 100 frames of a wide sky of
 /// formations, whose coordinates have more digits; see [`crate::limits::MAX_BIRD_FRAMES`]). It
-/// was 2 GiB, which refused the latter (issue 17).
+/// was 2 GiB, which refused the latter.
 pub const MAX_INPUT_BYTES: u64 = 4 * 1024 * 1024 * 1024;
 
 /// Opens an input for reading, refusing directories and regular files over the size limit up
@@ -746,7 +746,7 @@ impl Drop for AtomicDir {
     }
 }
 
-/// All outputs of one run, committed together or not at all (SPEC §4: a failed run leaves no
+/// All outputs of one run, committed together or not at all (a failed run leaves no
 /// output). While a batch is open, [`AtomicFile::commit`] and [`AtomicDir::commit`] only queue
 /// their temporaries; [`OutputBatch::commit`] moves them all into place, restoring the earlier
 /// targets if one rename fails; dropping the batch uncommitted removes every queued temporary.

@@ -1,7 +1,7 @@
 //! # formation
 //!
 //! Animates bird flocks flying in line formations (V, U, J, echelon), after M. Klotsman and
-//! A. Tal, "Animation of Flocks Flying in Line Formations". The pipeline (SPEC §1):
+//! A. Tal, "Animation of Flocks Flying in Line Formations". The pipeline:
 //!
 //! ```text
 //! annotated frames ─extract─▶ formation parameters ─steady─▶ key shapes + steady-flight frames
@@ -49,7 +49,7 @@
 //! (`steady.fps`) or the file, frame and bird at fault. The `formation` binary (feature `cli`, on
 //! by default) maps option paths to its flags.
 //!
-//! Conventions (SPEC §2): lengths in wingspans; formation frame `x` right of the flight direction,
+//! Conventions (docs/formats.md §2): lengths in wingspans; formation frame `x` right of the flight direction,
 //! `y` behind the leader; world frame `x` east, `y` north, `z` up, cruise heading +y.
 
 // `!(a > b)` is used on purpose: it also rejects NaN, which `a <= b` would let through.

@@ -1,4 +1,4 @@
-//! Size limits shared by every stage (issue 8): requests beyond them are refused up front, before
+//! Size limits shared by every stage: requests beyond them are refused up front, before
 //! any work, with a one-line message naming the flag or file (exit 2), instead of running out of
 //! memory, disk or patience hours later. They are far above what a line formation needs (the
 //! paper's flocks have 5–30 birds) and are documented with their memory cost in
@@ -39,7 +39,7 @@ pub const MAX_PICTURE_PIXELS: u64 = 20_000_000_000;
 /// Most birds in a shape or target (`power`, `solve`). `power` is quadratic in birds (10 000
 /// birds: about a second); one `formation solve` of 10 000 birds from a perturbed start takes
 /// about 2 s on the shared 2-core machine under load 8–10 (a progress bar shows from 1000 birds;
-/// `docs/performance.md`, issue 12 third round).
+/// `docs/performance.md`).
 pub const MAX_SHAPE_BIRDS: usize = 10_000;
 
 /// Largest coordinate in an animation file or shape, wingspans in magnitude (10⁷ wingspans is

@@ -1,4 +1,4 @@
-//! The whole chain in one call: annotations (a file in any SPEC §4.1 format, or points in memory)
+//! The whole chain in one call: annotations (a file in any docs/formats.md §4.1 format, or points in memory)
 //! or formation parameters → §4 extraction → §5 steady flight → §6 initiation → wingbeats, giving
 //! an [`Animation`] and a [`Report`] of what each stage did. `formation animate`, the benches, the
 //! tests and the fuzz targets all run this; so can a game engine, a DCC plug-in or a notebook.
@@ -63,7 +63,7 @@ pub struct Config {
     pub initiate: InitiateOptions,
     /// Wingbeats.
     pub wingbeat: WingbeatOptions,
-    /// The course: the path the flock follows, turn and bank limits (issue 19).
+    /// The course: the path the flock follows, turn and bank limits.
     pub course: CourseOptions,
     /// Large flocks as several formations (skeins): how many, how big, how far apart.
     pub skein: SkeinOptions,
@@ -244,7 +244,7 @@ pub struct Pipeline {
 }
 
 impl Pipeline {
-    /// Starts from a file: a params file (told apart by content) or annotations in any SPEC §4.1
+    /// Starts from a file: a params file (told apart by content) or annotations in any docs/formats.md §4.1
     /// format, read with [`Config::read`] when the pipeline runs.
     pub fn from_path(path: impl Into<PathBuf>) -> Pipeline {
         Pipeline {
@@ -427,7 +427,7 @@ pub fn takeoff_course(
     Ok((config, path))
 }
 
-/// The course step (issue 19): maps `anim`, made in the course frame by the stages before, onto
+/// The course step: maps `anim`, made in the course frame by the stages before, onto
 /// `path` (loaded with [`CourseOptions::load`]) or, without one, sets the cruise altitude of a
 /// flight without a take-off; fills banks and pitches. A take-off is recognised by the
 /// animation's `initiation` stage.

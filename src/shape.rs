@@ -1,4 +1,4 @@
-//! Formation-frame shapes (SPEC §2, §4.3): `x` is the lateral offset to the right of the flight
+//! Formation-frame shapes (docs/formats.md §2, §4.3): `x` is the lateral offset to the right of the flight
 //! direction, `y` the distance behind the leader (downstream positive), both in wingspans.
 
 use serde::{Deserialize, Serialize};
@@ -25,7 +25,7 @@ fn is_zero(v: &f64) -> bool {
     *v == 0.0
 }
 
-/// A flock's shape: the birds' positions in the formation frame (SPEC §4.3).
+/// A flock's shape: the birds' positions in the formation frame (docs/formats.md §4.3).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
 pub struct Shape {
     /// Birds in input order.

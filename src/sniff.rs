@@ -6,10 +6,10 @@
 
 use serde_json::Value;
 
-/// Format tag of params files (SPEC §4.2).
+/// Format tag of params files (docs/formats.md §4.2).
 pub const PARAMS_FORMAT: &str = "formation-params/1";
 
-/// Format tag of animation files (SPEC §4.4).
+/// Format tag of animation files (docs/formats.md §4.4).
 pub const ANIMATION_FORMAT: &str = "formation-animation/1";
 
 /// What a JSON document is, judged by its `"format"` tag and its top-level fields.
@@ -21,7 +21,7 @@ pub enum Kind {
     Animation,
     /// Another `"format"` tag (e.g. an older version).
     OtherFormat(String),
-    /// No tag, a `"birds"` array: a shape (SPEC §4.3).
+    /// No tag, a `"birds"` array: a shape (docs/formats.md §4.3).
     Shape,
     /// No tag, `"x"` and `"xi"`: a target of `solve`.
     Target,

@@ -64,6 +64,19 @@ fn power_reports_savings_of_total_power_from_the_power_curve() {
     }
     let flock = v["flock_saving"].as_f64().unwrap();
     assert!((v["flock_saving_total"].as_f64().unwrap() - flock * share).abs() < 1e-15);
+    // The sensitivity over the core radius holds the default's own number, and a wider core
+    // (a more diffuse vortex) saves less.
+    let sens = v["sensitivity"].as_array().unwrap();
+    assert_eq!(sens.len(), 5);
+    let at = |c: f64| {
+        sens.iter()
+            .find(|s| s["core_radius"].as_f64() == Some(c))
+            .unwrap()["flock_saving"]
+            .as_f64()
+            .unwrap()
+    };
+    assert!((at(0.04) - flock).abs() < 1e-15);
+    assert!(at(0.02) > at(0.04) && at(0.04) > at(0.16) && at(0.16) > at(0.32));
     // Faster flight: less of the power is induced, so the same positions save less of the total.
     let fast = json(&["--speed-ms", "25"]);
     assert!(fast["flight"]["induced_share"].as_f64().unwrap() < share);

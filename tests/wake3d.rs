@@ -666,6 +666,16 @@ fn power_with_the_3d_wake_uses_heights() {
     for (a, b) in savings(&three_high).iter().zip(&lib.e) {
         assert!((a - b).abs() < 1e-12, "{a} vs {b}");
     }
+    // The sensitivity over the core uses the same wake: its default-core entry is the saving.
+    let default_entry = three_high["sensitivity"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["core_radius"].as_f64() == Some(aero::DEFAULT_CORE_RADIUS))
+        .unwrap()["flock_saving"]
+        .as_f64()
+        .unwrap();
+    assert_eq!(default_entry, t);
     // The table names the wake.
     let out = run(&["power", s(&high), "--wake", "3d"]);
     assert_eq!(code(&out), 0);

@@ -229,9 +229,9 @@ impl Field {
     }
 
     /// e_i (input order) for longitudinal positions `y` (input order, no collision): the same
-    /// sums as [`Field::power_band`] without the band and the slopes. From [`PARALLEL_MIN`] birds
+    /// sums as [`Field::power_band`] without the band and the slopes. From `PARALLEL_MIN` (2000) birds
     /// the pairs are split into fixed chunks of sorted positions run on up to two threads (the
-    /// machine's cores, at most [`CHUNKS`]); each chunk adds into its own buffer and the buffers
+    /// machine's cores, at most `CHUNKS`); each chunk adds into its own buffer and the buffers
     /// are added in chunk order, so the result has the same bits for any number of threads.
     pub fn power(&self, y: &[f64]) -> Vec<f64> {
         self.power_threads(y, threads(self.len()))

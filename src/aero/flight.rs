@@ -221,6 +221,32 @@ impl PowerCurve {
 /// The power curve of an animation's birds: the species' typical bird (a goose when the file
 /// names none or one the tool does not know), scaled to the animation's wingspan.
 pub fn animation_curve(species: Option<&str>, wingspan_m: f64) -> PowerCurve {
+    animation_curve_with(species, wingspan_m, None)
+}
+
+/// [`animation_curve`] with the animation's mass, when it gives one.
+pub fn animation_curve_with(
+    species: Option<&str>,
+    wingspan_m: f64,
+    mass_kg: Option<f64>,
+) -> PowerCurve {
+    let mut c = animation_curve_plain(species, wingspan_m);
+    if let Some(m) = mass_kg.filter(|m| m.is_finite() && *m > 0.0) {
+        c.bird.mass_kg = m;
+    }
+    c
+}
+
+/// The curve of an animation: its species, wingspan and mass (`flight.mass_kg`).
+pub fn curve_of(anim: &Animation) -> PowerCurve {
+    animation_curve_with(
+        anim.species.as_deref(),
+        anim.wingspan_m,
+        anim.flight.and_then(|f| f.mass_kg),
+    )
+}
+
+fn animation_curve_plain(species: Option<&str>, wingspan_m: f64) -> PowerCurve {
     let sp = species
         .and_then(|s| s.parse::<Species>().ok())
         .unwrap_or(Species::Goose);
@@ -253,8 +279,15 @@ pub fn frame_savings_total(anim: &Animation, curve: &PowerCurve, k: usize) -> Op
         e.iter()
             .enumerate()
             .map(|(b, e)| {
-                let v = f.speed.get(b).copied().unwrap_or(f64::NAN);
-                e * curve.induced_share(airspeed_ms(curve, v, anim.wingspan_m))
+                let v = match anim.flight.and_then(|f| f.speed_ms) {
+                    Some(v) => v,
+                    None => airspeed_ms(
+                        curve,
+                        f.speed.get(b).copied().unwrap_or(f64::NAN),
+                        anim.wingspan_m,
+                    ),
+                };
+                e * curve.induced_share(v)
             })
             .collect(),
     )
@@ -264,7 +297,7 @@ pub fn frame_savings_total(anim: &Animation, curve: &PowerCurve, k: usize) -> Op
 /// or savings), with the animation's own curve ([`animation_curve`]).
 pub fn steady_saving_total(anim: &Animation) -> Option<f64> {
     let st = anim.stage("steady")?;
-    let curve = animation_curve(anim.species.as_deref(), anim.wingspan_m);
+    let curve = curve_of(anim);
     let (mut sum, mut n) = (0.0, 0usize);
     for k in st.start..st.end.min(anim.frames.len()) {
         if let Some(t) = frame_savings_total(anim, &curve, k) {
@@ -275,6 +308,28 @@ pub fn steady_saving_total(anim: &Animation) -> Option<f64> {
         }
     }
     (n > 0).then(|| sum / n as f64)
+}
+
+/// Checks an animation's flight settings; errors name `steady.flight.mass_kg` or
+/// `steady.flight.speed_ms`.
+pub fn validate_settings(s: &crate::animation::FlightSettings) -> Result<()> {
+    if let Some(m) = s.mass_kg {
+        let bird = Morphology {
+            mass_kg: m,
+            ..Morphology::of(Species::Goose)
+        };
+        bird.validate().map_err(|e| match e {
+            Error::Parameter { message, .. } => Error::parameter("steady.flight.mass_kg", message),
+            other => other,
+        })?;
+    }
+    if let Some(v) = s.speed_ms {
+        validate_speed(v).map_err(|e| match e {
+            Error::Parameter { message, .. } => Error::parameter("steady.flight.speed_ms", message),
+            other => other,
+        })?;
+    }
+    Ok(())
 }
 
 /// Checks an airspeed given on the command line or in options (`flight.speed_ms`).

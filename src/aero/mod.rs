@@ -1,7 +1,7 @@
 //! §5 step 2: Hummel's power-reduction model, as printed in Klotsman & Tal (after Hummel 1983),
 //! defined for every lateral distance: overlapping wingtips, line astern, and a vortex core.
 //!
-//! Takes lateral and longitudinal distances between birds in wingspans (SPEC §2–3) and gives the
+//! Takes lateral and longitudinal distances between birds in wingspans (docs/formats.md §2–3) and gives the
 //! pair function g(x, y), its partial derivatives, each bird's saving e_i, the total E and the
 //! relative values ξ_i = e_i / E. Pure functions; the drag ratio C of eq. (1) is dropped.
 //!
@@ -89,7 +89,7 @@ const A: f64 = VORTEX_SPAN;
 
 /// Pairs at least this far apart laterally (wingspans) are evaluated, inside the shape-level
 /// sums ([`AeroOptions::power_unchecked`] and the Jacobian), by the far-field expansion of
-/// [`far_pair`] instead of the closed form: relative error below 3·10⁻⁸, absolute below 10⁻¹²
+/// `far_pair` instead of the closed form: relative error below 3·10⁻⁸, absolute below 10⁻¹²
 /// (tested), and about a fifth of the cost, which is what makes flocks of thousands of birds fast.
 pub const FAR_FIELD: f64 = 60.0;
 /// Flocks of at least this many birds are summed by [`Field`] in [`AeroOptions::power_unchecked`]

@@ -1,4 +1,4 @@
-//! Each bird relative to its own formation's leader (issue 16): the formation frame of SPEC §2
+//! Each bird relative to its own formation's leader: the formation frame of docs/formats.md §2
 //! (`lateral` to the right of the leader's heading, `behind` the leader along it, wingspans) at
 //! every frame of a world-frame [`Animation`], and the bird's rank in its formation.
 //!
@@ -62,7 +62,7 @@ impl Animation {
         let formations = of.iter().copied().max().map_or(1, |m| m + 1);
         // Birds by formation in one pass (filtering all birds once per formation was quadratic
         // for a sky of many small formations: 11 111 formations of 100 000 birds took 14 s a
-        // frame in `formation report`, issue 17).
+        // frame in `formation report`).
         let mut by_formation: Vec<Vec<usize>> = vec![Vec::new(); formations];
         for (i, r) in out.iter().enumerate() {
             if let Some(m) = by_formation.get_mut(r.formation) {

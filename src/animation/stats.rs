@@ -1,8 +1,8 @@
-//! What an animation says about the flock (issue 16), for summaries, `plot savings` and
+//! What an animation says about the flock, for summaries, `plot savings` and
 //! `formation report`: its stages' lengths, how much the flock saves over time and in steady
 //! flight, and each bird's saving against its place in its formation.
 //!
-//! Savings are e_i (SPEC §3: the fraction of bird i's solo induced power that the others save
+//! Savings are e_i (docs/formats.md §3: the fraction of bird i's solo induced power that the others save
 //! it), as recorded in the frames; the flock's saving at a frame is their mean over the birds
 //! (E/N). Frames without `e` are skipped.
 

@@ -1,4 +1,4 @@
-//! The wingbeat options recorded in an animation file (`"wingbeat"`, SPEC §4.4) and the names
+//! The wingbeat options recorded in an animation file (`"wingbeat"`, docs/formats.md §4.4) and the names
 //! they use: species, phase relation between birds, gliding. Plain data, below the stages: the
 //! `wingbeat` stage reads them ([`crate::wingbeat`] re-exports every item), the animation file
 //! stores them, and renderers rebuild the same wingbeats from them. Times in seconds.

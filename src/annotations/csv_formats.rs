@@ -1,4 +1,4 @@
-//! The two CSV inputs of SPEC §4.1, in pixels.
+//! The two CSV inputs of docs/formats.md §4.1, in pixels.
 //!
 //! - Long CSV: header with `frame`, `x`, `y` and optionally `bird` (ids) and `wingspan_px`
 //!   (per-row scale, constant within a frame); other columns are ignored. One row per bird per

@@ -1,4 +1,4 @@
-//! Reading annotated frames (SPEC §4.1) from every supported format into one type (issue 3).
+//! Reading annotated frames (docs/formats.md §4.1) from every supported format into one type.
 //!
 //! Takes a file or directory of annotations in pixels: the native JSON, a long CSV
 //! (`frame,bird,x,y`), a DLTdv digitizer CSV (`ptN_camM_X/Y`) or Labelme JSON (a file or a directory
@@ -9,7 +9,7 @@
 //! order by lateral position in the first frame, with later frames matched by an optimal assignment
 //! after aligning the leaders ([`assign_ids`]).
 //!
-//! Heading (SPEC §2): θ clockwise from image-up, so the flight direction in the image (x right,
+//! Heading (docs/formats.md §2): θ clockwise from image-up, so the flight direction in the image (x right,
 //! y down) is d = (sin θ, −cos θ) and the right-hand side of the flight is r = (cos θ, sin θ).
 //! With the scale s = `wingspan_px`, a pixel point p maps to `lateral = p·r / s`,
 //! `forward = p·d / s` (wingspans).
@@ -110,7 +110,7 @@ pub struct ReadOptions {
     pub y_origin: Option<YOrigin>,
 }
 
-/// The input formats of SPEC §4.1.
+/// The input formats of docs/formats.md §4.1.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Format {
@@ -207,7 +207,7 @@ pub struct Annotations {
 
 impl Annotations {
     /// Annotations built from points in memory, checked and resolved exactly as a file of the
-    /// native format would be (SPEC §4.1): `frames[k]` holds the image positions `[x, y]` of the
+    /// native format would be (docs/formats.md §4.1): `frames[k]` holds the image positions `[x, y]` of the
     /// birds marked in frame `k`, pixels, x right and y down; `heading` is the flock's flight
     /// direction in the image; `wingspan_px` the scale, pixels per wingspan. Bird ids are
     /// assigned by lateral order and matched across frames, as for a file without ids. `source`
@@ -397,7 +397,7 @@ fn detect_text(path: &Path, text: &str) -> Result<Format> {
     csv_formats::detect_csv(path, t)
 }
 
-/// Reads annotations from `path` (a file in any SPEC §4.1 format, or a Labelme directory),
+/// Reads annotations from `path` (a file in any docs/formats.md §4.1 format, or a Labelme directory),
 /// resolving heading, scale and bird ids.
 pub fn read(path: &Path, opts: &ReadOptions) -> Result<Annotations> {
     if path.is_dir() {

@@ -1,4 +1,4 @@
-//! The native annotation JSON (SPEC §4.1): `{"source", "heading", "wingspan_px", "frames":
+//! The native annotation JSON (docs/formats.md §4.1): `{"source", "heading", "wingspan_px", "frames":
 //! [{"index", "image", "wingspan_px", "birds": [[x, y], ...]}]}` in pixels. A bird may also be an
 //! object `{"id": 3, "x": .., "y": ..}`, which carries its identity across frames.
 

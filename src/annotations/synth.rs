@@ -4,7 +4,7 @@
 //! gaps drawn from N(spacing, spacing_sd), at least 0.8), then for every frame adds a slow random
 //! walk to each bird's position, per-frame noise, and fixed offsets for the chosen outlier birds.
 //! [`SynthFlock`]'s writers turn it into pixels under any heading and scale, in every input format
-//! of SPEC §4.1. The truth kept per frame (formation-frame positions, outliers, leader) lets tests
+//! of docs/formats.md §4.1. The truth kept per frame (formation-frame positions, outliers, leader) lets tests
 //! check what `extract` finds.
 
 use rand::Rng;

@@ -1,4 +1,4 @@
-//! `formation animate`: the whole chain in one command (issue 6). The flags become a library
+//! `formation animate`: the whole chain in one command. The flags become a library
 //! `pipeline::Config`; `pipeline::Pipeline::from_path(INPUT).run_with` does annotations (any
 //! format) or a params file → §4 extraction → §5 steady flight → §6 initiation → wingbeats, and
 //! `export::write_outputs` every output the `-o` extensions ask for. Each stage draws from its own

@@ -1,4 +1,4 @@
-//! Course flags (issue 19) shared by `steady`, `initiate` and `animate`: the path the flock
+//! Course flags shared by `steady`, `initiate` and `animate`: the path the flock
 //! follows and its units (the `course` section of the library's `Config`), and the warnings the
 //! course step reports.
 

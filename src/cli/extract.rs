@@ -1,4 +1,4 @@
-//! `formation extract` and `formation plot shape` (issue 3): flags → [`ReadOptions`] and
+//! `formation extract` and `formation plot shape`: flags → [`ReadOptions`] and
 //! [`ExtractOptions`], the per-frame summary table on stdout, the params file through an atomic
 //! write.
 

@@ -88,6 +88,9 @@ pub const FLAGS: &[(&str, &str, &[Cmd])] = &[
     ("steady.keys.c1", "--c1", STEADY),
     ("steady.keys.c2", "--c2", STEADY),
     ("steady.wingspan_m", "--wingspan-m", STEADY),
+    ("steady.flight.mass_kg", "--mass-kg", STEADY),
+    ("steady.flight.speed_ms", "--speed-ms", STEADY),
+    ("aero.core_radius", "--core-radius", STEADY),
     ("steady.keys.max_jump", "--max-jump", STEADY),
     ("steady.jostle.scale", "--jostle", STEADY),
     (

@@ -1,4 +1,4 @@
-//! `formation initiate` and `formation plot paths` (issue 5): flags → [`InitiateOptions`], run the
+//! `formation initiate` and `formation plot paths`: flags → [`InitiateOptions`], run the
 //! §6 simulation into the first key shape of a steady-flight file, write the combined animation.
 
 use std::path::PathBuf;
@@ -269,7 +269,7 @@ pub fn run(args: InitiateArgs, g: Global) -> Result<()> {
     let mut rng = formation::rng::stream(g.seed, formation::rng::Stream::Initiate);
     let progress = TermProgress::new(g.quiet);
     let (mut anim, stats) = if steady.formations.is_some() {
-        // A flock of several formations takes off formation by formation (issue 13).
+        // A flock of several formations takes off formation by formation.
         let config = formation::pipeline::Config {
             seed: g.seed,
             initiate: opts,

@@ -128,7 +128,7 @@ pub fn warn(cmd: flags::Cmd, g: Global, warnings: &[formation::extract::Warning]
     warn_lines(cmd, g, &messages)
 }
 
-/// [`warn`] of plain one-line messages (the course step's, issue 19).
+/// [`warn`] of plain one-line messages (the course step's).
 pub fn warn_lines(cmd: flags::Cmd, g: Global, warnings: &[&str]) -> Result<()> {
     if g.strict {
         if let Some(first) = warnings.first() {

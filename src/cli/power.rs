@@ -117,6 +117,17 @@ fn reflag(e: Error, flag: &str) -> Error {
     }
 }
 
+/// Core radii the saving's sensitivity is shown over, wingspans: from a tight core to one of a
+/// third of the vortex span.
+const CORES: [f64; 5] = [0.02, 0.04, 0.08, 0.16, 0.32];
+
+#[derive(Serialize)]
+struct CoreJson {
+    core_radius: f64,
+    flock_saving: f64,
+    flock_saving_total: f64,
+}
+
 #[derive(Serialize)]
 struct FlightJson {
     species: String,
@@ -134,6 +145,7 @@ struct PowerJson {
     flock_saving: f64,
     flock_saving_total: f64,
     flight: FlightJson,
+    sensitivity: Vec<CoreJson>,
     birds: Vec<BirdJson>,
 }
 
@@ -197,6 +209,23 @@ pub fn run(args: PowerArgs, _g: Global) -> Result<()> {
         .power_reduction_3d(&x, &y, &z)
         .map_err(|e| in_file(&args.shape, e))?;
     let flock_saving = pr.total / shape.len() as f64;
+    // How much the number depends on the core radius (the model's one free length).
+    let sensitivity: Vec<CoreJson> = CORES
+        .iter()
+        .filter_map(|&c| {
+            let m = aero::AeroOptions {
+                core_radius: c,
+                ..model
+            };
+            let p = m.power_reduction_3d(&x, &y, &z).ok()?;
+            let f = p.total / shape.len() as f64;
+            Some(CoreJson {
+                core_radius: c,
+                flock_saving: f,
+                flock_saving_total: f * share,
+            })
+        })
+        .collect();
     let mut out = String::new();
     if args.json {
         let doc = PowerJson {
@@ -212,6 +241,7 @@ pub fn run(args: PowerArgs, _g: Global) -> Result<()> {
                 induced_share: share,
                 method: "Pennycuick 2008",
             },
+            sensitivity,
             birds: shape
                 .birds
                 .iter()
@@ -254,6 +284,23 @@ pub fn run(args: PowerArgs, _g: Global) -> Result<()> {
             shape.len(),
             pr.total
         ));
+        if let (Some(lo), Some(hi)) = (
+            sensitivity.iter().map(|c| c.flock_saving).reduce(f64::min),
+            sensitivity.iter().map(|c| c.flock_saving).reduce(f64::max),
+        ) {
+            out.push_str(&format!(
+                "with a vortex core of {} to {} wingspans: flock saving {:.1} to {:.1}% of induced power ({})\n",
+                CORES[0],
+                CORES[CORES.len() - 1],
+                100.0 * lo,
+                100.0 * hi,
+                sensitivity
+                    .iter()
+                    .map(|c| format!("{}: {:.1}%", c.core_radius, 100.0 * c.flock_saving))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ));
+        }
         let bird = &flight.curve.bird;
         out.push_str(&format!(
             "model: Hummel's horseshoe wake{}, core {} wingspans; power curve after Pennycuick (2008) for a {} of {:.2} kg, {:.2} m span at {:.1} m/s: induced power is {:.0}% of the total\n",

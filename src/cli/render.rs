@@ -1,4 +1,4 @@
-//! `formation render`: outputs from an existing animation file (issue 6). Flags become a
+//! `formation render`: outputs from an existing animation file. Flags become a
 //! [`RenderOptions`]; everything else is [`formation::export::write_outputs`].
 
 use std::path::PathBuf;
@@ -24,7 +24,7 @@ pub struct RenderArgs {
     #[command(flatten)]
     pub shot: ShotArgs,
     /// `--fps` is the animation's own rate, fixed by the file: refused with a pointer to
-    /// `--picture-fps` (one vocabulary across commands, issue 16).
+    /// `--picture-fps` (one vocabulary across commands).
     #[arg(long = "fps", hide = true, allow_hyphen_values = true)]
     pub animation_fps: Option<String>,
 }

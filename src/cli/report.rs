@@ -1,4 +1,4 @@
-//! `formation report INPUT -o report.html` (issue 16): reads annotations (extracted on the
+//! `formation report INPUT -o report.html`: reads annotations (extracted on the
 //! fly), a params file or an animation, and writes the library's self-contained page
 //! ([`formation::report`]) atomically.
 

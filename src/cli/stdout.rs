@@ -39,7 +39,7 @@ pub const MAX_DIAGNOSTIC_CHARS: usize = 2000;
 /// (`error::one_line_within`: control characters from file content or a file's name escaped,
 /// numbers of more than 24 digits shortened, cut at [`MAX_DIAGNOSTIC_CHARS`]). A failed write
 /// (stderr closed, on a full device) is ignored: a diagnostic never ends a run, so the run's
-/// outputs are still committed (`eprintln!` panicked there, exit 101, issue 17).
+/// outputs are still committed (`eprintln!` panicked there, exit 101).
 pub fn diagnostic(text: &str) {
     let mut safe = String::with_capacity(text.len() + 1);
     for line in text.lines() {

@@ -1,4 +1,4 @@
-//! `formation steady`, `formation plot power` and `formation plot xi` (issue 4): flags into
+//! `formation steady`, `formation plot power` and `formation plot xi`: flags into
 //! [`SteadyOptions`], the library's Algorithm 1, and the animation written as JSON or long CSV.
 
 use std::path::{Path, PathBuf};
@@ -93,6 +93,17 @@ pub struct SteadyFlags {
     /// moving frame; in the world on a closed --path). No take-off.
     #[arg(long = "loop")]
     pub looped: bool,
+    /// Vortex core radius of Hummel's model, wingspans (docs/model.md).
+    #[arg(long = "core-radius", value_name = "R", default_value_t = formation::aero::AeroOptions::default().core_radius, allow_negative_numbers = true)]
+    pub core_radius: f64,
+    /// Body mass of a bird, kg, for its power curve (savings of total power; default: the
+    /// species' typical mass scaled to --wingspan-m).
+    #[arg(long = "mass-kg", value_name = "KG", allow_negative_numbers = true)]
+    pub mass_kg: Option<f64>,
+    /// Airspeed, m/s, at which savings of total power are evaluated (default: each bird's own
+    /// speed).
+    #[arg(long = "speed-ms", value_name = "M/S", allow_negative_numbers = true)]
+    pub speed_ms: Option<f64>,
 }
 
 impl SteadyFlags {
@@ -117,6 +128,14 @@ impl SteadyFlags {
                 ..JostleOptions::default()
             },
             looped: self.looped,
+            aero: formation::aero::AeroOptions {
+                core_radius: self.core_radius,
+                ..formation::aero::AeroOptions::default()
+            },
+            flight: formation::animation::FlightSettings {
+                mass_kg: self.mass_kg,
+                speed_ms: self.speed_ms,
+            },
             ..SteadyOptions::default()
         }
     }

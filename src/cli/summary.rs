@@ -1,5 +1,5 @@
 //! The one-paragraph summary that `animate`, `steady` and `initiate` print on stderr after
-//! their outputs are committed (issue 16): the shape learnt, the formations, the take-off time,
+//! their outputs are committed: the shape learnt, the formations, the take-off time,
 //! the flock's saving and the files written with their sizes. `--quiet` hides it.
 
 use std::path::PathBuf;
@@ -108,8 +108,11 @@ pub fn animation_text(what: &str, anim: &Animation, params: Option<&FormationPar
             format!(" ({:.1} % of total power)", 100.0 * t)
         });
         parts.push(format!(
-            "flock saving {:.1} % of induced power{total} in steady flight by Hummel's model (models applied to measured spacings: 14–36 %)",
-            100.0 * e
+            "flock saving {:.1} % of induced power{total} in steady flight by {} (models applied to measured spacings: 14–36 %)",
+            100.0 * e,
+            anim.savings_model
+                .as_ref()
+                .map_or("Hummel's model".to_string(), |m| m.to_string())
         ));
     }
     parts.join(", ")

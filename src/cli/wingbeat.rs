@@ -1,4 +1,4 @@
-//! `formation plot wingbeat`: one wingbeat's joint angles over its phase (issue 7).
+//! `formation plot wingbeat`: one wingbeat's joint angles over its phase.
 
 use std::path::PathBuf;
 

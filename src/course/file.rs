@@ -1,4 +1,4 @@
-//! Reading a course file (issue 19): the leader's path in the world frame (SPEC §2: `x` east,
+//! Reading a course file: the leader's path in the world frame (docs/formats.md §2: `x` east,
 //! `y` north, `z` up) as JSON `{"units": "wingspans" | "m", "points": [[x, y, z], ...]}` or as a
 //! CSV of `x,y,z` rows (an optional header line `x,y,z`; units from [`CourseOptions::units`]).
 //! Gives the control points in wingspans. Every problem is one line naming the file and the point.

@@ -1,5 +1,5 @@
-//! The course (issue 19): where in the world the flock flies. Every earlier stage works in the
-//! *course frame*, a straight flight along +y at constant altitude (SPEC §2's world frame before
+//! The course: where in the world the flock flies. Every earlier stage works in the
+//! *course frame*, a straight flight along +y at constant altitude (docs/formats.md §2's world frame before
 //! this step); this stage maps it onto the user's path. A point at along-track distance `s`,
 //! lateral offset `d` (right of the track) and height `h` goes to
 //! ```math

@@ -278,10 +278,10 @@ pub fn widen(
     let mut done: Option<(Vec<[f64; 3]>, f64)> = None;
     // Smoothing shrinks a closed curve; one shorter than a full turn at the needed radius
     // cannot be flown (see `course::check_loop_size`) and would shrink to nothing (a thin spike
-    // did, and the stretch below grew without bound: a hang found by fuzzing, issue 17).
+    // did, and the stretch below grew without bound: a hang found by fuzzing).
     let shortest_loop = 2.0 * PI / max_turn;
     // At most 400 rounds, and at most WIDEN_WORK sample updates in all: a path that turns back
-    // onto itself along a long leg is never widened and took 35 s (found by fuzzing, issue 17).
+    // onto itself along a long leg is never widened and took 35 s (found by fuzzing).
     let mut work = 0usize;
     for round in 0..400usize {
         let n = q.len();

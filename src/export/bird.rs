@@ -1,4 +1,4 @@
-//! The built-in skinned bird of the glTF and USD exports (issue 14): a skeleton whose joints follow
+//! The built-in skinned bird of the glTF and USD exports: a skeleton whose joints follow
 //! a documented naming convention, one skinned mesh per species (goose, crane, pelican), and the
 //! per-frame motion of every bird (flight on the bird's root, bank on `body`, wingbeat on the wing
 //! joints, tail bend on `tail`).

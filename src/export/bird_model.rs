@@ -1,5 +1,5 @@
 //! `render.bird_model` (a `.glb` file): the user's own bird on every bird of the glTF and USD exports
-//! (issue 14).
+//!.
 //!
 //! The file must be a binary glTF 2.0 (`.glb`) with its buffer inside (no external files), at
 //! most [`MAX_BYTES`] bytes and [`MAX_VERTICES`] vertices, with at least one triangle mesh in its
@@ -177,7 +177,7 @@ impl Reader<'_> {
         // Every accessor the model uses holds vertices, indices (three per triangle) or one
         // matrix per joint: more elements than that cannot be a model within the limits, and an
         // accessor without a buffer view (zeros) costs memory for nothing (4·10⁹ MAT4 zeros in a
-        // 300-byte file tried to allocate 256 GB, issue 17).
+        // 300-byte file tried to allocate 256 GB).
         if count > MAX_ACCESSOR_ELEMENTS {
             return Err(self.err(format!(
                 "accessor {}: {count} elements, more than the {MAX_ACCESSOR_ELEMENTS} a bird model may have",
@@ -629,7 +629,7 @@ impl Reader<'_> {
         }
         // Finite inputs can still give a degenerate placement (a joint's matrix that overflows
         // f32, a bind rotation of a singular matrix): refuse it here, not as an internal error
-        // of the glTF writer or a NaN in the USD text (found by fuzzing, issue 17).
+        // of the glTF writer or a NaN in the USD text (found by fuzzing).
         let finite = mesh.positions.iter().all(|v| v.is_finite())
             && mesh.normals.iter().all(|v| v.is_finite())
             && skel.bind_pos.iter().all(|v| v.is_finite())

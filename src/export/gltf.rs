@@ -1,4 +1,4 @@
-//! glTF 2.0 binary (`.glb`) export, written with `gltf-json` (issue 14: skinned birds, one clip
+//! glTF 2.0 binary (`.glb`) export, written with `gltf-json` (skinned birds, one clip
 //! per stage, metadata, key reduction, the user's own bird).
 //!
 //! Scene `flock`: a node `flock` holding one root node per bird, `bird_000`, `bird_001`, … (zero
@@ -620,7 +620,7 @@ fn material(name: &str, rgb: [f32; 3]) -> json::Material {
 #[derive(Default)]
 struct Builder {
     bin: Vec<u8>,
-    /// The first accessor holding a non-finite number (issue 8: never written), by index.
+    /// The first accessor holding a non-finite number (never written), by index.
     non_finite: Option<String>,
 }
 

@@ -1,4 +1,4 @@
-//! Keyframe reduction for the glTF and USD exports (`render.keys` = reduced, issue 14).
+//! Keyframe reduction for the glTF and USD exports (`render.keys` = reduced).
 //!
 //! The animation is sampled at every frame; `reduced` keeps a subset of those frames such that
 //! LINEAR interpolation between the kept keys (straight lines for positions, slerp for rotations,

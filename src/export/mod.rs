@@ -1,4 +1,4 @@
-//! Outputs of an animation (issues 6, 14 and 15): the animation file (`.json`), the long CSV
+//! Outputs of an animation: the animation file (`.json`), the long CSV
 //! (`.csv`), an animated GIF (`.gif`), a directory of numbered PNG frames (`DIR/`), a video
 //! (`.mp4`, `.webm`, through the system ffmpeg), a glTF 2.0 binary (`.glb`) and text USD with
 //! UsdSkel (`.usda`). [`write_outputs`] is the one entry point of `formation render` and

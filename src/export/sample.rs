@@ -47,7 +47,7 @@ pub fn check_times(anim: &Animation, origin: &Path) -> Result<()> {
 }
 
 /// Number of output frames at `fps` (of [`output_times`]), computed without allocating them, so
-/// that an absurd count can be refused first (issue 8). Saturates at `usize::MAX`.
+/// that an absurd count can be refused first. Saturates at `usize::MAX`.
 pub fn output_count(anim: &Animation, fps: f64) -> usize {
     let (Some(first), Some(last)) = (anim.frames.first(), anim.frames.last()) else {
         return 0;

@@ -15,7 +15,7 @@
 //! - `spread` s < 1 flexes the wrist: the hand folds back by `(1 − s) · 90°` and the arm by a
 //!   third of that, so the wing shortens and narrows on the upstroke (wing flex).
 //!
-//! The bank angle φ (right wing down positive, SPEC §4.4) rolls the whole bird about `y`:
+//! The bank angle φ (right wing down positive, docs/formats.md §4.4) rolls the whole bird about `y`:
 //! `x′ = x cos φ + z sin φ`, `z′ = z cos φ − x sin φ`.
 //! Outline proportions are drawn from field-guide plates (span ≈ 1.5 m goose, 2.2 m crane,
 //! 2.1 m pelican, scaled to a unit span); they are a picture, not a measured model.

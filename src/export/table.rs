@@ -1,6 +1,7 @@
-//! CSV export in SPEC §4.4's long format, one row per frame and bird: first exactly the SPEC's
-//! columns `frame,t,bird,x,y,z,heading,speed,e,xi` (world frame, wingspans, radians, wingspans
-//! per second, seconds), then the analysis columns of issue 16 (never renamed, only added to):
+//! CSV export in the long format of docs/formats.md §4.4, one row per frame and bird: first
+//! exactly the ten fixed columns `frame,t,bird,x,y,z,heading,speed,e,xi` (world frame,
+//! wingspans, radians, wingspans per second, seconds), then the analysis columns (never
+//! renamed, only added to):
 //!
 //! | column | meaning |
 //! |---|---|
@@ -42,7 +43,7 @@ pub fn write_csv<W: Write>(anim: &Animation, w: &mut W) -> std::io::Result<()> {
     let stages = stage_words(anim);
     let of = anim.formation_of_birds();
     let leaders = anim.leaders();
-    let curve = crate::aero::flight::animation_curve(anim.species.as_deref(), anim.wingspan_m);
+    let curve = crate::aero::flight::curve_of(anim);
     for (k, f) in anim.frames.iter().enumerate() {
         let rel = anim.relative_with(k, &of, &leaders);
         for (b, r) in rel.iter().enumerate() {
@@ -59,7 +60,9 @@ pub fn write_csv<W: Write>(anim: &Animation, w: &mut W) -> std::io::Result<()> {
                 .unwrap_or(0.0);
             let total = match f.e.as_ref().and_then(|a| a.get(b)) {
                 Some(e) => {
-                    let v = crate::aero::flight::airspeed_ms(&curve, v(&f.speed), anim.wingspan_m);
+                    let v = anim.flight.and_then(|f| f.speed_ms).unwrap_or_else(|| {
+                        crate::aero::flight::airspeed_ms(&curve, v(&f.speed), anim.wingspan_m)
+                    });
                     format!("{}", e * curve.induced_share(v))
                 }
                 None => String::new(),

@@ -1,4 +1,4 @@
-//! Text USD (`.usda`) export with UsdSkel (issue 14): the flock as a stage that opens in
+//! Text USD (`.usda`) export with UsdSkel: the flock as a stage that opens in
 //! usdview, Houdini Solaris, Blender and Omniverse.
 //!
 //! Stage metadata: `metersPerUnit = 1`, `upAxis = "Y"` (the same axes and numbers as the `.glb`:

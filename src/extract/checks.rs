@@ -1,4 +1,4 @@
-//! Warnings instead of silent wrong answers (issue 16): suspicious annotations that extract
+//! Warnings instead of silent wrong answers: suspicious annotations that extract
 //! without error but probably do not say what the user meant.
 //!
 //! Takes the [`Annotations`], the extracted [`FormationParams`] and each frame's model-selection
@@ -73,6 +73,8 @@ pub enum WarningKind {
     FewFrames,
     /// Frames of exactly 3 birds (V and U indistinguishable).
     ThreeBirds,
+    /// Frames unlike the others (gaps, scatter or birds off the shape), left out of the spacing.
+    OddFrame,
 }
 
 /// One warning: its kind and a one-line message naming the option that fixes it.
@@ -245,6 +247,24 @@ pub fn check(
             message: format!(
                 "{path}: only {n} annotated frame{}; the spacing statistics are learnt across frames, annotate 10–30 frames for a steady flight that varies like the footage",
                 if n == 1 { "" } else { "s" }
+            ),
+        });
+    }
+    let odd = super::screen::odd_frames(params);
+    if !odd.is_empty() {
+        let list: Vec<String> = odd
+            .iter()
+            .map(|o| format!("frame {} ({})", o.index, o.reason))
+            .collect();
+        out.push(Warning {
+            kind: WarningKind::OddFrame,
+            message: format!(
+                "{path}: {} unlike the others: {}; the steady flight leaves {} out of the spacing it draws from; check {} marks (missing, swapped or extra birds) or remove {}",
+                if odd.len() == 1 { "one frame is".to_string() } else { format!("{} frames are", odd.len()) },
+                list.join(", "),
+                if odd.len() == 1 { "it" } else { "them" },
+                if odd.len() == 1 { "its" } else { "their" },
+                if odd.len() == 1 { "it" } else { "them" },
             ),
         });
     }

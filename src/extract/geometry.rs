@@ -1,4 +1,4 @@
-//! What a biologist reads off an extracted frame (issue 16): the V's apex angle per arm, the
+//! What a biologist reads off an extracted frame: the V's apex angle per arm, the
 //! formation's depth and width, and the mean wingtip spacing, per frame and over the movie.
 //!
 //! Takes [`FrameParams`] (formation frame, leader at the origin, wingspans) and gives

@@ -1,8 +1,8 @@
 //! §4 parameter extraction: per-frame ordering, lateral spacing statistics, leader, and the RANSAC
-//! shape fit (issue 3).
+//! shape fit.
 //!
 //! Takes [`Annotations`] (birds in wingspans along and across the flight direction, stable ids)
-//! and gives [`FormationParams`] (SPEC §4.2), one [`FrameParams`] per frame, formation frame with
+//! and gives [`FormationParams`] (docs/formats.md §4.2), one [`FrameParams`] per frame, formation frame with
 //! the leader at the origin, wingspans.
 //!
 //! **Step 1** (per frame): the leader is the front-most bird; `order` lists the ids by lateral
@@ -27,7 +27,7 @@
 //! model must buy its extra parameters with a residual drop of ln n each. The lowest S wins;
 //! equal scores (within a relative 1e-6, e.g. three birds, which a V and a parabola both fit
 //! exactly) go to the V, then the line, then the parabola: three birds are a V unless the data
-//! say otherwise (issue 16). The paper is silent on the choice; this criterion is ours.
+//! say otherwise. The paper is silent on the choice; this criterion is ours.
 //!
 //! After the frames, [`checks`] looks for suspicious input (a formation opening forward, a
 //! heading off by 90°, an implausible scale, few frames, 3-bird frames) and [`geometry`]
@@ -44,6 +44,7 @@ pub mod geometry;
 pub mod motion;
 pub mod params;
 pub mod ransac;
+pub mod screen;
 
 use rand::Rng;
 use serde::{Deserialize, Serialize};

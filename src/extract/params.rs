@@ -1,4 +1,4 @@
-//! The formation-parameters file (SPEC §4.2): what `extract` learns from each annotated frame and
+//! The formation-parameters file (docs/formats.md §4.2): what `extract` learns from each annotated frame and
 //! `steady` consumes. Formation frame (leader at the origin, `x` right of the flight direction,
 //! `y` behind the leader), wingspans.
 
@@ -20,7 +20,7 @@ pub struct FormationParams {
     pub birds: usize,
     /// One entry per annotated frame, in file order.
     pub frames: Vec<FrameParams>,
-    /// The movie's geometry over all frames and the warnings of the extraction (issue 16);
+    /// The movie's geometry over all frames and the warnings of the extraction;
     /// absent in files written before it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub summary: Option<Box<ParamsSummary>>,
@@ -74,7 +74,7 @@ pub struct FrameParams {
     /// deviation from the curve; in `order`.
     #[serde(default)]
     pub positions: Vec<BirdPosition>,
-    /// Apex angle per arm, depth, width and wingtip spacing (issue 16); absent in files
+    /// Apex angle per arm, depth, width and wingtip spacing; absent in files
     /// written before it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub geometry: Option<super::geometry::FrameGeometry>,

@@ -3,7 +3,7 @@
 //! of a steady-flight animation while they climb to the cruise altitude; the result is that
 //! animation with an `initiation` stage in front.
 //!
-//! Takes a [`crate::Animation`] (SPEC §4.4) whose `key_shapes[0]` (formation frame, wingspans) is
+//! Takes a [`crate::Animation`] (docs/formats.md §4.4) whose `key_shapes[0]` (formation frame, wingspans) is
 //! the target and whose frames are the steady flight (world frame, wingspans, wingspans per
 //! second, headings radians clockwise from +y). Gives the combined animation: frames `0..k` of
 //! initiation, then the steady frames translated in space (to the cruise altitude) and time so
@@ -634,7 +634,7 @@ impl StartState {
             }
         }
         // Where an animation file may hold a bird: one 10¹² wingspans away made the take-off's
-        // neighbour grid crawl (75 s), one at 10³⁰⁰ overflowed it (a panic; issue 17).
+        // neighbour grid crawl (75 s), one at 10³⁰⁰ overflowed it (a panic).
         let bound = crate::limits::MAX_COORDINATE;
         for (name, a) in [("x", &s.x), ("y", &s.y)] {
             if let Some(i) = a.iter().position(|v| v.abs() > bound) {
@@ -1650,7 +1650,7 @@ pub fn initiate(
 
 /// Refuses an initiation that could hold more than [`crate::limits::MAX_BIRD_FRAMES`]
 /// bird-frames in memory: `birds` × (`steady_frames` + `max_steps`), every step being kept for the
-/// output (issue 8: refused up front instead of exhausting memory).
+/// output (refused up front instead of exhausting memory).
 pub fn check_size(birds: usize, steady_frames: usize, max_steps: usize) -> Result<()> {
     let frames = steady_frames.saturating_add(max_steps);
     match birds.checked_mul(frames) {
@@ -1795,6 +1795,8 @@ pub fn hand_over(
     }
     let mut out = Animation::new(opts.seed, fps, steady.wingspan_m, n);
     out.species = steady.species.clone();
+    out.flight = steady.flight;
+    out.savings_model = steady.savings_model.clone();
     out.stages.push(Stage {
         name: "initiation".into(),
         start: 0,

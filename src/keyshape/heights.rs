@@ -1,4 +1,4 @@
-//! Small per-bird altitude differences, as in real flocks (issue 19): heights about the
+//! Small per-bird altitude differences, as in real flocks: heights about the
 //! leader's at every key shape, wingspans. A stereo-filmed V of white-fronted geese had a
 //! height spread of about 0.14 wingspans, lateral neighbours about 0.06 apart.
 

@@ -1,5 +1,5 @@
 //! §5 step 1: the correspondence between the N animated birds and the N̂ movie birds, and one
-//! N-bird initial shape per movie frame. Takes the formation parameters of §4 (SPEC §4.2); gives
+//! N-bird initial shape per movie frame. Takes the formation parameters of §4 (docs/formats.md §4.2); gives
 //! shapes in the formation frame (`x` right of the flight direction, `y` behind the leader),
 //! wingspans. Animated birds are indexed left to right (smallest `x` first).
 //!
@@ -296,7 +296,7 @@ pub fn positions_from_gaps(gaps: &[f64], leader: usize) -> Vec<f64> {
 /// fly). A U or J parabola is mapped by rank: with s the ratio of movie to animated birds on that
 /// side, the animated bird at x takes the movie curve's slope at x·s, i.e.
 /// y = (curve(x·s) − curve(0))/s. Each bird then sits behind its lateral neighbour by what the
-/// movie bird of the same relative rank does (the footage's spacing, issue 12), and a flock with
+/// movie bird of the same relative rank does (the footage's spacing), and a flock with
 /// more birds per side makes a U of the movie's proportions that is deeper in proportion to its
 /// birds per side (with the movie's depth, the neighbours of a larger flock would crowd
 /// together fore and aft; with the unscaled parabola, its outer birds would string out).

@@ -56,7 +56,7 @@ pub struct KeyOptions {
     pub max_depth_factor: f64,
     /// Widening of the band of the median longitudinal distance to the nearest bird ahead that
     /// the initial shapes span, inside which every key shape's must stay (the footage's
-    /// spacing, issue 12), fraction in [0, 1].
+    /// spacing), fraction in [0, 1].
     pub spacing_margin: f64,
 }
 

@@ -1,4 +1,4 @@
-//! Living lateral spacing (issue 19): the lateral positions of every key shape. The gaps between
+//! Living lateral spacing: the lateral positions of every key shape. The gaps between
 //! lateral neighbours are drawn once for the flight (§5 step 1's N(μ_x, σ_x), see
 //! [`crate::keyshape::steady`]) and each drifts slowly around its drawn value from key shape to
 //! key shape, so the V breathes sideways as well as fore and aft. Wingspans.

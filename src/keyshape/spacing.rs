@@ -1,4 +1,4 @@
-//! The footage's spacing in generated flocks (issue 12): the median lateral and longitudinal
+//! The footage's spacing in generated flocks: the median lateral and longitudinal
 //! distance from each bird to its nearest bird ahead (the nearest, in the plane, of the birds with
 //! a smaller `y`), for a shape or pooled over several. Formation frame, wingspans.
 //!
@@ -77,7 +77,7 @@ pub fn spacing<'a>(shapes: impl IntoIterator<Item = (&'a [f64], &'a [f64])>) -> 
     )
 }
 
-/// The footage's spacing from the positions of its frames (SPEC §4.2 `positions`), or `None`
+/// The footage's spacing from the positions of its frames (docs/formats.md §4.2 `positions`), or `None`
 /// when no frame has positions of at least two birds.
 pub fn footage_spacing(params: &crate::extract::params::FormationParams) -> Option<(f64, f64)> {
     let frames: Vec<(Vec<f64>, Vec<f64>)> = params

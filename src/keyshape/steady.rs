@@ -1,5 +1,5 @@
 //! §5 Algorithm 1, the whole steady flight: from the formation parameters of an N̂-bird movie
-//! (SPEC §4.2) to an F-frame animation of N birds (SPEC §4.4) whose key shapes keep the movie's
+//! (docs/formats.md §4.2) to an F-frame animation of N birds (docs/formats.md §4.4) whose key shapes keep the movie's
 //! energy-savings pattern. Lengths in wingspans, times in seconds, speeds in wingspans per second.
 //!
 //! 1. [`initial`](crate::keyshape::initial): correspondence and one N-bird shape per movie frame.
@@ -12,7 +12,7 @@
 //! The lateral positions are drawn once: gaps from N(d̄, σ̄_x) with
 //! d̄ uniform in the movie's range of mean gaps [min_f μ_xf, max_f μ_xf] and σ̄_x the mean of σ_xf,
 //! redrawn only at or below a body's width (`min_gap`; overlapping wingtips are kept); each gap
-//! then drifts slowly around its drawn value from key to key (`lateral_drift`, issue 19), so
+//! then drifts slowly around its drawn value from key to key (`lateral_drift`), so
 //! every key shape has its own x. Munk's theorem fixes E = Σ_{i≠j} g(|x_i − x_j|, 0) of each
 //! key shape (`aero::munk_total`), which makes eq. (3) exact instead of an estimate from a
 //! constant-gap flock. Heights differ slightly between birds (`height_spread`,
@@ -65,15 +65,18 @@ pub struct SteadyOptions {
     pub keys: KeyOptions,
     /// Step 1: the lateral gaps' physical bound and the initial shapes' redraws.
     pub initial: InitialOptions,
-    /// The lateral positions' slow drift between key shapes (issue 19).
+    /// The lateral positions' slow drift between key shapes.
     pub lateral: LateralOptions,
-    /// Small per-bird altitude differences (issue 19).
+    /// Small per-bird altitude differences.
     pub heights: HeightOptions,
     /// The aerodynamic model's vortex core and collision distance.
     pub aero: AeroOptions,
     /// Each bird's position-keeping motion about its slot (`keyshape::jostle`); none in a
     /// loop.
     pub jostle: JostleOptions,
+    /// The birds' mass and airspeed for their power curve (savings of total power), recorded in
+    /// the animation.
+    pub flight: crate::animation::FlightSettings,
     /// A seamless cycle: the last key shape is the first, placed one frame after the last
     /// frame, so the frame after the last is the first again (in the flock's moving frame).
     #[serde(rename = "loop")]
@@ -95,6 +98,7 @@ impl Default for SteadyOptions {
             heights: HeightOptions::default(),
             aero: AeroOptions::default(),
             jostle: JostleOptions::default(),
+            flight: crate::animation::FlightSettings::default(),
             looped: false,
         }
     }
@@ -155,6 +159,7 @@ impl SteadyOptions {
         self.heights.validate()?;
         self.aero.validate()?;
         self.jostle.validate()?;
+        crate::aero::flight::validate_settings(&self.flight)?;
         let seconds = self.frames as f64 / self.fps;
         if self.looped && seconds < self.keys.key_every_s {
             return Err(p(
@@ -294,7 +299,7 @@ const DEPTH_SCALE_LIMIT: f64 = 3.0;
 
 /// The factor on the U and J curves' rank scale ([`side_scales`]) that gives the initial shapes,
 /// at the key shapes' lateral positions `x`, the footage's median longitudinal distance to the
-/// nearest bird ahead (issue 12). The plain rank scale keeps each bird's step behind its
+/// nearest bird ahead. The plain rank scale keeps each bird's step behind its
 /// neighbour at the same relative place on the arm, but a median of the few steps of a small
 /// flock, or of the many of a large one, is not the footage's median of its own count (a
 /// parabola's steps grow along the arm), and the noise of the deviations adds to it. The
@@ -376,14 +381,16 @@ pub fn steady_flight_in(
 
     // Step 1.
     let corr: Correspondence = correspondence(first, n)?;
-    let (lo_mu, hi_mu) = params
-        .frames
+    // The spacing is drawn from the frames that look like the others (an odd frame, e.g. a
+    // half-tracked one, would widen every generated flock; `extract` warns about it).
+    let spacing_frames = crate::extract::screen::spacing_frames(params);
+    let (lo_mu, hi_mu) = spacing_frames
         .iter()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), f| {
             (a.min(f.mu_x), b.max(f.mu_x))
         });
     let sigma_bar =
-        params.frames.iter().map(|f| f.sigma_x).sum::<f64>() / params.frames.len() as f64;
+        spacing_frames.iter().map(|f| f.sigma_x).sum::<f64>() / spacing_frames.len().max(1) as f64;
     let u: f64 = rng.random();
     let mean_gap = (lo_mu + u * (hi_mu - lo_mu)).max(init_opts.min_gap);
     let gaps = lateral_gaps(rng, mean_gap, sigma_bar, n - 1, init_opts);
@@ -660,6 +667,11 @@ pub fn steady_flight_in(
     progress.finish();
 
     let mut anim = Animation::new(opts.seed, opts.fps, opts.wingspan_m, n);
+    anim.flight = (!opts.flight.is_empty()).then_some(opts.flight);
+    anim.savings_model = Some(crate::animation::SavingsModel {
+        wake: "planar".into(),
+        core_radius: opts.aero.core_radius,
+    });
     anim.stages.push(Stage {
         name: "steady".into(),
         start: 0,

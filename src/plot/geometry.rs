@@ -1,4 +1,4 @@
-//! The extracted geometry over the annotated frames (issue 16, for `formation report`): the V's
+//! The extracted geometry over the annotated frames (for `formation report`): the V's
 //! apex angle and each arm's angle per frame with the field studies' apex angles shaded, and the
 //! mean wingtip spacing per frame. Takes [`FormationParams`] with geometry (written by
 //! `formation extract`); angles in degrees, spacing in wingspans.
@@ -23,7 +23,7 @@ pub struct GeometryChart {
 }
 
 impl GeometryChart {
-    /// The chart of `p`; `None` when no frame has geometry (a file written before issue 16).
+    /// The chart of `p`; `None` when no frame has geometry (a params file written before per-frame geometry existed).
     pub fn from_params(p: &FormationParams, title: &str) -> Option<GeometryChart> {
         let rows: Vec<_> = p
             .frames

@@ -82,7 +82,7 @@ impl PowerChart {
                         ),
                     )
                 })?;
-                // The formation frame of SPEC §2 at this frame, whatever the heading: lateral
+                // The formation frame of docs/formats.md §2 at this frame, whatever the heading: lateral
                 // offsets to the right of the leader's heading, distances behind it along it.
                 let rel = anim.relative(k);
                 let lateral: Vec<f64> = rel.iter().map(|r| r.lateral).collect();
@@ -139,7 +139,7 @@ impl PowerChart {
         })
     }
 
-    /// The chart of the file at `path`: a shape file (SPEC §4.3), or formation `formation` of an
+    /// The chart of the file at `path`: a shape file (docs/formats.md §4.3), or formation `formation` of an
     /// animation file and its key shape or frame `of` (default: key shape 0), told apart by
     /// content ([`crate::sniff`]). Errors name `plot.formation`, `plot.key` or `plot.frame`.
     pub fn from_file(

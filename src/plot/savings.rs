@@ -1,9 +1,9 @@
 //! `formation plot savings`: how much each bird saves against its place in the formation, and how
 //! much the flock saves over time through the take-off, with the field studies' flock savings
-//! drawn for comparison (issue 16).
+//! drawn for comparison.
 //!
 //! Takes an animation with savings (`e` in its frames); savings are percentages of solo induced
-//! power (SPEC §3). Left panel: each bird's mean saving over the steady flight against its mean
+//! power (docs/formats.md §3). Left panel: each bird's mean saving over the steady flight against its mean
 //! rank (0 = its formation's leader, drawn as a red diamond), birds coloured by rank with the
 //! map of [`super::bird_colour`]. Right panel: the flock's saving E/N at every frame, the take-off
 //! shaded. Both panels shade the span of [`super::field::FLOCK_SAVING`].

@@ -269,6 +269,26 @@ fn animation_sections(page: &mut Page, a: &Animation, s: &Subject<'_>) -> Result
             pct(e),
         ]);
     }
+    if let Some(m) = &a.savings_model {
+        rows.push(vec!["savings model".into(), m.to_string()]);
+    }
+    {
+        let c = crate::aero::flight::curve_of(a);
+        let b = &c.bird;
+        let speed = a
+            .flight
+            .and_then(|f| f.speed_ms)
+            .map_or("each bird's own airspeed".to_string(), |v| {
+                format!("{v} m/s")
+            });
+        rows.push(vec![
+            "power curve (Pennycuick 2008)".into(),
+            format!(
+                "{:.2} kg, {:.2} m span, {:.3} m² wings; {speed}",
+                b.mass_kg, b.span_m, b.wing_area_m2
+            ),
+        ]);
+    }
     if let Some(t) = crate::aero::flight::steady_saving_total(a) {
         rows.push(vec![
             "flock saving in steady flight (of total power, Pennycuick's power curve)".into(),
@@ -385,7 +405,7 @@ fn bird_tables(page: &mut Page, birds: &[BirdStats]) {
     // (by mean distance behind the leader), pooled over formations.
     // Place k on an arm: 1 + the birds of the same formation and arm ahead of it, counted by
     // sorting each arm once (counting them for every bird was quadratic: 100 000 birds took
-    // seconds, issue 17).
+    // seconds).
     let mut arm: Vec<usize> = (0..birds.len()).filter(|&i| !birds[i].leader).collect();
     let side = |b: &BirdStats| (b.formation, b.lateral >= 0.0);
     arm.sort_by(|&i, &j| {

@@ -1,4 +1,4 @@
-//! `formation report INPUT -o report.html` (issue 16): one self-contained HTML page about
+//! `formation report INPUT -o report.html`: one self-contained HTML page about
 //! annotations (extracted on the fly), a params file or an animation: the extracted parameters
 //! per frame with fit charts, the savings per bird and per position, the take-off statistics and
 //! the comparison with field studies of real formations.
@@ -34,7 +34,7 @@ pub struct Subject<'a> {
     pub animation: Option<&'a Animation>,
 }
 
-/// The footage's own savings: Hummel's model (SPEC §3) evaluated on every annotated frame's
+/// The footage's own savings: Hummel's model (docs/formats.md §3) evaluated on every annotated frame's
 /// birds (formation frame), as [`AnimationStats`] with the frame index as "time". Birds whose
 /// wings overlap side by side are evaluated at the collision distance (never an error).
 pub fn footage_savings(p: &FormationParams) -> AnimationStats {

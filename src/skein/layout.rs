@@ -1,5 +1,5 @@
 //! Where the formations of a flock fly relative to one another, in the course frame (the world
-//! frame of a flock cruising north, SPEC §2): x east, y north, wingspans.
+//! frame of a flock cruising north, docs/formats.md §2): x east, y north, wingspans.
 //!
 //! **Drift.** Each formation wanders about its place on a slow Lissajous figure: a displacement
 //! (A_x sin(ωt + φ_x), A_y sin(ωt + φ_y)) − its value at t = 0, with the period 2π/ω uniform in

@@ -7,7 +7,7 @@
 //! formation's birds, leader and key shapes.
 //!
 //! Lengths in wingspans, times in seconds, the course frame (the world frame of a flock cruising
-//! north, SPEC §2); the take-off's own start region is centred on each formation's place.
+//! north, docs/formats.md §2); the take-off's own start region is centred on each formation's place.
 //!
 //! - Formation k draws every one of its own numbers from `rng::Scope::Formation(k)` (the streams
 //!   `rng::formation_stream(seed, Stream::Steady | SteadyLateral | SteadyHeight | Initiate |
@@ -420,7 +420,7 @@ pub const MIN_TAKEOFF_DISTANCE: f64 = 0.3;
 /// within the time limit is flown again, up to [`TAKEOFF_TRIES`] in all, from a fresh random start
 /// (stream `initiate/formation/f/try/t`) into a fresh steady flight (`redo`, when the flock was
 /// made from formation parameters; its first key shape is what the take-off failed to reach):
-/// now and then the §6 rules leave a bird or two of a formation short of their slots (issue 18),
+/// now and then the §6 rules leave a bird or two of a formation short of their slots,
 /// and a flock of a hundred formations should not fail for one of them.
 #[allow(clippy::type_complexity)]
 fn takeoff_run(
@@ -547,6 +547,8 @@ fn join(anims: &[Animation], reports: &[FormationReport]) -> Result<Animation> {
     }
     let mut out = Animation::new(first.seed, first.fps, first.wingspan_m, n);
     out.species = first.species.clone();
+    out.flight = first.flight;
+    out.savings_model = first.savings_model.clone();
     out.wingbeat = first.wingbeat.clone();
     out.stages = first.stages.clone();
     let steady_start = first.stage("steady").map(|s: &Stage| s.start);
