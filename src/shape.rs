@@ -14,6 +14,15 @@ pub struct Bird {
     pub x: f64,
     /// Distance behind the leader (downstream positive), wingspans.
     pub y: f64,
+    /// Height above the leader's plane (up positive), wingspans; 0 when absent, and then left
+    /// out of JSON. Only the 3-D wake uses it.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub z: f64,
+}
+
+/// True for 0 (and −0): the height left out of a bird's JSON.
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
 }
 
 /// A flock's shape: the birds' positions in the formation frame (docs/formats.md §4.3).
@@ -27,7 +36,11 @@ impl Shape {
     /// Builds a shape from parallel coordinate slices (wingspans).
     pub fn from_xy(x: &[f64], y: &[f64]) -> Shape {
         Shape {
-            birds: x.iter().zip(y).map(|(&x, &y)| Bird { x, y }).collect(),
+            birds: x
+                .iter()
+                .zip(y)
+                .map(|(&x, &y)| Bird { x, y, z: 0.0 })
+                .collect(),
         }
     }
 
@@ -39,6 +52,11 @@ impl Shape {
     /// Longitudinal positions, wingspans.
     pub fn ys(&self) -> Vec<f64> {
         self.birds.iter().map(|b| b.y).collect()
+    }
+
+    /// Heights above the leader's plane (up), wingspans.
+    pub fn zs(&self) -> Vec<f64> {
+        self.birds.iter().map(|b| b.z).collect()
     }
 
     /// Number of birds.
@@ -95,8 +113,14 @@ impl Shape {
                     format!("birds[{i}].y: not a finite number"),
                 ));
             }
+            if !b.z.is_finite() {
+                return Err(Error::format(
+                    origin,
+                    format!("birds[{i}].z: not a finite number"),
+                ));
+            }
             let c = crate::limits::MAX_COORDINATE;
-            if b.x.abs() > c || b.y.abs() > c {
+            if b.x.abs() > c || b.y.abs() > c || b.z.abs() > c {
                 return Err(Error::format(
                     origin,
                     format!(

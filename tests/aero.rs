@@ -12,6 +12,8 @@ const S: f64 = VORTEX_SPAN / 2.0;
 const IDEAL: AeroOptions = AeroOptions {
     core_radius: 0.0,
     collision_chord: aero::DEFAULT_COLLISION_CHORD,
+    wake: aero::Wake::Planar,
+    wake_descent: 0.0,
 };
 
 fn cored() -> AeroOptions {

@@ -204,6 +204,8 @@ fn commands() -> Vec<Command> {
             base: strings(&["power", &shape]),
             cases: vec![
                 ("--core-radius", "nan", None),
+                ("--wake", "sideways", None),
+                ("--wake-descent", "nan", None),
                 ("--mass-kg", "0", None),
                 ("--speed-ms", "-3", None),
                 ("--species", "owl", None),
@@ -217,6 +219,7 @@ fn commands() -> Vec<Command> {
             cases: vec![
                 ("--tolerance", "-1", None),
                 ("--core-radius", "nan", None),
+                ("--wake", "sideways", None),
                 o("OUT/s.txt"),
                 seed.clone(),
             ],

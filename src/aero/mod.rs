@@ -48,6 +48,10 @@
 //! (π²/2)·∂g/∂y = Σ/Y² + Σ_c w_c(1/r̃_c − 1/r_c), even in y and positive: g increases with y on
 //! each side of a collision, so e(y) is the gradient of a convex potential.
 //!
+//! **Heights.** `wake3d` extends g to birds at different heights, g₃(x, y, z) with
+//! g₃(x, y, 0) = g(x, y) ([`AeroOptions::g3`], [`AeroOptions::power_reduction_3d`], chosen by
+//! [`AeroOptions::wake`]); everything else in this module is planar.
+//!
 //! Symbols → code: x → `x` (lateral distance), y → `y` (how far the affected bird is behind
 //! the other), a → [`VORTEX_SPAN`], δ → [`AeroOptions::core_radius`], e_i →
 //! [`PowerReduction::e`], ξ_i → [`PowerReduction::xi`], E → [`PowerReduction::total`].
@@ -58,8 +62,10 @@ mod far;
 mod field;
 pub mod flight;
 mod tree;
+mod wake3d;
 pub use field::{ApproxField, Field};
 pub use tree::TreeOptions;
+pub use wake3d::Wake;
 
 use crate::animation::Animation;
 use crate::error::{Error, Result};
@@ -105,6 +111,26 @@ pub struct AeroOptions {
     /// [`COLLISION_SPAN`] apart laterally and less than this apart fore and aft have wings that
     /// overlap side by side. Coincident birds always collide.
     pub collision_chord: f64,
+    /// Which wake gives the savings of shapes whose birds fly at different heights
+    /// ([`AeroOptions::power_reduction_3d`]): [`Wake::Planar`] (the default, heights ignored) or
+    /// [`Wake::ThreeD`]. Functions without heights (g, the key-shape solve's sums, the frames'
+    /// savings) are planar whatever it says. Left out of serialised options when planar.
+    #[serde(skip_serializing_if = "Wake::is_planar")]
+    pub wake: Wake,
+    /// Slope at which the 3-D wake's trailing vortices sink behind the bird, wingspans of descent
+    /// per wingspan downstream (≥ 0, at most [`MAX_WAKE_DESCENT`]; 0, the default, keeps them
+    /// level). Only [`Wake::ThreeD`] uses it. Left out of serialised options when 0.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub wake_descent: f64,
+}
+
+/// Largest accepted [`AeroOptions::wake_descent`]: a slope of 0.2, far beyond a bird's wake
+/// (about 0.01).
+pub const MAX_WAKE_DESCENT: f64 = 0.2;
+
+/// True for 0: an option left out of serialised options.
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
 }
 
 impl Default for AeroOptions {
@@ -112,6 +138,8 @@ impl Default for AeroOptions {
         AeroOptions {
             core_radius: DEFAULT_CORE_RADIUS,
             collision_chord: DEFAULT_COLLISION_CHORD,
+            wake: Wake::Planar,
+            wake_descent: 0.0,
         }
     }
 }
@@ -212,6 +240,27 @@ impl AeroOptions {
                 format!(
                     "{}: the collision distance must be a number of wingspans in [0, 1] (default {DEFAULT_COLLISION_CHORD})",
                     self.collision_chord
+                ),
+            ));
+        }
+        if !(self.wake_descent.is_finite()
+            && self.wake_descent >= 0.0
+            && self.wake_descent <= MAX_WAKE_DESCENT)
+        {
+            return Err(Error::parameter(
+                "aero.wake_descent",
+                format!(
+                    "{}: the wake's descent must be a slope in [0, {MAX_WAKE_DESCENT}] (wingspans per wingspan; default 0)",
+                    self.wake_descent
+                ),
+            ));
+        }
+        if self.wake_descent != 0.0 && self.wake == Wake::Planar {
+            return Err(Error::parameter(
+                "aero.wake_descent",
+                format!(
+                    "{}: only the 3-D wake descends; choose the wake \"3d\" or a descent of 0",
+                    self.wake_descent
                 ),
             ));
         }
@@ -766,6 +815,8 @@ mod tests {
     const IDEAL: AeroOptions = AeroOptions {
         core_radius: 0.0,
         collision_chord: DEFAULT_COLLISION_CHORD,
+        wake: Wake::Planar,
+        wake_descent: 0.0,
     };
 
     /// The formula exactly as printed, with absolute values inside the logarithms, evaluated

@@ -21,6 +21,7 @@ mod stdout;
 mod steady;
 pub mod summary;
 mod track;
+mod wake;
 mod wingbeat;
 
 /// Animate bird flocks flying in line formations (V, U, J, echelon), after Klotsman & Tal.

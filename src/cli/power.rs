@@ -6,6 +6,7 @@ use clap::Args;
 use formation::{aero, Error, Result, Shape};
 use serde::Serialize;
 
+use super::wake::WakeArg;
 use super::Global;
 
 /// Arguments of `formation power`.
@@ -20,6 +21,19 @@ pub struct PowerArgs {
     /// Vortex core radius of Hummel's model, wingspans (docs/model.md).
     #[arg(long, allow_negative_numbers = true, default_value_t = formation::aero::AeroOptions::default().core_radius)]
     pub core_radius: f64,
+    /// Wake model: planar (Hummel's, heights ignored) or 3d (uses each bird's "z", wingspans,
+    /// up; docs/model.md).
+    #[arg(long, value_enum, default_value_t = WakeArg::Planar)]
+    pub wake: WakeArg,
+    /// With --wake 3d: slope at which the trailing vortices sink behind each bird, wingspans per
+    /// wingspan (0 = level; about 0.01 for a goose; docs/model.md).
+    #[arg(
+        long,
+        value_name = "SLOPE",
+        allow_negative_numbers = true,
+        default_value_t = 0.0
+    )]
+    pub wake_descent: f64,
     #[command(flatten)]
     pub flight: FlightArgs,
 }
@@ -139,10 +153,17 @@ struct PowerJson {
 struct BirdJson {
     x: f64,
     y: f64,
+    #[serde(skip_serializing_if = "is_zero")]
+    z: f64,
     e: f64,
     xi: f64,
     saving: f64,
     saving_total: f64,
+}
+
+/// True for 0: a height left out of the JSON (planar shapes print as before).
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
 }
 
 /// Runs `formation power`.
@@ -167,19 +188,25 @@ pub fn run(args: PowerArgs, _g: Global) -> Result<()> {
     }
     let shape: Shape = formation::io::parse_json(&args.shape, &text)?;
     shape.validate(&args.shape, 2)?;
-    let (x, y) = (shape.xs(), shape.ys());
+    let (x, y, z) = (shape.xs(), shape.ys(), shape.zs());
     let flight = args.flight.flight()?;
     let share = flight.induced_share();
     let model = aero::AeroOptions {
         core_radius: args.core_radius,
+        wake: args.wake.into(),
+        wake_descent: args.wake_descent,
         ..aero::AeroOptions::default()
     };
     model.validate().map_err(|e| match e {
+        Error::Parameter { name, message } if name == "aero.wake_descent" => Error::parameter(
+            "--wake-descent",
+            message.replace("the wake \"3d\"", "--wake 3d"),
+        ),
         Error::Parameter { message, .. } => Error::parameter("--core-radius", message),
         other => other,
     })?;
     let pr = model
-        .power_reduction(&x, &y)
+        .power_reduction_3d(&x, &y, &z)
         .map_err(|e| in_file(&args.shape, e))?;
     let flock_saving = pr.total / shape.len() as f64;
     // How much the number depends on the core radius (the model's one free length).
@@ -190,7 +217,7 @@ pub fn run(args: PowerArgs, _g: Global) -> Result<()> {
                 core_radius: c,
                 ..model
             };
-            let p = m.power_reduction(&x, &y).ok()?;
+            let p = m.power_reduction_3d(&x, &y, &z).ok()?;
             let f = p.total / shape.len() as f64;
             Some(CoreJson {
                 core_radius: c,
@@ -222,6 +249,7 @@ pub fn run(args: PowerArgs, _g: Global) -> Result<()> {
                 .map(|(b, (&e, &xi))| BirdJson {
                     x: b.x,
                     y: b.y,
+                    z: b.z,
                     e,
                     xi,
                     saving: e,
@@ -275,7 +303,17 @@ pub fn run(args: PowerArgs, _g: Global) -> Result<()> {
         }
         let bird = &flight.curve.bird;
         out.push_str(&format!(
-            "model: Hummel's horseshoe wake, core {} wingspans; power curve after Pennycuick (2008) for a {} of {:.2} kg, {:.2} m span at {:.1} m/s: induced power is {:.0}% of the total\n",
+            "model: Hummel's horseshoe wake{}, core {} wingspans; power curve after Pennycuick (2008) for a {} of {:.2} kg, {:.2} m span at {:.1} m/s: induced power is {:.0}% of the total\n",
+            match model.wake {
+                aero::Wake::Planar => String::new(),
+                aero::Wake::ThreeD if model.wake_descent == 0.0 => {
+                    " in 3-D (each bird's height z)".to_string()
+                }
+                aero::Wake::ThreeD => format!(
+                    " in 3-D (each bird's height z; trailing vortices sinking {} wingspans per wingspan)",
+                    model.wake_descent
+                ),
+            },
             args.core_radius,
             flight.species,
             bird.mass_kg,

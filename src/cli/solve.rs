@@ -11,6 +11,7 @@ use serde::{Deserialize, Serialize};
 
 use super::power::in_file;
 use super::progress::TermProgress;
+use super::wake::WakeArg;
 use super::Global;
 
 /// Solves of at least this many birds show a progress bar (smaller ones take milliseconds).
@@ -33,6 +34,10 @@ pub struct SolveArgs {
     /// Vortex core radius of Hummel's model, wingspans (docs/model.md).
     #[arg(long, allow_negative_numbers = true, default_value_t = formation::aero::AeroOptions::default().core_radius)]
     pub core_radius: f64,
+    /// Wake model, planar or 3d (docs/model.md); the key shape lies in one plane, where both
+    /// give the same savings.
+    #[arg(long, value_enum, default_value_t = WakeArg::Planar)]
+    pub wake: WakeArg,
 }
 
 #[derive(Debug, Deserialize)]
@@ -62,6 +67,7 @@ pub fn run(args: SolveArgs, g: Global) -> Result<()> {
         tolerance: args.tolerance,
         aero: formation::aero::AeroOptions {
             core_radius: args.core_radius,
+            wake: args.wake.into(),
             ..Default::default()
         },
         ..SolveOptions::default()
@@ -91,7 +97,7 @@ pub fn run(args: SolveArgs, g: Global) -> Result<()> {
             .x
             .iter()
             .zip(&rep.y)
-            .map(|(&x, &y)| formation::Bird { x, y })
+            .map(|(&x, &y)| formation::Bird { x, y, z: 0.0 })
             .collect(),
         xi: rep.xi.clone(),
         target: rep.target.clone(),
