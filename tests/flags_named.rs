@@ -95,6 +95,7 @@ fn commands() -> Vec<Command> {
         ("--core-radius", "nan", None),
         ("--mass-kg", "0", None),
         ("--speed-ms", "-3", None),
+        ("--wake", "sideways", None),
         ("--formations", "0", None),
         ("--formation-size", "1", None),
         ("--clearance", "-1", None),

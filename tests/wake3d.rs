@@ -760,3 +760,46 @@ fn solve_with_the_3d_wake_gives_the_planar_key_shape() {
     }
     assert_eq!(ys[0], ys[1]);
 }
+
+#[test]
+fn a_steady_flight_with_the_3d_wake_flies_the_same_and_saves_by_its_heights() {
+    let dir = scratch("wake3d-steady");
+    let params = support::repo_file("tests/data/steady_v9_params.json");
+    let fly = |wake: &str| {
+        let out = dir.join(format!("{wake}.json"));
+        let o = run(&[
+            "steady",
+            s(&params),
+            "--birds",
+            "9",
+            "--seconds",
+            "6",
+            "--wake",
+            wake,
+            "-o",
+            s(&out),
+        ]);
+        assert_eq!(code(&o), 0, "{}", stderr(&o));
+        formation::Animation::read(&out).unwrap()
+    };
+    let (planar, three) = (fly("planar"), fly("3d"));
+    assert_eq!(planar.savings_model.as_ref().unwrap().wake, "planar");
+    assert_eq!(three.savings_model.as_ref().unwrap().wake, "3d");
+    // The same motion: the key shapes are solved in the plane either way.
+    let mut differ = 0;
+    for (a, b) in planar.frames.iter().zip(&three.frames) {
+        assert_eq!((&a.x, &a.y, &a.z), (&b.x, &b.y, &b.z));
+        let (ea, eb) = (a.e.as_ref().unwrap(), b.e.as_ref().unwrap());
+        // The birds fly at slightly different heights, which the 3-D wake sees.
+        if ea.iter().zip(eb).any(|(p, q)| (p - q).abs() > 1e-9) {
+            differ += 1;
+        }
+        // Every saving finite, the shares a partition of the flock's total.
+        assert!(eb.iter().all(|v| v.is_finite()));
+    }
+    assert!(
+        differ * 2 > three.frames.len(),
+        "3-D savings differ in {differ} frames"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -801,7 +801,7 @@ pub fn fill_frame_savings(anim: &mut Animation, opts: &AeroOptions) {
         // d = (sin θ, cos θ) is the flight direction, (cos θ, −sin θ) its right.
         let lx: Vec<f64> = (0..n).map(|i| f.x[i] * c - f.y[i] * s).collect();
         let ly: Vec<f64> = (0..n).map(|i| -(f.x[i] * s + f.y[i] * c)).collect();
-        let e = opts.power_lenient(&lx, &ly);
+        let e = opts.power_lenient_3d(&lx, &ly, &f.z);
         let (xi, _) = relative(&e);
         f.e = Some(e);
         f.xi = Some(xi);

@@ -55,7 +55,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{AeroOptions, PowerReduction, A, TWO_OVER_PI2};
+use super::{AeroOptions, PowerReduction, A, COLLISION_SPAN, TWO_OVER_PI2};
 use crate::error::{Error, Result};
 
 /// Which wake gives the savings.
@@ -346,6 +346,50 @@ impl AeroOptions {
                     e[i] += front;
                     e[j] += back;
                 }
+            }
+        }
+        for v in e.iter_mut() {
+            *v *= TWO_OVER_PI2;
+        }
+        e
+    }
+
+    /// [`AeroOptions::power_lenient`] with heights: every frame of an animation gets finite
+    /// savings (a pair closer than a chord is evaluated at the collision distance). The planar
+    /// wake ignores `z`.
+    pub fn power_lenient_3d(&self, x: &[f64], y: &[f64], z: &[f64]) -> Vec<f64> {
+        if self.wake == Wake::Planar || z.len() != x.len() {
+            return self.power_lenient(x, y);
+        }
+        let n = x.len();
+        let chord = self.collision_chord.max(1e-3);
+        // Pairs closer than a chord: the one behind is evaluated a chord behind (as the planar
+        // lenient sum does).
+        let mut e = vec![0.0; n];
+        for i in 0..n {
+            for j in (i + 1)..n {
+                let dx = x[i] - x[j];
+                let mut dy = y[i] - y[j];
+                let dz = z[i] - z[j];
+                if !(dx.is_finite() && dy.is_finite() && dz.is_finite()) {
+                    continue;
+                }
+                if self.collides(dx.abs(), dy) || (dx.abs() < COLLISION_SPAN && dy.abs() < chord) {
+                    dy = if dy > 0.0 { chord } else { -chord };
+                }
+                let pair = if self.wake_descent != 0.0 {
+                    (self.descending(dx, dy, dz), self.descending(-dx, -dy, -dz))
+                } else {
+                    let (a_term, d_term) = self.pair3(dx, dy, dz);
+                    let (front, back) = (d_term, 2.0 * a_term - d_term);
+                    if dy > 0.0 {
+                        (back, front)
+                    } else {
+                        (front, back)
+                    }
+                };
+                e[i] += pair.0;
+                e[j] += pair.1;
             }
         }
         for v in e.iter_mut() {

@@ -96,6 +96,10 @@ pub struct SteadyFlags {
     /// Vortex core radius of Hummel's model, wingspans (docs/model.md).
     #[arg(long = "core-radius", value_name = "R", default_value_t = formation::aero::AeroOptions::default().core_radius, allow_negative_numbers = true)]
     pub core_radius: f64,
+    /// Wake model of the savings: planar (Hummel's, heights ignored) or 3d (each bird's height
+    /// in every frame; the key shapes are still solved in the plane).
+    #[arg(long, value_enum, default_value_t = super::wake::WakeArg::Planar)]
+    pub wake: super::wake::WakeArg,
     /// Body mass of a bird, kg, for its power curve (savings of total power; default: the
     /// species' typical mass scaled to --wingspan-m).
     #[arg(long = "mass-kg", value_name = "KG", allow_negative_numbers = true)]
@@ -130,6 +134,7 @@ impl SteadyFlags {
             looped: self.looped,
             aero: formation::aero::AeroOptions {
                 core_radius: self.core_radius,
+                wake: self.wake.into(),
                 ..formation::aero::AeroOptions::default()
             },
             flight: formation::animation::FlightSettings {

@@ -648,10 +648,17 @@ pub fn steady_flight_in(
         }
         // Between two collision-free keys a pair can pass within a chord: evaluated at the
         // collision distance there, so every frame has finite savings.
-        let e = aero.power_lenient(&fr.x, &ys);
-        let total_t = match aero.munk_total(&fr.x) {
-            Ok(t) if t > 0.0 => t,
-            _ => total,
+        let (e, total_t) = if aero.wake.is_planar() {
+            let t = match aero.munk_total(&fr.x) {
+                Ok(t) if t > 0.0 => t,
+                _ => total,
+            };
+            (aero.power_lenient(&fr.x, &ys), t)
+        } else {
+            // The 3-D wake: the birds' own heights in this frame.
+            let t = aero.munk_total_3d_unchecked(&fr.x, &fr.z);
+            let t = if t.is_finite() && t > 0.0 { t } else { total };
+            (aero.power_lenient_3d(&fr.x, &ys, &fr.z), t)
         };
         let xi: Vec<f64> = e.iter().map(|v| v / total_t).collect();
         let excess = feasible.excess(&xi);
@@ -669,7 +676,7 @@ pub fn steady_flight_in(
     let mut anim = Animation::new(opts.seed, opts.fps, opts.wingspan_m, n);
     anim.flight = (!opts.flight.is_empty()).then_some(opts.flight);
     anim.savings_model = Some(crate::animation::SavingsModel {
-        wake: "planar".into(),
+        wake: opts.aero.wake.name().into(),
         core_radius: opts.aero.core_radius,
     });
     anim.stages.push(Stage {
