@@ -5,9 +5,10 @@
 //! the sky, the clouds and the birds of this film rather than every possible picture. The
 //! species' plumage colours are added exactly (a few hundred bird pixels would otherwise be
 //! outvoted by half a million sky pixels), and the last entry is reserved for "unchanged since
-//! the previous frame" ([`TRANSPARENT`]). No dither is applied: with a palette fitted to the film
-//! the sky gradient steps by about one level, and a dither pattern would change under every
-//! moving cloud edge and defeat the frame differencing.
+//! the previous frame" ([`TRANSPARENT`]). The sky is mapped through a screen-fixed 8×8 ordered
+//! dither ([`dither_offset`], [`DITHER_SPREAD`] levels peak to peak): the same colour at the
+//! same pixel always gets the same entry, so frame differencing still works, while the palette's
+//! steps become a fine pattern instead of contour bands.
 //!
 //! Lookups go through a table indexed by the colour's top 6 bits per channel, filled lazily with
 //! the nearest palette entry (perceptually weighted squared RGB distance

@@ -6,14 +6,18 @@
 //! consumed in order), and every frame depends only on its own time, so outputs are
 //! byte-identical whatever the thread count.
 //!
-//! **GIF.** One global palette learnt from the film ([`Palette::learn`], NeuQuant), no dither.
+//! **GIF.** One global palette learnt from the film ([`Palette::learn`], NeuQuant), with a
+//! screen-fixed ordered dither in the sky ([`Lookup::index_dithered`]; the plumage is mapped
+//! exactly).
 //! Every frame after the first stores only what changed, as the bounding box of the changed
 //! pixels with unchanged ones transparent (disposal "keep"). "Changed" is judged against what the
 //! viewer currently sees, with a tolerance ([`super::RenderOptions::gif_tolerance`]): a pixel is
 //! redrawn only when its true colour differs from the shown palette colour by more than the
 //! tolerance in some channel, so a soft cloud sliding by a pixel costs little, while every bird
 //! (dark on the sky) is redrawn exactly. The shown picture therefore never strays from the true
-//! one by more than the tolerance (plus the palette's own error). The differencing is
+//! one by more than the tolerance (plus half the dither and the palette's own error), and a
+//! pixel held back that way is set to its own colour once its true colour stops changing. The
+//! differencing is
 //! sequential in time but independent per pixel, so it runs in parallel over bands of rows;
 //! LZW compression runs in parallel over frames. GIF frame delays are whole hundredths of a
 //! second, so the GIF frame rate is `100 / round(100 / fps)`: 25 fps by default.
