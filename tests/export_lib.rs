@@ -377,7 +377,19 @@ fn gif_frames_decode_to_the_drawn_pictures_within_the_tolerance() {
         let mut lagging = 0usize;
         for k in [0, 1, 2, 17, film.len() - 1] {
             film.draw(k, &mut canvas, &mut mask, true);
-            lookup.map_image(&canvas.rgba, &mut idx);
+            // Each pixel's own index: the sky dithered at its place on the screen, the plumage
+            // (held exactly by the palette) not.
+            let plumage = formation::export::silhouette::plumage(film.species);
+            let plain = [plumage.body, plumage.arm, plumage.hand, plumage.head];
+            idx.clear();
+            for (i, p) in canvas.rgba.chunks_exact(4).enumerate() {
+                let rgb = [p[0], p[1], p[2]];
+                idx.push(if plain.contains(&rgb) {
+                    lookup.index(rgb)
+                } else {
+                    lookup.index_dithered(rgb, i % canvas.width, i / canvas.width)
+                });
+            }
             let g = frames[k].buffer().as_raw();
             for (i, &p) in idx.iter().enumerate() {
                 let want = palette.colours[p as usize];

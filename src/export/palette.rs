@@ -5,9 +5,10 @@
 //! the sky, the clouds and the birds of this film rather than every possible picture. The
 //! species' plumage colours are added exactly (a few hundred bird pixels would otherwise be
 //! outvoted by half a million sky pixels), and the last entry is reserved for "unchanged since
-//! the previous frame" ([`TRANSPARENT`]). No dither is applied: with a palette fitted to the film
-//! the sky gradient steps by about one level, and a dither pattern would change under every
-//! moving cloud edge and defeat the frame differencing.
+//! the previous frame" ([`TRANSPARENT`]). The sky is mapped through a screen-fixed 8×8 ordered
+//! dither ([`dither_offset`], [`DITHER_SPREAD`] levels peak to peak): the same colour at the
+//! same pixel always gets the same entry, so frame differencing still works, while the palette's
+//! steps become a fine pattern instead of contour bands.
 //!
 //! Lookups go through a table indexed by the colour's top 6 bits per channel, filled lazily with
 //! the nearest palette entry (perceptually weighted squared RGB distance
@@ -17,6 +18,31 @@
 /// Palette index reserved for "unchanged since the previous frame" (GIF transparency); the
 /// colours are entries `0..TRANSPARENT`.
 pub const TRANSPARENT: u8 = 255;
+
+/// The 8×8 Bayer matrix (ordered-dither thresholds 0..64).
+const BAYER8: [[u8; 8]; 8] = [
+    [0, 32, 8, 40, 2, 34, 10, 42],
+    [48, 16, 56, 24, 50, 18, 58, 26],
+    [12, 44, 4, 36, 14, 46, 6, 38],
+    [60, 28, 52, 20, 62, 30, 54, 22],
+    [3, 35, 11, 43, 1, 33, 9, 41],
+    [51, 19, 59, 27, 49, 17, 57, 25],
+    [15, 47, 7, 39, 13, 45, 5, 37],
+    [63, 31, 55, 23, 61, 29, 53, 21],
+];
+
+/// Peak-to-peak spread of the ordered dither, colour levels: the offsets run from
+/// `-DITHER_SPREAD / 2` to just under `+DITHER_SPREAD / 2`. Wide enough to break palette steps
+/// of up to about 8 levels (the widest the learnt palette leaves in the clouds) into a fine
+/// pattern instead of a contour.
+pub const DITHER_SPREAD: i32 = 8;
+
+/// The ordered-dither offset (colour levels, the same for every channel) at screen pixel
+/// `(x, y)`: an 8×8 Bayer pattern fixed to the screen.
+#[inline]
+pub fn dither_offset(x: usize, y: usize) -> i32 {
+    (BAYER8[y & 7][x & 7] as i32 * DITHER_SPREAD) / 64 - DITHER_SPREAD / 2
+}
 
 /// NeuQuant's sampling factor: 1 looks at every training pixel, 30 at one in 30.
 const SAMPLE_FACTOR: i32 = 3;
@@ -112,6 +138,16 @@ impl<'a> Lookup<'a> {
         let n = self.nearest(cell);
         self.table[cell] = n as u16 + 1;
         n
+    }
+
+    /// Palette index for an RGB colour at pixel `(x, y)` of the picture, with the ordered
+    /// dither [`dither_offset`] added to every channel first. The offset depends only on the
+    /// pixel's place on the screen, so an unchanged colour maps to the same index in every
+    /// frame and the frame differencing still sees it unchanged.
+    #[inline]
+    pub fn index_dithered(&mut self, rgb: [u8; 3], x: usize, y: usize) -> u8 {
+        let d = dither_offset(x, y);
+        self.index(rgb.map(|c| (c as i32 + d).clamp(0, 255) as u8))
     }
 
     /// Maps a whole opaque RGBA image to palette indices.

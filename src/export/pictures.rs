@@ -6,14 +6,18 @@
 //! consumed in order), and every frame depends only on its own time, so outputs are
 //! byte-identical whatever the thread count.
 //!
-//! **GIF.** One global palette learnt from the film ([`Palette::learn`], NeuQuant), no dither.
+//! **GIF.** One global palette learnt from the film ([`Palette::learn`], NeuQuant), with a
+//! screen-fixed ordered dither in the sky ([`Lookup::index_dithered`]; the plumage is mapped
+//! exactly).
 //! Every frame after the first stores only what changed, as the bounding box of the changed
 //! pixels with unchanged ones transparent (disposal "keep"). "Changed" is judged against what the
 //! viewer currently sees, with a tolerance ([`super::RenderOptions::gif_tolerance`]): a pixel is
 //! redrawn only when its true colour differs from the shown palette colour by more than the
 //! tolerance in some channel, so a soft cloud sliding by a pixel costs little, while every bird
 //! (dark on the sky) is redrawn exactly. The shown picture therefore never strays from the true
-//! one by more than the tolerance (plus the palette's own error). The differencing is
+//! one by more than the tolerance (plus half the dither and the palette's own error), and a
+//! pixel held back that way is set to its own colour once its true colour stops changing. The
+//! differencing is
 //! sequential in time but independent per pixel, so it runs in parallel over bands of rows;
 //! LZW compression runs in parallel over frames. GIF frame delays are whole hundredths of a
 //! second, so the GIF frame rate is `100 / round(100 / fps)`: 25 fps by default.
@@ -321,13 +325,18 @@ fn crop_changed(delta: &[u8], width: usize) -> (usize, usize, usize, usize, Vec<
     (x0, y0, w, h, out)
 }
 
-/// One step of the tolerant differencing for a run of pixels: `shown` (palette indices the viewer
-/// sees, updated in place; `first` for the first frame), the frame's true colours `rgba` and the
-/// previous frame's `prev`; writes the sub-frame indices (or [`TRANSPARENT`]) to `out`. Only pixels that must change
-/// are looked up in the palette.
+/// One step of the tolerant differencing for a run of pixels starting at pixel `start` of a
+/// picture `width` wide: `shown` (palette indices the viewer sees, updated in place; `first` for
+/// the first frame), `dirty` (1 where the shown index was held back by the tolerance and may
+/// differ from the true colour's own index), the frame's true colours `rgba` and the previous
+/// frame's `prev`; writes the sub-frame indices (or [`TRANSPARENT`]) to `out`. Only pixels that
+/// must change are looked up in the palette. A pixel's "own" index is its colour with the
+/// screen-fixed ordered dither ([`Lookup::index_dithered`]), except the colours in `plain` (the
+/// plumage, which the palette holds exactly) which are mapped undithered.
 #[allow(clippy::too_many_arguments)]
 fn delta_step(
     shown: &mut [u8],
+    dirty: &mut [u8],
     first: bool,
     rgba: &[u8],
     prev: &[u8],
@@ -336,24 +345,63 @@ fn delta_step(
     palette: &Palette,
     tolerance: i32,
     catch_up: bool,
+    (start, width): (usize, usize),
+    plain: &[[u8; 3]],
 ) {
-    for (((s, p), o), q) in shown
+    let width = width.max(1);
+    let (mut x, mut y) = (start % width, start / width);
+    for ((((s, d), p), o), q) in shown
         .iter_mut()
+        .zip(dirty.iter_mut())
         .zip(rgba.chunks_exact(4))
         .zip(out.iter_mut())
         .zip(prev.chunks_exact(4))
     {
-        // Same true colour as in the previous frame: what is shown was within the tolerance of
-        // it then (or set to it), so it still is, unless the tolerance is lower now (the end of
-        // a loop catching up with what earlier frames held back: every pixel is checked).
-        if !first && !catch_up && p == q {
-            *o = TRANSPARENT;
-            continue;
+        let (px, py) = (x, y);
+        x += 1;
+        if x == width {
+            x = 0;
+            y += 1;
         }
+        let rgb = [p[0], p[1], p[2]];
+        let own = |lookup: &mut Lookup| {
+            if plain.contains(&rgb) {
+                lookup.index(rgb)
+            } else {
+                lookup.index_dithered(rgb, px, py)
+            }
+        };
         if first {
-            let q = lookup.index([p[0], p[1], p[2]]);
+            let q = own(lookup);
             *s = q;
             *o = q;
+            *d = 0;
+            continue;
+        }
+        // Same true colour as in the previous frame: what is shown was within the tolerance of
+        // it then (or set to it), so it still is, unless the tolerance is lower now (the end of
+        // a loop catching up with what earlier frames held back: every pixel is checked). A
+        // pixel held back while its colour moved (a cloud edge sliding by) is set to its own
+        // index as soon as its colour stops changing, so nothing stale stays behind a cloud.
+        if !catch_up && p == q {
+            *o = TRANSPARENT;
+            if *d != 0 {
+                *d = 0;
+                // Within the settle margin of the true colour: as good as its own index.
+                let c = palette.colours[*s as usize];
+                let err = (0..3)
+                    .map(|k| (c[k] as i32 - p[k] as i32).abs())
+                    .max()
+                    .unwrap_or(0);
+                if err <= SETTLE_MARGIN {
+                    continue;
+                }
+                let q = own(lookup);
+                if q != *s {
+                    *o = q;
+                    *s = q;
+                }
+            }
             continue;
         }
         let c = palette.colours[*s as usize];
@@ -363,9 +411,11 @@ fn delta_step(
             .max((c[2] as i32 - p[2] as i32).abs());
         if err <= tolerance {
             *o = TRANSPARENT;
+            *d = 1;
             continue;
         }
-        let q = lookup.index([p[0], p[1], p[2]]);
+        *d = 0;
+        let q = own(lookup);
         if q == *s {
             *o = TRANSPARENT;
         } else {
@@ -374,6 +424,12 @@ fn delta_step(
         }
     }
 }
+
+/// A held-back pixel whose colour has stopped changing is set to its own index only when what
+/// is shown is more than this many levels (in some channel) from its true colour: the dither's
+/// half spread plus two levels of the palette, so what is left is no more visible than the
+/// dither itself.
+const SETTLE_MARGIN: i32 = super::palette::DITHER_SPREAD / 2 + 2;
 
 /// Seconds over which the GIF of a loop lowers its tolerance to 0 before the last frame.
 const LOOP_CATCH_UP_S: f64 = 2.0;
@@ -412,6 +468,9 @@ pub fn write_gif(film: &Film, path: &Path, threads: usize, progress: &dyn Progre
         // (one per worker), each with its own lookup table.
         let band = h.div_ceil(threads.max(1)).max(1) * w;
         let mut shown = vec![0u8; w * h];
+        let mut dirty = vec![0u8; w * h];
+        let pl = super::silhouette::plumage(film.species);
+        let plain = [pl.body, pl.arm, pl.hand, pl.head];
         let mut lookups: Vec<Lookup> = shown.chunks(band).map(|_| Lookup::new(&palette)).collect();
         // The previous frame's picture, the batch's sub-frames, and spare picture buffers.
         let mut last = vec![0u8; w * h * 4];
@@ -449,8 +508,14 @@ pub fn write_gif(film: &Film, path: &Path, threads: usize, progress: &dyn Progre
                 let drawn = &drawn;
                 let palette = &palette;
                 let last = &last;
+                let plain = &plain;
                 std::thread::scope(|scope| {
-                    for (b, (s, lookup)) in shown.chunks_mut(band).zip(&mut lookups).enumerate() {
+                    for (b, ((s, dt), lookup)) in shown
+                        .chunks_mut(band)
+                        .zip(dirty.chunks_mut(band))
+                        .zip(&mut lookups)
+                        .enumerate()
+                    {
                         let mine: Vec<&mut [u8]> =
                             outs.iter_mut().map(|o| o.next().expect("band")).collect();
                         scope.spawn(move || {
@@ -467,6 +532,7 @@ pub fn write_gif(film: &Film, path: &Path, threads: usize, progress: &dyn Progre
                                 );
                                 delta_step(
                                     s,
+                                    dt,
                                     start + k == 0,
                                     &drawn[k][lo * 4..hi * 4],
                                     &prev[lo * 4..hi * 4],
@@ -475,6 +541,8 @@ pub fn write_gif(film: &Film, path: &Path, threads: usize, progress: &dyn Progre
                                     palette,
                                     tol,
                                     tol < tolerance,
+                                    (lo, w),
+                                    plain,
                                 );
                             }
                         });
@@ -775,10 +843,13 @@ mod tests {
         let palette = Palette { colours };
         let mut lookup = Lookup::new(&palette);
         let white = [255u8, 255, 255, 255];
+        let white3 = [255u8, 255, 255];
         let mut out = [TRANSPARENT];
         let mut shown = [0u8];
+        let mut dirty = [0u8];
         delta_step(
             &mut shown,
+            &mut dirty,
             false,
             &white,
             &white,
@@ -787,10 +858,13 @@ mod tests {
             &palette,
             255,
             false,
+            (0, 1),
+            &[white3],
         );
         assert_eq!((shown[0], out[0]), (0, TRANSPARENT));
         delta_step(
             &mut shown,
+            &mut dirty,
             false,
             &white,
             &white,
@@ -799,6 +873,8 @@ mod tests {
             &palette,
             0,
             true,
+            (0, 1),
+            &[white3],
         );
         assert_eq!((shown[0], out[0]), (1, 1));
     }

@@ -1,0 +1,164 @@
+//! The GIF's sky decoded back and compared with the full-colour pictures of the same film: no
+//! pixel outside the birds strays from its true colour by more than a documented bound, nothing
+//! stale stays behind once the sky stops changing, no column seam, and the sky gradient is not
+//! posterised into wide flat bands.
+
+use std::fs::File;
+
+use formation::export::palette::DITHER_SPREAD;
+use formation::export::pictures::write_gif;
+use formation::export::raster::{Canvas, Mask};
+use formation::export::{Film, RenderOptions};
+use formation::progress::Silent;
+use formation::Animation;
+
+mod support;
+
+use support::{run as formation, s, scratch as tmpdir};
+
+const GEESE: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/examples_data/barnacle_geese_v.json"
+);
+
+/// Largest error of a sky pixel, levels per channel: the GIF tolerance (10 by default), half the
+/// dither's spread, and the learnt palette's own error (under 10 levels in the clouds).
+const SKY_BOUND: i32 = 10 + DITHER_SPREAD / 2 + 10;
+
+/// Widest run of one palette colour down a column, in levels of the true colour it covers: the
+/// tolerance plus the settle margin of pixels held back while a cloud slid by (measured 17 on
+/// this film; the sky gradient alone is dithered into runs of a few pixels).
+const BAND_BOUND: i32 = 20;
+
+#[test]
+fn readme_gif_sky_matches_the_full_colour_pictures() {
+    let d = tmpdir("gif-sky");
+    let json = d.join("flock.json");
+    let out = formation(&[
+        "animate",
+        GEESE,
+        "--birds",
+        "14",
+        "--seconds",
+        "4",
+        "-o",
+        s(&json),
+        "--quiet",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let anim = Animation::read(&json).unwrap();
+    let opts = RenderOptions::default();
+    let film = Film::with_options(&anim, 25.0, &opts);
+    let (w, h) = (film.width, film.height);
+    let gif_path = d.join("flock.gif");
+    write_gif(&film, &gif_path, 2, &Silent).unwrap();
+
+    let mut dopts = gif::DecodeOptions::new();
+    dopts.set_color_output(gif::ColorOutput::Indexed);
+    let mut dec = dopts.read_info(File::open(&gif_path).unwrap()).unwrap();
+    let pal: Vec<u8> = dec.global_palette().unwrap().to_vec();
+    let mut screen = vec![0u8; w * h];
+    let (mut canvas, mut sky, mut mask) = (Canvas::new(w, h), Canvas::new(w, h), Mask::new());
+    let mut k = 0;
+    let (mut worst, mut worst_at) = (0, (0, 0, 0));
+    let mut worst_jump = 0.0f64;
+    let mut worst_band = 0i32;
+    let mut over = 0usize;
+    let mut sky_px = 0usize;
+    while let Some(f) = dec.read_next_frame().unwrap() {
+        for fy in 0..f.height as usize {
+            for fx in 0..f.width as usize {
+                let v = f.buffer[fy * f.width as usize + fx];
+                if Some(v) != f.transparent {
+                    screen[(f.top as usize + fy) * w + f.left as usize + fx] = v;
+                }
+            }
+        }
+        film.draw(k, &mut canvas, &mut mask, true);
+        film.backdrop().paint(&film.views[k], &mut sky);
+        // Sky pixels: the bird-free picture there, two pixels from any bird.
+        let mut bird = vec![false; w * h];
+        for y in 0..h {
+            for x in 0..w {
+                let i = (y * w + x) * 4;
+                if canvas.rgba[i..i + 3] != sky.rgba[i..i + 3] {
+                    for yy in y.saturating_sub(2)..(y + 3).min(h) {
+                        for xx in x.saturating_sub(2)..(x + 3).min(w) {
+                            bird[yy * w + xx] = true;
+                        }
+                    }
+                }
+            }
+        }
+        let err = |x: usize, y: usize, c: usize| -> i32 {
+            let p = screen[y * w + x] as usize;
+            pal[p * 3 + c] as i32 - canvas.rgba[(y * w + x) * 4 + c] as i32
+        };
+        for y in 0..h {
+            for x in 0..w {
+                if bird[y * w + x] {
+                    continue;
+                }
+                sky_px += 1;
+                let e = (0..3).map(|c| err(x, y, c).abs()).max().unwrap();
+                if e > worst {
+                    (worst, worst_at) = (e, (k, x, y));
+                }
+                over += (e > 10 + DITHER_SPREAD / 2) as usize;
+            }
+        }
+        // Column seam: the mean signed error of each column over strips of 64 rows (the
+        // dither's columns all have the same mean) must not jump between neighbours.
+        for y0 in (0..h.saturating_sub(63)).step_by(64) {
+            for c in 0..3 {
+                let mean = |x: usize| -> Option<f64> {
+                    let ys: Vec<usize> = (y0..y0 + 64).filter(|&y| !bird[y * w + x]).collect();
+                    (ys.len() == 64)
+                        .then(|| ys.iter().map(|&y| err(x, y, c) as f64).sum::<f64>() / 64.0)
+                };
+                for x in 0..w - 1 {
+                    if let (Some(a), Some(b)) = (mean(x), mean(x + 1)) {
+                        worst_jump = worst_jump.max((a - b).abs());
+                    }
+                }
+            }
+        }
+        // Bands: along each column, a run of one palette colour must not cover more than a
+        // few levels of the true gradient.
+        for x in (0..w).step_by(7) {
+            let mut y = 0;
+            while y < h {
+                let v = screen[y * w + x];
+                let (mut lo, mut hi) = ([255i32; 3], [0i32; 3]);
+                let mut e = y;
+                while e < h && screen[e * w + x] == v && !bird[e * w + x] {
+                    for c in 0..3 {
+                        let t = canvas.rgba[(e * w + x) * 4 + c] as i32;
+                        lo[c] = lo[c].min(t);
+                        hi[c] = hi[c].max(t);
+                    }
+                    e += 1;
+                }
+                if e > y {
+                    worst_band = worst_band.max((0..3).map(|c| hi[c] - lo[c]).max().unwrap());
+                }
+                y = e.max(y + 1);
+            }
+        }
+        k += 1;
+    }
+    assert_eq!(k, film.len());
+    let size = std::fs::metadata(&gif_path).unwrap().len();
+    eprintln!(
+        "{k} frames, {size} bytes: worst sky error {worst} at {worst_at:?}, {:.4} % over {}, column jump {worst_jump:.2}, widest band {worst_band} levels",
+        100.0 * over as f64 / sky_px as f64,
+        10 + DITHER_SPREAD / 2
+    );
+    assert!(worst <= SKY_BOUND, "sky error {worst} at {worst_at:?}");
+    assert!(worst_jump <= 3.0, "column seam: {worst_jump:.2}");
+    assert!(worst_band <= BAND_BOUND, "band over {worst_band} levels");
+}
