@@ -313,21 +313,21 @@ pub fn steady_saving_total(anim: &Animation) -> Option<f64> {
 /// Checks an animation's flight settings; errors name `steady.flight.mass_kg` or
 /// `steady.flight.speed_ms`.
 pub fn validate_settings(s: &crate::animation::FlightSettings) -> Result<()> {
+    fn named(name: &'static str) -> impl Fn(Error) -> Error {
+        move |e| match e {
+            Error::Parameter { message, .. } => Error::parameter(name, message),
+            other => other,
+        }
+    }
     if let Some(m) = s.mass_kg {
         let bird = Morphology {
             mass_kg: m,
             ..Morphology::of(Species::Goose)
         };
-        bird.validate().map_err(|e| match e {
-            Error::Parameter { message, .. } => Error::parameter("steady.flight.mass_kg", message),
-            other => other,
-        })?;
+        bird.validate().map_err(named("steady.flight.mass_kg"))?;
     }
     if let Some(v) = s.speed_ms {
-        validate_speed(v).map_err(|e| match e {
-            Error::Parameter { message, .. } => Error::parameter("steady.flight.speed_ms", message),
-            other => other,
-        })?;
+        validate_speed(v).map_err(named("steady.flight.speed_ms"))?;
     }
     Ok(())
 }

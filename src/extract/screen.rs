@@ -37,18 +37,10 @@ pub struct OddFrame {
     pub reason: String,
 }
 
+/// The median of the finite values of `v` (NaN when there are none).
 fn median(v: &[f64]) -> f64 {
-    let mut s: Vec<f64> = v.iter().copied().filter(|x| x.is_finite()).collect();
-    if s.is_empty() {
-        return f64::NAN;
-    }
-    s.sort_by(f64::total_cmp);
-    let n = s.len();
-    if n % 2 == 1 {
-        s[n / 2]
-    } else {
-        0.5 * (s[n / 2 - 1] + s[n / 2])
-    }
+    let mut finite: Vec<f64> = v.iter().copied().filter(|x| x.is_finite()).collect();
+    super::bootstrap::median(&mut finite).unwrap_or(f64::NAN)
 }
 
 fn outlier_share(f: &FrameParams) -> f64 {
