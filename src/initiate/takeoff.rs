@@ -1,0 +1,142 @@
+//! The take-off plan: how long the take-off lasts for a flock of a given size, and the drives
+//! scaled to that length ([`TakeoffPlan`]).
+
+use super::*;
+
+/// What the take-off duration sets: the start area, the departure stagger and the drive gain.
+/// Derived by [`TakeoffPlan::new`] from the flock size and [`InitiateOptions::takeoff`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TakeoffPlan {
+    /// The take-off duration aimed at, seconds.
+    pub seconds: f64,
+    /// Width of the start area across the cruise heading, wingspans.
+    pub width: f64,
+    /// Depth of the start area along the cruise heading, wingspans.
+    pub depth: f64,
+    /// Time between the first and the last departure (ground start), seconds.
+    pub stagger: f64,
+    /// |K| of eq. (5) used, per √wingspan.
+    pub k: f64,
+    /// Catch-up distance of eq. (5) used, wingspans.
+    pub catchup_distance: f64,
+    /// How hard the birds drive: the natural duration over the wanted one, within
+    /// [[`TakeoffPlan::MIN_DRIVE`], [`TakeoffPlan::MAX_DRIVE`]]. The run and vertical
+    /// accelerations and the climb rate are multiplied by it, the approach time divided by it
+    /// (by at most [`TakeoffPlan::MAX_APPROACH_DRIVE`]);
+    /// the departure stagger is 1 s over it; below 1 the take-off area also grows by 1/drive.
+    pub drive: f64,
+}
+
+impl TakeoffPlan {
+    /// The weakest drive: a take-off at most about twice the natural one.
+    pub const MIN_DRIVE: f64 = 0.45;
+    /// The strongest drive: a take-off down to about 0.7 of the natural one (the climb to the
+    /// cruise altitude bounds it).
+    pub const MAX_DRIVE: f64 = 1.6;
+    /// The strongest drive of the final approach to the slots: a short take-off runs, climbs
+    /// and departs faster, but no bird closes on its slot harder than in the natural take-off.
+    /// Driven 1.6 times as hard, birds of neighbouring slots came 0.29 wingspans close (100
+    /// birds, `initiate.takeoff` 8 s, 2 of 21 seeds) and 0.22 (300 birds, 10 seeds); at 1 they
+    /// keep 0.36 and 0.34, and the take-off lasts 0.4–1.1 s longer (docs/initiation.md).
+    pub const MAX_APPROACH_DRIVE: f64 = 1.0;
+
+    /// The natural take-off of `n` birds from the ground at the default options, seconds:
+    /// measured medians (docs/initiation.md) about 9.5 s for 9–14 birds, 10.7 s for 41, 12.7 s
+    /// for 100, 23 s for 300 (the lift-off and climb to 10 wingspans take about 7 s; the rest
+    /// grows with the width of the V).
+    pub fn natural_seconds(n: usize) -> f64 {
+        9.0 + 0.045 * n.max(1) as f64
+    }
+
+    /// The automatic take-off duration of `n` birds, seconds: the natural one.
+    pub fn auto_seconds(n: usize) -> f64 {
+        Self::natural_seconds(n)
+    }
+
+    /// The shortest take-off of `n` birds from the ground at the strongest drive, seconds:
+    /// measured medians 7.9 s for 9 birds, 8.3 for 14, 9.2 for 41, 11.7 for 100, 22.4 for 300
+    /// (`initiate.takeoff` 5 s, docs/initiation.md); fitted 8.1, 8.4, 9.7, 12.6 and 22.4. The
+    /// run, lift-off and climb to the cruise altitude take about 7 s at the strongest drive
+    /// (climb rate and accelerations bounded), and the outer birds of a wider V have farther to
+    /// fly to their slots at bounded speeds.
+    pub fn shortest_seconds(n: usize) -> f64 {
+        7.7 + 0.049 * n.max(1) as f64
+    }
+
+    /// A warning when the take-off duration of `opts` cannot be met within 25 % for `n` birds:
+    /// shorter than [`Self::shortest_seconds`] allows, or longer than twice the natural
+    /// duration; it names `initiate.takeoff`, the duration the take-off will have and why.
+    pub fn warning(n: usize, opts: &InitiateOptions) -> Option<String> {
+        let t = opts.takeoff?;
+        if !matches!(opts.start, Start::Ground(_)) {
+            return None;
+        }
+        let shortest = Self::shortest_seconds(n);
+        let longest = 2.0 * Self::natural_seconds(n);
+        if t * 1.25 < shortest {
+            Some(format!(
+                "initiate.takeoff {t} s: {n} birds cannot take off in less than about {shortest:.0} s (the run and the climb to the cruise altitude take about 7 s at the strongest drive, and the outer birds of a wide V need longer to reach their slots); the take-off will last about {shortest:.0} s"
+            ))
+        } else if t > 1.25 * longest {
+            Some(format!(
+                "initiate.takeoff {t} s: {n} birds form in at most about {longest:.0} s with these rules (the drive is at its weakest); the take-off will last about {longest:.0} s"
+            ))
+        } else {
+            None
+        }
+    }
+
+    /// The plan for `n` birds under `opts` (its `takeoff`, or the automatic duration): the
+    /// drive is the natural duration over the wanted one (bounded), which scales the departure
+    /// stagger, the accelerations, the climb rate, the approach and (for a longer take-off) the
+    /// take-off area, so that every part of the take-off takes about `seconds / natural` times
+    /// as long. The simulation itself is never cut.
+    pub fn new(n: usize, opts: &InitiateOptions) -> TakeoffPlan {
+        let natural = Self::natural_seconds(n);
+        let seconds = opts.takeoff.unwrap_or(natural);
+        let drive = (natural / seconds).clamp(Self::MIN_DRIVE, Self::MAX_DRIVE);
+        let root = (n.max(1) as f64).sqrt();
+        let (width, depth, stagger) = match &opts.start {
+            Start::Ground(g) => {
+                // About 6.8 square wingspans per bird (1.1 times what random packing of birds
+                // `min_spacing` = 2 apart needs), more for a slow take-off; three times as wide
+                // as deep, at most GROUND_MAX_DEPTH deep (wider instead).
+                let base =
+                    (1.3 * g.min_spacing * root).max(4.0 * g.min_spacing) / drive.min(1.0).sqrt();
+                let aspect = GROUND_ASPECT;
+                let depth = (base / aspect.sqrt()).min(GROUND_MAX_DEPTH);
+                (
+                    g.width.unwrap_or(base * base / depth),
+                    g.depth.unwrap_or(depth),
+                    g.stagger.unwrap_or(1.0 / drive),
+                )
+            }
+            Start::Random(r) => {
+                let (w, d) = r.size(n);
+                (w, d, 0.0)
+            }
+            Start::Given(_) => (0.0, 0.0, 0.0),
+        };
+        TakeoffPlan {
+            seconds,
+            width,
+            depth,
+            stagger,
+            k: opts.k,
+            catchup_distance: opts.catchup_distance,
+            drive,
+        }
+    }
+}
+
+/// An angle in radians as degrees for a message or a flag's default, rounded to 10⁻⁹° so that
+/// a value given in degrees and converted to radians reads back as given.
+pub fn display_degrees(rad: f64) -> f64 {
+    let d = rad.to_degrees();
+    let r = (d * 1e9).round() / 1e9;
+    if r.is_finite() {
+        r
+    } else {
+        d
+    }
+}
