@@ -315,6 +315,7 @@ impl Pipeline {
         // Savings (e, ξ) in the take-off frames too.
         crate::aero::fill_frame_savings(&mut anim, &config.steady_options()?.aero);
         let course = course_stage(&mut anim, path.as_ref(), config)?;
+        wingbeat::rest::stand_on_ground(&mut anim, config.wingbeat.species);
         wingbeat::assign_phases(&mut anim, &config.wingbeat)?;
         Ok((
             anim,
@@ -475,6 +476,7 @@ fn flock_run(
         progress,
     )?;
     let course = course_stage(&mut anim, path, config)?;
+    wingbeat::rest::stand_on_ground(&mut anim, config.wingbeat.species);
     wingbeat::assign_phases(&mut anim, &config.wingbeat)?;
     let first = report
         .formations

@@ -128,6 +128,7 @@ fn commands() -> Vec<Command> {
         ("--tolerance", "0", None),
         ("--hold", "nan", None),
         ("--takeoff", "0", None),
+        ("--ground-seconds", "-1", None),
         ("--cruise-altitude", "1e9", None),
         ("--climb-rate", "0", None),
         // A start file that does not exist is named by its path.

@@ -213,7 +213,12 @@ fn a_take_off_starts_at_the_first_point_and_joins_the_path() {
     let f0 = &a.frames[0];
     let cx = f0.x.iter().sum::<f64>() / a.birds as f64;
     let cy = f0.y.iter().sum::<f64>() / a.birds as f64;
-    assert!(f0.z.iter().all(|&z| z.abs() < 1e-9), "on the ground");
+    // Sitting on the ground: the root at the bird's sitting height.
+    let sit = formation::wingbeat::rest::stance(c.wingbeat.species).sit;
+    assert!(
+        f0.z.iter().all(|&z| (z - sit).abs() < 1e-9),
+        "on the ground"
+    );
     assert!(
         cx.hypot(cy) < 25.0,
         "start area centre {cx:.1}, {cy:.1} far from the first point"

@@ -468,6 +468,7 @@ fn ground_birds_start_at_rest_and_end_at_the_cruise_altitude() {
     for alt in [10.0, 25.0] {
         let opts = InitiateOptions {
             cruise_altitude: alt,
+            ground_seconds: 0.0,
             ..Default::default()
         };
         let st = steady(&v_shape(14, 1.0, 0.6), 30, 30.0, 10.0);
@@ -712,8 +713,10 @@ fn takeoff_8_and_20_keep_apart_and_close_in() {
 fn takeoff_8_for_larger_flocks_is_met_or_warned_about() {
     let seeds = if cfg!(debug_assertions) { 1 } else { 11 };
     for n in [41usize, 100] {
+        // The take-off from the first run (the time sitting before it is not the plan's).
         let opts = InitiateOptions {
             takeoff: Some(8.0),
+            ground_seconds: 0.0,
             ..Default::default()
         };
         let mut secs: Vec<f64> = (0..seeds)

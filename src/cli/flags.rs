@@ -139,6 +139,7 @@ pub const FLAGS: &[(&str, &str, &[Cmd])] = &[
     ("initiate.hold", "--hold", INITIATE),
     ("initiate.start", "--start", INITIATE),
     ("initiate.takeoff", "--takeoff", INITIATE),
+    ("initiate.ground_seconds", "--ground-seconds", INITIATE),
     ("initiate.cruise_altitude", "--cruise-altitude", INITIATE),
     ("initiate.climb_rate", "--climb-rate", INITIATE),
     (

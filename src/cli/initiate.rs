@@ -124,6 +124,10 @@ pub struct InitiateFlags {
     /// softer to form in about this time.
     #[arg(long, allow_negative_numbers = true, help = takeoff_help())]
     pub takeoff: Option<f64>,
+    /// Seconds the birds sit on the ground, wings folded, before the first one starts its run
+    /// (ground start).
+    #[arg(long, allow_negative_numbers = true, default_value_t = d().ground_seconds)]
+    pub ground_seconds: f64,
     /// Cruise altitude of the steady flight above the ground (`z`), wingspans.
     #[arg(long, allow_negative_numbers = true, default_value_t = d().cruise_altitude)]
     pub cruise_altitude: f64,
@@ -214,6 +218,7 @@ impl InitiateFlags {
             max_steps: self.max_steps,
             max_time: self.max_seconds,
             takeoff: self.takeoff,
+            ground_seconds: self.ground_seconds,
             cruise_altitude: self.cruise_altitude,
             climb_rate: self.climb_rate,
             alpha: self.alpha,
@@ -283,6 +288,7 @@ pub fn run(args: InitiateArgs, g: Global) -> Result<()> {
     formation::aero::fill_frame_savings(&mut anim, &Default::default());
     let report = formation::pipeline::course_stage(&mut anim, course.1.as_ref(), &course.0)?;
     super::course::warn(super::flags::Cmd::Initiate, g, &report)?;
+    formation::wingbeat::rest::stand_on_ground(&mut anim, wing.species);
     formation::wingbeat::assign_phases(&mut anim, &wing)?;
     super::write_animation(&anim, &args.output, &args.scene.options(), g)?;
     if args.json {

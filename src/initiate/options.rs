@@ -62,6 +62,9 @@ pub struct InitiateOptions {
     /// stagger and how hard the birds drive (accelerations, climb, approach) to it
     /// ([`TakeoffPlan::drive`]); the simulation is never cut.
     pub takeoff: Option<f64>,
+    /// Time the birds sit on the ground before the first one starts its run, seconds (a ground
+    /// start only).
+    pub ground_seconds: f64,
     /// Separation drive threshold, wingspans (paper: 10).
     pub separation_distance: f64,
     /// Look-ahead of a bird near or ahead of its target, wingspans.
@@ -159,6 +162,7 @@ impl Default for InitiateOptions {
             vertical_accel: 2.0,
             run_accel: 3.0,
             takeoff: None,
+            ground_seconds: 1.0,
             separation_distance: 10.0,
             lookahead: 4.0,
             avoid_distance: 0.3,
@@ -351,6 +355,15 @@ impl InitiateOptions {
                     format!("{t} s is longer than the time limit of {} s", self.max_time),
                 ));
             }
+        }
+        if !(self.ground_seconds.is_finite() && (0.0..=600.0).contains(&self.ground_seconds)) {
+            return Err(Error::parameter(
+                "initiate.ground_seconds",
+                format!(
+                    "must be a number of seconds from 0 to 600, got {}",
+                    self.ground_seconds
+                ),
+            ));
         }
         if !(self.cruise_altitude.is_finite() && self.cruise_altitude >= 0.0) {
             return Err(Error::parameter(

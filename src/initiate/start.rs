@@ -521,6 +521,13 @@ pub fn start_simulation(
     let (pos, z, heading, speed, depart) = match &opts.start {
         Start::Ground(g) => {
             let (pos, heading, depart) = ground_start(n, g, &plan, &params, rng)?;
+            // The flock sits for `ground_seconds` before the first run starts.
+            let first = depart.iter().copied().fold(f64::INFINITY, f64::min);
+            let first = if first.is_finite() { first } else { 0.0 };
+            let depart = depart
+                .iter()
+                .map(|d| d - first + opts.ground_seconds)
+                .collect();
             (pos, vec![0.0; n], heading, vec![0.0; n], depart)
         }
         Start::Random(region) => {

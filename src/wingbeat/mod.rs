@@ -18,6 +18,7 @@
 //! from the stored phases, so renderers see exactly the wingbeats [`assign_phases`] produced.
 
 pub mod kinematics;
+pub mod rest;
 pub mod species;
 
 use std::f64::consts::{PI, TAU};
@@ -32,6 +33,7 @@ use crate::rng::{stream, FlockRng};
 
 pub use crate::animation::wing::{Glide, PhaseMode, Species, WingbeatOptions};
 pub use kinematics::{blend_weight, g1, g2, pose, PhaseMap, Stroke, Strokes, Timing};
+pub use rest::FOLDED;
 pub use species::SpeciesPreset;
 
 /// Joint angles of one wing (both wings mirror each other), radians.
@@ -473,6 +475,8 @@ struct Run {
     phase: Vec<f64>,
     /// Unwrapped phase per frame and bird (frame-major), radians.
     unwrapped: Vec<f64>,
+    /// Fold weight per frame and bird (frame-major; empty: never at rest), see [`rest`].
+    fold: Vec<f64>,
 }
 
 /// Integrates every bird's phase through the animation (what [`assign_phases`] stores).
@@ -481,6 +485,7 @@ fn simulate(anim: &Animation, opts: &WingbeatOptions) -> Run {
     let nf = anim.frames.len();
     let preset = opts.species.preset();
     let eff = efforts(anim, &preset);
+    let fold = rest::fold_weights(anim);
     let (mut birds, mut rngs) = draw_birds(anim.seed, n, opts);
     let mut phi: Vec<f64> = birds.iter().map(|b| b.phase0).collect();
     let mut cycles = vec![0u64; n];
@@ -516,6 +521,14 @@ fn simulate(anim: &Animation, opts: &WingbeatOptions) -> Run {
                     locked_rate(frame, i, ahead, &phi, &last_rate, own[i], opts.lock_time_s)
                 }
             };
+        }
+        if !fold.is_empty() {
+            // A bird at rest holds its phase (folded wings, no wingbeat).
+            for i in 0..n {
+                if fold[k * n + i] >= 1.0 {
+                    rate[i] = 0.0;
+                }
+            }
         }
         for i in 0..n {
             let step = (TAU * rate[i] * dt).clamp(0.0, PI);
@@ -554,6 +567,7 @@ fn simulate(anim: &Animation, opts: &WingbeatOptions) -> Run {
         birds,
         phase,
         unwrapped,
+        fold,
     }
 }
 
@@ -645,6 +659,7 @@ fn replay_phases(
         birds,
         phase,
         unwrapped,
+        fold: rest::fold_weights(anim),
     }
 }
 
@@ -683,6 +698,11 @@ pub struct Flapper {
     phase: Vec<f64>,
     /// Unwrapped phase per frame and bird (frame-major).
     unwrapped: Vec<f64>,
+    /// Fold weight per frame and bird (frame-major; empty: never at rest).
+    fold: Vec<f64>,
+    /// Root height and bank per frame and bird (frame-major) of a flight that starts on the
+    /// ground (empty otherwise): the downstroke is kept off the ground.
+    ground: Vec<(f64, f64)>,
     nbirds: usize,
     nframes: usize,
 }
@@ -714,6 +734,21 @@ impl Flapper {
             birds: run.birds,
             phase: run.phase,
             unwrapped: run.unwrapped,
+            ground: if run.fold.is_empty() {
+                Vec::new()
+            } else {
+                anim.frames
+                    .iter()
+                    .flat_map(|f| {
+                        (0..n).map(move |i| {
+                            let z = f.z.get(i).copied().unwrap_or(f64::INFINITY);
+                            let bank = f.bank.as_ref().and_then(|b| b.get(i)).copied();
+                            (z, bank.unwrap_or(0.0))
+                        })
+                    })
+                    .collect()
+            },
+            fold: run.fold,
             nbirds: n,
             nframes: anim.frames.len(),
         }
@@ -747,10 +782,35 @@ impl Flapper {
         let (Some(k), Some(b)) = (self.index(frame, bird), self.birds.get(bird)) else {
             return WingPose::EXTENDED;
         };
-        match (self.unwrapped.get(k), self.phase.get(k)) {
+        let p = match (self.unwrapped.get(k), self.phase.get(k)) {
             (Some(&s), Some(&phi)) => b.pose_at(s, phi),
-            _ => WingPose::EXTENDED,
+            _ => return WingPose::EXTENDED,
+        };
+        let p = self.folded(p, self.fold.get(k).copied().unwrap_or(0.0));
+        match self.ground.get(k) {
+            Some(&(z, bank)) if z < 1.0 => rest::clear_ground(p, z, bank),
+            _ => p,
         }
+    }
+
+    /// `p` folded by weight `w` (1: the resting pose).
+    fn folded(&self, p: WingPose, w: f64) -> WingPose {
+        if w >= 1.0 {
+            FOLDED
+        } else if w > 0.0 {
+            p.lerp(&FOLDED, w)
+        } else {
+            p
+        }
+    }
+
+    /// Fold weight of `bird` at `frame`: 1 at rest on the ground (wings folded, no wingbeat), 0
+    /// in the wingbeat, between while the wings unfold or fold (see [`rest`]).
+    pub fn fold(&self, frame: usize, bird: usize) -> f64 {
+        self.index(frame, bird)
+            .and_then(|k| self.fold.get(k))
+            .copied()
+            .unwrap_or(0.0)
     }
 
     /// Poses of every bird at `frame`, written into `out` (cleared first).
@@ -777,7 +837,24 @@ impl Flapper {
             .copied()
             .unwrap_or(s0);
         let s = s0 + w * (s1 - s0);
-        b.pose_at(s, s.rem_euclid(TAU))
+        let f0 = self.fold.get(a).copied().unwrap_or(0.0);
+        let f1 = self
+            .index(k + 1, bird)
+            .and_then(|i| self.fold.get(i))
+            .copied()
+            .unwrap_or(f0);
+        let p = self.folded(b.pose_at(s, s.rem_euclid(TAU)), f0 + w * (f1 - f0));
+        let g0 = self.ground.get(a).copied();
+        let g1 = self
+            .index(k + 1, bird)
+            .and_then(|i| self.ground.get(i))
+            .copied();
+        match (g0, g1.or(g0)) {
+            (Some((z0, b0)), Some((z1, b1))) if z0.min(z1) < 1.0 => {
+                rest::clear_ground(p, z0.min(z1), b0.abs().max(b1.abs()))
+            }
+            _ => p,
+        }
     }
 }
 

@@ -1,0 +1,268 @@
+//! Birds at rest on the ground: wings folded, no wingbeat.
+//!
+//! A bird is *at rest* in a frame when it is slower than [`REST_SPEED_MS`] (0.5 m/s) and within
+//! [`GROUND_BAND`] wingspans of the ground: it holds the [`FOLDED`] pose and its wingbeat phase
+//! does not advance. When it leaves rest (the take-off run starts) its wings unfold into the
+//! wingbeat over [`UNFOLD_S`] seconds, and fold again over the same time when it comes to rest.
+//! The weights depend on the frames' speeds, heights and times only, so they are the same when
+//! the phases are computed and when they are replayed from a file, and the same at any frame rate.
+
+use crate::animation::Animation;
+
+use super::{Species, WingPose};
+
+/// Below this ground speed, metres per second, a bird on the ground is at rest.
+pub const REST_SPEED_MS: f64 = 0.5;
+/// A slow bird less than this far above the ground (wingspans) is on the ground.
+pub const GROUND_BAND: f64 = 1.0;
+/// Time the wings take to unfold into the wingbeat, or to fold from it, seconds.
+pub const UNFOLD_S: f64 = 0.15;
+
+/// Ground speed, metres per second, at which a bird that starts its run has risen from sitting
+/// to standing (the body lifts as speed builds).
+pub const STAND_UP_SPEED_MS: f64 = 0.5;
+
+/// Heights of a bird's root (body centre) above the ground, wingspans.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Stance {
+    /// Sitting at rest, belly on the ground, wings folded.
+    pub sit: f64,
+    /// Standing and running: high enough that a full downstroke clears the ground.
+    pub stand: f64,
+}
+
+/// The stance of the built-in bird of `species` (its lowest point folded, and over a wingbeat,
+/// plus a margin; the ground tests check these against the mesh). A goose of 1.5 m stands with
+/// its body centre 0.39 m up, about a real goose's.
+pub fn stance(species: Species) -> Stance {
+    match species {
+        Species::Goose => Stance {
+            sit: 0.070,
+            stand: 0.26,
+        },
+        Species::Crane => Stance {
+            sit: 0.057,
+            stand: 0.24,
+        },
+        Species::Pelican => Stance {
+            sit: 0.072,
+            stand: 0.22,
+        },
+    }
+}
+
+/// Puts the take-off's birds (the `initiation` stage) on the ground as they are: sitting at
+/// rest, standing up as the run starts, and lifted by their standing height at lift-off, fading
+/// out as they climb. The root's height becomes
+/// ```math
+/// z' = z + h(v)\,e^{-z/h_\text{stand}}, \qquad
+/// h(v) = h_\text{sit} + (h_\text{stand} - h_\text{sit})\,\operatorname{smoothstep}(v / v_\text{up})
+/// ```
+/// (v the ground speed, v_up = [`STAND_UP_SPEED_MS`]): monotonic and smooth in z, equal to z
+/// for a bird high up (below 1e-17 wingspans from 10 wingspans up). Run it after the course
+/// (whose pitch comes from the height change, so the body stays level while the bird stands
+/// up) and before the wingbeats. Animations without a take-off are left as they are.
+pub fn stand_on_ground(anim: &mut Animation, species: Species) {
+    let Some(stage) = anim.stage("initiation").cloned() else {
+        return;
+    };
+    let st = stance(species);
+    let ws = anim.wingspan_m;
+    if !(ws.is_finite() && ws > 0.0) {
+        return;
+    }
+    let end = stage.end.min(anim.frames.len());
+    for f in &mut anim.frames[stage.start.min(end)..end] {
+        for (z, &v) in f.z.iter_mut().zip(&f.speed) {
+            let u = (v * ws / STAND_UP_SPEED_MS).clamp(0.0, 1.0);
+            let h = st.sit + (st.stand - st.sit) * u * u * (3.0 - 2.0 * u);
+            let lift = h * (-z.max(0.0) / st.stand).exp();
+            if z.is_finite() && lift.is_finite() {
+                *z += lift;
+            }
+        }
+    }
+}
+
+/// Height of the shoulder above the bird's root, wingspans (the built-in birds: 0.02 or less).
+const SHOULDER_UP: f64 = 0.02;
+/// Reach of a wing from the shoulder to the tip, and half its widest chord, wingspans: at least
+/// the built-in birds' (0.44 and 0.125), so the clearance below is on the safe side.
+const WING_REACH: f64 = 0.46;
+const HALF_CHORD: f64 = 0.13;
+/// Least gap kept between a wingtip and the ground, wingspans.
+const GROUND_GAP: f64 = 0.01;
+
+/// Lowest point of a wing in `p` below the root, wingspans, for a bird banked by `bank` radians
+/// (an upper bound for the built-in birds).
+fn wing_drop(p: &WingPose, bank: f64) -> f64 {
+    let arm = (0.45 * WING_REACH) * p.dihedral.min(0.0).sin();
+    let hand = (0.55 * WING_REACH) * (p.dihedral + p.hand_dihedral).min(0.0).sin();
+    let twist = HALF_CHORD * p.arm_twist.sin().abs().max(p.hand_twist.sin().abs());
+    -(SHOULDER_UP + arm + hand) + twist + (WING_REACH + 0.1) * bank.sin().abs()
+}
+
+/// `p` with its downstroke made shallower where a bird whose root is `height` wingspans above the
+/// ground would strike it (a bird running or just airborne): the arm and hand dihedral are scaled
+/// towards level until the lowest wing point keeps a small gap. Unchanged higher up.
+pub fn clear_ground(p: WingPose, height: f64, bank: f64) -> WingPose {
+    let room = height - GROUND_GAP;
+    if wing_drop(&p, bank) <= room {
+        return p;
+    }
+    let scaled = |l: f64| WingPose {
+        dihedral: if p.dihedral < 0.0 {
+            l * p.dihedral
+        } else {
+            p.dihedral
+        },
+        hand_dihedral: if p.dihedral + p.hand_dihedral < 0.0 {
+            l * p.hand_dihedral
+        } else {
+            p.hand_dihedral
+        },
+        ..p
+    };
+    let (mut lo, mut hi) = (0.0, 1.0);
+    for _ in 0..30 {
+        let mid = 0.5 * (lo + hi);
+        if wing_drop(&scaled(mid), bank) <= room {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    scaled(lo)
+}
+
+/// Wings folded along the body, the primaries crossing over the tail: the whole wing swept back
+/// 69°, a quarter folded (so the hand tucks in behind the wrist), level, untwisted.
+pub const FOLDED: WingPose = WingPose {
+    dihedral: -0.05,
+    hand_dihedral: 0.0,
+    sweep: -1.2,
+    arm_twist: 0.0,
+    hand_twist: 0.0,
+    spread: 0.75,
+    tail_bend: 0.0,
+};
+
+impl WingPose {
+    /// The pose a fraction `w` of the way from `self` to `other` (every angle linearly).
+    pub fn lerp(&self, other: &WingPose, w: f64) -> WingPose {
+        let l = |a: f64, b: f64| a + w * (b - a);
+        WingPose {
+            dihedral: l(self.dihedral, other.dihedral),
+            hand_dihedral: l(self.hand_dihedral, other.hand_dihedral),
+            sweep: l(self.sweep, other.sweep),
+            arm_twist: l(self.arm_twist, other.arm_twist),
+            hand_twist: l(self.hand_twist, other.hand_twist),
+            spread: l(self.spread, other.spread),
+            tail_bend: l(self.tail_bend, other.tail_bend),
+        }
+    }
+}
+
+/// Whether bird `i` is at rest in frame `k` of `anim`.
+pub fn at_rest(anim: &Animation, k: usize, i: usize) -> bool {
+    let Some(f) = anim.frames.get(k) else {
+        return false;
+    };
+    let (Some(&v), Some(&z)) = (f.speed.get(i), f.z.get(i)) else {
+        return false;
+    };
+    let v_ms = v * anim.wingspan_m;
+    v_ms.is_finite() && v_ms < REST_SPEED_MS && z.is_finite() && z < GROUND_BAND
+}
+
+/// Fold weight of every bird in every frame (frame-major): 1 at rest (folded, phase held), 0 in
+/// the wingbeat, a smoothstep between while the wings unfold or fold. Empty when no bird is ever
+/// at rest (the common case of a flight that starts in the air), so callers can skip the blend.
+pub fn fold_weights(anim: &Animation) -> Vec<f64> {
+    let n = anim.birds;
+    let nf = anim.frames.len();
+    if !(anim.wingspan_m.is_finite() && anim.wingspan_m > 0.0) {
+        return Vec::new();
+    }
+    let rest: Vec<bool> = (0..nf)
+        .flat_map(|k| (0..n).map(move |i| (k, i)))
+        .map(|(k, i)| at_rest(anim, k, i))
+        .collect();
+    if !rest.iter().any(|&r| r) {
+        return Vec::new();
+    }
+    let smooth = |x: f64| {
+        let x = x.clamp(0.0, 1.0);
+        x * x * (3.0 - 2.0 * x)
+    };
+    let mut out = vec![0.0; n * nf];
+    for i in 0..n {
+        // Time of the last change between rest and motion, and the weight then.
+        let mut since = f64::NEG_INFINITY;
+        let mut from = if rest[i] { 1.0 } else { 0.0 };
+        let mut was = rest[i];
+        for k in 0..nf {
+            let t = anim.frames[k].t;
+            let r = rest[k * n + i];
+            if r != was {
+                // Start the new ramp from the weight reached so far (no jump mid-ramp).
+                from = out[k.saturating_sub(1) * n + i];
+                since = anim.frames[k.saturating_sub(1)].t;
+                was = r;
+            }
+            let target = if r { 1.0 } else { 0.0 };
+            let u = if since.is_finite() {
+                smooth((t - since) / UNFOLD_S)
+            } else {
+                1.0
+            };
+            out[k * n + i] = from + (target - from) * u;
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::animation::Frame;
+
+    fn anim(speeds: &[f64], fps: f64) -> Animation {
+        let frames = speeds
+            .iter()
+            .enumerate()
+            .map(|(k, &v)| Frame {
+                t: k as f64 / fps,
+                x: vec![0.0],
+                y: vec![0.0],
+                z: vec![0.07],
+                heading: vec![0.0],
+                speed: vec![v],
+                ..Default::default()
+            })
+            .collect();
+        let mut a = Animation::new(0, fps, 1.5, 1);
+        a.frames = frames;
+        a
+    }
+
+    #[test]
+    fn a_resting_bird_is_folded_and_unfolds_smoothly_when_it_runs() {
+        let mut v = vec![0.0; 30];
+        v.extend((1..60).map(|k| 0.05 * k as f64));
+        let w = fold_weights(&anim(&v, 30.0));
+        assert!(w[..30].iter().all(|&x| x == 1.0));
+        // 0.5 m/s = 0.333 wingspans/s: frame 36 is the first in motion.
+        assert!(w[36] < 1.0 && w[35] == 1.0, "{:?}", &w[30..40]);
+        let done = 35 + (UNFOLD_S * 30.0).ceil() as usize;
+        assert!(w[done..].iter().all(|&x| x == 0.0));
+        for p in w.windows(2) {
+            assert!(p[1] <= p[0]);
+        }
+    }
+
+    #[test]
+    fn a_flight_without_rest_needs_no_weights() {
+        assert!(fold_weights(&anim(&[5.0; 10], 30.0)).is_empty());
+    }
+}

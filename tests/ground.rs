@@ -1,0 +1,179 @@
+//! Birds on the ground (take-off): at rest they sit, wings folded, not flapping; the run starts
+//! the wingbeat; no part of the built-in bird goes below the ground in any frame.
+
+use std::path::Path;
+
+use formation::animation::Animation;
+use formation::export::bird::{self, BirdAsset, JOINTS, PARENT};
+use formation::pipeline::{Config, Pipeline};
+use formation::wingbeat::rest::{stance, REST_SPEED_MS};
+use formation::wingbeat::{self, Flapper, Species, WingPose};
+use glam::{Quat, Vec3};
+
+/// World positions (bird frame of the export: +Y up) of the built-in bird's vertices for a pose,
+/// root at `root` with rotation `rot`, bank `bank`.
+fn posed(asset: &BirdAsset, pose: &WingPose, bank: f32, root: Vec3, rot: Quat) -> Vec<Vec3> {
+    let q = bird::joint_rotations(pose, bank);
+    let skel = &asset.skeleton;
+    let mut g = [Quat::IDENTITY; 7];
+    let mut t = [Vec3::ZERO; 7];
+    let mut global = [(Quat::IDENTITY, Vec3::ZERO); 7];
+    for j in 0..JOINTS.len() {
+        match PARENT[j] {
+            None => {
+                g[j] = rot * q[j];
+                t[j] = root + rot * skel.bind_pos[j];
+            }
+            Some(p) => {
+                g[j] = g[p] * q[j];
+                t[j] = t[p] + g[p] * (skel.bind_pos[j] - skel.bind_pos[p]);
+            }
+        }
+        global[j] = (g[j] * skel.bind_rot[j], t[j]);
+    }
+    asset.mesh.posed(skel, &global)
+}
+
+fn lowest(asset: &BirdAsset, pose: &WingPose) -> f32 {
+    posed(asset, pose, 0.0, Vec3::ZERO, Quat::IDENTITY)
+        .iter()
+        .map(|p| p.y)
+        .fold(f32::INFINITY, f32::min)
+}
+
+#[test]
+fn the_stance_keeps_the_built_in_bird_above_the_ground_folded_and_flapping() {
+    for sp in [Species::Goose, Species::Crane, Species::Pelican] {
+        let a = BirdAsset::builtin(sp);
+        let st = stance(sp);
+        let folded = lowest(&a, &wingbeat::FOLDED);
+        let flap = wingbeat::wingbeat_curve(sp, 256)
+            .iter()
+            .map(|(_, p)| lowest(&a, p))
+            .fold(f32::INFINITY, f32::min);
+        // Sitting: the belly on the ground (within 5 mm for a goose), never under it.
+        assert!(
+            st.sit as f32 + folded >= 0.0,
+            "{sp}: sits {} under",
+            st.sit as f32 + folded
+        );
+        assert!(
+            st.sit as f32 + folded < 0.004,
+            "{sp}: sits {} above",
+            st.sit as f32 + folded
+        );
+        // Standing: the lowest wingtip of a full downstroke clears the ground.
+        assert!(
+            st.stand as f32 + flap >= 0.0,
+            "{sp}: a downstroke reaches {}",
+            st.stand as f32 + flap
+        );
+        assert!(st.stand > st.sit);
+    }
+}
+
+fn take_off(birds: usize, species: Species, seed: u64) -> Animation {
+    let mut c = Config {
+        seed,
+        seconds: Some(1.0),
+        ..Config::default()
+    };
+    c.steady.birds = birds;
+    c.wingbeat.species = species;
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples_data/barnacle_geese_v.json");
+    Pipeline::from_path(path)
+        .run(&c)
+        .expect("the take-off runs")
+        .0
+}
+
+/// Checks every frame of the take-off on the rig: no vertex under the ground; at rest folded and
+/// not flapping; the wingbeat under way within 0.2 s of the run's start. Returns the lowest
+/// vertex over the take-off (wingspans).
+fn check_on_the_rig(anim: &Animation, species: Species) -> f32 {
+    let asset = BirdAsset::builtin(species);
+    let flapper = Flapper::from_animation(anim);
+    let ws = anim.wingspan_m;
+    let stage = anim.stage("initiation").expect("a take-off").clone();
+    let mut lowest_all = f32::INFINITY;
+    for b in 0..anim.birds {
+        let flight = bird::flight(anim, b, ws);
+        let mut run_start: Option<f64> = None;
+        let mut flapping_from: Option<f64> = None;
+        for k in stage.start..stage.end {
+            let f = &anim.frames[k];
+            let v_ms = f.speed[b] * ws;
+            let pose = flapper.pose(k, b);
+            if v_ms < REST_SPEED_MS && f.z[b] < 1.0 {
+                assert_eq!(
+                    pose,
+                    wingbeat::FOLDED,
+                    "bird {b} frame {k}: at rest, wings folded"
+                );
+                if k > stage.start {
+                    let before = &anim.frames[k - 1];
+                    if before.speed[b] * ws < REST_SPEED_MS {
+                        assert_eq!(
+                            flapper.phase(k, b),
+                            flapper.phase(k - 1, b),
+                            "bird {b} frame {k}: no wingbeat at rest"
+                        );
+                    }
+                }
+            }
+            if run_start.is_none() && f.speed[b] > 0.0 && f.z[b] < 1.0 {
+                run_start = Some(f.t);
+            }
+            if flapping_from.is_none() && pose != wingbeat::FOLDED {
+                flapping_from = Some(f.t);
+            }
+            let root = flight.translation[k] / ws as f32;
+            if root.y > 0.7 {
+                continue; // every pose fits in a sphere of 0.6 wingspans
+            }
+            let low = posed(&asset, &pose, flight.bank[k], root, flight.yaw[k])
+                .iter()
+                .map(|p| p.y)
+                .fold(f32::INFINITY, f32::min);
+            assert!(
+                low >= -1e-4,
+                "bird {b} frame {k}: a vertex {low} wingspans under the ground"
+            );
+            lowest_all = lowest_all.min(low);
+        }
+        if let (Some(r), Some(fl)) = (run_start, flapping_from) {
+            assert!(
+                fl - r <= 0.2 + 1e-9,
+                "bird {b}: runs at {r:.3} s, flaps at {fl:.3} s"
+            );
+        } else if run_start.is_some() {
+            panic!("bird {b} runs but never flaps");
+        }
+    }
+    lowest_all
+}
+
+#[test]
+fn take_offs_sit_fold_run_and_flap_above_the_ground() {
+    for (birds, species, seed) in [
+        (9, Species::Goose, 1),
+        (14, Species::Goose, 0),
+        (14, Species::Crane, 2),
+        (14, Species::Pelican, 3),
+        (41, Species::Goose, 4),
+        (100, Species::Goose, 5),
+    ] {
+        let anim = take_off(birds, species, seed);
+        let low = check_on_the_rig(&anim, species);
+        // The flock sat on the ground first: its lowest point touches it.
+        assert!(low < 0.01, "{birds} {species}: lowest point {low}");
+        // Sitting for the default second before the first run.
+        let first_run = (0..anim.birds)
+            .filter_map(|b| anim.frames.iter().find(|f| f.speed[b] > 0.0).map(|f| f.t))
+            .fold(f64::INFINITY, f64::min);
+        assert!(
+            (first_run - 1.0).abs() < 0.05,
+            "{birds}: the first run starts at {first_run} s"
+        );
+    }
+}
