@@ -26,9 +26,11 @@ const GEESE: &str = concat!(
 const SKY_BOUND: i32 = 10 + DITHER_SPREAD / 2 + 10;
 
 /// Widest run of one palette colour down a column, in levels of the true colour it covers: the
-/// tolerance plus the settle margin of pixels held back while a cloud slid by (measured 17 on
-/// this film; the sky gradient alone is dithered into runs of a few pixels).
-const BAND_BOUND: i32 = 20;
+/// tolerance plus the settle margin of pixels held back while a cloud slid by, or the learnt
+/// palette's spacing over a near-white cloud low over the horizon (measured 17 on this film
+/// before the take-off began with a second of sitting, 22 since: a pale cloud at the bottom
+/// right 11 s in; the sky gradient alone is dithered into runs of a few pixels).
+const BAND_BOUND: i32 = 24;
 
 #[test]
 fn readme_gif_sky_matches_the_full_colour_pictures() {

@@ -155,12 +155,15 @@ impl Film {
     /// The GIF palette: NeuQuant over pixels of up to 9 frames spread over the film (every
     /// 7th pixel of each), plus the species' plumage exactly.
     pub fn palette(&self) -> Palette {
+        const PALETTE_FRAMES: usize = 9;
+        const PALETTE_STEP: usize = 7;
         let (w, h) = (self.width, self.height);
         let n = self.len();
         let picks: Vec<usize> = if n == 0 {
             Vec::new()
         } else {
-            let m = n.min(9);
+            // Frames spread over the film; as many training pixels as 9 frames at every 7th.
+            let m = n.min(PALETTE_FRAMES);
             let mut v: Vec<usize> = (0..m).map(|i| i * (n - 1) / (m - 1).max(1)).collect();
             v.dedup();
             v
@@ -170,7 +173,7 @@ impl Film {
         let mut train = Vec::new();
         for k in picks {
             self.draw(k, &mut canvas, &mut mask, true);
-            for p in canvas.rgba.chunks_exact(4).step_by(7) {
+            for p in canvas.rgba.chunks_exact(4).step_by(PALETTE_STEP) {
                 train.extend_from_slice(p);
             }
         }
@@ -345,6 +348,7 @@ fn delta_step(
     palette: &Palette,
     tolerance: i32,
     catch_up: bool,
+    refresh: bool,
     (start, width): (usize, usize),
     plain: &[[u8; 3]],
 ) {
@@ -409,7 +413,10 @@ fn delta_step(
             .abs()
             .max((c[1] as i32 - p[1] as i32).abs())
             .max((c[2] as i32 - p[2] as i32).abs());
-        if err <= tolerance {
+        // Held back within the tolerance; a refresh frame (every REFRESH_S) sends the held
+        // pixels that have drifted past the settle margin, so a cloud drifting under a still
+        // camera cannot leave a stale half beside a fresh one.
+        if err <= tolerance && !(refresh && err > SETTLE_MARGIN) {
             *o = TRANSPARENT;
             *d = 1;
             continue;
@@ -430,6 +437,9 @@ fn delta_step(
 /// half spread plus two levels of the palette, so what is left is no more visible than the
 /// dither itself.
 const SETTLE_MARGIN: i32 = super::palette::DITHER_SPREAD / 2 + 2;
+
+/// Held-back pixels more than [`SETTLE_MARGIN`] off are sent at least this often, seconds.
+const REFRESH_S: f64 = 0.5;
 
 /// Seconds over which the GIF of a loop lowers its tolerance to 0 before the last frame.
 const LOOP_CATCH_UP_S: f64 = 2.0;
@@ -454,6 +464,7 @@ pub fn write_gif(film: &Film, path: &Path, threads: usize, progress: &dyn Progre
     let tolerance = film.gif_tolerance;
     let (looped, frames_total) = (film.looped, film.len());
     let ramp = (LOOP_CATCH_UP_S * film.fps).round().max(1.0) as usize;
+    let refresh_every = (REFRESH_S * film.fps).round().max(1.0) as usize;
     let mut file = AtomicFile::create(path)?;
     let io_err = |e: gif::EncodingError| match e {
         gif::EncodingError::Io(e) => Error::io(path, e),
@@ -541,6 +552,7 @@ pub fn write_gif(film: &Film, path: &Path, threads: usize, progress: &dyn Progre
                                     palette,
                                     tol,
                                     tol < tolerance,
+                                    (start + k) % refresh_every == 0,
                                     (lo, w),
                                     plain,
                                 );
@@ -858,6 +870,7 @@ mod tests {
             &palette,
             255,
             false,
+            false,
             (0, 1),
             &[white3],
         );
@@ -873,6 +886,7 @@ mod tests {
             &palette,
             0,
             true,
+            false,
             (0, 1),
             &[white3],
         );
