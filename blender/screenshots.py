@@ -70,9 +70,9 @@ def step2():
     ext = max((p - c).length for p in ps)
     r3d = area.spaces.active.region_3d
     r3d.view_location = c
-    r3d.view_distance = max(ext * 3.0, 20.0)
+    r3d.view_distance = max(ext * 2.2, 20.0)
     from mathutils import Euler
-    r3d.view_rotation = Euler((1.1, 0.0, 2.5)).to_quaternion()
+    r3d.view_rotation = Euler((0.55, 0.0, 3.4)).to_quaternion()
     bpy.app.timers.register(step3, first_interval=1.5)
     return None
 

@@ -1,9 +1,10 @@
 # Imports a .glb written by `formation` into Blender (headless) and checks what arrived: one
 # armature per bird with the documented bones, one action per clip and bird, the wing bones turning
 # and the birds moving while the clips play. Prints a summary; exits 1 when a check fails.
-# Usage: blender -b --python scripts/blender_import_check.py -- flock.glb [FPS]
-# FPS (default 30) is set on the scene BEFORE the import, as docs/export.md advises, so that the
-# importer turns the file's seconds into frames at the animation's own rate.
+# Usage: blender -b --python scripts/blender_import_check.py -- flock.glb [FPS|-] [flock.csv]
+# FPS (default: the file's own, from the scene's extras) is set on the scene BEFORE the import,
+# as docs/export.md advises, so that the importer turns the file's seconds into frames at the
+# animation's own rate. With the CSV of the same animation, bird positions are checked.
 # (Debian's Blender 3.4 glTF add-on still uses numpy.bool, which numpy 1.24 removed: the first
 # lines put Debian's numpy first and restore the alias.)
 import sys; sys.path.insert(0, "/usr/lib/python3/dist-packages"); [sys.modules.pop(m) for m in list(sys.modules) if m.startswith("numpy")]
@@ -12,7 +13,14 @@ import bpy
 
 args = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else sys.argv[-1:]
 path = args[0]
-fps = int(args[1]) if len(args) > 1 else 30
+csv_path = args[2] if len(args) > 2 else None
+import json as _json, struct as _struct
+with open(path, "rb") as fh:
+    _head = fh.read(20)
+    _doc = _json.loads(fh.read(_struct.unpack("<I", _head[12:16])[0]))
+_extras = _doc["scenes"][0].get("extras", {})
+wingspan = float(_extras.get("wingspan_m", 1.0))
+fps = int(args[1]) if len(args) > 1 and args[1] != "-" else int(round(_extras.get("fps", 30)))
 bpy.ops.wm.read_factory_settings(use_empty=True)
 sc = bpy.context.scene
 sc.render.fps = fps
@@ -36,28 +44,70 @@ for a in arms:
     if not any(m.parent == a for m in meshes):
         failed.append("%s has no skinned mesh" % a.name)
         break
-# Play each clip alone on the first armature (as its active action) and look at the motion.
+# The default .glb has one clip per bird over the whole flight: it must play on import, with no
+# NLA change. With a CSV of the same animation: every bird at 10 frames across the flight where
+# the CSV puts it (within 1 mm); the wings flap and the birds move over a second of steady flight.
 a0 = arms[0]
-for clip in clips:
-    act = bpy.data.actions.get("%s_%s" % (clip, a0.name))
-    if act is None:
-        failed.append("no action for clip %s" % clip)
-        continue
-    for t in a0.animation_data.nla_tracks:
-        t.mute = True
-    a0.animation_data.action = act
-    lo, hi = int(act.frame_range[0]), int(act.frame_range[1])
+if "flight" in clips:
+    for a in arms:
+        ad = a.animation_data
+        playing = ad is not None and (ad.action is not None or any(not t.mute for t in ad.nla_tracks))
+        if not playing:
+            failed.append("%s: nothing plays on import" % a.name)
+            break
+    lo = 0
+    hi = int(round(max(act.frame_range[1] for act in bpy.data.actions)))
+    mid = (lo + hi) // 2
     wing, pos = [], []
-    for f in range(lo, min(hi, lo + 60) + 1):
+    for f in range(mid, mid + fps + 1):
         sc.frame_set(f)
         wing.append(round(a0.pose.bones["upper_arm.L"].matrix.to_euler()[2], 4))
         pos.append(tuple(round(v, 3) for v in a0.matrix_world.translation))
-    print("CLIP", clip, "frames", lo, hi, "wing angles", len(set(wing)), "positions", len(set(pos)),
-          "start", pos[0], "after 60 frames", pos[-1])
+    print("CLIP flight frames", lo, hi, "wing angles", len(set(wing)), "positions", len(set(pos)))
     if len(set(wing)) < 10:
-        failed.append("%s: upper_arm.L does not flap" % clip)
+        failed.append("flight: upper_arm.L does not flap")
     if len(set(pos)) < 10:
-        failed.append("%s: %s does not move" % (clip, a0.name))
+        failed.append("flight: %s does not move" % a0.name)
+    if csv_path:
+        import csv as _csv
+        rows = {}
+        with open(csv_path) as fh:
+            for r in _csv.DictReader(fh):
+                rows[(int(r["frame"]), int(r["bird"]))] = (float(r["x"]), float(r["y"]), float(r["z"]))
+        frames = sorted({k[0] for k in rows})
+        picks = [frames[round(i * (len(frames) - 1) / 9)] for i in range(10)]
+        worst = 0.0
+        for f in picks:
+            sc.frame_set(f)
+            for b, a in enumerate(arms):
+                want = [v * wingspan for v in rows[(f, b)]]
+                got = a.matrix_world.translation
+                worst = max(worst, max(abs(got[i] - want[i]) for i in range(3)))
+        print("POSITIONS 10 frames %d..%d, %d birds: worst %.6f m" % (picks[0], picks[-1], len(arms), worst))
+        if worst > 0.001:
+            failed.append("positions off the CSV by %.4f m" % worst)
+else:
+    # Per-stage clips (--clips stages): play each alone on the first armature.
+    for clip in clips:
+        act = bpy.data.actions.get("%s_%s" % (clip, a0.name))
+        if act is None:
+            failed.append("no action for clip %s" % clip)
+            continue
+        for t in a0.animation_data.nla_tracks:
+            t.mute = True
+        a0.animation_data.action = act
+        lo, hi = int(act.frame_range[0]), int(act.frame_range[1])
+        wing, pos = [], []
+        for f in range(lo, min(hi, lo + 60) + 1):
+            sc.frame_set(f)
+            wing.append(round(a0.pose.bones["upper_arm.L"].matrix.to_euler()[2], 4))
+            pos.append(tuple(round(v, 3) for v in a0.matrix_world.translation))
+        print("CLIP", clip, "frames", lo, hi, "wing angles", len(set(wing)), "positions", len(set(pos)),
+              "start", pos[0], "after 60 frames", pos[-1])
+        if len(set(wing)) < 10 and clip != "initiation":
+            failed.append("%s: upper_arm.L does not flap" % clip)
+        if len(set(pos)) < 10 and clip != "initiation":
+            failed.append("%s: %s does not move" % (clip, a0.name))
 print("SCENE fps", sc.render.fps, "range", sc.frame_start, sc.frame_end)
 if failed:
     print("FAILED", "; ".join(failed))

@@ -325,7 +325,9 @@ impl Animation {
                 ),
             ));
         }
-        use crate::limits::{MAX_COORDINATE, MAX_FPS, MAX_FRAME_VALUE, MAX_WINGSPAN_M};
+        use crate::limits::{
+            MAX_COORDINATE, MAX_FPS, MAX_FRAME_VALUE, MAX_WINGSPAN_M, MIN_WINGSPAN_M,
+        };
         if !(self.fps.is_finite() && self.fps > 0.0 && self.fps <= MAX_FPS) {
             return Err(Error::format(
                 origin,
@@ -333,13 +335,13 @@ impl Animation {
             ));
         }
         if !(self.wingspan_m.is_finite()
-            && self.wingspan_m > 0.0
+            && self.wingspan_m >= MIN_WINGSPAN_M
             && self.wingspan_m <= MAX_WINGSPAN_M)
         {
             return Err(Error::format(
                 origin,
                 format!(
-                    "wingspan_m: must be a positive number of metres, at most {MAX_WINGSPAN_M}"
+                    "wingspan_m: must be a number of metres from {MIN_WINGSPAN_M} to {MAX_WINGSPAN_M}"
                 ),
             ));
         }

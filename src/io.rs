@@ -241,6 +241,19 @@ impl OutputKind {
         let kind = if s.ends_with('/') || s.ends_with(std::path::MAIN_SEPARATOR) {
             Some(OutputKind::Directory)
         } else if let Some(k) = by_extension {
+            // A pipe, socket or device under that name would be replaced by a regular file
+            // (outputs are written to a temporary and renamed): refused instead.
+            if std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir()) {
+                return Err(Error::parameter(
+                    flag,
+                    format!(
+                        "{}: exists and is not a regular file (a pipe, socket or device), which \
+                         the {} output would replace; remove it or choose another name",
+                        path.display(),
+                        k.describe()
+                    ),
+                ));
+            }
             if path.is_dir() {
                 return Err(Error::parameter(
                     flag,

@@ -47,6 +47,10 @@ pub const MAX_SHAPE_BIRDS: usize = 10_000;
 /// keeps centimetre precision.
 pub const MAX_COORDINATE: f64 = 1e7;
 
+/// Smallest wingspan of a bird, metres (1 cm; the smallest birds span about 10 cm): below it
+/// the exported geometry underflows to zero.
+pub const MIN_WINGSPAN_M: f64 = 0.01;
+
 /// Largest `wingspan_m` of an animation file, metres (a flock of 747s is 68 m).
 pub const MAX_WINGSPAN_M: f64 = 1000.0;
 

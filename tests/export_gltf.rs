@@ -5,7 +5,7 @@
 
 use formation::export::bird::{self, JOINTS};
 use formation::export::gltf::{glb_bytes, glb_bytes_with, SceneOptions};
-use formation::export::keys::{KeyMode, Tolerance};
+use formation::export::keys::{ClipMode, KeyMode, Tolerance};
 use formation::export::rig::{self, Side};
 use formation::export::synthetic::{synthetic_flock, SyntheticParams};
 use formation::wingbeat::{assign_phases, Flapper, WingbeatOptions};
@@ -140,7 +140,11 @@ fn slerp_at(times: &[f32], values: &[f32], t: f32) -> Quat {
 #[test]
 fn skinned_rig_follows_the_convention_and_the_animation_file() {
     let anim = flock(3.0, 30.0);
-    let g = Glb::parse(&glb_bytes(&anim, WS).unwrap());
+    let stages = SceneOptions {
+        clips: ClipMode::Stages,
+        ..SceneOptions::default()
+    };
+    let g = Glb::parse(&glb_bytes_with(&anim, WS, &stages).unwrap());
     let j = &g.json;
     // One skin per bird, seven joints named by the convention, one inverse bind matrix each.
     let skins = j["skins"].as_array().unwrap();
@@ -269,9 +273,18 @@ fn skinned_rig_follows_the_convention_and_the_animation_file() {
 #[test]
 fn reduced_keys_stay_within_the_documented_tolerances_and_shrink_the_file() {
     let anim = flock(6.0, 30.0);
-    let all = glb_bytes(&anim, WS).unwrap();
+    let all = glb_bytes_with(
+        &anim,
+        WS,
+        &SceneOptions {
+            clips: ClipMode::Stages,
+            ..SceneOptions::default()
+        },
+    )
+    .unwrap();
     let opts = SceneOptions {
         keys: KeyMode::Reduced,
+        clips: ClipMode::Stages,
         ..SceneOptions::default()
     };
     let red = glb_bytes_with(&anim, WS, &opts).unwrap();
@@ -315,6 +328,55 @@ fn reduced_keys_stay_within_the_documented_tolerances_and_shrink_the_file() {
                 assert!(a <= tol.rotation_rad + 1e-4, "bank {a}");
                 let a = slerp_at(&tw, &hand, tt).angle_between(exact.joints[k][4]);
                 assert!(a <= tol.wing_rad + 2e-3, "hand {a}");
+            }
+        }
+    }
+}
+
+/// The default: one clip, `flight`, over every stage, keyed at the animation's own times from its
+/// first frame, so it plays on import; the stages as markers; the scene's timeline in `extras`.
+#[test]
+fn one_clip_covers_every_stage_at_the_animation_s_times() {
+    let anim = flock(6.0, 30.0);
+    assert!(anim.stages.len() >= 2, "a flock with stages");
+    let g = Glb::parse(&glb_bytes(&anim, WS).unwrap());
+    let clips: Vec<&str> = g.json["animations"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|a| a["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(clips, ["flight"]);
+    let x = &g.json["scenes"][0]["extras"];
+    assert_eq!(x["frame_start"], 0);
+    assert_eq!(x["frame_end"], anim.frames.len() - 1);
+    assert_eq!(x["clips"], "one");
+    let markers = g.json["animations"][0]["extras"]["markers"]
+        .as_array()
+        .unwrap()
+        .clone();
+    assert_eq!(markers.len(), anim.stages.len());
+    for (m, st) in markers.iter().zip(&anim.stages) {
+        assert_eq!(m["name"], st.name.as_str());
+        assert_eq!(m["frame"], st.start);
+    }
+    let t0 = anim.frames[0].t;
+    for bird in [0, anim.birds - 1] {
+        let root = g.node_named(&format!("bird_{bird:03}"))[0];
+        let (t, tr) = g.channel("flight", root, "translation");
+        assert_eq!(t.len(), anim.frames.len());
+        for (k, f) in anim.frames.iter().enumerate() {
+            assert!(
+                (t[k] as f64 - (f.t - t0)).abs() < 1e-5,
+                "frame {k}: key at {} s",
+                t[k]
+            );
+            let want = [f.x[bird] * WS, f.z[bird] * WS, -f.y[bird] * WS];
+            for c in 0..3 {
+                assert!(
+                    (tr[3 * k + c] as f64 - want[c]).abs() < 1e-5,
+                    "bird {bird} frame {k}"
+                );
             }
         }
     }

@@ -146,6 +146,7 @@ fn commands() -> Vec<Command> {
     ];
     let scene: Vec<(&str, &str, Option<String>)> = vec![
         ("--keys", "some", None),
+        ("--clips", "reel", None),
         ("--bird-model", "OUT/no-bird.glb", None),
     ];
     let seed = ("--seed", "x", None);

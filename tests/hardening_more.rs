@@ -197,7 +197,7 @@ fn closed_paths_too_small_for_the_flock_are_refused_naming_the_path() {
 #[test]
 fn a_full_or_closed_stderr_loses_no_output() {
     let dir = scratch("stderr");
-    std::fs::write(dir.join("u.csv"), "0,0,10\n0,100,10\n0,0.5,10\n").unwrap();
+    std::fs::write(dir.join("u.csv"), "0,0,10\n0,25,10\n6,19,10\n").unwrap();
     let params = data("tests/data/steady_v9_params.json");
     let steady = data("tests/data/initiate_steady_v9.json");
     let ex = data("examples_data/barnacle_geese_v.json");
@@ -259,7 +259,7 @@ fn a_full_or_closed_stderr_loses_no_output() {
 fn warnings_are_one_safe_line() {
     let dir = scratch("warnings");
     let name = "p\u{1b}[31m\nq.csv";
-    std::fs::write(dir.join(name), "0,0,10\n0,100,10\n0,0.5,10\n").unwrap();
+    std::fs::write(dir.join(name), "0,0,10\n0,25,10\n6,19,10\n").unwrap();
     let o = steady_with_path(&dir, name, "a.json");
     assert!(o.status.success(), "{}", stderr(&o));
     let e = stderr(&o);
@@ -387,4 +387,33 @@ fn every_animation_file_written_can_be_read_back() {
     let o = run_in(&dir, &["render", "five.json", "-o", "a.csv"]);
     assert_refused(&o, "more than the 4294967296 byte limit", "5 GB");
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// `-o` naming an existing FIFO (or any file that is not a regular file) is refused up front: the
+/// output, written to a temporary and renamed, would silently replace it. The FIFO stays.
+#[test]
+fn an_output_that_is_a_fifo_is_refused_and_left_alone() {
+    let dir = scratch("fifo-output");
+    let fifo = dir.join("flock.json");
+    let made = Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .expect("mkfifo runs");
+    assert!(made.success());
+    let params = data("tests/data/steady_v9_params.json");
+    let args = [
+        "steady",
+        &params,
+        "--birds",
+        "9",
+        "--seconds",
+        "1",
+        "-o",
+        "flock.json",
+    ];
+    let out = run_in(&dir, &args);
+    assert_refused(&out, "exists and is not a regular file", "-o FIFO");
+    let meta = std::fs::symlink_metadata(&fifo).unwrap();
+    use std::os::unix::fs::FileTypeExt;
+    assert!(meta.file_type().is_fifo(), "the FIFO was replaced");
 }

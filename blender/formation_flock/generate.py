@@ -298,6 +298,10 @@ def import_flock(context, glb: str, fps: float, name: str = COLLECTION) -> tuple
                 c.objects.unlink(obj)
             coll.objects.link(obj)
     start, end = round(t0 * fps), round(t1 * fps)
+    # The file's own range where it says it (a loop ends before its closing key).
+    extras = (doc.get("scenes") or [{}])[0].get("extras") or {}
+    if isinstance(extras.get("frame_end"), int) and isinstance(extras.get("frame_start"), int):
+        start, end = extras["frame_start"], extras["frame_end"]
     scene.frame_start, scene.frame_end = start, end
     scene.frame_set(start)
     return start, end

@@ -104,6 +104,7 @@ pub fn run(args: AnimateArgs, g: Global) -> Result<()> {
         height: args.size.height,
         fps: args.picture_fps,
         keys: args.scene.keys,
+        clips: args.scene.clips,
         bird_model: args.scene.bird_model.clone(),
         ..RenderOptions::default()
     };

@@ -180,6 +180,7 @@ pub const FLAGS: &[(&str, &str, &[Cmd])] = &[
     ("render.fps", "--picture-fps", &[Render, Animate]),
     ("render.wingspan_m", "--wingspan-m", &[Render]),
     ("render.keys", "--keys", SCENE),
+    ("render.clips", "--clips", SCENE),
     ("render.bird_model", "--bird-model", SCENE),
     ("render.camera", "--camera", PICTURES),
     ("render.camera.fixed", "--view", PICTURES),

@@ -79,10 +79,11 @@ impl FlightArgs {
         let preset = aero::flight::Morphology::of(species);
         let mut bird = match self.wingspan_m {
             Some(b) => {
-                if !(b.is_finite() && b > 0.0 && b <= 100.0) {
+                let least = formation::limits::MIN_WINGSPAN_M;
+                if !(b.is_finite() && b >= least && b <= 100.0) {
                     return Err(Error::parameter(
                         "--wingspan-m",
-                        format!("{b}: must be in (0, 100] metres"),
+                        format!("{b}: must be in [{least}, 100] metres"),
                     ));
                 }
                 preset.scaled_to(b)

@@ -98,6 +98,10 @@ pub struct SceneArgs {
     /// stay within 1 mm and 0.1° of every frame for the flight, 1° for the wingbeat).
     #[arg(long, value_name = "all|reduced", default_value_t = RenderOptions::default().keys)]
     pub keys: formation::export::keys::KeyMode,
+    /// Clips of the .glb: `one` (one clip per bird over the whole flight, which plays on import)
+    /// or `stages` (one clip per stage: initiation, steady, ..., each from time 0).
+    #[arg(long, value_name = "one|stages", default_value_t = RenderOptions::default().clips)]
+    pub clips: formation::export::keys::ClipMode,
     /// Your own bird (.glb) on every bird of the .glb and .usda: a static mesh flies and banks, a
     /// skinned one whose joints follow the naming convention (docs/export.md) also flaps.
     #[arg(long, value_name = "FILE.glb")]
@@ -109,6 +113,7 @@ impl SceneArgs {
     pub fn options(&self) -> RenderOptions {
         RenderOptions {
             keys: self.keys,
+            clips: self.clips,
             bird_model: self.bird_model.clone(),
             ..RenderOptions::default()
         }
@@ -124,6 +129,7 @@ impl PictureArgs {
             fps: self.fps,
             wingspan_m: self.wingspan_m,
             keys: self.scene.keys,
+            clips: self.scene.clips,
             bird_model: self.scene.bird_model.clone(),
             ..RenderOptions::default()
         }

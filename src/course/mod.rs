@@ -83,10 +83,12 @@ impl CourseOptions {
     pub fn validate(&self) -> Result<()> {
         let p = |name: &str, msg: String| Err(Error::parameter(name, msg));
         if let Some(a) = self.cruise_altitude {
-            if !(a.is_finite() && a.abs() <= 1e5) {
+            if !(a.is_finite() && (0.0..=1e5).contains(&a)) {
                 return p(
                     "course.cruise_altitude",
-                    format!("{a}: must be a number of wingspans within ±1e5"),
+                    format!(
+                        "{a}: must be a number of wingspans at or above the ground, at most 1e5"
+                    ),
                 );
             }
         }
@@ -315,6 +317,7 @@ pub fn apply(
         }
         depth = depth.max(hi - lo);
     }
+    check_above_ground(points, &origin)?;
     check_backwards(points, depth, &origin)?;
     let (r_min, why) = min_radius(d_lo, d_hi, flight.speed, g, opts);
     let dense = spline::spline_points(&points.points, points.closed);
@@ -371,6 +374,17 @@ pub fn apply(
                 ),
             ));
         }
+    }
+    // A reversal at one point (a spike) that the widening let through: no turn of any radius
+    // follows both legs, and the widened course would be flown straight through it.
+    if let Some((i, deg, along)) = reversal(points) {
+        return Err(Error::format(
+            &origin,
+            format!(
+                "the turn near point {i} ({}), {along:.0} wingspans along the path, turns back by {deg:.0}° at one point and cannot be widened into a turn the flock can fly; give that turn a radius of at least {r_min:.0} wingspans, drawn with two or more points",
+                file::show(points.points[i]),
+            ),
+        ));
     }
     report.length = course.length();
     for t in &tight {
@@ -539,6 +553,43 @@ fn atan_small(t: f64) -> f64 {
         t.atan()
     }
 }
+
+/// Refuses a path with a point below the ground (z < 0): the flock would fly underground.
+fn check_above_ground(points: &PathPoints, origin: &Path) -> Result<()> {
+    match points.points.iter().position(|p| p[2] < 0.0) {
+        Some(i) => Err(Error::format(
+            origin,
+            format!(
+                "point {i} ({}): below the ground (z = {:.2} wingspans); a path is flown at or above z = 0",
+                file::show(points.points[i]),
+                points.points[i][2]
+            ),
+        )),
+        None => Ok(()),
+    }
+}
+
+/// The first control point where the path turns back by more than 150° (its index, the turn in
+/// degrees and its distance along the control polygon, wingspans).
+fn reversal(points: &PathPoints) -> Option<(usize, f64, f64)> {
+    let p = &points.points;
+    let n = p.len();
+    let mut along = 0.0;
+    for i in 1..n.saturating_sub(1) {
+        let (a, b, c) = (p[i - 1], p[i], p[i + 1]);
+        along += file::dist(a, b);
+        let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+        let v = [c[0] - b[0], c[1] - b[1], c[2] - b[2]];
+        let cos = (u[0] * v[0] + u[1] * v[1] + u[2] * v[2]) / (file::dist(a, b) * file::dist(b, c));
+        if cos < REVERSAL_COS {
+            return Some((i, cos.clamp(-1.0, 1.0).acos().to_degrees(), along));
+        }
+    }
+    None
+}
+
+/// Cosine of the largest turn at one control point that can be widened (150°).
+const REVERSAL_COS: f64 = -0.866_025_403_784_438_6;
 
 /// Refuses a path that turns back on itself (more than 90° at a control point) with a segment
 /// shorter than the formation's length `depth` (wingspans): the formation would fly into itself.

@@ -10,9 +10,14 @@
 //! accessor; each bird's mesh node `bird_000_mesh` sits at the scene root, untransformed, as glTF
 //! asks of skinned meshes (only the joints place it), with its own skin `bird_000_skin`.
 //!
-//! Clips: one animation per stage of the animation file, named after it (`initiation`,
-//! `steady`, …; `flight` when the file has no stages), each starting at time 0 and ending on the
-//! first frame of the next stage, so that played back to back they join without a jump. LINEAR
+//! Clips ([`ClipMode`]): by default one animation, `flight`, over every frame, its times those of
+//! the animation from its first frame (frame k at k / fps s), so that it plays on import; the
+//! stages are in its `extras` and the scene's (`frame_start`, `frame_end`, `fps`). With
+//! `ClipMode::Stages`, one animation per stage of the animation file, named after it
+//! (`initiation`, `steady`, …; `flight` when the file has no stages), each starting at time 0
+//! and ending on the first frame of the next stage, so that played back to back they join
+//! without a jump. A loop ends on its closing key (the first frame again, one frame on), which
+//! a player cycling by time shows once; `frame_end` is the frame before it. LINEAR
 //! keys at every frame (`render.keys` = all) or only those [`keys::keep`] needs (reduced).
 //! Metadata in `extras`: the scene holds fps, wingspan_m, seed, species, birds, the stages and the
 //! bird model; each clip its stage, first frame and start time; each bird root its index.
@@ -28,7 +33,7 @@ use gltf_json as json;
 use json::validation::{Checked::Valid, USize64};
 
 use super::bird::{self, BirdAsset, Flight};
-use super::keys::{self, Curve, KeyMode, Tolerance};
+use super::keys::{self, ClipMode, Curve, KeyMode, Tolerance};
 use super::rig::Side;
 use crate::animation::Animation;
 use crate::error::{Error, Result};
@@ -41,6 +46,8 @@ pub struct SceneOptions {
     pub keys: KeyMode,
     /// Tolerances of `KeyMode::Reduced`.
     pub tolerance: Tolerance,
+    /// One clip over every stage, or one per stage.
+    pub clips: ClipMode,
     /// The bird placed on every bird; `None` = the built-in bird of the animation's species.
     pub asset: Option<BirdAsset>,
 }
@@ -105,9 +112,17 @@ pub fn closed_loop(anim: &Animation) -> std::borrow::Cow<'_, Animation> {
     Cow::Owned(out)
 }
 
-/// The clips of `anim`: one per non-empty stage, or `flight` over every frame.
-pub fn clips(anim: &Animation) -> Vec<Clip> {
+/// The clips of `anim`: `flight` over every frame ([`ClipMode::One`]), or one per non-empty
+/// stage (`flight` over every frame when there is none).
+pub fn clips(anim: &Animation, mode: ClipMode) -> Vec<Clip> {
     let n = anim.frames.len();
+    if mode == ClipMode::One {
+        return vec![Clip {
+            name: "flight".into(),
+            first: 0,
+            last: n - 1,
+        }];
+    }
     let mut out: Vec<Clip> = anim
         .stages
         .iter()
@@ -149,6 +164,53 @@ pub fn metadata(
         "joints": bird::JOINTS,
         "keys": keys.to_string(),
     })
+}
+
+/// The scene's `extras`: [`metadata`] and the timeline a player needs: the rate, the first and
+/// last frame of the range to play (a loop's closing key is one frame past `frame_end`), and the
+/// clip mode.
+fn scene_metadata(
+    anim: &Animation,
+    wingspan_m: f64,
+    asset: &BirdAsset,
+    opts: &SceneOptions,
+) -> serde_json::Value {
+    let mut m = metadata(anim, wingspan_m, asset, opts.keys);
+    if let Some(o) = m.as_object_mut() {
+        let last = play_end(anim);
+        o.insert("frame_start".into(), 0.into());
+        o.insert("frame_end".into(), last.into());
+        o.insert("clips".into(), opts.clips.to_string().into());
+    }
+    m
+}
+
+/// The last frame of the range to play of an animation as [`closed_loop`] gives it: the last
+/// frame, or for a loop the one before its closing frame (which repeats the first).
+pub fn play_end(anim: &Animation) -> usize {
+    let n = anim.frames.len();
+    n.saturating_sub(1 + usize::from(anim.looped && n > 2))
+}
+
+/// A clip's `extras`: its stage (or `flight`), frames and start time; in one clip, the stages
+/// as markers (name, first frame, time).
+fn clip_metadata(anim: &Animation, c: &Clip) -> serde_json::Value {
+    let mut v = serde_json::json!({
+        "stage": c.name,
+        "first_frame": c.first,
+        "last_frame": c.last,
+        "start_s": anim.frames[c.first].t,
+        "fps": anim.fps,
+    });
+    if c.name == "flight" && !anim.stages.is_empty() {
+        v["markers"] = anim
+            .stages
+            .iter()
+            .filter(|s| s.start < anim.frames.len())
+            .map(|s| serde_json::json!({"name": s.name, "frame": s.start, "t": anim.frames[s.start].t}))
+            .collect();
+    }
+    v
 }
 
 fn extras(v: &serde_json::Value) -> json::Extras {
@@ -249,7 +311,7 @@ pub fn glb_bytes_with(anim: &Animation, wingspan_m: f64, opts: &SceneOptions) ->
         .collect();
     let ibm_acc = b.accessor(&mut root, &ibm, 16, json::accessor::Type::Mat4, false, None);
 
-    let clips = clips(anim);
+    let clips = clips(anim, opts.clips);
     let flapper = Flapper::from_animation(anim);
     let digits = bird_digits(anim.birds);
     let mut bird_nodes = Vec::with_capacity(anim.birds);
@@ -421,7 +483,7 @@ pub fn glb_bytes_with(anim: &Animation, wingspan_m: f64, opts: &SceneOptions) ->
     scene_nodes.extend(mesh_nodes);
     let scene = root.push(json::Scene {
         extensions: None,
-        extras: extras(&metadata(anim, wingspan_m, &asset, opts.keys)),
+        extras: extras(&scene_metadata(anim, wingspan_m, &asset, opts)),
         name: Some("flock".into()),
         nodes: scene_nodes,
     });
@@ -429,13 +491,7 @@ pub fn glb_bytes_with(anim: &Animation, wingspan_m: f64, opts: &SceneOptions) ->
     for (c, (channels, samplers)) in clips.iter().zip(anims) {
         root.push(json::Animation {
             extensions: None,
-            extras: extras(&serde_json::json!({
-                "stage": c.name,
-                "first_frame": c.first,
-                "last_frame": c.last,
-                "start_s": anim.frames[c.first].t,
-                "fps": anim.fps,
-            })),
+            extras: extras(&clip_metadata(anim, c)),
             channels,
             name: Some(c.name.clone()),
             samplers,

@@ -19,6 +19,41 @@ use glam::{Quat, Vec3};
 
 use crate::error::{Error, Result};
 
+/// How the 3D outputs' animation is cut into clips.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ClipMode {
+    /// One clip per bird over every stage (`flight`), times from the animation's first frame:
+    /// plays on import without arranging anything (the default).
+    #[default]
+    One,
+    /// One clip per stage (`initiation`, `steady`, ...), each from time 0.
+    Stages,
+}
+
+impl FromStr for ClipMode {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<ClipMode> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "one" => Ok(ClipMode::One),
+            "stages" => Ok(ClipMode::Stages),
+            _ => Err(Error::parameter(
+                "render.clips",
+                format!("unknown clip mode \"{s}\": expected one or stages"),
+            )),
+        }
+    }
+}
+
+impl fmt::Display for ClipMode {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            ClipMode::One => "one",
+            ClipMode::Stages => "stages",
+        })
+    }
+}
+
 /// Which keys to write.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]

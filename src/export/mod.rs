@@ -95,6 +95,8 @@ pub struct RenderOptions {
     /// Keyframes of the `.glb` and `.usda`: every frame, or reduced within the documented
     /// tolerances ([`keys::Tolerance`]).
     pub keys: keys::KeyMode,
+    /// Clips of the .glb: one over every stage (default) or one per stage.
+    pub clips: keys::ClipMode,
     /// The user's bird (`.glb`) for the `.glb` and `.usda`; `None` = the built-in bird.
     pub bird_model: Option<PathBuf>,
 }
@@ -113,6 +115,7 @@ impl Default for RenderOptions {
             sun: false,
             gif_tolerance: 10.0,
             keys: keys::KeyMode::All,
+            clips: keys::ClipMode::One,
             bird_model: None,
         }
     }
@@ -163,7 +166,7 @@ impl RenderOptions {
             ));
         }
         if let Some(w) = self.wingspan_m {
-            if !(w.is_finite() && w > 0.0 && w <= 100.0) {
+            if !(w.is_finite() && (crate::limits::MIN_WINGSPAN_M..=100.0).contains(&w)) {
                 return Err(Error::parameter(
                     "render.wingspan_m",
                     format!("{w} m is not a wingspan; give metres between 0 and 100 (a goose is about 1.5)"),
@@ -382,6 +385,7 @@ pub fn write_outputs(
     let scene = gltf::SceneOptions {
         keys: opts.keys,
         tolerance: keys::Tolerance::default(),
+        clips: opts.clips,
         asset,
     };
     let threads = pictures::worker_count(opts.threads);

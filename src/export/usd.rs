@@ -135,7 +135,13 @@ pub fn write_usda(
         "    doc = \"Flock animation written by formation {}\"",
         env!("CARGO_PKG_VERSION")
     );
-    let _ = writeln!(head, "    endTimeCode = {}", time_code(anim, n - 1));
+    // A loop's closing frame (the first again) is past the end: cycling the range shows each
+    // frame once.
+    let _ = writeln!(
+        head,
+        "    endTimeCode = {}",
+        time_code(anim, super::gltf::play_end(anim).min(n - 1))
+    );
     let _ = writeln!(head, "    framesPerSecond = {}", anim.fps);
     let _ = writeln!(head, "    metersPerUnit = 1");
     let _ = writeln!(head, "    startTimeCode = 0");

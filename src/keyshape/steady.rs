@@ -147,10 +147,17 @@ impl SteadyOptions {
                 format!("{}: must be in (0, 1000] wingspans per second", self.speed),
             ));
         }
-        if !(self.wingspan_m.is_finite() && self.wingspan_m > 0.0 && self.wingspan_m <= 100.0) {
+        if !(self.wingspan_m.is_finite()
+            && self.wingspan_m >= crate::limits::MIN_WINGSPAN_M
+            && self.wingspan_m <= 100.0)
+        {
             return Err(p(
                 "steady.wingspan_m",
-                format!("{}: must be in (0, 100] metres", self.wingspan_m),
+                format!(
+                    "{}: must be in [{}, 100] metres",
+                    self.wingspan_m,
+                    crate::limits::MIN_WINGSPAN_M
+                ),
             ));
         }
         self.keys.validate()?;
