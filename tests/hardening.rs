@@ -575,7 +575,7 @@ fn size_limits_are_refused_early() {
     let o = run_in(&dir, &["render", "huge.json", "-o", "h.glb"]);
     assert_refused(
         &o,
-        "wingspan_m: must be a positive number of metres, at most 1000",
+        "wingspan_m: must be a number of metres from 0.01 to 1000",
         "wingspan",
     );
     assert!(!dir.join("h.glb").exists());
