@@ -67,7 +67,7 @@ fn flights_reproduce_the_footage_s_position_keeping() {
     );
     assert!((lat.move_median / move_median - 1.0).abs() < 0.15);
     assert!((lat.spread / spread - 1.0).abs() < 0.15);
-    params.motion = Some(keep.clone());
+    params.motion = Some(keep);
     for birds in [n_hat, 2 * n_hat] {
         for seed in 1..=3 {
             let opts = SteadyOptions {
