@@ -107,6 +107,18 @@ fn cases() -> Vec<(&'static str, &'static str, Vec<String>)> {
             "90",
         ]),
     ));
+    // `--jostle 0` (key-shape interpolation only) must keep reproducing the flights from
+    // before the position-keeping motion became the default: these digests are those outputs'.
+    let still: Vec<_> = out
+        .iter()
+        .filter(|(name, _, _)| name.starts_with("animate-"))
+        .map(|(name, file, args)| {
+            let mut args = args.clone();
+            args.extend(v(&["--jostle", "0"]));
+            (leak(format!("{name}-jostle0")), *file, args)
+        })
+        .collect();
+    out.extend(still);
     out
 }
 

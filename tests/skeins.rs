@@ -39,7 +39,11 @@ fn min_within(a: &Animation, f: usize) -> f64 {
 
 #[test]
 fn a_thousand_geese_take_off_into_many_line_formations() {
-    let c = config(1000, 0, 20.0);
+    // Line formations of key shapes (the leader front-most even where its nearest neighbours
+    // fly almost abreast): without position keeping, whose fore-aft moves can bring an abreast
+    // neighbour level with the leader. The clearance between formations is checked with it.
+    let mut c = config(1000, 0, 20.0);
+    c.steady.jostle.scale = 0.0;
     let (a, report) = Pipeline::from_path(example("barnacle_geese_v.json"))
         .run(&c)
         .unwrap();
@@ -278,9 +282,16 @@ fn the_clearance_holds_for_many_seeds_and_is_settable() {
             let sep = min_separation(&a);
             assert!(sep >= clearance, "seed {seed}: {sep} < {clearance}");
             assert_eq!(r.skein.unwrap().min_separation, sep);
-            // Drift: headings differ from the course by at most about 1°, speeds by about 2 %.
+            // Drift: the formations' headings differ from the course by at most about 1° (the
+            // mean over the birds); each bird's own heading also carries its position keeping
+            // (lateral moves of ~0.3 wingspans/s at ~10 wingspans/s: a few degrees).
             let f = a.frames.last().unwrap();
-            assert!(f.heading.iter().all(|h| h.abs() < 2f64.to_radians()));
+            let mean = f.heading.iter().sum::<f64>() / f.heading.len() as f64;
+            assert!(
+                mean.abs() < 2f64.to_radians(),
+                "seed {seed}: mean heading {mean}"
+            );
+            assert!(f.heading.iter().all(|h| h.abs() < 8f64.to_radians()));
         }
     }
 }

@@ -1,17 +1,31 @@
 //! Algorithm 1 invariants (issue 4): for N = N̂, N > N̂ and N < N̂, every key shape is solved,
 //! inside the feasible ranges, with no two birds wing to wing, and the motion between frames is
-//! smooth; equal seeds give equal bytes.
+//! smooth; equal seeds give equal bytes. These are invariants of the key-shape interpolation, so
+//! the flights here are flown without position keeping (`--jostle 0`, [`still`]); the jostled
+//! motion's own invariants (spacing, smoothness) are checked by
+//! `jostled_flights_keep_apart_and_smooth`.
 
 mod steady_support;
 
 use formation::aero::power_reduction;
 use formation::extract::params::FormationParams;
 use formation::keyshape::{
-    steady_flight, steady_flight_report, KeyOptions, SteadyOptions, SteadyReport,
+    steady_flight, steady_flight_report, JostleOptions, KeyOptions, SteadyOptions, SteadyReport,
 };
 use formation::progress::Silent;
 use formation::rng::seeded;
 use formation::Animation;
+
+/// The default options without position keeping: key-shape interpolation only.
+fn still() -> SteadyOptions {
+    SteadyOptions {
+        jostle: JostleOptions {
+            scale: 0.0,
+            ..JostleOptions::default()
+        },
+        ..SteadyOptions::default()
+    }
+}
 
 fn run(
     params: &FormationParams,
@@ -23,7 +37,7 @@ fn run(
         birds,
         frames,
         seed,
-        ..SteadyOptions::default()
+        ..still()
     };
     steady_flight_report(params, &opts, &mut seeded(seed), &Silent).expect("steady flight")
 }
@@ -150,7 +164,7 @@ fn case(params: &FormationParams, birds: usize) {
             key_every_s: 1.0,
             ..KeyOptions::default()
         },
-        ..SteadyOptions::default()
+        ..still()
     };
     let (anim, rep) = steady_flight_report(params, &opts, &mut seeded(7), &Silent).unwrap();
     eprintln!("{birds} birds: {:?}", rep.keys);
@@ -211,7 +225,7 @@ fn steady_flight_matches_report_variant() {
     let opts = SteadyOptions {
         birds: 9,
         frames: 40,
-        ..SteadyOptions::default()
+        ..still()
     };
     let a = steady_flight(&p, &opts, &mut seeded(1), &Silent).unwrap();
     let b = steady_flight_report(&p, &opts, &mut seeded(1), &Silent)
@@ -279,7 +293,7 @@ fn odd_movies_still_give_valid_flights() {
             key_every_s: 1.0,
             ..KeyOptions::default()
         },
-        ..SteadyOptions::default()
+        ..still()
     };
     let err = steady_flight_report(&tiny, &opts, &mut seeded(2), &Silent).unwrap_err();
     assert!(err.to_string().contains("lateral gap"), "{err}");
@@ -300,7 +314,7 @@ fn odd_movies_still_give_valid_flights() {
                     key_every_s: 1.0,
                     ..KeyOptions::default()
                 },
-                ..SteadyOptions::default()
+                ..still()
             };
             let (anim, rep) = steady_flight_report(p, &opts, &mut seeded(2), &Silent).unwrap();
             check(&anim, &rep, &opts);
@@ -355,7 +369,7 @@ fn lateral_gaps_breathe_like_the_footage() {
             birds,
             frames: 3600,
             seed: 5,
-            ..SteadyOptions::default()
+            ..still()
         };
         let (anim, rep) = steady_flight_report(&p, &opts, &mut seeded(5), &Silent).unwrap();
         let keys = anim.key_shapes.len();
@@ -397,6 +411,56 @@ fn lateral_gaps_breathe_like_the_footage() {
                 let dx = (anim.frames[f].x[i] - anim.frames[f - 1].x[i]).abs();
                 assert!(dx < 0.05, "{name} frame {f} bird {i}: lateral step {dx}");
             }
+        }
+    }
+}
+
+/// With position keeping on (the default), every frame keeps the birds at least 0.3 wingspans
+/// apart, and each bird's acceleration and turn rate stay bounded (finite differences of the
+/// sampled positions at 30 fps), for both shapes and three seeds.
+#[test]
+fn jostled_flights_keep_apart_and_smooth() {
+    for (name, p) in [("v9", steady_support::v9()), ("j16", steady_support::j16())] {
+        for seed in 1..=3 {
+            let opts = SteadyOptions {
+                birds: 14,
+                frames: 901,
+                fps: 30.0,
+                seed,
+                ..SteadyOptions::default()
+            };
+            assert!(opts.jostle.scale == 1.0, "position keeping is the default");
+            let (anim, _) = steady_flight_report(&p, &opts, &mut seeded(seed), &Silent).unwrap();
+            let dt = 1.0 / anim.fps;
+            let (mut closest, mut acc, mut turn) = (f64::INFINITY, 0.0f64, 0.0f64);
+            for (f, fr) in anim.frames.iter().enumerate() {
+                for i in 0..fr.x.len() {
+                    for j in 0..i {
+                        closest = closest.min((fr.x[i] - fr.x[j]).hypot(fr.y[i] - fr.y[j]));
+                    }
+                    if f >= 2 {
+                        let (a, b) = (&anim.frames[f - 1], &anim.frames[f - 2]);
+                        let ax = (fr.x[i] - 2.0 * a.x[i] + b.x[i]) / (dt * dt);
+                        let ay = (fr.y[i] - 2.0 * a.y[i] + b.y[i]) / (dt * dt);
+                        acc = acc.max(ax.hypot(ay));
+                        turn = turn.max((fr.heading[i] - a.heading[i]).abs() / dt);
+                    }
+                }
+            }
+            eprintln!("{name} seed {seed}: closest {closest:.3}, accel {acc:.2}, turn {turn:.3}");
+            assert!(
+                closest >= 0.3,
+                "{name} seed {seed}: birds {closest} wingspans apart"
+            );
+            assert!(
+                acc <= 4.0,
+                "{name} seed {seed}: acceleration {acc} wingspans/s²"
+            );
+            assert!(
+                turn <= 30f64.to_radians(),
+                "{name} seed {seed}: turn rate {} °/s",
+                turn.to_degrees()
+            );
         }
     }
 }

@@ -85,7 +85,7 @@ pub struct SteadyFlags {
     pub max_jump: f64,
     /// Scale of each bird's small, frequent moves about its slot: 1 = as measured in the
     /// footage (or the field-data default without footage timing), 0 = key-shape interpolation
-    /// only (the default for now); in [0, 10].
+    /// only; in [0, 10].
     #[arg(long, value_name = "S", default_value_t = JostleOptions::default().scale, allow_negative_numbers = true)]
     pub jostle: f64,
     /// A seamless cycle: the last key shape is the first and the wingbeats make whole cycles, so

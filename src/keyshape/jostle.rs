@@ -38,9 +38,8 @@ pub struct JostleOptions {
 impl Default for JostleOptions {
     fn default() -> Self {
         JostleOptions {
-            // 0 until the steady-flight tests and golden files are adapted to the motion
-            // (`steady.jostle.scale` 1 gives the footage's position keeping).
-            scale: 0.0,
+            // The footage's position keeping (scale 0: key-shape interpolation only).
+            scale: 1.0,
             components: 24,
             ramp_s: 2.0,
             limit: 0.5,
