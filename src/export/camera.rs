@@ -535,6 +535,10 @@ fn ground(
         .collect()
 }
 
+/// Standard deviation of the follow camera's zoom smoothing, seconds (the aim uses
+/// `CameraParams::smoothing_s`).
+const ZOOM_SMOOTHING_S: f64 = 2.0;
+
 fn follow(
     states: &[Vec<BirdState>],
     fps: f64,
@@ -546,6 +550,11 @@ fn follow(
     let sigma = (p.smoothing_s * fps).max(0.5);
     let half = ((2.0 * sigma).ceil() as usize).min(n.max(1));
     let kernel = gaussian(sigma, half);
+    // The zoom changes more slowly than the aim: birds keeping position move about their slots
+    // all the time, and a zoom following the outermost of them would breathe.
+    let zoom_sigma = (ZOOM_SMOOTHING_S * fps).max(sigma);
+    let zoom_half = ((2.0 * zoom_sigma).ceil() as usize).min(n.max(1));
+    let zoom_kernel = gaussian(zoom_sigma, zoom_half);
     let (w, h) = (width as f64, height as f64);
     let m = p.margin * w.min(h);
     let (hw, hh) = ((0.5 * w - m).max(1.0), (0.5 * h - m).max(1.0));
@@ -594,7 +603,7 @@ fn follow(
         .collect();
     let eroded: Vec<f64> = (0..n)
         .map(|i| {
-            (-(half as isize)..=half as isize)
+            (-(zoom_half as isize)..=zoom_half as isize)
                 .map(|d| log_need[near(i, d)])
                 .fold(f64::MAX, f64::min)
         })
@@ -603,8 +612,8 @@ fn follow(
         .map(|i| {
             let mut acc = 0.0;
             let mut wsum = 0.0;
-            for (k, wk) in kernel.iter().enumerate() {
-                let j = near(i, k as isize - half as isize);
+            for (k, wk) in zoom_kernel.iter().enumerate() {
+                let j = near(i, k as isize - zoom_half as isize);
                 acc += wk * eroded[j];
                 wsum += wk;
             }
