@@ -780,9 +780,10 @@ mod tests {
             if cyclic {
                 assert!(wrap <= 1.05 * inner, "wrap {wrap} > largest step {inner}");
             } else {
-                // Without wrapping, the ends are smoothed one-sidedly: here the wrap is 15 %
-                // larger than any step inside (the case tells the two apart).
-                assert!(wrap > 1.1 * inner, "wrap {wrap}, largest step {inner}");
+                // Without wrapping, the ends are smoothed one-sidedly: here the wrap is 10 %
+                // larger than any step inside (the case tells the two apart; with the zoom
+                // smoothed over 2 s the zoom hardly differs at the ends, the aim does).
+                assert!(wrap > 1.05 * inner, "wrap {wrap}, largest step {inner}");
             }
         }
     }
