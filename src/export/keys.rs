@@ -102,7 +102,9 @@ pub struct Tolerance {
 impl Default for Tolerance {
     fn default() -> Self {
         Tolerance {
-            position_m: 0.001,
+            // 0.9 mm, so that every frame stays within 1 mm after the files' own rounding
+            // (f32 positions hundreds of metres out, USD's text digits).
+            position_m: 0.0009,
             rotation_rad: 0.1f32.to_radians(),
             wing_rad: 1.0f32.to_radians(),
         }
