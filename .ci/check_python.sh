@@ -28,10 +28,14 @@ retry "$py" -m pip install --quiet --disable-pip-version-check maturin pytest nu
 # The documented `pip install ./python`, without build isolation (maturin is installed above).
 CARGO_TARGET_DIR="$PWD/target" retry "$py" -m pip install --quiet --disable-pip-version-check \
     --no-build-isolation ./python
-"$py" -c "import formation; help(formation.animate)" | grep -q "steady.fps"
+# Captured first: grep -q stops reading at the first match, and under pipefail the writer's
+# broken pipe would fail the step.
+help_text="$("$py" -c "import formation; help(formation.animate)")"
+grep -q "steady.fps" <<<"$help_text"
 FORMATION_BIN="$PWD/target/release/formation" "$py" -m pytest -q -p no:cacheprovider python/tests
 "$py" examples/python/flock_savings.py --out "$dir/example"
 for f in savings.png savings_tidy.csv savings_per_bird.csv; do
     [ -s "$dir/example/$f" ] || { echo "the example wrote no $f"; exit 1; }
 done
-head -c 8 "$dir/example/savings.png" | od -An -c | grep -q 'P   N   G' || { echo "savings.png is not a PNG"; exit 1; }
+magic="$(head -c 8 "$dir/example/savings.png" | od -An -c)"
+grep -q 'P   N   G' <<<"$magic" || { echo "savings.png is not a PNG"; exit 1; }
