@@ -60,6 +60,9 @@ pub struct Animation {
     /// The wake model the savings (`e`, `xi`) were computed with, when recorded.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub savings_model: Option<SavingsModel>,
+    /// Reorganisations of the steady flight (leader changes, swaps, joins), in time order.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub events: Vec<Event>,
     /// One entry per frame.
     pub frames: Vec<Frame>,
 }
@@ -229,6 +232,32 @@ pub struct KeyShapeRecord {
     pub birds: Vec<KeyBird>,
 }
 
+/// The kind of a reorganisation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum EventKind {
+    /// The leader and the first bird of an arm exchange slots.
+    LeaderChange,
+    /// Two neighbours along an arm exchange slots.
+    Swap,
+    /// A bird joins the formation.
+    Join,
+}
+
+/// One reorganisation of a steady flight, in the animation file's `events`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Event {
+    /// Start of the manoeuvre, seconds (the animation's time).
+    pub t: f64,
+    /// What happened.
+    pub kind: EventKind,
+    /// The birds involved (animation indices); for a leader change the old leader first, then
+    /// the new one.
+    pub birds: Vec<usize>,
+    /// Length of the manoeuvre, seconds.
+    pub duration: f64,
+}
+
 /// One bird of a key shape.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct KeyBird {
@@ -238,6 +267,11 @@ pub struct KeyBird {
     pub y: f64,
     /// Relative power reduction ξ achieved.
     pub xi: f64,
+    /// The slot the bird flies in at this key (index into `xi_ranges` and into the first key
+    /// shape's birds), when birds have changed places (leader changes, swaps); absent: its own
+    /// index.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub slot: Option<usize>,
 }
 
 /// The state of every bird at one instant (world frame).
@@ -293,6 +327,7 @@ impl Animation {
             path: None,
             flight: None,
             savings_model: None,
+            events: Vec::new(),
             frames: Vec::new(),
         }
     }
@@ -443,6 +478,26 @@ impl Animation {
                         format!("key_shapes[{s}].birds[{i}]: not a finite number within ±{MAX_COORDINATE:e}"),
                     ));
                 }
+                if b.slot.is_some_and(|q| q >= n) {
+                    return Err(Error::format(
+                        origin,
+                        format!("key_shapes[{s}].birds[{i}].slot: not one of the {n} slots"),
+                    ));
+                }
+            }
+        }
+        for (k, e) in self.events.iter().enumerate() {
+            if !(e.t.is_finite() && e.duration.is_finite() && e.duration >= 0.0) {
+                return Err(Error::format(
+                    origin,
+                    format!("events[{k}]: t and duration must be finite, duration ≥ 0"),
+                ));
+            }
+            if let Some(b) = e.birds.iter().find(|&&b| b >= n) {
+                return Err(Error::format(
+                    origin,
+                    format!("events[{k}].birds: bird {b} is not one of the {n} birds"),
+                ));
             }
         }
         if let Some(fs) = &self.formations {

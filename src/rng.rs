@@ -37,6 +37,8 @@ pub enum Stream {
     SkeinLayout,
     /// Steady flight: each bird's position-keeping motion about its slot.
     SteadyJostle,
+    /// Steady flight: leader changes and swaps (when, which birds).
+    SteadyEvents,
 }
 
 impl Stream {
@@ -54,6 +56,7 @@ impl Stream {
             Stream::SkeinSizes => "skein/sizes",
             Stream::SkeinLayout => "skein/layout",
             Stream::SteadyJostle => "steady.jostle",
+            Stream::SteadyEvents => "steady.events",
         }
     }
 }

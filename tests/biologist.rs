@@ -506,7 +506,7 @@ fn charts_draw_the_leader_the_ranges_and_the_stages_they_claim() {
     let a: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     assert_eq!(a["xi_ranges"].as_array().unwrap().len(), 14);
-    let pow = svg(&["plot", "power", j, "--key", "1", "-o", &out("p.svg")]);
+    let pow = svg(&["plot", "power", j, "--key", "0", "-o", &out("p.svg")]);
     assert!(pow.contains("feasible range"), "no ranges drawn");
     // A steady-only file is not titled a take-off.
     let steady = dir.join("steady.json");

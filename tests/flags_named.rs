@@ -92,6 +92,8 @@ fn commands() -> Vec<Command> {
         ("--wingspan-m", "0", None),
         ("--max-jump", "0", None),
         ("--jostle", "-1", None),
+        ("--leader-changes", "nan", None),
+        ("--swaps", "1e9", None),
         ("--core-radius", "nan", None),
         ("--mass-kg", "0", None),
         ("--speed-ms", "-3", None),

@@ -9,7 +9,7 @@ mod steady_support;
 use formation::extract::motion::footage_keeping;
 use formation::extract::params::FrameParams;
 use formation::keyshape::jostle::measure_animation;
-use formation::keyshape::{steady_flight_report, SteadyOptions};
+use formation::keyshape::{steady_flight_report, ReorganiseOptions, SteadyOptions};
 use formation::progress::Silent;
 use formation::rng::seeded;
 use rand_distr::{Distribution, Normal};
@@ -70,15 +70,37 @@ fn flights_reproduce_the_footage_s_position_keeping() {
     params.motion = Some(keep);
     for birds in [n_hat, 2 * n_hat] {
         for seed in 1..=3 {
+            // Position keeping alone: a bird that changes places (leader changes, swaps) moves
+            // its mean slot, which the footage's birds, measured between reorganisations, do not.
             let opts = SteadyOptions {
                 birds,
                 frames: 2701,
                 fps,
                 seed,
+                reorganise: ReorganiseOptions::none(),
                 ..SteadyOptions::default()
             };
             let (anim, _) =
                 steady_flight_report(&params, &opts, &mut seeded(seed), &Silent).unwrap();
+            // With the default reorganisations the short moves are still the footage's.
+            let (lively, _) = steady_flight_report(
+                &params,
+                &SteadyOptions {
+                    reorganise: ReorganiseOptions::default(),
+                    ..opts.clone()
+                },
+                &mut seeded(seed),
+                &Silent,
+            )
+            .unwrap();
+            assert!(!lively.events.is_empty());
+            let (moves, _) = measure_animation(&lively, 5.0).expect("long enough");
+            assert!(
+                (moves.move_median / lat.move_median - 1.0).abs() <= 0.25,
+                "N {birds} seed {seed}: with reorganisations, 0.5 s move {} vs the footage's {}",
+                moves.move_median,
+                lat.move_median
+            );
             let (got, _) = measure_animation(&anim, 5.0).expect("long enough");
             eprintln!(
                 "N {birds} seed {seed}: move {:.4} vs {:.4}, spread {:.4} vs {:.4}",

@@ -34,12 +34,33 @@ impl Animation {
         self.relative_with(k, &of, &leaders)
     }
 
-    /// [`Animation::relative`] with the formations and leaders computed once by the caller.
+    /// The formations' leaders at `t` seconds: `leaders` (at the start of the steady flight,
+    /// [`Animation::leaders`]) after every leader change whose manoeuvre is half done by `t`
+    /// (the new leader is then ahead of the old).
+    pub fn leaders_at(&self, leaders: &[usize], t: f64) -> Vec<usize> {
+        let mut out = leaders.to_vec();
+        for e in &self.events {
+            if e.kind != super::EventKind::LeaderChange || e.t + 0.5 * e.duration > t {
+                continue;
+            }
+            if let [old, new] = e.birds[..] {
+                for l in out.iter_mut().filter(|l| **l == old) {
+                    *l = new;
+                }
+            }
+        }
+        out
+    }
+
+    /// [`Animation::relative`] with the formations and leaders computed once by the caller
+    /// (leaders at the start; leader changes are applied at each frame's time).
     pub fn relative_with(&self, k: usize, of: &[usize], leaders: &[usize]) -> Vec<Relative> {
         let Some(f) = self.frames.get(k) else {
             return Vec::new();
         };
         let n = self.birds;
+        let current = self.leaders_at(leaders, f.t);
+        let leaders = current.as_slice();
         let mut out: Vec<Relative> = (0..n)
             .map(|i| {
                 let fm = of.get(i).copied().unwrap_or(0);

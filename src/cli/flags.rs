@@ -94,6 +94,12 @@ pub const FLAGS: &[(&str, &str, &[Cmd])] = &[
     ("steady.keys.max_jump", "--max-jump", STEADY),
     ("steady.jostle.scale", "--jostle", STEADY),
     (
+        "steady.reorganise.leader_changes",
+        "--leader-changes",
+        STEADY,
+    ),
+    ("steady.reorganise.swaps", "--swaps", STEADY),
+    (
         "extract.footage_fps",
         "--footage-fps",
         &[Extract, Report, Animate],

@@ -62,7 +62,7 @@ enum Command {
     /// Key shape whose ξ matches the targets (Levenberg–Marquardt, eq. 4).
     Solve(solve::SolveArgs),
     /// §5 Algorithm 1: a steady-flight animation from formation parameters.
-    Steady(steady::SteadyArgs),
+    Steady(Box<steady::SteadyArgs>),
     /// §6 initiation: random take-off converging into the first key shape.
     Initiate(Box<initiate::InitiateArgs>),
     /// The whole chain: annotations or params → extract → steady → initiate → outputs.
@@ -94,7 +94,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Extract(a) => (Cmd::Extract, extract::run(a, g)),
         Command::Power(a) => (Cmd::Power, power::run(a, g)),
         Command::Solve(a) => (Cmd::Solve, solve::run(a, g)),
-        Command::Steady(a) => (Cmd::Steady, steady::run(a, g)),
+        Command::Steady(a) => (Cmd::Steady, steady::run(*a, g)),
         Command::Initiate(a) => (Cmd::Initiate, initiate::run(*a, g)),
         Command::Animate(a) => (Cmd::Animate, animate::run(*a, g)),
         Command::Render(a) => (Cmd::Render, render::run(a, g)),

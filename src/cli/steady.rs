@@ -88,6 +88,19 @@ pub struct SteadyFlags {
     /// only; in [0, 10].
     #[arg(long, value_name = "S", default_value_t = JostleOptions::default().scale, allow_negative_numbers = true)]
     pub jostle: f64,
+    /// Leader changes per minute of steady flight: the leader drops back into the first slot of
+    /// an arm and that arm's first bird takes the lead, in a manoeuvre of a few seconds; 0 =
+    /// never. Default: 1 with position keeping on (--jostle above 0), else 0.
+    #[arg(
+        long = "leader-changes",
+        value_name = "R",
+        allow_negative_numbers = true
+    )]
+    pub leader_changes: Option<f64>,
+    /// Swaps of two neighbours along an arm per minute of steady flight; 0 = never. Default: 2
+    /// with position keeping on, else 0.
+    #[arg(long, value_name = "R", allow_negative_numbers = true)]
+    pub swaps: Option<f64>,
     /// A seamless cycle: the last key shape is the first and the wingbeats make whole cycles, so
     /// the GIF, the glTF clip or a game's background flock loops without a jump (in the flock's
     /// moving frame; in the world on a closed --path). No take-off.
@@ -130,6 +143,11 @@ impl SteadyFlags {
             jostle: JostleOptions {
                 scale: self.jostle,
                 ..JostleOptions::default()
+            },
+            reorganise: formation::keyshape::ReorganiseOptions {
+                leader_changes: self.leader_changes,
+                swaps: self.swaps,
+                ..formation::keyshape::ReorganiseOptions::default()
             },
             looped: self.looped,
             aero: formation::aero::AeroOptions {

@@ -180,7 +180,12 @@ pub fn synthetic_flock(rng: &mut impl Rng, p: &SyntheticParams) -> Animation {
         birds: key
             .iter()
             .zip(&xi0)
-            .map(|(&(x, y), &xi)| KeyBird { x, y, xi })
+            .map(|(&(x, y), &xi)| KeyBird {
+                x,
+                y,
+                xi,
+                slot: None,
+            })
             .collect(),
     }];
     anim

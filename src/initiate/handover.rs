@@ -155,6 +155,15 @@ pub fn hand_over(
             k
         })
         .collect();
+    out.events = steady
+        .events
+        .iter()
+        .map(|e| {
+            let mut e = e.clone();
+            e.t = t_start + (e.t - t0);
+            e
+        })
+        .collect();
     // The steady flight's feasible ξ ranges stay with its key shapes (plot power draws them).
     out.xi_ranges = steady.xi_ranges.clone();
     out.frames = frames;

@@ -8,6 +8,7 @@ pub mod jostle;
 pub mod keys;
 pub mod lateral;
 pub mod ranges;
+pub mod reorganise;
 pub mod solve;
 pub mod spacing;
 pub mod steady;
@@ -17,6 +18,7 @@ pub use initial::InitialOptions;
 pub use jostle::JostleOptions;
 pub use keys::KeyOptions;
 pub use lateral::LateralOptions;
+pub use reorganise::ReorganiseOptions;
 pub use solve::{solve, SolveOptions, SolveReport};
 pub use steady::{
     steady_flight, steady_flight_in, steady_flight_report, SteadyOptions, SteadyReport,

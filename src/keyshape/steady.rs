@@ -40,6 +40,7 @@ use crate::keyshape::keys::{
 };
 use crate::keyshape::lateral::{lateral_plan, LateralOptions};
 use crate::keyshape::ranges::{power_at, xi_ranges, XiRanges};
+use crate::keyshape::reorganise::{Plan, ReorganiseOptions, SlotState};
 use crate::keyshape::spacing;
 use crate::progress::Progress;
 use crate::rng::{Scope, Stream};
@@ -74,6 +75,8 @@ pub struct SteadyOptions {
     /// Each bird's position-keeping motion about its slot (`keyshape::jostle`); none in a
     /// loop.
     pub jostle: JostleOptions,
+    /// Leader changes and neighbour swaps (`keyshape::reorganise`); none in a loop.
+    pub reorganise: ReorganiseOptions,
     /// The birds' mass and airspeed for their power curve (savings of total power), recorded in
     /// the animation.
     pub flight: crate::animation::FlightSettings,
@@ -98,6 +101,7 @@ impl Default for SteadyOptions {
             heights: HeightOptions::default(),
             aero: AeroOptions::default(),
             jostle: JostleOptions::default(),
+            reorganise: ReorganiseOptions::default(),
             flight: crate::animation::FlightSettings::default(),
             looped: false,
         }
@@ -166,6 +170,23 @@ impl SteadyOptions {
         self.heights.validate()?;
         self.aero.validate()?;
         self.jostle.validate()?;
+        self.reorganise.validate()?;
+        if self.looped {
+            let (l, sw) = (
+                self.reorganise.leader_changes.unwrap_or(0.0),
+                self.reorganise.swaps.unwrap_or(0.0),
+            );
+            if l > 0.0 || sw > 0.0 {
+                return Err(p(
+                    if l > 0.0 {
+                        "steady.reorganise.leader_changes"
+                    } else {
+                        "steady.reorganise.swaps"
+                    },
+                    "a loop cannot reorganise: the birds would not be back in their slots when it comes round; give 0 or set steady.loop to false".into(),
+                ));
+            }
+        }
         crate::aero::flight::validate_settings(&self.flight)?;
         let seconds = self.frames as f64 / self.fps;
         if self.looped && seconds < self.keys.key_every_s {
@@ -178,6 +199,30 @@ impl SteadyOptions {
             ));
         }
         Ok(())
+    }
+
+    /// A living flight: position keeping or reorganisations on (never in a loop). Its key
+    /// shapes come at fixed times in seconds ([`SteadyOptions::key_times`]), so the same seed
+    /// gives the same motion at any frame rate.
+    pub fn living(&self) -> bool {
+        !self.looped && (self.jostle.scale > 0.0 || self.reorganise.any(self.jostle.scale > 0.0))
+    }
+
+    /// The time of every key shape, seconds. A living flight ([`SteadyOptions::living`]): every
+    /// `keys.key_every_s` seconds from 0 until one at or after the flight's length F/fps (the
+    /// same times at any frame rate); otherwise at [`SteadyOptions::key_frames`].
+    pub fn key_times(&self) -> Vec<f64> {
+        if !self.living() {
+            return self
+                .key_frames()
+                .iter()
+                .map(|&f| f as f64 / self.fps)
+                .collect();
+        }
+        let every = self.keys.key_every_s;
+        let length = self.frames as f64 / self.fps;
+        let k = ((length / every - 1e-9).ceil() as usize).max(1);
+        (0..=k).map(|i| i as f64 * every).collect()
     }
 
     /// Number of key shapes and the frame of each (evenly spread, first at 0, last at F − 1; for
@@ -493,9 +538,13 @@ pub fn steady_flight_in(
     };
 
     // Step 3.
-    let key_frames = opts.key_frames();
+    let key_times = opts.key_times();
+    let key_frames: Vec<usize> = key_times
+        .iter()
+        .map(|&t| (t * opts.fps).round() as usize)
+        .collect();
     let solve_opts = opts.keys.solve_options(&opts.aero);
-    let nk = key_frames.len();
+    let nk = key_times.len();
     progress.start("steady: key shapes", nk as u64);
     let ctx = KeyContext {
         x: &x,
@@ -593,12 +642,36 @@ pub fn steady_flight_in(
         )
     };
 
+    // Leader changes and swaps: which bird flies in which slot, over time.
+    let plan = if opts.living() {
+        Plan::draw(
+            &keys[0].x,
+            &keys[0].y,
+            corr.leader,
+            opts.frames as f64 / opts.fps,
+            &opts.reorganise,
+            opts.jostle.scale > 0.0,
+            &mut scope.stream(opts.seed, Stream::SteadyEvents),
+        )
+    } else {
+        Plan::draw(
+            &x,
+            &y0,
+            corr.leader,
+            0.0,
+            &ReorganiseOptions::none(),
+            false,
+            rng,
+        )
+    };
+    let reorganised = !plan.exchanges.is_empty();
+
     // Step 4.
     progress.start("steady: frames", opts.frames as u64);
-    let times: Vec<f64> = key_frames.iter().map(|&f| f as f64 / opts.fps).collect();
+    let times = &key_times;
     let track = |v: &dyn Fn(usize) -> f64| {
         let v: Vec<f64> = (0..nk).map(v).collect();
-        Track::pchip(&times, &v)
+        Track::pchip(times, &v)
     };
     let tracks: Vec<[Track; 3]> = (0..n)
         .map(|i| {
@@ -627,14 +700,38 @@ pub fn steady_flight_in(
         // The key-shape placement, then each bird's position keeping about it.
         let mut ys = Vec::with_capacity(n);
         let (mut vxs, mut vys) = (Vec::with_capacity(n), Vec::with_capacity(n));
-        for [ty, tx, tz] in &tracks {
-            let (y, dy) = ty.eval(t);
-            let (xl, dx) = tx.eval(t);
-            ys.push(y);
-            fr.x.push(xl);
-            fr.z.push(tz.eval(t).0);
-            vxs.push(dx);
-            vys.push(dy);
+        if reorganised {
+            let slots: Vec<SlotState> = tracks
+                .iter()
+                .map(|[ty, tx, tz]| {
+                    let (y, vy) = ty.eval(t);
+                    let (x, vx) = tx.eval(t);
+                    SlotState {
+                        x,
+                        y,
+                        z: tz.eval(t).0,
+                        vx,
+                        vy,
+                    }
+                })
+                .collect();
+            for b in plan.birds_at(t, &slots, opts.reorganise.pass_offset) {
+                ys.push(b.y);
+                fr.x.push(b.x);
+                fr.z.push(b.z);
+                vxs.push(b.vx);
+                vys.push(b.vy);
+            }
+        } else {
+            for [ty, tx, tz] in &tracks {
+                let (y, dy) = ty.eval(t);
+                let (xl, dx) = tx.eval(t);
+                ys.push(y);
+                fr.x.push(xl);
+                fr.z.push(tz.eval(t).0);
+                vxs.push(dx);
+                vys.push(dy);
+            }
         }
         if let Some(j) = &jostle {
             let near = nearest(&fr.x, &ys, &vxs, &vys);
@@ -668,7 +765,17 @@ pub fn steady_flight_in(
             (aero.power_lenient_3d(&fr.x, &ys, &fr.z), t)
         };
         let xi: Vec<f64> = e.iter().map(|v| v / total_t).collect();
-        let excess = feasible.excess(&xi);
+        // Ranges belong to slots: each bird's ξ against its slot's (the one it left, during an
+        // exchange).
+        let excess = if reorganised {
+            let mut by_slot = vec![0.0; n];
+            for (b, &s) in plan.slots_at(t).iter().enumerate() {
+                by_slot[s] = xi[b];
+            }
+            feasible.excess(&by_slot)
+        } else {
+            feasible.excess(&xi)
+        };
         if excess > 1e-12 {
             frames_outside_range += 1;
         }
@@ -695,18 +802,24 @@ pub fn steady_flight_in(
     anim.key_shapes = keys
         .iter()
         .zip(&key_frames)
-        .filter(|(_, &frame)| frame < opts.frames)
-        .map(|(k, &frame)| KeyShapeRecord {
+        .zip(&key_times)
+        .filter(|((_, &frame), _)| frame < opts.frames)
+        .map(|((k, &frame), &t)| KeyShapeRecord {
             frame,
-            birds: k
-                .x
+            // Each bird with the slot it flies in at this key.
+            birds: plan
+                .slots_at(t)
                 .iter()
-                .zip(&k.y)
-                .zip(&k.xi)
-                .map(|((&x, &y), &xi)| KeyBird { x, y, xi })
+                .map(|&s| KeyBird {
+                    x: k.x[s],
+                    y: k.y[s],
+                    xi: k.xi[s],
+                    slot: reorganised.then_some(s),
+                })
                 .collect(),
         })
         .collect();
+    anim.events = plan.events(0.0);
     anim.frames = frames;
     anim.xi_ranges = Some(
         feasible

@@ -134,7 +134,18 @@ impl PowerChart {
             },
             x,
             metric,
-            ranges: anim.xi_ranges.clone(),
+            // Ranges belong to slots: a key shape's birds that changed places take their
+            // slot's.
+            ranges: anim.xi_ranges.as_ref().map(|r| match of {
+                PowerOf::Key(k) => anim.key_shapes.get(k).map_or(r.clone(), |ks| {
+                    ks.birds
+                        .iter()
+                        .enumerate()
+                        .map(|(i, b)| r.get(b.slot.unwrap_or(i)).copied().unwrap_or([0.0, 1.0]))
+                        .collect()
+                }),
+                _ => r.clone(),
+            }),
             leader,
         })
     }

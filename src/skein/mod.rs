@@ -563,8 +563,14 @@ fn join(anims: &[Animation], reports: &[FormationReport]) -> Result<Animation> {
             xi_ranges: a.xi_ranges.clone(),
             steady_start,
         });
+        out.events.extend(a.events.iter().map(|e| {
+            let mut e = e.clone();
+            e.birds.iter_mut().for_each(|b| *b += base);
+            e
+        }));
         base += a.birds;
     }
+    out.events.sort_by(|a, b| a.t.total_cmp(&b.t));
     out.xi_ranges = anims
         .iter()
         .map(|a| a.xi_ranges.clone())

@@ -55,6 +55,7 @@ pub fn steady(shape: &[(f64, f64)], frames: usize, fps: f64, speed: f64) -> Anim
                 x,
                 y,
                 xi: 1.0 / n as f64,
+                slot: None,
             })
             .collect(),
     });
