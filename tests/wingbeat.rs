@@ -516,3 +516,85 @@ fn files_without_wingbeat_record_use_their_species_and_bad_files_are_rejected() 
     let _ = f.pose(5, 2);
     let _ = f.pose_at(5.5, 2);
 }
+
+/// A line of birds, each `lateral` wingspans to the side of and 1.2 wingspans behind the one
+/// ahead, flying straight at 10 wingspans/s for 20 s at 30 fps.
+fn line_flock(birds: usize, lateral: impl Fn(usize, f64) -> f64) -> Animation {
+    let (fps, speed) = (30.0, 10.0);
+    let mut a = Animation::new(7, fps, 1.6, birds);
+    for k in 0..600 {
+        let t = k as f64 / fps;
+        let mut f = Frame {
+            t,
+            ..Frame::default()
+        };
+        for i in 0..birds {
+            f.x.push(lateral(i, t));
+            f.y.push(speed * t - 1.2 * i as f64);
+            f.z.push(0.0);
+            f.heading.push(0.0);
+            f.speed.push(speed);
+        }
+        a.frames.push(f);
+    }
+    a
+}
+
+/// Bird `i`'s phase relative to the spatial-phasing target behind bird `i − 1` at frame `k`
+/// (0: spatial phase, ±π: spatial antiphase).
+fn offset_from_spatial_phase(a: &Animation, k: usize, i: usize) -> f64 {
+    let ph = phases(a);
+    let f = Species::Goose.preset().frequency_hz;
+    let mut adv = 0.0;
+    for m in k - 30..k {
+        adv += (ph[m + 1][i - 1] - ph[m][i - 1]).rem_euclid(TAU);
+    }
+    let f_ahead = adv / TAU;
+    assert!(
+        (f_ahead - f).abs() < 0.1 * f,
+        "bird ahead beats at {f_ahead} Hz"
+    );
+    wrap_pi(ph[k][i - 1] - TAU * f_ahead * 1.2 / 10.0 - ph[k][i])
+}
+
+#[test]
+fn birds_directly_behind_flap_in_antiphase_and_birds_in_upwash_in_phase() {
+    let opts = WingbeatOptions {
+        variation: 0.0,
+        ..WingbeatOptions::default()
+    };
+    // A column: each bird 0.2 wingspans aside of the one ahead, in its downwash.
+    let mut column = line_flock(4, |i, _| 0.2 * i as f64);
+    assign_phases(&mut column, &opts).unwrap();
+    // An echelon: each bird 0.85 wingspans aside, in the upwash of the one ahead.
+    let mut echelon = line_flock(4, |i, _| 0.85 * i as f64);
+    assign_phases(&mut echelon, &opts).unwrap();
+    for i in 1..4 {
+        let anti = offset_from_spatial_phase(&column, 599, i);
+        assert!(
+            PI - anti.abs() < 0.02,
+            "bird {i} behind: {anti} rad from spatial phase"
+        );
+        let upwash = offset_from_spatial_phase(&echelon, 599, i);
+        assert!(upwash.abs() < 0.02, "bird {i} in upwash: {upwash} rad");
+    }
+    // A bird that drifts from 1 wingspan aside to directly behind over 10 s and back changes
+    // rule once each way (hysteresis: no flicker at the boundary), and holds each rule.
+    let drift = |i: usize, t: f64| {
+        if i == 0 {
+            0.0
+        } else {
+            let u = (t / 10.0).min(2.0 - t / 10.0).clamp(0.0, 1.0);
+            1.0 - u
+        }
+    };
+    let mut mover = line_flock(2, drift);
+    assign_phases(&mut mover, &opts).unwrap();
+    let states: Vec<bool> = (60..600)
+        .map(|k| offset_from_spatial_phase(&mover, k, 1).abs() > PI / 2.0)
+        .collect();
+    let switches = states.windows(2).filter(|w| w[0] != w[1]).count();
+    assert_eq!(switches, 2, "rule switches: {switches}");
+    assert!(offset_from_spatial_phase(&mover, 290, 1).abs() > PI - 0.1);
+    assert!(offset_from_spatial_phase(&mover, 90, 1).abs() < 0.1);
+}

@@ -96,6 +96,12 @@ const AHEAD_MIN: f64 = 0.1;
 const AHEAD_MAX_LATERAL: f64 = 3.0;
 /// ...and at most this far ahead (wingspans): further ahead, its wake has decayed.
 const AHEAD_MAX_ALONG: f64 = 6.0;
+/// A bird whose bird ahead is less than this far to the side (wingspans) is directly behind it,
+/// in its downwash, and flaps in spatial antiphase (Portugal et al. 2014)...
+const ANTIPHASE_ENTER: f64 = 0.4;
+/// ...until it is more than this far to the side (hysteresis, so a bird keeping position near
+/// the boundary does not switch back and forth).
+const ANTIPHASE_LEAVE: f64 = 0.6;
 /// Below this ground speed (wingspans/s) the streamwise lag is meaningless and a bird flaps freely.
 const LOCK_MIN_SPEED: f64 = 0.5;
 
@@ -370,18 +376,19 @@ fn efforts(anim: &Animation, preset: &SpeciesPreset) -> Vec<f64> {
 /// side, the nearest one (ties: the lower index). `None` for a leader (or a bird index out of
 /// range). O(n); [`AheadIndex`] answers the same question for a whole frame in O(n).
 pub fn bird_ahead(frame: &Frame, i: usize) -> Option<(usize, f64)> {
-    ahead_among(frame, i, 0..frame.x.len())
+    ahead_among(frame, i, 0..frame.x.len()).map(|(j, along, _)| (j, along))
 }
 
-/// [`bird_ahead`] restricted to the candidates `js`.
+/// [`bird_ahead`] restricted to the candidates `js`, with the bird ahead's distance to the side
+/// (wingspans, ≥ 0).
 fn ahead_among(
     frame: &Frame,
     i: usize,
     js: impl IntoIterator<Item = usize>,
-) -> Option<(usize, f64)> {
+) -> Option<(usize, f64, f64)> {
     let (xi, yi, hd) = (*frame.x.get(i)?, *frame.y.get(i)?, *frame.heading.get(i)?);
     let (fx, fy) = (hd.sin(), hd.cos());
-    let mut best: Option<(usize, f64, f64)> = None;
+    let mut best: Option<(usize, f64, f64, f64)> = None;
     for j in js {
         let (Some(&xj), Some(&yj)) = (frame.x.get(j), frame.y.get(j)) else {
             continue;
@@ -396,14 +403,14 @@ fn ahead_among(
             let d2 = along * along + lateral * lateral;
             let better = match best {
                 None => true,
-                Some((bj, _, bd)) => d2 < bd || (d2 == bd && j < bj),
+                Some((bj, _, _, bd)) => d2 < bd || (d2 == bd && j < bj),
             };
             if better {
-                best = Some((j, along, d2));
+                best = Some((j, along, lateral, d2));
             }
         }
     }
-    best.map(|(j, along, _)| (j, along))
+    best.map(|(j, along, lateral, _)| (j, along, lateral))
 }
 
 /// A uniform grid over one frame's positions (cells of 6.75 wingspans) that finds every bird's
@@ -443,8 +450,13 @@ impl AheadIndex {
 
     /// Same answer as [`bird_ahead`]`(frame, i)`; `frame` must be the indexed frame.
     pub fn ahead(&self, frame: &Frame, i: usize) -> Option<(usize, f64)> {
+        self.ahead_aside(frame, i).map(|(j, along, _)| (j, along))
+    }
+
+    /// [`AheadIndex::ahead`] with the bird ahead's distance to the side (wingspans, ≥ 0).
+    pub fn ahead_aside(&self, frame: &Frame, i: usize) -> Option<(usize, f64, f64)> {
         if frame.x.len() < Self::SCAN_BELOW {
-            return bird_ahead(frame, i);
+            return ahead_among(frame, i, 0..frame.x.len());
         }
         let (xi, yi) = (*frame.x.get(i)?, *frame.y.get(i)?);
         let (cx, cy) = Self::key(xi, yi);
@@ -492,6 +504,7 @@ fn simulate(anim: &Animation, opts: &WingbeatOptions) -> Run {
     let mut own = vec![0.0; n];
     let mut rate = vec![0.0; n];
     let mut last_rate = vec![0.0; n];
+    let mut anti = vec![false; n];
     let mut phase = vec![0.0; n * nf];
     let mut unwrapped = vec![0.0; n * nf];
     for k in 0..nf {
@@ -517,8 +530,18 @@ fn simulate(anim: &Animation, opts: &WingbeatOptions) -> Run {
             rate[i] = match &index {
                 None => own[i],
                 Some(index) => {
-                    let ahead = index.ahead(frame, i);
-                    locked_rate(frame, i, ahead, &phi, &last_rate, own[i], opts.lock_time_s)
+                    let ahead = index.ahead_aside(frame, i);
+                    anti[i] = match ahead {
+                        Some((_, _, aside)) if anti[i] => aside < ANTIPHASE_LEAVE,
+                        Some((_, _, aside)) => aside < ANTIPHASE_ENTER,
+                        None => false,
+                    };
+                    let ahead = ahead.map(|(j, along, _)| (j, along));
+                    let lock = Lock {
+                        tau: opts.lock_time_s,
+                        antiphase: anti[i],
+                    };
+                    locked_rate(frame, i, ahead, &phi, &last_rate, own[i], lock)
                 }
             };
         }
@@ -571,8 +594,18 @@ fn simulate(anim: &Animation, opts: &WingbeatOptions) -> Run {
     }
 }
 
+/// How a follower locks to the bird ahead.
+#[derive(Debug, Clone, Copy)]
+struct Lock {
+    /// Time constant of the lock, seconds.
+    tau: f64,
+    /// Directly behind the bird ahead: spatial antiphase (π added to the target).
+    antiphase: bool,
+}
+
 /// Phase-locked frequency of bird `i` (Hz): the bird ahead's frequency plus a correction that
-/// pulls the phase towards the spatial-phasing target φ_ahead − 2π f Δy / U.
+/// pulls the phase towards the spatial-phasing target φ_ahead − 2π f Δy / U (plus π directly
+/// behind it: spatial antiphase), with U the bird's own speed.
 fn locked_rate(
     frame: &Frame,
     i: usize,
@@ -580,8 +613,9 @@ fn locked_rate(
     phi: &[f64],
     last_rate: &[f64],
     own: f64,
-    tau: f64,
+    lock: Lock,
 ) -> f64 {
+    let tau = lock.tau;
     let speed = frame.speed.get(i).copied().unwrap_or(0.0);
     let Some((j, dy)) = ahead else {
         return own;
@@ -592,7 +626,7 @@ fn locked_rate(
     if speed.is_nan() || speed < LOCK_MIN_SPEED {
         return own;
     }
-    let target = pj - TAU * fj * dy / speed;
+    let target = pj - TAU * fj * dy / speed + if lock.antiphase { PI } else { 0.0 };
     let err = wrap_pi(target - pi);
     (fj + err / (TAU * tau)).clamp(0.5 * own, 1.5 * own)
 }
