@@ -201,6 +201,12 @@ impl Config {
                 "a loop is a steady flight alone and cannot begin with a take-off; fly it without the take-off (initiation false)",
             ));
         }
+        if self.steady.reorganise.joiners > 0 && self.initiation {
+            return Err(Error::parameter(
+                "steady.reorganise.joiners",
+                "late birds join a formation already flying: they cannot take off with the flock; fly it without the take-off (initiation false), or give a start file with birds to the side",
+            ));
+        }
         self.render.validate()?;
         self.extract.validate()
     }

@@ -94,6 +94,7 @@ fn commands() -> Vec<Command> {
         ("--jostle", "-1", None),
         ("--leader-changes", "nan", None),
         ("--swaps", "1e9", None),
+        ("--joiners", "99", None),
         ("--core-radius", "nan", None),
         ("--mass-kg", "0", None),
         ("--speed-ms", "-3", None),

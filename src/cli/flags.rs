@@ -99,6 +99,7 @@ pub const FLAGS: &[(&str, &str, &[Cmd])] = &[
         STEADY,
     ),
     ("steady.reorganise.swaps", "--swaps", STEADY),
+    ("steady.reorganise.joiners", "--joiners", STEADY),
     (
         "extract.footage_fps",
         "--footage-fps",

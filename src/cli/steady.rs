@@ -101,6 +101,11 @@ pub struct SteadyFlags {
     /// with position keeping on, else 0.
     #[arg(long, value_name = "R", allow_negative_numbers = true)]
     pub swaps: Option<f64>,
+    /// Late birds: K of the birds fly in from one side, about 30 wingspans out, and join at the
+    /// free end of an arm in about 5.5 s, as in footage of wild geese; the others keep their
+    /// order. Needs a flight without the take-off (--no-initiation for animate).
+    #[arg(long, value_name = "K", default_value_t = 0)]
+    pub joiners: usize,
     /// A seamless cycle: the last key shape is the first and the wingbeats make whole cycles, so
     /// the GIF, the glTF clip or a game's background flock loops without a jump (in the flock's
     /// moving frame; in the world on a closed --path). No take-off.
@@ -147,6 +152,7 @@ impl SteadyFlags {
             reorganise: formation::keyshape::ReorganiseOptions {
                 leader_changes: self.leader_changes,
                 swaps: self.swaps,
+                joiners: self.joiners,
                 ..formation::keyshape::ReorganiseOptions::default()
             },
             looped: self.looped,

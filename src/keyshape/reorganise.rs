@@ -39,6 +39,14 @@ pub struct ReorganiseOptions {
     /// Half the lateral distance at which the two birds pass each other, wingspans, in
     /// [0.2, 2].
     pub pass_offset: f64,
+    /// Late birds: this many birds fly in from one side and join at the free end of an arm
+    /// (0 = none; fewer than the formation's birds).
+    #[serde(skip_serializing_if = "is_zero")]
+    pub joiners: usize,
+}
+
+fn is_zero(v: &usize) -> bool {
+    *v == 0
 }
 
 impl Default for ReorganiseOptions {
@@ -49,6 +57,7 @@ impl Default for ReorganiseOptions {
             min_duration_s: 4.0,
             max_accel: 0.5,
             pass_offset: 0.35,
+            joiners: 0,
         }
     }
 }
@@ -126,7 +135,7 @@ impl ReorganiseOptions {
     /// Whether any reorganisation can happen, with position keeping on (`living`) or off.
     pub fn any(&self, living: bool) -> bool {
         let (l, s) = self.rates(living);
-        l > 0.0 || s > 0.0
+        l > 0.0 || s > 0.0 || self.joiners > 0
     }
 }
 
@@ -140,6 +149,98 @@ const SETTLE_S: f64 = 3.0;
 
 /// Seconds between the end of one manoeuvre and the start of the next.
 const GAP_S: f64 = 1.0;
+
+/// The gap late birds close, wingspans to the side of their slots, and the time they take
+/// (field data: a stereo-filmed wild V of white-fronted geese, where birds about 30 wingspans
+/// to the side joined in about 5.5 s).
+pub const JOIN_GAP: f64 = 30.0;
+/// See [`JOIN_GAP`].
+pub const JOIN_SECONDS: f64 = 5.5;
+/// The last seconds of a join, in which the sideways speed falls smoothly to the formation's.
+pub const JOIN_BRAKE_S: f64 = 2.0;
+/// The sideways speed of a join is at most this fraction of the cruise speed (a heading at
+/// most 39° off the formation's).
+pub const JOIN_MAX_SIDEWAYS: f64 = 0.8;
+/// Seconds into the steady flight at which the joiners are [`JOIN_GAP`] aside.
+pub const JOIN_FROM_S: f64 = 1.0;
+
+/// Late birds flying in from one side to the free end of an arm. Before `t0` they fly in at a
+/// constant sideways speed from farther out; from `t0` they close the last [`JOIN_GAP`]
+/// wingspans, braking smoothly over the last `brake` seconds, and reach their slots at
+/// `t0 + duration`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Join {
+    /// When the joiners are [`JOIN_GAP`] aside, seconds from the start of the steady flight.
+    pub t0: f64,
+    /// Seconds from `t0` until they are in their slots.
+    pub duration: f64,
+    /// The joining birds (the slots they join: the free end of one arm, innermost first).
+    pub birds: Vec<usize>,
+    /// The side they come from: +1 right, −1 left (the arm's side).
+    pub side: f64,
+    /// Sideways speed before braking, wingspans per second.
+    pub speed: f64,
+    /// Braking time, seconds.
+    pub brake: f64,
+}
+
+impl Join {
+    /// Plans `k` joiners into the outermost slots of the arm `arm` (ordered from the leader
+    /// outwards; when it is shorter than `k`, the other arm's outermost slots follow), for a
+    /// formation flying at `cruise` wingspans per second.
+    pub fn plan(arms: &[Vec<usize>; 2], arm: usize, k: usize, cruise: f64) -> Join {
+        let mut birds: Vec<usize> = arms[arm].iter().rev().take(k).copied().collect();
+        if birds.len() < k {
+            let more = k - birds.len();
+            birds.extend(arms[1 - arm].iter().rev().take(more));
+        }
+        birds.reverse();
+        let brake = JOIN_BRAKE_S;
+        // JOIN_GAP = v (T − brake) + v brake / 2.
+        let speed = (JOIN_GAP / (JOIN_SECONDS - 0.5 * brake)).min(JOIN_MAX_SIDEWAYS * cruise);
+        let duration = (JOIN_GAP - 0.5 * speed * brake) / speed + brake;
+        Join {
+            t0: JOIN_FROM_S,
+            duration,
+            birds,
+            side: if arm == 1 { 1.0 } else { -1.0 },
+            speed,
+            brake,
+        }
+    }
+
+    /// When the joiners are in their slots, seconds.
+    pub fn end(&self) -> f64 {
+        self.t0 + self.duration
+    }
+
+    /// A joiner's distance to the side of its slot (outwards, wingspans) at `t` and its rate:
+    /// a constant closing speed, then a brake whose deceleration rises and falls smoothly
+    /// (the speed follows 1 − smoothstep), so the acceleration is continuous.
+    pub fn offset(&self, t: f64) -> (f64, f64) {
+        let tb = self.end() - self.brake;
+        let (v, b) = (self.speed, self.brake);
+        if t >= self.end() {
+            (0.0, 0.0)
+        } else if t >= tb {
+            let u = (t - tb) / b;
+            let left = 0.5 - u + u * u * u - 0.5 * u * u * u * u;
+            (v * b * left, -v * (1.0 - u * u * (3.0 - 2.0 * u)))
+        } else {
+            (0.5 * v * b + v * (tb - t), -v)
+        }
+    }
+
+    /// The joiners' event.
+    pub fn event(&self, offset: f64) -> Event {
+        Event {
+            t: offset + self.t0,
+            kind: EventKind::Join,
+            birds: self.birds.clone(),
+            duration: self.duration,
+        }
+    }
+}
 
 /// One planned exchange of two slots.
 #[derive(Debug, Clone, PartialEq)]
@@ -203,6 +304,8 @@ fn bump(u: f64) -> (f64, f64) {
 /// each of them.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Plan {
+    /// The late birds, if any; the exchanges come after they have joined.
+    pub join: Option<Join>,
     /// The exchanges.
     pub exchanges: Vec<Exchange>,
     /// `slot_of[k][b]`: bird b's slot after the first k exchanges (`slot_of[0]` is the identity).
@@ -232,22 +335,41 @@ impl Plan {
     /// seconds), so a rate of R per minute gives close to R a minute, never a long drought;
     /// a manoeuvre starts at least `GAP_S` after the previous ends and only when it ends before
     /// the flight does.
+    #[allow(clippy::too_many_arguments)]
     pub fn draw(
         x: &[f64],
         y: &[f64],
         leader: usize,
         seconds: f64,
+        cruise: f64,
         opts: &ReorganiseOptions,
         living: bool,
         rng: &mut impl Rng,
     ) -> Plan {
         let n = x.len();
         let mut plan = Plan {
+            join: None,
             exchanges: Vec::new(),
             slot_of: vec![(0..n).collect()],
         };
         if !opts.any(living) || n < 2 {
             return plan;
+        }
+        let arms = arms(x, y, leader);
+        let mut free_from = SETTLE_S;
+        if opts.joiners > 0 {
+            // Late birds join the longer arm, so the formation they find is the more even one
+            // (a V of five finding two more at the end of an arm, as in the footage); between
+            // arms of one length the side is drawn (first, so it does not depend on the rates).
+            let drawn = rng.random_range(0..2usize);
+            let arm = match arms[0].len().cmp(&arms[1].len()) {
+                std::cmp::Ordering::Less => 1,
+                std::cmp::Ordering::Greater => 0,
+                std::cmp::Ordering::Equal => drawn,
+            };
+            let join = Join::plan(&arms, arm, opts.joiners.min(n - 1), cruise);
+            free_from = free_from.max(join.end() + GAP_S);
+            plan.join = Some(join);
         }
         let (leader_changes, swaps) = opts.rates(living);
         let mut times: Vec<(f64, EventKind)> = Vec::new();
@@ -269,7 +391,6 @@ impl Plan {
             }
         }
         times.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let arms = arms(x, y, leader);
         let pairs_of = |kind: EventKind| -> Vec<(usize, usize)> {
             match kind {
                 EventKind::LeaderChange => arms
@@ -282,7 +403,6 @@ impl Plan {
                     .collect(),
             }
         };
-        let mut free_from = SETTLE_S;
         for (t, kind) in times {
             let pairs = pairs_of(kind);
             if pairs.is_empty() {
@@ -361,7 +481,21 @@ impl Plan {
             out[e.birds.0] = blend(pa, pb, 1.0);
             out[e.birds.1] = blend(pb, pa, -1.0);
         }
+        if let Some(j) = &self.join {
+            let (o, v) = j.offset(t);
+            for &b in &j.birds {
+                out[b].x += j.side * o;
+                out[b].vx += j.side * v;
+            }
+        }
         out
+    }
+
+    /// Whether bird `b` is still flying in to join at `t`.
+    pub fn joining(&self, b: usize, t: f64) -> bool {
+        self.join
+            .as_ref()
+            .is_some_and(|j| t < j.end() && j.birds.contains(&b))
     }
 
     /// The slot of every bird at `t`: before an exchange in progress ends, the one it started
@@ -372,15 +506,14 @@ impl Plan {
 
     /// The exchanges as the animation file's events, at `offset` seconds plus their start.
     pub fn events(&self, offset: f64) -> Vec<Event> {
-        self.exchanges
-            .iter()
-            .map(|e| Event {
-                t: offset + e.t0,
-                kind: e.kind,
-                birds: vec![e.birds.0, e.birds.1],
-                duration: e.duration,
-            })
-            .collect()
+        let join = self.join.iter().map(|j| j.event(offset));
+        join.chain(self.exchanges.iter().map(|e| Event {
+            t: offset + e.t0,
+            kind: e.kind,
+            birds: vec![e.birds.0, e.birds.1],
+            duration: e.duration,
+        }))
+        .collect()
     }
 }
 
@@ -424,7 +557,16 @@ mod tests {
             ..ReorganiseOptions::default()
         };
         for seed in 0..20 {
-            let plan = Plan::draw(&x, &y, 4, 120.0, &opts, true, &mut crate::rng::seeded(seed));
+            let plan = Plan::draw(
+                &x,
+                &y,
+                4,
+                120.0,
+                10.0,
+                &opts,
+                true,
+                &mut crate::rng::seeded(seed),
+            );
             let leaders = plan
                 .exchanges
                 .iter()
@@ -453,7 +595,16 @@ mod tests {
             swaps: Some(3.0),
             ..ReorganiseOptions::default()
         };
-        let plan = Plan::draw(&x, &y, 4, 60.0, &opts, true, &mut crate::rng::seeded(7));
+        let plan = Plan::draw(
+            &x,
+            &y,
+            4,
+            60.0,
+            10.0,
+            &opts,
+            true,
+            &mut crate::rng::seeded(7),
+        );
         assert!(!plan.exchanges.is_empty());
         let slots: Vec<SlotState> = (0..9)
             .map(|i| SlotState {
@@ -487,6 +638,7 @@ mod tests {
             &y,
             4,
             600.0,
+            10.0,
             &ReorganiseOptions::none(),
             true,
             &mut crate::rng::seeded(1),
@@ -497,6 +649,7 @@ mod tests {
             &y,
             4,
             600.0,
+            10.0,
             &ReorganiseOptions::default(),
             false,
             &mut crate::rng::seeded(1),

@@ -189,6 +189,36 @@ impl SteadyOptions {
         }
         crate::aero::flight::validate_settings(&self.flight)?;
         let seconds = self.frames as f64 / self.fps;
+        let joiners = self.reorganise.joiners;
+        if joiners > 0 {
+            let name = "steady.reorganise.joiners";
+            if joiners >= self.birds {
+                return Err(p(
+                    name,
+                    format!(
+                        "{joiners}: more late birds than the formation can take; give at most {} (the formation has {} birds, at least one of them in formation from the start)",
+                        self.birds - 1,
+                        self.birds
+                    ),
+                ));
+            }
+            if self.looped {
+                return Err(p(
+                    name,
+                    "a loop cannot have late birds: they would not be back where they came from when it comes round; give 0 or set steady.loop to false".into(),
+                ));
+            }
+            let end =
+                crate::keyshape::reorganise::Join::plan(&[vec![], vec![]], 0, 0, self.speed).end();
+            if seconds < end {
+                return Err(p(
+                    name,
+                    format!(
+                        "late birds need a steady flight of at least {end:.1} s to join (this one lasts {seconds:.1} s); make it longer"
+                    ),
+                ));
+            }
+        }
         if self.looped && seconds < self.keys.key_every_s {
             return Err(p(
                 "steady.loop",
@@ -649,6 +679,7 @@ pub fn steady_flight_in(
             &keys[0].y,
             corr.leader,
             opts.frames as f64 / opts.fps,
+            opts.speed,
             &opts.reorganise,
             opts.jostle.scale > 0.0,
             &mut scope.stream(opts.seed, Stream::SteadyEvents),
@@ -659,12 +690,13 @@ pub fn steady_flight_in(
             &y0,
             corr.leader,
             0.0,
+            opts.speed,
             &ReorganiseOptions::none(),
             false,
             rng,
         )
     };
-    let reorganised = !plan.exchanges.is_empty();
+    let reorganised = !plan.exchanges.is_empty() || plan.join.is_some();
 
     // Step 4.
     progress.start("steady: frames", opts.frames as u64);
@@ -770,7 +802,12 @@ pub fn steady_flight_in(
         let excess = if reorganised {
             let mut by_slot = vec![0.0; n];
             for (b, &s) in plan.slots_at(t).iter().enumerate() {
-                by_slot[s] = xi[b];
+                // A bird still flying in is not in its slot: its ξ is not the slot's.
+                by_slot[s] = if plan.joining(b, t) {
+                    xi[b].clamp(feasible.min[s], feasible.max[s])
+                } else {
+                    xi[b]
+                };
             }
             feasible.excess(&by_slot)
         } else {
