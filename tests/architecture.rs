@@ -215,14 +215,6 @@ fn no_import_cycles_between_the_files_of_a_module() {
             }
         }
     }
-    // Known: the steady flight's orchestrator and three of its steps still share options and a
-    // helper both ways (keyshape: steady <-> heights, keys, lateral). No new cycle may appear.
-    let known = [
-        "keyshape: heights <-> steady",
-        "keyshape: keys <-> steady",
-        "keyshape: lateral <-> steady",
-    ];
-    cycles.retain(|c| !known.contains(&c.as_str()));
     assert!(
         cycles.is_empty(),
         "import cycles inside modules: {cycles:?}"

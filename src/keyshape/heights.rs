@@ -6,7 +6,6 @@ use rand_distr::{Distribution, StandardNormal};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
-use crate::keyshape::steady::SteadyOptions;
 
 /// Options of the heights (the `steady.heights` section of [`crate::pipeline::Config`]).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -72,10 +71,10 @@ pub fn heights(
     x: &[f64],
     leader: usize,
     keys: usize,
-    opts: &SteadyOptions,
+    h: &HeightOptions,
+    looped: bool,
     rng: &mut crate::rng::FlockRng,
 ) -> Vec<Vec<f64>> {
-    let h = &opts.heights;
     let rho = h.correlation;
     let nf = n as f64;
     let walk_var = h.neighbour.powi(2) * (nf * nf - 1.0) / (6.0 * nf);
@@ -109,7 +108,7 @@ pub fn heights(
         let lead = field[leader];
         out.push(field.iter().map(|v| v - lead).collect::<Vec<f64>>());
     }
-    if opts.looped && keys > 1 {
+    if looped && keys > 1 {
         out[keys - 1] = out[0].clone();
     }
     out

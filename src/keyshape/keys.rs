@@ -351,7 +351,7 @@ fn attempt(
     } = *ctx;
     stats.solves += 1;
     // A predicted start may put two birds wing to wing; the solve starts from them separated.
-    let start = crate::keyshape::steady::separate(x, start, &solve_opts.aero);
+    let start = crate::keyshape::separate::separate(x, start, &solve_opts.aero);
     let report = match solve(x, target, Some(&start), solve_opts) {
         Ok(r) => r,
         Err(Error::Unreachable(_) | Error::Collision { .. } | Error::NotConverged(_)) => {
@@ -507,7 +507,7 @@ pub fn next_key(
         prev
     } else {
         // A pair brought wing to wing by the drift: the bird behind drops back (as in step 1).
-        let y = crate::keyshape::steady::separate(x, &prev.y, &solve_opts.aero);
+        let y = crate::keyshape::separate::separate(x, &prev.y, &solve_opts.aero);
         let xi: Vec<f64> = solve_opts
             .aero
             .power_lenient(x, &y)

@@ -12,7 +12,6 @@ use std::collections::BTreeMap;
 use crate::error::{Error, Result};
 use crate::extract::params::FormationParams;
 use crate::keyshape::initial::positions_from_gaps;
-use crate::keyshape::steady::SteadyOptions;
 
 /// Drift of the lateral gaps when the footage gives no measure of its own (no per-bird
 /// positions): the median of the four example flocks' (0.06–0.09), wingspans.
@@ -108,10 +107,23 @@ pub fn footage_drift(params: &FormationParams) -> Option<f64> {
     m.is_finite().then_some(m.min(0.25))
 }
 
+/// What bounds the drift of [`lateral_plan`] (from the steady flight's options).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LateralBounds {
+    /// Correlation of a gap's deviation from one key to the next (`steady.lateral.correlation`).
+    pub correlation: f64,
+    /// No gap at or below this, wingspans (`steady.initial.min_gap`).
+    pub min_gap: f64,
+    /// No bird moves more than this between keys, wingspans (`steady.keys.max_jump`).
+    pub max_jump: f64,
+    /// A seamless loop.
+    pub looped: bool,
+}
+
 /// Lateral positions of every key shape (the first the drawn `x` from `gaps`): each gap drifts
 /// around its drawn value as an AR(1) process from key to key (standard deviation `drift`,
-/// correlation `opts.lateral.correlation`), never at or below `opts.initial.min_gap`, no bird
-/// moving more than `opts.keys.max_jump` between keys. A loop's drift is 0 at its first and
+/// correlation `opts.correlation`), never at or below `opts.min_gap`, no bird
+/// moving more than `opts.max_jump` between keys. A loop's drift is 0 at its first and
 /// last key (= the first) and averages to 0 over the loop (a sine bump times the mean is taken
 /// off each gap's deviations), so that every bird covers the same distance along a path in
 /// every lap and the loop closes.
@@ -120,11 +132,11 @@ pub fn lateral_plan(
     leader: usize,
     keys: usize,
     drift: f64,
-    opts: &SteadyOptions,
+    opts: &LateralBounds,
     rng: &mut impl Rng,
 ) -> Vec<Vec<f64>> {
-    let rho = opts.lateral.correlation;
-    let min_gap = opts.initial.min_gap;
+    let rho = opts.correlation;
+    let min_gap = opts.min_gap;
     let mut dev = vec![0.0; gaps.len()];
     let mut devs: Vec<Vec<f64>> = vec![dev.clone()];
     for _ in 1..keys {
@@ -160,8 +172,8 @@ pub fn lateral_plan(
             .collect();
         let mut xk = positions_from_gaps(&g, leader);
         let jump = crate::keyshape::keys::max_jump(&prev, &xk);
-        if jump > opts.keys.max_jump {
-            let f = opts.keys.max_jump / jump;
+        if jump > opts.max_jump {
+            let f = opts.max_jump / jump;
             for (a, b) in xk.iter_mut().zip(&prev) {
                 *a = b + f * (*a - b);
             }

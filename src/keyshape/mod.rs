@@ -9,6 +9,7 @@ pub mod keys;
 pub mod lateral;
 pub mod ranges;
 pub mod reorganise;
+pub mod separate;
 pub mod solve;
 pub mod spacing;
 pub mod steady;

@@ -38,9 +38,10 @@ use crate::keyshape::jostle::{
 use crate::keyshape::keys::{
     key_shapes, KeyContext, KeyOptions, KeyPlan, KeyShape, KeyStats, LateralKey, Structure,
 };
-use crate::keyshape::lateral::{lateral_plan, LateralOptions};
+use crate::keyshape::lateral::{lateral_plan, LateralBounds, LateralOptions};
 use crate::keyshape::ranges::{power_at, xi_ranges, XiRanges};
 use crate::keyshape::reorganise::{Plan, ReorganiseOptions, SlotState};
+pub use crate::keyshape::separate::separate;
 use crate::keyshape::spacing;
 use crate::progress::Progress;
 use crate::rng::{Scope, Stream};
@@ -231,6 +232,16 @@ impl SteadyOptions {
         Ok(())
     }
 
+    /// What bounds the lateral positions' drift ([`lateral_plan`]).
+    pub fn lateral_bounds(&self) -> LateralBounds {
+        LateralBounds {
+            correlation: self.lateral.correlation,
+            min_gap: self.initial.min_gap,
+            max_jump: self.keys.max_jump,
+            looped: self.looped,
+        }
+    }
+
     /// A living flight: position keeping or reorganisations on (never in a loop). Its key
     /// shapes come at fixed times in seconds ([`SteadyOptions::key_times`]), so the same seed
     /// gives the same motion at any frame rate.
@@ -312,55 +323,6 @@ pub struct SteadyReport {
     pub frames_outside_range: usize,
     /// Largest amount by which a frame's ξ leaves the feasible range.
     pub max_frame_excess: f64,
-}
-
-/// Moves birds back until no two collide at lateral positions `x` (wingspans): for every pair
-/// under one wingspan apart laterally and under `aero.collision_chord` fore and aft, the rear bird
-/// (larger y; ties: the one farther from the front-most bird laterally, then the higher index) is
-/// put two chords behind the other (clear of its wing, not just touching it, so that key shapes
-/// near this placement are not all on the collision boundary). Passes repeat until nothing moves
-/// (at most N).
-pub fn separate(x: &[f64], y: &[f64], aero: &AeroOptions) -> Vec<f64> {
-    let n = x.len();
-    let mut y = y.to_vec();
-    let chord = aero.collision_chord;
-    let front = (0..n)
-        .min_by(|&a, &b| y[a].total_cmp(&y[b]).then(a.cmp(&b)))
-        .unwrap_or(0);
-    let mut idx: Vec<usize> = (0..n).collect();
-    idx.sort_by(|&a, &b| x[a].total_cmp(&x[b]).then(a.cmp(&b)));
-    for _ in 0..n.max(1) {
-        let mut moved = false;
-        for (k, &i) in idx.iter().enumerate() {
-            for &j in &idx[k + 1..] {
-                if !(x[j] - x[i] < crate::aero::COLLISION_SPAN) {
-                    break;
-                }
-                if !aero.collides(x[j] - x[i], y[i] - y[j]) {
-                    continue;
-                }
-                let far = |b: usize| ((x[b] - x[front]).abs(), b);
-                let rear = if y[i] != y[j] {
-                    if y[i] > y[j] {
-                        i
-                    } else {
-                        j
-                    }
-                } else if far(i) > far(j) {
-                    i
-                } else {
-                    j
-                };
-                let other = if rear == i { j } else { i };
-                y[rear] = y[other] + 1.05 * chord.max(1e-9);
-                moved = true;
-            }
-        }
-        if !moved {
-            break;
-        }
-    }
-    y
 }
 
 /// The shapes' depths with every collision at lateral positions `x` resolved by [`separate`]
@@ -610,7 +572,14 @@ pub fn steady_flight_in(
             feasible: xi_ranges(&values).ok()?.widened(opts.keys.epsilon),
         })
     };
-    for xk in lateral_plan(&gaps, corr.leader, nk, drift, opts, &mut lat_rng) {
+    for xk in lateral_plan(
+        &gaps,
+        corr.leader,
+        nk,
+        drift,
+        &opts.lateral_bounds(),
+        &mut lat_rng,
+    ) {
         lateral.push(if xk == x {
             drawn.clone()
         } else {
@@ -654,7 +623,8 @@ pub fn steady_flight_in(
         &x,
         corr.leader,
         nk,
-        opts,
+        &opts.heights,
+        opts.looped,
         &mut scope.stream(opts.seed, Stream::SteadyHeight),
     );
 
