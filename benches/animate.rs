@@ -31,8 +31,18 @@ fn flock(birds: usize, takeoff: bool) -> Animation {
 
 /// [`flock`] along a path, if given.
 fn flock_on(birds: usize, takeoff: bool, path: Option<PathBuf>) -> Animation {
+    flock_with(birds, takeoff, path, true)
+}
+
+/// [`flock_on`], with the living steady flight (position keeping, leader changes, swaps: the
+/// default) or without it (`--jostle 0`: the key shapes interpolated, as before it existed), to
+/// hold what it costs side by side.
+fn flock_with(birds: usize, takeoff: bool, path: Option<PathBuf>, living: bool) -> Animation {
     let input = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples_data/barnacle_geese_v.json");
     let mut config = Config::default();
+    if !living {
+        config.steady.jostle.scale = 0.0;
+    }
     config.steady.birds = birds;
     config.seconds = Some(20.0);
     config.course.path = path;
@@ -136,10 +146,28 @@ fn bench(c: &mut Criterion) {
             .unwrap()
         })
     });
+    g.bench_function("geese_14_birds_20s_with_gif_960x540_jostle0", |b| {
+        b.iter(|| {
+            let anim = flock_with(14, true, None, false);
+            write_outputs(
+                &anim,
+                std::slice::from_ref(&gif),
+                &RenderOptions::default(),
+                &Silent,
+            )
+            .unwrap()
+        })
+    });
     let files: Vec<PathBuf> = vec![dir.join("flock.json"), dir.join("flock.csv")];
     g.bench_function("geese_1000_birds_takeoff_20s_json_csv", |b| {
         b.iter(|| {
             let anim = flock(1000, true);
+            write_outputs(&anim, &files, &RenderOptions::default(), &Silent).unwrap()
+        })
+    });
+    g.bench_function("geese_1000_birds_takeoff_20s_json_csv_jostle0", |b| {
+        b.iter(|| {
+            let anim = flock_with(1000, true, None, false);
             write_outputs(&anim, &files, &RenderOptions::default(), &Silent).unwrap()
         })
     });

@@ -278,6 +278,71 @@ impl Axis {
         }
         (self.amp * u, self.amp * du)
     }
+
+    /// u, u′ from each wave's (cos, sin) of its angle ω t + φ.
+    fn eval_from(&self, cs: &[(f64, f64)]) -> (f64, f64) {
+        let (mut u, mut du) = (0.0, 0.0);
+        for (&(w, _), &(c, s)) in self.waves.iter().zip(cs) {
+            u += c;
+            du -= w * s;
+        }
+        (self.amp * u, self.amp * du)
+    }
+}
+
+/// Frames between two exact evaluations of a [`JostleClock`]: in between, each wave's angle is
+/// advanced by a rotation, whose rounding stays below 10⁻¹⁴ wingspans over this many frames.
+const CLOCK_ANCHOR: usize = 64;
+
+/// [`Jostle::at`] for the frames t = k / fps, k = 0, 1, 2, … in order: every wave's cos and sin
+/// advance by one rotation a frame (four multiplications instead of a sine and a cosine),
+/// recomputed exactly every [`CLOCK_ANCHOR`] frames.
+#[derive(Debug, Clone)]
+pub struct JostleClock<'a> {
+    jostle: &'a Jostle,
+    fps: f64,
+    frame: Option<usize>,
+    /// Per bird and axis, each wave's (cos, sin) of its angle at the current frame, then its
+    /// rotation per frame (cos ω dt, sin ω dt).
+    state: Vec<[WaveState; 2]>,
+}
+
+/// One axis's waves in a [`JostleClock`]: (cos, sin) of each angle, and of each step.
+type WaveState = (Vec<(f64, f64)>, Vec<(f64, f64)>);
+
+impl<'a> JostleClock<'a> {
+    /// Moves to frame `k` (t = k / fps): one step from the previous frame, else exactly.
+    pub fn seek(&mut self, k: usize) {
+        let t = k as f64 / self.fps;
+        let step = self.frame.is_some_and(|f| f + 1 == k) && k % CLOCK_ANCHOR != 0;
+        for (b, axes) in self.jostle.birds.iter().zip(self.state.iter_mut()) {
+            for (axis, (cs, rot)) in b.iter().zip(axes.iter_mut()) {
+                if step {
+                    for ((c, s), &(rc, rs)) in cs.iter_mut().zip(rot.iter()) {
+                        let (c0, s0) = (*c, *s);
+                        *c = c0 * rc - s0 * rs;
+                        *s = s0 * rc + c0 * rs;
+                    }
+                } else {
+                    for ((c, s), &(w, p)) in cs.iter_mut().zip(&axis.waves) {
+                        let (sn, cn) = (w * t + p).sin_cos();
+                        *c = cn;
+                        *s = sn;
+                    }
+                }
+            }
+        }
+        self.frame = Some(k);
+    }
+
+    /// Bird `i`'s deviation at the current frame (see [`Jostle::at`]).
+    pub fn at(&self, i: usize, nearest: f64, nearest_rate: f64) -> Deviation {
+        let t = self.frame.unwrap_or(0) as f64 / self.fps;
+        let [(cx, _), (cy, _)] = &self.state[i];
+        let [ax, ay] = &self.jostle.birds[i];
+        self.jostle
+            .shape(t, nearest, nearest_rate, ax.eval_from(cx), ay.eval_from(cy))
+    }
 }
 
 /// The drawn motion of a flock.
@@ -341,6 +406,48 @@ impl Jostle {
     /// room = 0.02 + (nearest − CLEARANCE)/2, so a bird crowded by a neighbour keeps still (the
     /// tests check every frame's closest pair).
     pub fn at(&self, i: usize, t: f64, nearest: f64, nearest_rate: f64) -> Deviation {
+        let [ax, ay] = &self.birds[i];
+        self.shape(t, nearest, nearest_rate, ax.eval(t), ay.eval(t))
+    }
+
+    /// A clock for the frames t = k / fps in order ([`JostleClock`]).
+    pub fn clock(&self, fps: f64) -> JostleClock<'_> {
+        let dt = 1.0 / fps;
+        let state = self
+            .birds
+            .iter()
+            .map(|axes| {
+                axes.clone().map(|a| {
+                    let rot = a
+                        .waves
+                        .iter()
+                        .map(|&(w, _)| {
+                            let (s, c) = (w * dt).sin_cos();
+                            (c, s)
+                        })
+                        .collect();
+                    (vec![(1.0, 0.0); a.waves.len()], rot)
+                })
+            })
+            .collect();
+        JostleClock {
+            jostle: self,
+            fps,
+            frame: None,
+            state,
+        }
+    }
+
+    /// The deviation from the raw axis motions (u, u′) of both axes: the ramp, the room scaling
+    /// and the bound of [`Jostle::at`].
+    fn shape(
+        &self,
+        t: f64,
+        nearest: f64,
+        nearest_rate: f64,
+        ux: (f64, f64),
+        uy: (f64, f64),
+    ) -> Deviation {
         let (e, de) = if self.ramp > 0.0 && t < self.ramp {
             let s = (t / self.ramp).max(0.0);
             (s * s * (3.0 - 2.0 * s), 6.0 * s * (1.0 - s) / self.ramp)
@@ -366,9 +473,8 @@ impl Jostle {
             let df = (1.0 + r).powf(-9.0 / 8.0) * du;
             (e * g * f, (de * g + e * dg) * f + e * g * df)
         };
-        let [ax, ay] = &self.birds[i];
-        let (x, vx) = bound(ax.eval(t));
-        let (y, vy) = bound(ay.eval(t));
+        let (x, vx) = bound(ux);
+        let (y, vy) = bound(uy);
         Deviation { x, y, vx, vy }
     }
 }
@@ -423,6 +529,34 @@ mod tests {
             assert!(((b.y - a.y) / (2.0 * h) - d.vy).abs() < 1e-6);
         }
         assert_eq!(j.at(2, 0.0, 2.0, 0.0), Deviation::default());
+    }
+
+    #[test]
+    fn the_clock_gives_the_direct_evaluation() {
+        let keep = PositionKeeping::field_default();
+        let j = Jostle::draw(4, &keep, &JostleOptions::default(), &mut stream(2, "t")).unwrap();
+        for fps in [24.0, 30.0, 60.0] {
+            let mut clock = j.clock(fps);
+            let mut worst: f64 = 0.0;
+            // An hour of flight, with a jump (seek out of order) half way.
+            let frames = (3600.0 * fps) as usize;
+            for k in (0..frames / 2).chain(frames / 2 + 7..frames) {
+                clock.seek(k);
+                let t = k as f64 / fps;
+                for i in 0..4 {
+                    let (a, b) = (clock.at(i, 1.0, 0.1), j.at(i, t, 1.0, 0.1));
+                    worst = worst
+                        .max((a.x - b.x).abs())
+                        .max((a.y - b.y).abs())
+                        .max((a.vx - b.vx).abs())
+                        .max((a.vy - b.vy).abs());
+                    if k % CLOCK_ANCHOR == 0 {
+                        assert_eq!(a, b, "anchor frame {k} at {fps} fps");
+                    }
+                }
+            }
+            assert!(worst < 1e-12, "{fps} fps: {worst}");
+        }
     }
 
     #[test]

@@ -685,6 +685,7 @@ pub fn steady_flight_in(
         })
         .collect();
     let mut frames = Vec::with_capacity(opts.frames);
+    let mut clock = jostle.as_ref().map(|j| j.clock(opts.fps));
     let mut frames_outside_range = 0;
     let mut max_frame_excess: f64 = 0.0;
     for j in 0..opts.frames {
@@ -735,10 +736,11 @@ pub fn steady_flight_in(
                 vys.push(dy);
             }
         }
-        if let Some(j) = &jostle {
+        if let Some(clock) = &mut clock {
+            clock.seek(j);
             let near = nearest(&fr.x, &ys, &vxs, &vys);
             for (i, &(d, rate)) in near.iter().enumerate() {
-                let dev = j.at(i, t, d, rate);
+                let dev = clock.at(i, d, rate);
                 fr.x[i] += dev.x;
                 ys[i] += dev.y;
                 vxs[i] += dev.vx;
