@@ -296,7 +296,7 @@ const CLOCK_ANCHOR: usize = 64;
 
 /// [`Jostle::at`] for the frames t = k / fps, k = 0, 1, 2, … in order: every wave's cos and sin
 /// advance by one rotation a frame (four multiplications instead of a sine and a cosine),
-/// recomputed exactly every [`CLOCK_ANCHOR`] frames.
+/// recomputed exactly every 64 frames (`CLOCK_ANCHOR`).
 #[derive(Debug, Clone)]
 pub struct JostleClock<'a> {
     jostle: &'a Jostle,
