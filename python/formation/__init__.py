@@ -214,26 +214,28 @@ def power(x, y, z=None, core_radius: float | None = None, **options: _Any):
     ``x`` (lateral, right of the flight direction) and ``y`` (distance behind the leader) are
     array-likes of wingspans, one value per bird. ``e[i]`` is bird i's saving (the fraction of
     its solo induced power the others save it), ``xi = e / E`` and ``E = e.sum()``.
-    ``core_radius`` is the vortex core radius in wingspans (the ``aero.core_radius`` option);
-    ``options`` are other options of the aerodynamic model by name. ``z`` (heights) must be
-    None or all zero: the model is planar (the library places every bird in the wing plane).
+    ``z`` (heights, wingspans, up) selects the 3-D wake: each pair of birds at its own vertical
+    distance (the option ``wake`` is then ``"3d"`` unless given; ``wake="planar"`` ignores the
+    heights, as the command line's ``--wake planar`` does). ``core_radius`` is the vortex core
+    radius in wingspans (the ``aero.core_radius`` option); ``options`` are other options of the
+    aerodynamic model by name (``wake``, ``wake_descent``, ...).
 
     Raises ValueError naming the birds when two birds' wings overlap, or for non-finite
-    values or fewer than two birds.
+    values, a ``z`` of another length than ``x``, or fewer than two birds.
     """
     x = _np.asarray(x, dtype=_np.float64).ravel()
     y = _np.asarray(y, dtype=_np.float64).ravel()
+    zs = None
     if z is not None:
         z = _np.asarray(z, dtype=_np.float64).ravel()
         if z.shape != x.shape:
             raise ValueError(f"z: {z.size} values for {x.size} birds in x")
-        if _np.any(z != 0):
-            raise ValueError(
-                "z: the aerodynamic model is planar (all birds in one wing plane); give z=None or zeros"
-            )
+        zs = z.tolist()
+        if "wake" not in options and "aero.wake" not in options:
+            options = {**options, "wake": "3d"}
     if core_radius is not None:
         options = {"core_radius": core_radius, **options}
-    return _native.power(x.tolist(), y.tolist(), _pairs(options, "aero."))
+    return _native.power(x.tolist(), y.tolist(), zs, _pairs(options, "aero."))
 
 
 def solve(x, xi, y=None, *, tolerance: float | None = None, patience: int | None = None,

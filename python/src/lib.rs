@@ -94,6 +94,50 @@ fn leaves(root: &Value, name: &str, value: Value, out: &mut Vec<(String, Value)>
     }
 }
 
+/// `root` with the option `leaf` set to `value` when `leaf` names a field its section leaves
+/// out of the serialised form at its default (such as `aero.wake` when planar): the section
+/// must reject unknown fields (checked with a name no section has) and accept this one.
+/// `Ok(None)`: not such a field; `Err`: the field exists but `value` is not one of its values.
+fn set_hidden<T: DeserializeOwned>(
+    root: &Value,
+    leaf: &str,
+    value: Value,
+) -> Result<Option<Value>, String> {
+    let (parent, last) = match leaf.rsplit_once('.') {
+        Some((p, l)) => (Some(p), l),
+        None => (None, leaf),
+    };
+    let with = |key: &str, v: Value| -> Option<Value> {
+        let mut out = root.clone();
+        let section = match parent {
+            Some(p) => p
+                .split('.')
+                .try_fold(&mut out, |node, part| node.get_mut(part))?,
+            None => &mut out,
+        };
+        let map = section.as_object_mut()?;
+        if map.contains_key(key) {
+            return None;
+        }
+        map.insert(key.to_string(), v);
+        Some(out)
+    };
+    let Some(probe) = with("__no_such_option__", Value::Null) else {
+        return Ok(None);
+    };
+    if serde_json::from_value::<T>(probe).is_ok() {
+        return Ok(None);
+    }
+    let Some(candidate) = with(last, value) else {
+        return Ok(None);
+    };
+    match serde_json::from_value::<T>(candidate.clone()) {
+        Ok(_) => Ok(Some(candidate)),
+        Err(e) if e.to_string().contains("unknown field") => Ok(None),
+        Err(e) => Err(e.to_string()),
+    }
+}
+
 /// `base` with every `(option path, JSON text)` pair applied in order, checked by the type's
 /// own deserializer after each option so that a bad value is named by its path.
 fn merged<T: Serialize + DeserializeOwned>(
@@ -110,9 +154,20 @@ fn merged<T: Serialize + DeserializeOwned>(
         let mut each = Vec::new();
         leaves(&value, name, new, &mut each);
         for (leaf, new) in each {
-            // Sections serialise every field, so an unknown name is caught by the walk.
-            set_path(&mut value, &leaf, new)
-                .map_err(|e| PyValueError::new_err(format!("{prefix}{e}")))?;
+            // Sections serialise every field but those left out at their default (such as
+            // `aero.wake` when planar), so an unknown name is caught by the walk or the probe.
+            if let Err(e) = set_path(&mut value, &leaf, new.clone()) {
+                match set_hidden::<T>(&value, &leaf, new) {
+                    Ok(Some(v)) => value = v,
+                    Ok(None) => return Err(PyValueError::new_err(format!("{prefix}{e}"))),
+                    Err(bad) => {
+                        return Err(PyValueError::new_err(format!(
+                            "{prefix}{leaf}: {}",
+                            one_line(&bad)
+                        )))
+                    }
+                }
+            }
             out = serde_json::from_value::<T>(value.clone()).map_err(|e| {
                 PyValueError::new_err(format!("{prefix}{leaf}: {}", one_line(&e.to_string())))
             })?;
@@ -516,12 +571,15 @@ fn extract(
 /// What `power` returns: e and ξ per bird, and E.
 type PowerOut<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>, f64);
 
-/// e, ξ and E of a shape (see `formation.power`).
+/// e, ξ and E of a shape (see `formation.power`): the planar wake, or with heights `z` and the
+/// option `wake` = `3d` the 3-D one.
 #[pyfunction]
+#[pyo3(signature = (x, y, z, options))]
 fn power<'py>(
     py: Python<'py>,
     x: Vec<f64>,
     y: Vec<f64>,
+    z: Option<Vec<f64>>,
     options: Vec<(String, String)>,
 ) -> PyResult<PowerOut<'py>> {
     let aero = merged(&formation::aero::AeroOptions::default(), &options, "aero.")?;
@@ -532,7 +590,12 @@ fn power<'py>(
             x.len()
         )));
     }
-    let pr = py.detach(|| aero.power_reduction(&x, &y)).map_err(py_err)?;
+    let pr = py
+        .detach(|| match &z {
+            Some(z) => aero.power_reduction_3d(&x, &y, z),
+            None => aero.power_reduction(&x, &y),
+        })
+        .map_err(py_err)?;
     Ok((pr.e.into_pyarray(py), pr.xi.into_pyarray(py), pr.total))
 }
 

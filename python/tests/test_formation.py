@@ -222,7 +222,30 @@ def test_power_matches_the_cli_and_munk(tmp_path):
     with pytest.raises(ValueError, match="core_radius"):
         formation.power(x, y, core_radius=-1)
     with pytest.raises(ValueError, match="z: "):
-        formation.power(x, y, z=np.ones(5))
+        formation.power(x, y, z=np.ones(4))
+
+
+def test_power_with_heights_is_the_3d_wake_of_the_cli(tmp_path):
+    x = np.array([0.0, -0.77, 0.77, -1.54, 1.54])
+    y = np.array([0.0, 1.24, 1.24, 2.48, 2.48])
+    z = np.array([0.0, 0.06, -0.06, 0.14, 0.0])
+    e, xi, total = formation.power(x, y, z=z)
+    shape = tmp_path / "shape.json"
+    birds = [{"x": a, "y": b, "z": c} for a, b, c in zip(x, y, z)]
+    shape.write_text(json.dumps({"birds": birds}))
+    doc = json.loads(cli("power", shape, "--wake", "3d", "--json").stdout)
+    np.testing.assert_allclose(e, [b["e"] for b in doc["birds"]], rtol=1e-12)
+    assert total == pytest.approx(e.sum(), rel=1e-12)
+    # Heights cost savings; at zero heights the 3-D wake is the planar one.
+    e_planar, _, total_planar = formation.power(x, y)
+    assert total < total_planar
+    e0, _, _ = formation.power(x, y, z=np.zeros(5))
+    np.testing.assert_allclose(e0, e_planar, rtol=1e-10, atol=1e-12)
+    # wake="planar" ignores the heights, as --wake planar does.
+    e_ignored, _, _ = formation.power(x, y, z=z, wake="planar")
+    np.testing.assert_allclose(e_ignored, e_planar, rtol=1e-12)
+    with pytest.raises(ValueError, match=r"z\[1\]"):
+        formation.power(x, y, z=[0.0, float("nan"), 0.0, 0.0, 0.0])
 
 
 def test_solve_reaches_the_targets_power_gives():
@@ -250,3 +273,16 @@ def test_command_line_from_the_package(tmp_path):
     bad = subprocess.run(cmd + ["animate", str(EXAMPLE), "--birds", "0", "-o", str(out)],
                          capture_output=True, text=True)
     assert bad.returncode == 2 and bad.stderr.startswith("error: ") and "--birds" in bad.stderr
+
+
+def test_options_left_out_at_their_default_can_be_set():
+    # aero.wake is not in default_options() while planar, yet it is an option like the others.
+    kw = dict(birds=7, seconds=3, seed=1)
+    planar = formation.animate(EXAMPLE, **kw)
+    wake3d = formation.animate(EXAMPLE, **kw, **{"steady.aero.wake": "3d"})
+    np.testing.assert_array_equal(planar.positions, wake3d.positions)
+    assert not np.array_equal(np.nan_to_num(planar.savings), np.nan_to_num(wake3d.savings))
+    with pytest.raises(ValueError, match="steady.aero.wake: unknown variant"):
+        formation.animate(EXAMPLE, **kw, **{"steady.aero.wake": "4d"})
+    with pytest.raises(ValueError, match="steady.aero.bogus: unknown option"):
+        formation.animate(EXAMPLE, **kw, **{"steady.aero.bogus": 1})
