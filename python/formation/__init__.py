@@ -159,7 +159,7 @@ def animate(
     seed: int = 0,
     path: str | _os.PathLike | None = None,
     initiation: bool = True,
-    progress: bool = False,
+    progress: _Any = False,
     **options: _Any,
 ) -> Animation:
     """The whole pipeline: extraction, steady flight, take-off, wingbeats, savings.
@@ -170,8 +170,11 @@ def animate(
     equal seeds and inputs give identical motion, the same as ``formation animate --seed``.
     ``path``: a JSON or CSV file of the leader's path (the ``course.path`` option).
     ``initiation``: fly the take-off first (False: the steady flight alone). ``progress``:
-    show the command line's progress bar on stderr (only when stderr is a terminal, so a
-    script run in a terminal shows it and a notebook does not).
+    False (the default) shows nothing; True shows a progress bar: the command line's on a
+    terminal, elsewhere (a notebook) a tqdm bar per stage when tqdm is installed, else one
+    line on ``sys.stderr`` rewritten in place; a callable is called as
+    ``progress(stage, done, total)`` at the start of each stage, at most ten times a second
+    while it runs and at its end (an exception it raises ends the run and is raised here).
 
     ``options``: any other option by its path in the library's configuration, dotted
     (``**{"steady.fps": 30, "initiate.max_turn_rate": 1.2}``) or per section
@@ -199,7 +202,66 @@ def animate(
         pairs.append(("course.path", _json.dumps(_os.fspath(path))))
     if isinstance(input, _os.PathLike):
         input = _os.fspath(input)
+    if callable(progress):
+        return _native.animate(input, pairs + _pairs(options), False, progress)
+    if progress and not _stderr_is_terminal():
+        bar = _StageBar()
+        try:
+            return _native.animate(input, pairs + _pairs(options), False, bar)
+        finally:
+            bar.close()
     return _native.animate(input, pairs + _pairs(options), bool(progress))
+
+
+def _stderr_is_terminal() -> bool:
+    import sys
+
+    try:
+        return sys.stderr is not None and sys.stderr.isatty()
+    except (AttributeError, ValueError):
+        return False
+
+
+class _StageBar:
+    """``animate(progress=True)`` away from a terminal: a tqdm bar per stage (``tqdm.auto``,
+    a widget in Jupyter) when tqdm is installed, else one line on ``sys.stderr`` rewritten
+    with a carriage return."""
+
+    def __init__(self):
+        try:
+            from tqdm.auto import tqdm
+        except ImportError:
+            tqdm = None
+        self._tqdm = tqdm
+        self._bar = None
+        self._stage = None
+
+    def __call__(self, stage: str, done: int, total: int) -> None:
+        if stage != self._stage:
+            self.close()
+            self._stage = stage
+            if self._tqdm is not None:
+                self._bar = self._tqdm(total=total, desc=stage, leave=False)
+        if self._bar is not None:
+            self._bar.update(done - self._bar.n)
+        else:
+            import sys
+
+            width = 30
+            filled = width * done // total if total else width
+            sys.stderr.write(f"\r{stage:>12} [{'=' * filled}{' ' * (width - filled)}] {done}/{total}")
+            sys.stderr.flush()
+
+    def close(self) -> None:
+        if self._bar is not None:
+            self._bar.close()
+            self._bar = None
+        elif self._stage is not None and self._tqdm is None:
+            import sys
+
+            sys.stderr.write("\n")
+            sys.stderr.flush()
+        self._stage = None
 
 
 def read_animation(path: str | _os.PathLike) -> Animation:

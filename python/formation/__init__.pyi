@@ -1,7 +1,7 @@
 """Type stubs of the `formation` package (see `help(formation)`)."""
 
 import os
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 import numpy.typing as npt
@@ -94,7 +94,7 @@ def animate(
     seed: int = 0,
     path: _Path | None = None,
     initiation: bool = True,
-    progress: bool = False,
+    progress: bool | Callable[[str, int, int], object] = False,
     **options: Any,
 ) -> Animation: ...
 def read_animation(path: _Path) -> Animation: ...

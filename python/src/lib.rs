@@ -482,21 +482,114 @@ impl PyAnimation {
     }
 }
 
+/// Progress handed to a Python callable `callback(stage, done, total)`: at the start of each
+/// stage, at most every [`CALLBACK_EVERY`] while it runs, and at its end. The pipeline runs
+/// with the GIL released; each call takes it for the call's length. The first exception the
+/// callable raises is kept and raised when the run ends (later calls are skipped).
+struct CallbackProgress {
+    callback: Py<PyAny>,
+    state: std::sync::Mutex<CallbackState>,
+}
+
+struct CallbackState {
+    stage: String,
+    done: u64,
+    total: u64,
+    last: Option<std::time::Instant>,
+    error: Option<PyErr>,
+}
+
+/// Shortest interval between two calls of a progress callable while a stage runs.
+const CALLBACK_EVERY: std::time::Duration = std::time::Duration::from_millis(100);
+
+impl CallbackProgress {
+    fn new(callback: Py<PyAny>) -> Self {
+        CallbackProgress {
+            callback,
+            state: std::sync::Mutex::new(CallbackState {
+                stage: String::new(),
+                done: 0,
+                total: 0,
+                last: None,
+                error: None,
+            }),
+        }
+    }
+
+    /// Calls the callable with the state (holding the state's lock, so calls never overlap).
+    fn call(&self, st: &mut CallbackState) {
+        if st.error.is_some() {
+            return;
+        }
+        st.last = Some(std::time::Instant::now());
+        let args = (st.stage.clone(), st.done.min(st.total), st.total);
+        if let Err(e) = Python::attach(|py| self.callback.call1(py, args).map(|_| ())) {
+            st.error = Some(e);
+        }
+    }
+
+    fn take_error(&self) -> Option<PyErr> {
+        self.state.lock().ok().and_then(|mut s| s.error.take())
+    }
+}
+
+impl formation::progress::Progress for CallbackProgress {
+    fn start(&self, stage: &str, total: u64) {
+        if let Ok(mut st) = self.state.lock() {
+            st.stage = stage.to_string();
+            st.done = 0;
+            st.total = total;
+            self.call(&mut st);
+        }
+    }
+
+    fn advance(&self, n: u64) {
+        if let Ok(mut st) = self.state.lock() {
+            st.done = st.done.saturating_add(n);
+            let due = st.last.map_or(true, |t| t.elapsed() >= CALLBACK_EVERY);
+            if due || st.done >= st.total {
+                self.call(&mut st);
+            }
+        }
+    }
+
+    fn finish(&self) {
+        if let Ok(mut st) = self.state.lock() {
+            st.done = st.total;
+            self.call(&mut st);
+        }
+    }
+}
+
 /// Runs the whole pipeline (see `formation.animate`); `progress`: the command line's progress
-/// bar on stderr (drawn only when stderr is a terminal).
+/// bar on stderr (drawn only when stderr is a terminal); `callback`: a callable given the
+/// progress instead (`callback(stage, done, total)`).
 #[pyfunction]
+#[pyo3(signature = (input, options, progress, callback=None))]
 fn animate(
     py: Python<'_>,
     input: &Bound<'_, PyAny>,
     options: Vec<(String, String)>,
     progress: bool,
+    callback: Option<Py<PyAny>>,
 ) -> PyResult<PyAnimation> {
     let pipeline = pipeline(input)?;
     let config = config(&options)?;
-    let bar = cli_main::cli::progress::TermProgress::new(!progress);
-    let (anim, _report) = py
-        .detach(|| pipeline.run_with(&config, &bar))
-        .map_err(py_err)?;
+    let (anim, _report) = match callback {
+        Some(callback) => {
+            let bar = CallbackProgress::new(callback);
+            let out = py.detach(|| pipeline.run_with(&config, &bar));
+            if let Some(e) = bar.take_error() {
+                return Err(e);
+            }
+            out.map_err(py_err)?
+        }
+        None => {
+            let bar = cli_main::cli::progress::TermProgress::new(!progress);
+            py.detach(|| pipeline.run_with(&config, &bar))
+                .map_err(py_err)?
+        }
+    };
     Ok(PyAnimation {
         inner: anim,
         config,

@@ -286,3 +286,31 @@ def test_options_left_out_at_their_default_can_be_set():
         formation.animate(EXAMPLE, **kw, **{"steady.aero.wake": "4d"})
     with pytest.raises(ValueError, match="steady.aero.bogus: unknown option"):
         formation.animate(EXAMPLE, **kw, **{"steady.aero.bogus": 1})
+
+
+def test_progress_callable_and_notebook_bar(capsys):
+    calls = []
+    kw = dict(birds=9, seconds=4, seed=2)
+    a = formation.animate(EXAMPLE, progress=lambda s, d, t: calls.append((s, d, t)), **kw)
+    b = formation.animate(EXAMPLE, **kw)
+    np.testing.assert_array_equal(a.positions, b.positions)
+    stages = [s for s, _, _ in calls]
+    assert stages, "the callable was never called"
+    for s, d, t in calls:
+        assert isinstance(s, str) and 0 <= d <= t
+    # Each stage is reported from 0 to its total, done never going back within a stage.
+    for stage in dict.fromkeys(stages):
+        mine = [(d, t) for s, d, t in calls if s == stage]
+        assert mine[0][0] == 0 and mine[-1][0] == mine[-1][1]
+        assert all(x[0] <= y[0] for x, y in zip(mine, mine[1:]))
+
+    def boom(stage, done, total):
+        raise KeyError("stop here")
+
+    with pytest.raises(KeyError, match="stop here"):
+        formation.animate(EXAMPLE, progress=boom, **kw)
+    # progress=True away from a terminal (pytest captures stderr, as a notebook does): a bar
+    # drawn through sys.stderr, not silence.
+    formation.animate(EXAMPLE, progress=True, **kw)
+    err = capsys.readouterr().err
+    assert "[" in err and "/" in err
