@@ -1,10 +1,11 @@
 """Checks a .usda written by `formation` with Pixar's USD (PyPI `usd-core`), against the animation
-file it came from (issue 14). Usage: python .ci/check_usd.py flock.usda flock.json [--tolerance M] [--static]
+file it came from. Usage: python .ci/check_usd.py flock.usda flock.json [--tolerance M] [--static] [--subframes K]
 
 - the stage opens; USD's validators (the UsdValidation framework behind `usdchecker`, all
   registered validators) report no errors;
 - metersPerUnit 1, upAxis Y, timeCodesPerSecond and framesPerSecond = the animation's fps,
-  startTimeCode 0 and endTimeCode = the last frame;
+  startTimeCode = the file's start_frame (0 when absent) and endTimeCode = the last frame; with
+  --subframes K, K time samples a frame (time codes start + k/K);
 - one SkelRoot, Skeleton (with the 7 joints of the convention) and SkelAnimation per bird, the
   animation bound to the skeleton, the skinned mesh bound to it with 4 influences a vertex;
 - every bird's root transform at every frame matches the JSON positions (x, z, -y) * wingspan_m
@@ -29,6 +30,11 @@ def main():
     static = "--static" in args
     if static:
         args.remove("--static")
+    subframes = 1
+    if "--subframes" in args:
+        i = args.index("--subframes")
+        subframes = int(args[i + 1])
+        del args[i:i + 2]
     if "--tolerance" in args:
         i = args.index("--tolerance")
         tol = float(args[i + 1])
@@ -64,8 +70,10 @@ def main():
     check(UsdGeom.GetStageUpAxis(stage) == UsdGeom.Tokens.y, "upAxis")
     check(stage.GetTimeCodesPerSecond() == fps, "timeCodesPerSecond %s" % stage.GetTimeCodesPerSecond())
     check(stage.GetFramesPerSecond() == fps, "framesPerSecond")
-    check(stage.GetStartTimeCode() == 0, "startTimeCode")
-    check(stage.GetEndTimeCode() == n - 1, "endTimeCode %s, expected %d" % (stage.GetEndTimeCode(), n - 1))
+    start = anim.get("start_frame", 0)
+    check(stage.GetStartTimeCode() == start, "startTimeCode %s, expected %d" % (stage.GetStartTimeCode(), start))
+    check(stage.GetEndTimeCode() == start + n - 1,
+          "endTimeCode %s, expected %d" % (stage.GetEndTimeCode(), start + n - 1))
 
     roots = [p for p in stage.Traverse() if p.IsA(UsdSkel.Root)]
     skels = [p for p in stage.Traverse() if p.IsA(UsdSkel.Skeleton)]
@@ -92,11 +100,19 @@ def main():
         check(mesh.GetSkeletonRel().GetTargets() == [skel.GetPath()], "%s: mesh not bound to its rig" % root.GetPath())
         check(mesh.GetJointIndicesPrimvar().GetElementSize() == 4, "%s: jointIndices elementSize" % root.GetPath())
         xf = UsdGeom.Xformable(root)
+        keys = stage.GetRootLayer().customLayerData.get("formation", {}).get("keys", "all")
+        if b == 0 and keys == "all":
+            codes = xf.GetOrderedXformOps()[0].GetAttr().GetTimeSamples()
+            want_codes = [start + i / subframes for i in range(subframes * (n - 1) + 1)]
+            check(len(codes) == len(want_codes)
+                  and max(abs(a - w) for a, w in zip(codes, want_codes)) < 1e-6,
+                  "%s: %d time samples, expected %d (%d a frame from %d)"
+                  % (root.GetPath(), len(codes), len(want_codes), subframes, start))
         # Every frame for the first and last birds, every 7th frame for the others.
         step = 1 if b in (0, birds - 1) else 7
         for k in range(0, n, step):
             fr = frames[k]
-            t = Usd.TimeCode(round((fr["t"] - frames[0]["t"]) * fps, 6))
+            t = Usd.TimeCode(start + round((fr["t"] - frames[0]["t"]) * fps, 6))
             p = xf.ComputeLocalToWorldTransform(t).ExtractTranslation()
             want = (fr["x"][b] * ws, fr["z"][b] * ws, -fr["y"][b] * ws)
             err = math.sqrt(sum((p[i] - want[i]) ** 2 for i in range(3)))
@@ -112,7 +128,7 @@ def main():
             # sitting, wings folded, not flapping).
             k0 = max(0, n // 2 - 30)
             for k in range(k0, min(n, k0 + 60)):
-                local = q.ComputeJointLocalTransforms(Usd.TimeCode(k))[arm]
+                local = q.ComputeJointLocalTransforms(Usd.TimeCode(start + k))[arm]
                 ys.append(round(local.ExtractRotationQuat().GetImaginary()[2], 4))
             if static:
                 check(len(set(ys)) == 1, "upper_arm_L turns although the model is static")

@@ -55,7 +55,13 @@ if "flight" in clips:
         if not playing:
             failed.append("%s: nothing plays on import" % a.name)
             break
-    lo = 0
+    # The first key sits on the file's first frame (0, or the --start-frame it was written with).
+    start = int(_extras.get("frame_start", 0))
+    first = min(act.frame_range[0] for act in bpy.data.actions)
+    print("FIRST KEY", round(first, 4), "frame_start", start)
+    if abs(first - start) > 0.01:
+        failed.append("first key at frame %.4f, expected %d" % (first, start))
+    lo = start
     hi = int(round(max(act.frame_range[1] for act in bpy.data.actions)))
     mid = (lo + hi) // 2
     wing, pos = [], []

@@ -7,7 +7,9 @@ use std::path::Path;
 
 use crate::error::{Error, Result};
 
+pub mod axes;
 pub mod relative;
+pub mod resample;
 pub mod stats;
 pub mod wing;
 
@@ -50,6 +52,18 @@ pub struct Animation {
     /// would be the first again, in the flock's moving frame (in the world too on a closed path).
     #[serde(default, skip_serializing_if = "std::ops::Not::not", rename = "loop")]
     pub looped: bool,
+    /// Number of the first frame in outputs that number frames (glTF keys, USD time codes, the
+    /// CSV's `frame`, PNG file names), e.g. 1001 (0 when absent).
+    #[serde(default, skip_serializing_if = "is_zero_u64")]
+    pub start_frame: u64,
+    /// Length unit of the frames' positions and speeds and of the path in this file (absent:
+    /// wingspans). In memory always wingspans: [`Animation::read`] converts.
+    #[serde(default, skip_serializing_if = "axes::Units::is_default")]
+    pub units: axes::Units,
+    /// Up axis of the frames' positions and of the path in this file (absent: `z`, the world
+    /// frame). In memory always `z`: [`Animation::read`] converts.
+    #[serde(default, skip_serializing_if = "axes::Up::is_default")]
+    pub up: axes::Up,
     /// The path the flock follows (world frame), when it was given one.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub path: Option<PathRecord>,
@@ -309,6 +323,71 @@ pub struct Frame {
 }
 
 impl Animation {
+    /// Keeps the first `frames` frames: stages end by then (those starting later are dropped),
+    /// key shapes and a formation's first steady frame past it are dropped, and so are events
+    /// after the last frame kept. A loop stops being one.
+    pub fn truncate(&mut self, frames: usize) {
+        if frames >= self.frames.len() {
+            return;
+        }
+        self.frames.truncate(frames);
+        self.stages.retain(|s| s.start < frames);
+        for s in &mut self.stages {
+            s.end = s.end.min(frames);
+        }
+        self.key_shapes.retain(|k| k.frame < frames);
+        if let Some(forms) = self.formations.as_mut() {
+            for f in forms {
+                f.key_shapes.retain(|k| k.frame < frames);
+                if f.steady_start.is_some_and(|s| s >= frames) {
+                    f.steady_start = None;
+                }
+            }
+        }
+        let end = self.frames.last().map_or(f64::NEG_INFINITY, |f| f.t);
+        self.events.retain(|e| e.t <= end);
+        self.looped = false;
+    }
+
+    /// A looping animation (`Animation::looped`) with its closing frame appended: the first frame
+    /// again, one frame after the last, moved by the flock's travel over the loop (none on a closed
+    /// path, which loops in the world), so that a clip played over and over has no jump in the
+    /// flock's moving frame (a game moving the flock itself gets a seamless cycle). Any other
+    /// animation as it is.
+    pub fn closed_loop(&self) -> std::borrow::Cow<'_, Animation> {
+        let anim = self;
+        use std::borrow::Cow;
+        let (Some(first), Some(last)) = (anim.frames.first(), anim.frames.last()) else {
+            return Cow::Borrowed(anim);
+        };
+        if !anim.looped || anim.frames.len() < 2 {
+            return Cow::Borrowed(anim);
+        }
+        let lead = anim.leaders().first().copied().unwrap_or(0);
+        let dt = 1.0 / anim.fps;
+        let (dx, dy) = if anim.path.as_ref().is_some_and(|p| p.closed) {
+            (0.0, 0.0)
+        } else {
+            let v = last.speed[lead] * dt;
+            (
+                last.x[lead] + v * last.heading[lead].sin() - first.x[lead],
+                last.y[lead] + v * last.heading[lead].cos() - first.y[lead],
+            )
+        };
+        let mut close = first.clone();
+        close.t = last.t + dt;
+        close.x.iter_mut().for_each(|x| *x += dx);
+        close.y.iter_mut().for_each(|y| *y += dy);
+        let mut out = anim.clone();
+        out.frames.push(close);
+        for st in &mut out.stages {
+            if st.end == anim.frames.len() {
+                st.end += 1;
+            }
+        }
+        Cow::Owned(out)
+    }
+
     /// An empty animation with the format tag set.
     pub fn new(seed: u64, fps: f64, wingspan_m: f64, birds: usize) -> Animation {
         Animation {
@@ -324,6 +403,9 @@ impl Animation {
             xi_ranges: None,
             formations: None,
             looped: false,
+            start_frame: 0,
+            units: axes::Units::Wingspans,
+            up: axes::Up::Z,
             path: None,
             flight: None,
             savings_model: None,
@@ -335,7 +417,7 @@ impl Animation {
     /// Reads and validates an animation file.
     pub fn read(path: &Path) -> Result<Animation> {
         let text = crate::io::read_text(path)?;
-        let a: Animation = crate::io::parse_json(path, &text).map_err(|e| {
+        let mut a: Animation = crate::io::parse_json(path, &text).map_err(|e| {
             // A structure error on another kind of file: say what the file is instead.
             match crate::sniff::text_kind(&text) {
                 Some(kind) if kind != crate::sniff::Kind::Animation => Error::format(
@@ -345,6 +427,14 @@ impl Animation {
                 _ => e,
             }
         })?;
+        let metres = !a.units.is_default();
+        if metres && !(a.wingspan_m.is_finite() && a.wingspan_m > 0.0) {
+            return Err(Error::format(
+                path,
+                "wingspan_m: must be a positive number of metres to read positions in metres",
+            ));
+        }
+        a.to_world_axes();
         a.validate(path)?;
         Ok(a)
     }
@@ -377,6 +467,16 @@ impl Animation {
                 origin,
                 format!(
                     "wingspan_m: must be a number of metres from {MIN_WINGSPAN_M} to {MAX_WINGSPAN_M}"
+                ),
+            ));
+        }
+        if self.start_frame > crate::limits::MAX_START_FRAME {
+            return Err(Error::format(
+                origin,
+                format!(
+                    "start_frame: {} is past the largest first frame, {}",
+                    self.start_frame,
+                    crate::limits::MAX_START_FRAME
                 ),
             ));
         }
@@ -676,4 +776,8 @@ impl Animation {
             .unwrap_or(0);
         vec![lead]
     }
+}
+
+fn is_zero_u64(v: &u64) -> bool {
+    *v == 0
 }

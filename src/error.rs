@@ -90,6 +90,18 @@ impl Error {
     }
 
     /// Shorthand for an [`Error::Io`] error.
+    /// This error with a parameter named `from` renamed `to` (any other error as it is): a
+    /// helper's parameter named by the caller's option path.
+    pub fn renamed(self, from: &str, to: &str) -> Self {
+        match self {
+            Error::Parameter { name, message } if name == from => Error::Parameter {
+                name: to.to_string(),
+                message,
+            },
+            other => other,
+        }
+    }
+
     pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
         Error::Io {
             path: path.into(),

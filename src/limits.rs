@@ -112,6 +112,10 @@ pub fn check_animation_size(what: &str, birds: usize, frames: usize) -> crate::R
     }
 }
 
+/// Largest first frame number of an animation's outputs (`start_frame`): far beyond a studio's
+/// 1001, and small enough that 32-bit glTF key times keep sub-frame samples apart.
+pub const MAX_START_FRAME: u64 = 1_000_000;
+
 #[cfg(test)]
 mod tests {
     use super::*;

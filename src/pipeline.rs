@@ -51,6 +51,10 @@ pub struct Config {
     /// Length of the steady flight, seconds: `steady.frames` = round(seconds · `steady.fps`).
     /// `None`: `steady.frames` as given.
     pub seconds: Option<f64>,
+    /// Length of the whole shot, seconds, take-off included (`None`: the take-off's own length
+    /// plus [`Config::seconds`]). The steady flight takes what the take-off leaves: the
+    /// animation has exactly round(shot_seconds · `steady.fps`) frames. Replaces `seconds`.
+    pub shot_seconds: Option<f64>,
     /// Fly the §6 take-off before the steady flight; `false`: the steady flight alone.
     pub initiation: bool,
     /// How annotation files are read (ignored for params and for annotations in memory).
@@ -76,6 +80,7 @@ impl Default for Config {
         Config {
             seed: 0,
             seconds: Some(DEFAULT_SECONDS),
+            shot_seconds: None,
             initiation: true,
             read: ReadOptions::default(),
             extract: ExtractOptions::default(),
@@ -94,12 +99,16 @@ impl Config {
     /// without `seconds`. An unusable `steady.fps` is left to [`SteadyOptions::validate`] to
     /// report (the count is then 1).
     pub fn frames(&self) -> Result<usize> {
-        let Some(seconds) = self.seconds else {
-            return Ok(self.steady.frames);
+        // A whole shot of S seconds has round(S · fps) frames; its steady flight is made that
+        // long and cut where the shot ends (after the take-off's frames).
+        let (seconds, name) = match (self.shot_seconds, self.seconds) {
+            (Some(s), _) => (s, "shot_seconds"),
+            (None, Some(s)) => (s, "seconds"),
+            (None, None) => return Ok(self.steady.frames),
         };
         if !(seconds.is_finite() && seconds > 0.0) {
             return Err(Error::parameter(
-                "seconds",
+                name,
                 format!("must be a positive number of seconds, got {seconds}"),
             ));
         }
@@ -110,7 +119,7 @@ impl Config {
         let frames = (seconds * fps).round();
         if !(1.0..=crate::limits::MAX_FRAMES as f64).contains(&frames) {
             return Err(Error::parameter(
-                "seconds",
+                name,
                 format!(
                     "{seconds} s at {fps} fps is {frames} frames; give between 1 and {} frames",
                     crate::limits::MAX_FRAMES
@@ -200,6 +209,22 @@ impl Config {
                 "steady.loop",
                 "a loop is a steady flight alone and cannot begin with a take-off; fly it without the take-off (initiation false)",
             ));
+        }
+        if let Some(shot) = self.shot_seconds {
+            if self.steady.looped {
+                return Err(Error::parameter(
+                    "shot_seconds",
+                    "a loop lasts its own cycle; give the loop's length with seconds instead",
+                ));
+            }
+            if let (true, Some(takeoff)) = (self.initiation, self.initiate.takeoff) {
+                if takeoff >= shot {
+                    return Err(Error::parameter(
+                        "shot_seconds",
+                        format!("{shot} s is not longer than the {takeoff} s take-off asked for; give a longer shot, a shorter take-off, or no take-off"),
+                    ));
+                }
+            }
         }
         if self.steady.reorganise.joiners > 0 && self.initiation {
             return Err(Error::parameter(
@@ -321,6 +346,7 @@ impl Pipeline {
         // Savings (e, ξ) in the take-off frames too.
         crate::aero::fill_frame_savings(&mut anim, &config.steady_options()?.aero);
         let course = course_stage(&mut anim, path.as_ref(), config)?;
+        fit_shot(&mut anim, config)?;
         wingbeat::rest::stand_on_ground(&mut anim, config.wingbeat.species);
         wingbeat::assign_phases(&mut anim, &config.wingbeat)?;
         Ok((
@@ -455,6 +481,35 @@ pub fn course_stage(
     crate::course::apply(anim, path, &config.course, flight)
 }
 
+/// Cuts `anim` to the shot's length when [`Config::shot_seconds`] is set: exactly
+/// round(shot_seconds · fps) frames, the steady flight taking what the take-off leaves; an error
+/// names `shot_seconds` when the take-off alone is as long as the shot.
+pub fn fit_shot(anim: &mut Animation, config: &Config) -> Result<()> {
+    let Some(shot) = config.shot_seconds else {
+        return Ok(());
+    };
+    let frames = (shot * anim.fps).round() as usize;
+    let takeoff = anim
+        .stages
+        .iter()
+        .filter(|s| s.name != crate::animation::StageName::Steady)
+        .map(|s| s.end)
+        .max()
+        .unwrap_or(0);
+    if takeoff >= frames {
+        return Err(Error::parameter(
+            "shot_seconds",
+            format!(
+                "{shot} s is shorter than the take-off alone ({:.2} s, {takeoff} frames at {} fps); give a longer shot, a shorter take-off, or no take-off",
+                takeoff as f64 / anim.fps,
+                anim.fps
+            ),
+        ));
+    }
+    anim.truncate(frames);
+    Ok(())
+}
+
 /// The whole run of a flock of several formations of `sizes` birds: steady flights, take-offs
 /// (when `config.initiation`), arrangement, savings and wingbeats.
 fn flock_run(
@@ -482,6 +537,7 @@ fn flock_run(
         progress,
     )?;
     let course = course_stage(&mut anim, path, config)?;
+    fit_shot(&mut anim, config)?;
     wingbeat::rest::stand_on_ground(&mut anim, config.wingbeat.species);
     wingbeat::assign_phases(&mut anim, &config.wingbeat)?;
     let first = report

@@ -416,14 +416,14 @@ fn csv_columns_match_the_json_in_every_frame() {
     let mut lines = text.lines();
     assert_eq!(
         lines.next().unwrap(),
-        "frame,t,bird,x,y,z,heading,speed,e,xi,stage,formation,rank,leader,lateral,behind,wing_phase,bank,saving_total"
+        "frame,t,bird,x,y,z,heading,speed,e,xi,stage,formation,rank,leader,lateral,behind,wing_phase,bank,saving_total,qx,qy,qz,qw,pitch"
     );
     let leaders = a.leaders();
     let curve = formation::aero::flight::animation_curve(a.species.as_deref(), a.wingspan_m);
     let mut rows = 0;
     for line in lines {
         let c: Vec<&str> = line.split(',').collect();
-        assert_eq!(c.len(), 19, "{line}");
+        assert_eq!(c.len(), 24, "{line}");
         let (k, b): (usize, usize) = (c[0].parse().unwrap(), c[2].parse().unwrap());
         let f = &a.frames[k];
         let num = |i: usize| c[i].parse::<f64>().unwrap_or_else(|_| panic!("{line}"));
@@ -447,6 +447,14 @@ fn csv_columns_match_the_json_in_every_frame() {
         assert!((num(14) - lateral).abs() < 1e-12 && (num(15) - behind).abs() < 1e-12);
         assert_eq!(num(16), f.wing_phase.as_ref().unwrap()[b]);
         assert_eq!(num(17), f.bank.as_ref().map_or(0.0, |v| v[b]));
+        assert_eq!(num(23), f.pitch.as_ref().map_or(0.0, |v| v[b]));
+        let q = formation::animation::axes::orientation(
+            formation::animation::axes::Up::Z,
+            f.heading[b],
+            num(23),
+            num(17),
+        );
+        assert_eq!([num(19), num(20), num(21), num(22)], q);
         // The saving of total power: e times the induced share of the power curve at the bird's
         // airspeed, a fraction between 0 and 1 of e.
         let e = num(8);
@@ -602,7 +610,8 @@ fn one_vocabulary_for_rates_and_lengths() {
         "-q",
     ]);
     assert_eq!((code(&o), stderr(&o)), (0, String::new()));
-    // render: --picture-fps is the picture rate; --fps (the animation's rate) is refused.
+    // render: --picture-fps is the picture rate; --fps is the animation's rate, which render
+    // changes by resampling the motion (the same seconds at the new rate).
     let o = run(&[
         "render",
         &out("s.json"),
@@ -619,12 +628,12 @@ fn one_vocabulary_for_rates_and_lengths() {
         "--fps",
         "10",
         "-o",
-        &out("r2.gif"),
+        &out("r2.json"),
     ]);
-    assert_usage_error(
-        &o,
-        &["--fps", "the animation's own frame rate", "--picture-fps"],
-    );
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let r = formation::Animation::read(Path::new(&out("r2.json"))).unwrap();
+    assert_eq!((r.fps, r.frames.len()), (10.0, 15));
+    assert_eq!(r.frames.last().unwrap().t, a.frames[28].t);
     // animate on a shape or a target says which command reads it.
     let o = run(&[
         "animate",

@@ -151,6 +151,10 @@ fn commands() -> Vec<Command> {
         ("--keys", "some", None),
         ("--clips", "reel", None),
         ("--bird-model", "OUT/no-bird.glb", None),
+        ("--start-frame", "-5", None),
+        ("--subframes", "0", None),
+        ("--units", "feet", None),
+        ("--up", "x", None),
     ];
     let seed = ("--seed", "x", None);
     let o = |ext: &'static str| ("-o", ext, None);
@@ -291,6 +295,7 @@ fn commands() -> Vec<Command> {
                 scene.clone(),
                 vec![
                     ("--seconds", "-1", None),
+                    ("--shot-seconds", "-1", None),
                     ("--size", "0x0", None),
                     ("--picture-fps", "-3", None),
                     o("OUT/a.txt"),
@@ -307,6 +312,7 @@ fn commands() -> Vec<Command> {
                 vec![
                     ("--size", "0x0", None),
                     ("--picture-fps", "0", None),
+                    ("--fps", "0", None),
                     ("--wingspan-m", "0", None),
                     o("OUT/r.txt"),
                     seed.clone(),

@@ -70,7 +70,7 @@ fn every_frame_and_csv_row_carries_numeric_e_and_xi() {
     let mut lines = text.lines();
     assert_eq!(
         lines.next().unwrap(),
-        "frame,t,bird,x,y,z,heading,speed,e,xi,stage,formation,rank,leader,lateral,behind,wing_phase,bank,saving_total"
+        "frame,t,bird,x,y,z,heading,speed,e,xi,stage,formation,rank,leader,lateral,behind,wing_phase,bank,saving_total,qx,qy,qz,qw,pitch"
     );
     let mut rows = 0;
     for line in lines {

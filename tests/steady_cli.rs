@@ -44,7 +44,7 @@ fn writes_json_and_csv_and_plots() {
     let text = std::fs::read_to_string(&csv).unwrap();
     let mut lines = text.lines();
     // SPEC §4.4's ten columns first, then the analysis columns (docs/formats.md).
-    assert_eq!(lines.next(), Some("frame,t,bird,x,y,z,heading,speed,e,xi,stage,formation,rank,leader,lateral,behind,wing_phase,bank,saving_total"));
+    assert_eq!(lines.next(), Some("frame,t,bird,x,y,z,heading,speed,e,xi,stage,formation,rank,leader,lateral,behind,wing_phase,bank,saving_total,qx,qy,qz,qw,pitch"));
     assert_eq!(lines.count(), 90 * 14);
 
     // Same seed, same bytes; another seed, other bytes.

@@ -38,6 +38,16 @@ pub struct AnimateArgs {
     /// needs to form, see --takeoff; the summary printed at the end says how long it took).
     #[arg(long, default_value_t = formation::pipeline::DEFAULT_SECONDS, allow_negative_numbers = true)]
     pub seconds: f64,
+    /// Length of the whole shot, seconds, take-off included: the animation has exactly
+    /// round(S × fps) frames and the steady flight takes what the take-off leaves (refused when
+    /// the take-off alone is as long). Instead of --seconds.
+    #[arg(
+        long,
+        value_name = "S",
+        allow_negative_numbers = true,
+        conflicts_with = "seconds"
+    )]
+    pub shot_seconds: Option<f64>,
     /// Skip the take-off: the animation is the steady flight alone.
     #[arg(long)]
     pub no_initiation: bool,
@@ -77,6 +87,7 @@ pub fn run(args: AnimateArgs, g: Global) -> Result<()> {
     let mut config = Config {
         seed: g.seed,
         seconds: Some(args.seconds),
+        shot_seconds: args.shot_seconds,
         initiation: !args.no_initiation,
         read: args.read.options(),
         extract: ExtractOptions {
@@ -103,10 +114,7 @@ pub fn run(args: AnimateArgs, g: Global) -> Result<()> {
         width: args.size.width,
         height: args.size.height,
         fps: args.picture_fps,
-        keys: args.scene.keys,
-        clips: args.scene.clips,
-        bird_model: args.scene.bird_model.clone(),
-        ..RenderOptions::default()
+        ..args.scene.options()
     };
     args.shot.apply(&mut config.render)?;
     // Everything that can be checked is checked before any work.

@@ -23,10 +23,11 @@ pub struct RenderArgs {
     pub picture: PictureArgs,
     #[command(flatten)]
     pub shot: ShotArgs,
-    /// `--fps` is the animation's own rate, fixed by the file: refused with a pointer to
-    /// `--picture-fps` (one vocabulary across commands).
-    #[arg(long = "fps", hide = true, allow_hyphen_values = true)]
-    pub animation_fps: Option<String>,
+    /// Resample the animation to FPS frames per second before writing every output (the motion
+    /// in seconds is unchanged: positions by a smooth curve through the frames, wingbeats
+    /// phase-continuous); a loop needs a rate that gives it a whole number of frames.
+    #[arg(long = "fps", value_name = "FPS", allow_negative_numbers = true)]
+    pub animation_fps: Option<f64>,
 }
 
 /// Camera and look of the pictures, shared by `render` and `animate` (defaults from
@@ -106,6 +107,45 @@ pub struct SceneArgs {
     /// skinned one whose joints follow the naming convention (docs/export.md) also flaps.
     #[arg(long, value_name = "FILE.glb")]
     pub bird_model: Option<PathBuf>,
+    /// Number of the first frame in every output that numbers frames: .glb keys and range, USD
+    /// time codes, the CSV's frame column, PNG file names (e.g. 1001; default: the animation
+    /// file's, else 0).
+    #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = parse_start_frame)]
+    pub start_frame: Option<u64>,
+    /// Samples per frame in the .glb and .usda (1 to 16): keys at fractional frames, from the
+    /// motion between the frames, for motion blur (USD time samples at fractional time codes).
+    #[arg(long, value_name = "K", default_value_t = 1, allow_negative_numbers = true, value_parser = parse_subframes)]
+    pub subframes: u32,
+    /// Length unit of the .csv and .json: wingspans (the model's) or m (metres, × the
+    /// wingspan); a .json in metres records it and reads back as usual.
+    #[arg(long, value_name = "wingspans|m", default_value_t = RenderOptions::default().units)]
+    pub units: formation::animation::axes::Units,
+    /// Up axis of the .csv and .json: z (x east, y north, z up) or y (x east, y up, z south, as
+    /// the .glb and .usda; for Houdini and Unreal).
+    #[arg(long, value_name = "z|y", default_value_t = RenderOptions::default().up)]
+    pub up: formation::animation::axes::Up,
+}
+
+/// Parses `--start-frame`: a whole number from 0 to the largest first frame.
+fn parse_start_frame(s: &str) -> std::result::Result<u64, String> {
+    let max = formation::export::MAX_START_FRAME;
+    match s.trim().parse::<i64>() {
+        Ok(v) if (0..=max as i64).contains(&v) => Ok(v as u64),
+        _ => Err(format!(
+            "the first frame is a whole number from 0 to {max} (studios use 0, 1, 101 or 1001)"
+        )),
+    }
+}
+
+/// Parses `--subframes`: a whole number of samples per frame, 1 to the largest.
+fn parse_subframes(s: &str) -> std::result::Result<u32, String> {
+    let max = formation::export::MAX_SUBFRAMES;
+    match s.trim().parse::<i64>() {
+        Ok(v) if (1..=i64::from(max)).contains(&v) => Ok(v as u32),
+        _ => Err(format!(
+            "give 1 (one sample a frame) to {max} samples per frame (4 is plenty for motion blur)"
+        )),
+    }
 }
 
 impl SceneArgs {
@@ -115,6 +155,10 @@ impl SceneArgs {
             keys: self.keys,
             clips: self.clips,
             bird_model: self.bird_model.clone(),
+            start_frame: self.start_frame,
+            subframes: self.subframes,
+            units: self.units,
+            up: self.up,
             ..RenderOptions::default()
         }
     }
@@ -128,10 +172,7 @@ impl PictureArgs {
             height: self.size.height,
             fps: self.fps,
             wingspan_m: self.wingspan_m,
-            keys: self.scene.keys,
-            clips: self.scene.clips,
-            bird_model: self.scene.bird_model.clone(),
-            ..RenderOptions::default()
+            ..self.scene.options()
         }
     }
 }
@@ -192,15 +233,8 @@ pub fn parse_size(s: &str) -> std::result::Result<Size, String> {
 
 /// Runs `formation render`.
 pub fn run(args: RenderArgs, g: Global) -> Result<()> {
-    if let Some(v) = &args.animation_fps {
-        return Err(formation::Error::parameter(
-            "--fps",
-            format!(
-                "{v}: --fps is the animation's own frame rate, fixed by the file for `render`; give the rate of the pictures with --picture-fps"
-            ),
-        ));
-    }
     let mut opts = args.picture.options();
+    opts.animation_fps = args.animation_fps;
     args.shot.apply(&mut opts)?;
     opts.validate()?;
     // Check the outputs before reading a possibly large animation.

@@ -50,6 +50,40 @@ pub struct SceneOptions {
     pub clips: ClipMode,
     /// The bird placed on every bird; `None` = the built-in bird of the animation's species.
     pub asset: Option<BirdAsset>,
+    /// Number of the animation's first frame (e.g. 1001): the one clip's keys start at
+    /// `start_frame / fps` seconds, and the frame numbers in the metadata and USD time codes
+    /// count from it.
+    pub start_frame: u64,
+    /// The shot's frame rate when the animation is sampled finer (sub-frame samples for motion
+    /// blur): frame numbers and the scene's rate are in these frames; `None` = the animation's
+    /// own rate.
+    pub frame_rate: Option<f64>,
+}
+
+impl SceneOptions {
+    /// The shot's frame rate of `anim`'s samples.
+    pub fn rate(&self, anim: &Animation) -> f64 {
+        self.frame_rate.unwrap_or(anim.fps)
+    }
+
+    /// The shot's frame number of sample `k` of `anim` (fractional between frames).
+    pub fn frame_of(&self, anim: &Animation, k: usize) -> f64 {
+        let t0 = anim.frames.first().map_or(0.0, |f| f.t);
+        let f = (anim.frames[k].t - t0) * self.rate(anim);
+        // Frame numbers that are whole to rounding are exactly whole.
+        let r = f.round();
+        self.start_frame as f64 + if (f - r).abs() < 1e-6 { r } else { f }
+    }
+
+    /// The last frame of the range to play (see [`play_end`]), in the shot's frames.
+    pub fn frame_end(&self, anim: &Animation) -> u64 {
+        let n = anim.frames.len();
+        if n == 0 {
+            return self.start_frame;
+        }
+        let last = (self.frame_of(anim, n - 1) - self.start_frame as f64).round() as u64;
+        self.start_frame + last.saturating_sub(u64::from(anim.looped && n > 2))
+    }
 }
 
 /// Builds the `.glb` bytes for `anim` with birds `wingspan_m` metres wide, every frame keyed and
@@ -74,42 +108,10 @@ pub struct Clip {
     pub last: usize,
 }
 
-/// A looping animation (`Animation::looped`) with its closing frame appended: the first frame
-/// again, one frame after the last, moved by the flock's travel over the loop (none on a closed
-/// path, which loops in the world), so that a clip played over and over has no jump in the
-/// flock's moving frame (a game moving the flock itself gets a seamless cycle). Any other
-/// animation as it is.
+/// A looping animation with its closing frame appended ([`Animation::closed_loop`]); any
+/// other animation as it is.
 pub fn closed_loop(anim: &Animation) -> std::borrow::Cow<'_, Animation> {
-    use std::borrow::Cow;
-    let (Some(first), Some(last)) = (anim.frames.first(), anim.frames.last()) else {
-        return Cow::Borrowed(anim);
-    };
-    if !anim.looped || anim.frames.len() < 2 {
-        return Cow::Borrowed(anim);
-    }
-    let lead = anim.leaders().first().copied().unwrap_or(0);
-    let dt = 1.0 / anim.fps;
-    let (dx, dy) = if anim.path.as_ref().is_some_and(|p| p.closed) {
-        (0.0, 0.0)
-    } else {
-        let v = last.speed[lead] * dt;
-        (
-            last.x[lead] + v * last.heading[lead].sin() - first.x[lead],
-            last.y[lead] + v * last.heading[lead].cos() - first.y[lead],
-        )
-    };
-    let mut close = first.clone();
-    close.t = last.t + dt;
-    close.x.iter_mut().for_each(|x| *x += dx);
-    close.y.iter_mut().for_each(|y| *y += dy);
-    let mut out = anim.clone();
-    out.frames.push(close);
-    for st in &mut out.stages {
-        if st.end == anim.frames.len() {
-            st.end += 1;
-        }
-    }
-    Cow::Owned(out)
+    anim.closed_loop()
 }
 
 /// The clips of `anim`: `flight` over every frame ([`ClipMode::One`]), or one per non-empty
@@ -148,22 +150,51 @@ pub fn metadata(
     anim: &Animation,
     wingspan_m: f64,
     asset: &BirdAsset,
-    keys: KeyMode,
+    opts: &SceneOptions,
 ) -> serde_json::Value {
     let species = WingbeatOptions::for_animation(anim).species;
-    serde_json::json!({
+    let rate = opts.rate(anim);
+    let stage_frame = |k: usize| {
+        let n = anim.frames.len();
+        frame_value(if k < n || n == 0 {
+            opts.frame_of(anim, k.min(n.saturating_sub(1)))
+        } else {
+            // Past the last sample (a stage's exclusive end): whole frames on from it.
+            opts.frame_of(anim, n - 1) + (k - (n - 1)) as f64
+        })
+    };
+    let mut m = serde_json::json!({
         "generator": format!("formation {}", env!("CARGO_PKG_VERSION")),
-        "fps": anim.fps,
+        "fps": rate,
         "wingspan_m": wingspan_m,
         "seed": anim.seed,
         "species": anim.species.clone().unwrap_or_else(|| species.name().to_string()),
         "birds": anim.birds,
-        "frames": anim.frames.len(),
-        "stages": anim.stages.iter().map(|s| serde_json::json!({"name": s.name, "start": s.start, "end": s.end})).collect::<Vec<_>>(),
+        "frames": opts.frame_end(anim) - opts.start_frame + 1,
+        "stages": anim.stages.iter().map(|s| serde_json::json!({"name": s.name, "start": stage_frame(s.start), "end": stage_frame(s.end)})).collect::<Vec<_>>(),
         "bird_model": asset.source,
         "joints": bird::JOINTS,
-        "keys": keys.to_string(),
-    })
+        "keys": opts.keys.to_string(),
+    });
+    if opts.frame_rate.is_some() {
+        if let Some(o) = m.as_object_mut() {
+            o.insert(
+                "subframes".into(),
+                ((anim.fps / rate).round() as u64).into(),
+            );
+        }
+    }
+    m
+}
+
+/// A frame number as JSON: an integer when whole (every frame), else the fractional number
+/// (a sub-frame sample).
+fn frame_value(f: f64) -> serde_json::Value {
+    if f.fract() == 0.0 && (0.0..9.0e15).contains(&f) {
+        (f as u64).into()
+    } else {
+        f.into()
+    }
 }
 
 /// The scene's `extras`: [`metadata`] and the timeline a player needs: the rate, the first and
@@ -175,11 +206,10 @@ fn scene_metadata(
     asset: &BirdAsset,
     opts: &SceneOptions,
 ) -> serde_json::Value {
-    let mut m = metadata(anim, wingspan_m, asset, opts.keys);
+    let mut m = metadata(anim, wingspan_m, asset, opts);
     if let Some(o) = m.as_object_mut() {
-        let last = play_end(anim);
-        o.insert("frame_start".into(), 0.into());
-        o.insert("frame_end".into(), last.into());
+        o.insert("frame_start".into(), opts.start_frame.into());
+        o.insert("frame_end".into(), opts.frame_end(anim).into());
         o.insert("clips".into(), opts.clips.to_string().into());
     }
     m
@@ -194,20 +224,21 @@ pub fn play_end(anim: &Animation) -> usize {
 
 /// A clip's `extras`: its stage (or `flight`), frames and start time; in one clip, the stages
 /// as markers (name, first frame, time).
-fn clip_metadata(anim: &Animation, c: &Clip) -> serde_json::Value {
+fn clip_metadata(anim: &Animation, c: &Clip, opts: &SceneOptions) -> serde_json::Value {
+    let frame = |k: usize| frame_value(opts.frame_of(anim, k));
     let mut v = serde_json::json!({
         "stage": c.name,
-        "first_frame": c.first,
-        "last_frame": c.last,
+        "first_frame": frame(c.first),
+        "last_frame": frame(c.last),
         "start_s": anim.frames[c.first].t,
-        "fps": anim.fps,
+        "fps": opts.rate(anim),
     });
     if c.name == "flight" && !anim.stages.is_empty() {
         v["markers"] = anim
             .stages
             .iter()
             .filter(|s| s.start < anim.frames.len())
-            .map(|s| serde_json::json!({"name": s.name, "frame": s.start, "t": anim.frames[s.start].t}))
+            .map(|s| serde_json::json!({"name": s.name, "frame": frame(s.start), "t": anim.frames[s.start].t}))
             .collect();
     }
     v
@@ -225,17 +256,24 @@ pub fn asset_for(anim: &Animation, opts: &SceneOptions) -> BirdAsset {
     }
 }
 
-/// Frame times relative to `first`, refused when 32-bit floats cannot keep them increasing.
-fn clip_times(anim: &Animation, c: &Clip) -> Result<Vec<f32>> {
+/// Key times of clip `c`: from the clip's first frame, and for the one clip over every stage
+/// from the shot's first frame number (`start_frame / fps` s); refused when 32-bit floats cannot
+/// keep them increasing.
+fn clip_times(anim: &Animation, c: &Clip, opts: &SceneOptions) -> Result<Vec<f32>> {
     let t0 = anim.frames[c.first].t;
+    let offset = if opts.clips == ClipMode::One {
+        opts.start_frame as f64 / opts.rate(anim)
+    } else {
+        0.0
+    };
     let times: Vec<f32> = anim.frames[c.first..=c.last]
         .iter()
-        .map(|f| (f.t - t0) as f32)
+        .map(|f| (f.t - t0 + offset) as f32)
         .collect();
     if times.windows(2).any(|w| w[1] <= w[0]) {
         return Err(Error::parameter(
             "frames",
-            "frame times are too close to store as glTF keyframes (32-bit floats); render at a lower fps",
+            "frame times are too close to store as glTF keyframes (32-bit floats); render at a lower fps, fewer sub-frames or an earlier first frame",
         ));
     }
     Ok(times)
@@ -321,7 +359,7 @@ pub fn glb_bytes_with(anim: &Animation, wingspan_m: f64, opts: &SceneOptions) ->
         clips.iter().map(|_| (Vec::new(), Vec::new())).collect();
     let clip_t: Vec<Vec<f32>> = clips
         .iter()
-        .map(|c| clip_times(anim, c))
+        .map(|c| clip_times(anim, c, opts))
         .collect::<Result<_>>()?;
     // One time accessor per clip for every channel keyed at every frame (made when first needed).
     let mut shared_t: Vec<Option<json::Index<json::Accessor>>> = vec![None; clips.len()];
@@ -491,7 +529,7 @@ pub fn glb_bytes_with(anim: &Animation, wingspan_m: f64, opts: &SceneOptions) ->
     for (c, (channels, samplers)) in clips.iter().zip(anims) {
         root.push(json::Animation {
             extensions: None,
-            extras: extras(&clip_metadata(anim, c)),
+            extras: extras(&clip_metadata(anim, c, opts)),
             channels,
             name: Some(c.name.clone()),
             samplers,

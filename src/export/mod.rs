@@ -99,7 +99,25 @@ pub struct RenderOptions {
     pub clips: keys::ClipMode,
     /// The user's bird (`.glb`) for the `.glb` and `.usda`; `None` = the built-in bird.
     pub bird_model: Option<PathBuf>,
+    /// Number of the first frame in every output that numbers frames (glTF keys and range, USD
+    /// time codes, the CSV's `frame`, PNG file names), e.g. 1001; `None` = the animation's own
+    /// (`start_frame` of the file, else 0).
+    pub start_frame: Option<u64>,
+    /// Resample the animation to this many frames per second before writing any output (the
+    /// motion in seconds unchanged, see [`crate::animation::resample`]); `None` = its own rate.
+    pub animation_fps: Option<f64>,
+    /// Samples per frame of the `.glb` and `.usda` (1 = one per frame): keys at fractional
+    /// frames for motion blur, from the motion between the frames.
+    pub subframes: u32,
+    /// Length unit of the CSV and the written animation JSON: wingspans (default) or metres.
+    pub units: crate::animation::axes::Units,
+    /// Up axis of the CSV and the written animation JSON: `z` (the world frame, default) or `y`.
+    pub up: crate::animation::axes::Up,
 }
+
+pub use crate::limits::MAX_START_FRAME;
+/// Largest accepted [`RenderOptions::subframes`].
+pub const MAX_SUBFRAMES: u32 = 16;
 
 impl Default for RenderOptions {
     fn default() -> Self {
@@ -117,6 +135,11 @@ impl Default for RenderOptions {
             keys: keys::KeyMode::All,
             clips: keys::ClipMode::One,
             bird_model: None,
+            start_frame: None,
+            animation_fps: None,
+            subframes: 1,
+            units: crate::animation::axes::Units::Wingspans,
+            up: crate::animation::axes::Up::Z,
         }
     }
 }
@@ -151,6 +174,31 @@ impl RenderOptions {
                     format!("{f} frames per second is not a usable frame rate; give a number from 1 to {MAX_FPS}"),
                 ));
             }
+        }
+        if let Some(f) = self.animation_fps {
+            if !(f.is_finite() && (1.0..=MAX_FPS).contains(&f)) {
+                return Err(Error::parameter(
+                    "render.animation_fps",
+                    format!("{f} frames per second is not a usable frame rate; give a number from 1 to {MAX_FPS}"),
+                ));
+            }
+        }
+        if let Some(s) = self.start_frame {
+            if s > MAX_START_FRAME {
+                return Err(Error::parameter(
+                    "render.start_frame",
+                    format!("{s} is past the largest first frame, {MAX_START_FRAME}; studios start at 0, 1, 101 or 1001"),
+                ));
+            }
+        }
+        if !(1..=MAX_SUBFRAMES).contains(&self.subframes) {
+            return Err(Error::parameter(
+                "render.subframes",
+                format!(
+                    "{} samples per frame: give 1 (one per frame) to {MAX_SUBFRAMES}",
+                    self.subframes
+                ),
+            ));
         }
         self.camera.validate()?;
         if !(self.min_bird_px.is_finite() && (0.0..=1000.0).contains(&self.min_bird_px)) {
@@ -304,10 +352,23 @@ pub fn write_outputs(
 ) -> Result<()> {
     opts.validate()?;
     let origin = Path::new("animation");
-    // Issue 8: no NaN or infinity reaches any output (CSV, glTF, pictures, JSON).
+    // No NaN or infinity reaches any output (CSV, glTF, pictures, JSON).
     crate::finite::check_serialize("animation", anim)?;
     anim.validate(origin)?;
     sample::check_times(anim, origin)?;
+    let mut shot = match opts.animation_fps {
+        Some(f) if f != anim.fps => std::borrow::Cow::Owned(
+            crate::animation::resample::resample(anim, f)
+                .map_err(|e| e.renamed("fps", "render.animation_fps"))?,
+        ),
+        _ => std::borrow::Cow::Borrowed(anim),
+    };
+    if let Some(s) = opts.start_frame {
+        if s != shot.start_frame {
+            shot.to_mut().start_frame = s;
+        }
+    }
+    let anim: &Animation = &shot;
     let plan = plan_outputs(outputs)?;
     for o in &plan {
         let video = matches!(o.kind, OutputKind::Mp4 | OutputKind::Webm);
@@ -387,6 +448,27 @@ pub fn write_outputs(
         tolerance: keys::Tolerance::default(),
         clips: opts.clips,
         asset,
+        start_frame: anim.start_frame,
+        frame_rate: None,
+    };
+    // The 3-D outputs' samples: the animation (a loop with its closing frame), at
+    // `subframes` samples a frame.
+    let scene_anim = || -> Result<(std::borrow::Cow<'_, Animation>, gltf::SceneOptions)> {
+        let closed = gltf::closed_loop(anim);
+        if opts.subframes <= 1 {
+            return Ok((closed, scene.clone()));
+        }
+        // A loop's closing frame is part of the samples already: resampled as an open
+        // stretch, then marked as the loop it is (its last sample closes it).
+        let mut open = closed.into_owned();
+        open.looped = false;
+        let mut fine =
+            crate::animation::resample::resample(&open, anim.fps * f64::from(opts.subframes))
+                .map_err(|e| e.renamed("fps", "render.subframes"))?;
+        fine.looped = anim.looped;
+        let mut sc = scene.clone();
+        sc.frame_rate = Some(anim.fps);
+        Ok((std::borrow::Cow::Owned(fine), sc))
     };
     let threads = pictures::worker_count(opts.threads);
     for o in &plan {
@@ -394,17 +476,22 @@ pub fn write_outputs(
             OutputKind::Json => {
                 let mut a = anim.clone();
                 a.wingspan_m = wingspan_m;
+                if !(opts.units.is_default() && opts.up.is_default()) {
+                    a = a.in_axes(opts.units, opts.up);
+                }
                 write_json_atomic(&o.path, &a)?;
             }
             OutputKind::Csv => {
                 // Streamed into the temporary file (not built in memory: up to 1.4 GB).
                 let mut f = AtomicFile::create(&o.path)?;
-                table::write_csv(anim, f.writer()).map_err(|e| Error::io(&o.path, e))?;
+                table::write_csv_in(anim, opts.units, opts.up, wingspan_m, f.writer())
+                    .map_err(|e| Error::io(&o.path, e))?;
                 f.commit()?;
             }
             OutputKind::Glb => {
                 progress.start("glb", 1);
-                let bytes = gltf::glb_bytes_with(&gltf::closed_loop(anim), wingspan_m, &scene)?;
+                let (a, sc) = scene_anim()?;
+                let bytes = gltf::glb_bytes_with(&a, wingspan_m, &sc)?;
                 write_bytes_atomic(&o.path, &bytes)?;
                 progress.advance(1);
                 progress.finish();
@@ -413,7 +500,8 @@ pub fn write_outputs(
                 progress.start("usda", 1);
                 // Streamed into the temporary file (a 100-bird minute is tens of MB of text).
                 let mut f = AtomicFile::create(&o.path)?;
-                usd::write_usda(&gltf::closed_loop(anim), wingspan_m, &scene, f.writer())
+                let (a, sc) = scene_anim()?;
+                usd::write_usda(&a, wingspan_m, &sc, f.writer())
                     .map_err(|e| Error::io(&o.path, e))?;
                 f.commit()?;
                 progress.advance(1);
@@ -425,7 +513,7 @@ pub fn write_outputs(
             }
             OutputKind::Directory => {
                 let film = Film::with_options(anim, picture_fps(anim, o.kind, opts), opts);
-                pictures::write_png_dir(&film, &o.path, threads, progress)?;
+                pictures::write_png_dir(&film, &o.path, anim.start_frame, threads, progress)?;
             }
             OutputKind::Mp4 | OutputKind::Webm => {
                 let film = Film::with_options(anim, picture_fps(anim, o.kind, opts), opts);

@@ -620,12 +620,13 @@ pub fn frame_name(k: usize) -> String {
     format!("frame_{k:05}.png")
 }
 
-/// Writes numbered PNG frames `frame_00000.png`, … of `film` into the directory `path`
-/// (atomically: a temporary sibling directory renamed into place when complete). Frames are RGB,
+/// Writes numbered PNG frames `frame_00000.png`, … of `film` into the directory `path`, numbered
+/// from `first` (`frame_01001.png`, … for a shot starting at 1001) (atomically: a temporary sibling directory renamed into place when complete). Frames are RGB,
 /// or RGBA with `render.background` none (transparent sky, for compositing).
 pub fn write_png_dir(
     film: &Film,
     path: &Path,
+    first: u64,
     threads: usize,
     progress: &dyn Progress,
 ) -> Result<()> {
@@ -639,7 +640,7 @@ pub fn write_png_dir(
         || (Canvas::new(w, h), Mask::new()),
         |k, (canvas, mask): &mut (Canvas, Mask)| {
             film.draw(k, canvas, mask, false);
-            let target = dir.path(&frame_name(k));
+            let target = dir.path(&frame_name(first as usize + k));
             let file = std::fs::File::create(&target).map_err(|e| Error::io(path, e))?;
             let mut out = std::io::BufWriter::new(file);
             let enc = image::codecs::png::PngEncoder::new_with_quality(

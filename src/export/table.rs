@@ -13,6 +13,12 @@
 //! | `wing_phase` | radians in [0, 2π), 0 = start of the downstroke |
 //! | `bank` | radians, right wing down positive (0 when the file carries none: level) |
 //! | `saving_total` | `e` as a fraction of the bird's total mechanical power: `e` × the induced share of its power curve at its airspeed (empty where `e` is) |
+//! | `qx`, `qy`, `qz`, `qw` | the bird's orientation as a unit quaternion (heading, pitch and bank; [`axes::orientation`]) |
+//! | `pitch` | radians, nose up positive (0 when the file carries none) |
+//!
+//! `render.units` (`wingspans` or `m`) and `render.up` (`z` or `y`, see [`axes`]) set the units
+//! of `x`, `y`, `z`, `speed`, `lateral` and `behind` and the axes of `x`, `y`, `z` and of the
+//! quaternion, for tools that want metres and Y up (Houdini, Unreal).
 //!
 //! `e` (the saving), `xi` and `wing_phase` are numbers in every frame of a file written by this
 //! tool; they are empty only for a hand-made animation file without them. Numbers use the
@@ -20,11 +26,12 @@
 
 use std::io::Write;
 
+use crate::animation::axes::{self, Units, Up};
 use crate::animation::Animation;
 
 /// The header line, without newline.
 pub const CSV_HEADER: &str =
-    "frame,t,bird,x,y,z,heading,speed,e,xi,stage,formation,rank,leader,lateral,behind,wing_phase,bank,saving_total";
+    "frame,t,bird,x,y,z,heading,speed,e,xi,stage,formation,rank,leader,lateral,behind,wing_phase,bank,saving_total,qx,qy,qz,qw,pitch";
 
 /// The stage word of every frame (`none` outside every stage).
 fn stage_words(anim: &Animation) -> Vec<&str> {
@@ -37,13 +44,29 @@ fn stage_words(anim: &Animation) -> Vec<&str> {
     w
 }
 
-/// Writes the CSV text of `anim` to `w`.
+/// Writes the CSV text of `anim` to `w` (wingspans, `z` up).
 pub fn write_csv<W: Write>(anim: &Animation, w: &mut W) -> std::io::Result<()> {
+    write_csv_in(anim, Units::Wingspans, Up::Z, anim.wingspan_m, w)
+}
+
+/// Writes the CSV text of `anim` to `w` in `units` (metres: birds `wingspan_m` wide) on the
+/// `up` axes.
+pub fn write_csv_in<W: Write>(
+    anim: &Animation,
+    units: Units,
+    up: Up,
+    wingspan_m: f64,
+    w: &mut W,
+) -> std::io::Result<()> {
     writeln!(w, "{CSV_HEADER}")?;
     let stages = stage_words(anim);
     let of = anim.formation_of_birds();
     let leaders = anim.leaders();
     let curve = crate::aero::flight::curve_of(anim);
+    let scale = match units {
+        Units::Wingspans => 1.0,
+        Units::M => wingspan_m,
+    };
     for (k, f) in anim.frames.iter().enumerate() {
         let rel = anim.relative_with(k, &of, &leaders);
         for (b, r) in rel.iter().enumerate() {
@@ -52,12 +75,10 @@ pub fn write_csv<W: Write>(anim: &Animation, w: &mut W) -> std::io::Result<()> {
                 Some(x) => format!("{x}"),
                 None => String::new(),
             };
-            let bank = f
-                .bank
-                .as_ref()
-                .and_then(|a| a.get(b))
-                .copied()
-                .unwrap_or(0.0);
+            let or0 =
+                |a: &Option<Vec<f64>>| a.as_ref().and_then(|a| a.get(b)).copied().unwrap_or(0.0);
+            let bank = or0(&f.bank);
+            let pitch = or0(&f.pitch);
             let total = match f.e.as_ref().and_then(|a| a.get(b)) {
                 Some(e) => {
                     let v = anim.flight.and_then(|f| f.speed_ms).unwrap_or_else(|| {
@@ -67,24 +88,33 @@ pub fn write_csv<W: Write>(anim: &Animation, w: &mut W) -> std::io::Result<()> {
                 }
                 None => String::new(),
             };
+            let p = up
+                .from_world([v(&f.x), v(&f.y), v(&f.z)])
+                .map(|c| c * scale);
+            let q = axes::orientation(up, v(&f.heading), pitch, bank);
             writeln!(
                 w,
-                "{k},{},{b},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{bank},{total}",
+                "{},{},{b},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{bank},{total},{},{},{},{},{pitch}",
+                anim.start_frame + k as u64,
                 f.t,
-                v(&f.x),
-                v(&f.y),
-                v(&f.z),
+                p[0],
+                p[1],
+                p[2],
                 v(&f.heading),
-                v(&f.speed),
+                v(&f.speed) * scale,
                 o(&f.e),
                 o(&f.xi),
                 stages[k],
                 r.formation,
                 r.rank,
                 u8::from(r.leader),
-                r.lateral,
-                r.behind,
+                r.lateral * scale,
+                r.behind * scale,
                 o(&f.wing_phase),
+                q[0],
+                q[1],
+                q[2],
+                q[3],
             )?;
         }
     }

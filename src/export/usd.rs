@@ -66,9 +66,9 @@ fn string(s: &str) -> String {
     serde_json::to_string(s).unwrap_or_else(|_| "\"\"".into())
 }
 
-/// Time code of frame `k`.
-fn time_code(anim: &Animation, k: usize) -> String {
-    let tc = (anim.frames[k].t - anim.frames[0].t) * anim.fps;
+/// Time code of sample `k`: the shot's frame number (fractional for a sub-frame sample).
+fn time_code(anim: &Animation, opts: &SceneOptions, k: usize) -> String {
+    let tc = opts.frame_of(anim, k);
     let r = (tc * 1e6).round() / 1e6;
     if r == r.round() {
         format!("{}", r as i64)
@@ -124,7 +124,7 @@ pub fn write_usda(
         "    customLayerData = {{\n        dictionary formation = {{"
     );
     dict_entries(
-        &metadata(anim, wingspan_m, &asset, opts.keys),
+        &metadata(anim, wingspan_m, &asset, opts),
         "            ",
         &mut head,
     );
@@ -137,15 +137,11 @@ pub fn write_usda(
     );
     // A loop's closing frame (the first again) is past the end: cycling the range shows each
     // frame once.
-    let _ = writeln!(
-        head,
-        "    endTimeCode = {}",
-        time_code(anim, super::gltf::play_end(anim).min(n - 1))
-    );
-    let _ = writeln!(head, "    framesPerSecond = {}", anim.fps);
+    let _ = writeln!(head, "    endTimeCode = {}", opts.frame_end(anim));
+    let _ = writeln!(head, "    framesPerSecond = {}", opts.rate(anim));
     let _ = writeln!(head, "    metersPerUnit = 1");
-    let _ = writeln!(head, "    startTimeCode = 0");
-    let _ = writeln!(head, "    timeCodesPerSecond = {}", anim.fps);
+    let _ = writeln!(head, "    startTimeCode = {}", opts.start_frame);
+    let _ = writeln!(head, "    timeCodesPerSecond = {}", opts.rate(anim));
     let _ = writeln!(head, "    upAxis = \"Y\"\n)\n");
     out.write_all(head.as_bytes()).map_err(io)?;
     out.write_all(prototype(&asset, ws).as_bytes())
@@ -190,7 +186,7 @@ pub fn write_usda(
             let _ = writeln!(
                 s,
                 "            {}: {},",
-                time_code(anim, k),
+                time_code(anim, opts, k),
                 vec3(track.flight.translation[k])
             );
         }
@@ -202,7 +198,7 @@ pub fn write_usda(
             let _ = writeln!(
                 s,
                 "            {}: {},",
-                time_code(anim, k),
+                time_code(anim, opts, k),
                 quat(track.flight.yaw[k])
             );
         }
@@ -232,7 +228,7 @@ pub fn write_usda(
             writeln!(
                 out,
                 "                {}: [{}],",
-                time_code(anim, k),
+                time_code(anim, opts, k),
                 q.join(", ")
             )
             .map_err(io)?;
