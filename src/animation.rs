@@ -133,6 +133,10 @@ pub struct PathRecord {
     pub length: f64,
     /// Some turn was too tight for the flock and was widened.
     pub widened: bool,
+    /// The course as flown (turns widened), wingspans, world frame: points about a wingspan
+    /// apart along it (empty in files written before it was recorded).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub flown: Vec<[f64; 3]>,
 }
 
 /// One formation (skein) of a flock of several formations.
@@ -323,6 +327,41 @@ pub struct Frame {
 }
 
 impl Animation {
+    /// The path the flock flew, wingspans, world frame: the course as flown when it followed a
+    /// path (turns widened), else the flock's centre once a second over the steady flight (the
+    /// whole animation when it has no steady stage), and at its last frame.
+    pub fn flown_path(&self) -> Vec<[f64; 3]> {
+        if let Some(p) = self.path.as_ref().filter(|p| !p.flown.is_empty()) {
+            return p.flown.clone();
+        }
+        let range = self
+            .stage("steady")
+            .map(|s| s.start..s.end.min(self.frames.len()))
+            .filter(|r| !r.is_empty())
+            .unwrap_or(0..self.frames.len());
+        let step = (self.fps.round() as usize).max(1);
+        let centre = |f: &Frame| {
+            let n = f.x.len().max(1) as f64;
+            [
+                f.x.iter().sum::<f64>() / n,
+                f.y.iter().sum::<f64>() / n,
+                f.z.iter().sum::<f64>() / n,
+            ]
+        };
+        let mut out: Vec<[f64; 3]> = range
+            .clone()
+            .step_by(step)
+            .map(|k| centre(&self.frames[k]))
+            .collect();
+        let first = range.start;
+        if let Some(last) = range.last() {
+            if (last - first) % step != 0 {
+                out.push(centre(&self.frames[last]));
+            }
+        }
+        out
+    }
+
     /// Keeps the first `frames` frames: stages end by then (those starting later are dropped),
     /// key shapes and a formation's first steady frame past it are dropped, and so are events
     /// after the last frame kept. A loop stops being one.

@@ -155,6 +155,7 @@ fn commands() -> Vec<Command> {
         ("--subframes", "0", None),
         ("--units", "feet", None),
         ("--up", "x", None),
+        ("--path-out", "OUT/path.txt", None),
     ];
     let seed = ("--seed", "x", None);
     let o = |ext: &'static str| ("-o", ext, None);

@@ -215,3 +215,118 @@ fn units_and_up_on_the_command_line() {
         assert!(stderr(&o).contains(flag), "{}", stderr(&o));
     }
 }
+
+#[test]
+fn the_flown_path_is_written_for_layout_and_reads_back_as_a_path() {
+    let dir = scratch("point-path");
+    let path = dir.join("course.json");
+    // A right-angle corner much tighter than a flock of 9 can turn: it gets widened.
+    std::fs::write(
+        &path,
+        r#"{"units": "wingspans", "points": [[0, 0, 30], [0, 120, 30], [120, 120, 30]]}"#,
+    )
+    .unwrap();
+    let (flown, json, glb, usda) = (
+        dir.join("flown.json"),
+        dir.join("a.json"),
+        dir.join("a.glb"),
+        dir.join("a.usda"),
+    );
+    let o = bin()
+        .args([
+            "animate",
+            s(&example("barnacle_geese_v.json")),
+            "--birds",
+            "9",
+            "--seconds",
+            "14",
+            "--path",
+            s(&path),
+            "--quiet",
+            "--path-out",
+            s(&flown),
+            "-o",
+            s(&json),
+            "-o",
+            s(&glb),
+            "-o",
+            s(&usda),
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let a = Animation::read(&json).unwrap();
+    let rec = a.path.as_ref().unwrap();
+    assert!(rec.widened);
+    let doc: serde_json::Value = serde_json::from_slice(&std::fs::read(&flown).unwrap()).unwrap();
+    assert_eq!(doc["units"], "wingspans");
+    let pts: Vec<[f64; 3]> = serde_json::from_value(doc["points"].clone()).unwrap();
+    assert_eq!(pts, rec.flown);
+    // About a wingspan apart, from the path's first point to its last, and the corner cut: the
+    // widened course passes inside the drawn corner at (0, 120).
+    for w in pts.windows(2) {
+        let d = ((w[1][0] - w[0][0]).powi(2) + (w[1][1] - w[0][1]).powi(2)).sqrt();
+        assert!(d > 0.5 && d < 1.5, "{d}");
+    }
+    let near = |p: [f64; 3], q: [f64; 3]| (0..3).all(|i| (p[i] - q[i]).abs() < 1e-9);
+    assert!(near(pts[0], [0.0, 0.0, 30.0]), "{:?}", pts[0]);
+    assert!(near(*pts.last().unwrap(), [120.0, 120.0, 30.0]));
+    let corner = pts
+        .iter()
+        .map(|p| (p[0].powi(2) + (p[1] - 120.0).powi(2)).sqrt())
+        .fold(f64::INFINITY, f64::min);
+    assert!(corner > 1.0, "{corner}");
+    // It reads back as a path.
+    let o = bin()
+        .args([
+            "animate",
+            s(&example("barnacle_geese_v.json")),
+            "--birds",
+            "9",
+            "--seconds",
+            "4",
+            "--path",
+            s(&flown),
+            "--quiet",
+            "-o",
+            s(&dir.join("b.json")),
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    // The .glb has it as a line strip node, the .usda as a guide curve.
+    let bytes = std::fs::read(&glb).unwrap();
+    let n = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+    let j: serde_json::Value = serde_json::from_slice(&bytes[20..20 + n]).unwrap();
+    let node = j["nodes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|n| n["name"] == "flown_path")
+        .unwrap();
+    let mesh = &j["meshes"][node["mesh"].as_u64().unwrap() as usize];
+    assert_eq!(mesh["primitives"][0]["mode"], 3);
+    let acc = &j["accessors"][mesh["primitives"][0]["attributes"]["POSITION"]
+        .as_u64()
+        .unwrap() as usize];
+    assert_eq!(acc["count"], pts.len());
+    let text = std::fs::read_to_string(&usda).unwrap();
+    assert!(text.contains("def BasisCurves \"flown_path\""));
+    assert!(text.contains(&format!("int[] curveVertexCounts = [{}]", pts.len())));
+    // A bad name is refused before any work.
+    let o = bin()
+        .args([
+            "animate",
+            s(&example("barnacle_geese_v.json")),
+            "--birds",
+            "5",
+            "--path-out",
+            s(&json),
+            "-o",
+            s(&json),
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(code(&o), 2);
+    assert!(stderr(&o).contains("--path-out"), "{}", stderr(&o));
+}

@@ -175,7 +175,7 @@ impl Animation {
             f.speed.iter_mut().for_each(|v| *v *= s);
         }
         if let Some(path) = a.path.as_mut() {
-            for p in &mut path.points {
+            for p in path.points.iter_mut().chain(path.flown.iter_mut()) {
                 *p = up.from_world(*p).map(|v| v * s);
             }
             path.length *= s;
@@ -206,7 +206,7 @@ impl Animation {
             f.speed.iter_mut().for_each(|v| *v *= s);
         }
         if let Some(path) = self.path.as_mut() {
-            for p in &mut path.points {
+            for p in path.points.iter_mut().chain(path.flown.iter_mut()) {
                 *p = up.to_world(*p).map(|v| v * s);
             }
             path.length *= s;

@@ -193,6 +193,7 @@ pub const FLAGS: &[(&str, &str, &[Cmd])] = &[
     ("render.subframes", "--subframes", SCENE),
     ("render.units", "--units", SCENE),
     ("render.up", "--up", SCENE),
+    ("render.path_out", "--path-out", SCENE),
     ("render.animation_fps", "--fps", &[Render]),
     ("render.bird_model", "--bird-model", SCENE),
     ("render.camera", "--camera", PICTURES),

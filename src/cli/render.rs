@@ -124,6 +124,11 @@ pub struct SceneArgs {
     /// the .glb and .usda; for Houdini and Unreal).
     #[arg(long, value_name = "z|y", default_value_t = RenderOptions::default().up)]
     pub up: formation::animation::axes::Up,
+    /// Also write the path the flock flew to FILE.json, in the path file format that --path
+    /// reads (world frame, z up, in --units): the course with its turns widened, or without a
+    /// path the flock's centre once a second.
+    #[arg(long, value_name = "FILE.json")]
+    pub path_out: Option<PathBuf>,
 }
 
 /// Parses `--start-frame`: a whole number from 0 to the largest first frame.
@@ -159,6 +164,7 @@ impl SceneArgs {
             subframes: self.subframes,
             units: self.units,
             up: self.up,
+            path_out: self.path_out.clone(),
             ..RenderOptions::default()
         }
     }

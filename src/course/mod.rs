@@ -502,9 +502,13 @@ pub fn apply(
         closed: points.closed,
         length: len,
         widened: !report.widened.is_empty(),
+        flown: course.points(1.0, FLOWN_POINTS),
     });
     Ok(report)
 }
+
+/// Largest number of points of the recorded flown course ([`PathRecord::flown`]).
+pub const FLOWN_POINTS: usize = 20_000;
 
 /// Refuses a closed path too small for the flock's turns: seen from above, a closed curve whose
 /// turns have radii of at least `r_min` is at least 2π `r_min` long (its heading turns through at

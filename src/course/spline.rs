@@ -550,6 +550,24 @@ impl Course {
         Course { knots, ds, closed }
     }
 
+    /// Points of the course about `spacing` wingspans apart (at least every sample's spacing),
+    /// its first and last sample included, at most `max` points (spaced further apart if
+    /// needed).
+    pub fn points(&self, spacing: f64, max: usize) -> Vec<[f64; 3]> {
+        let n = self.knots.len();
+        if n == 0 {
+            return Vec::new();
+        }
+        let by_spacing = (spacing / self.ds).round().max(1.0) as usize;
+        let by_count = n.div_ceil(max.max(2) - 1).max(1);
+        let step = by_spacing.max(by_count);
+        let mut out: Vec<[f64; 3]> = self.knots.iter().step_by(step).map(|k| k.p).collect();
+        if (n - 1) % step != 0 {
+            out.push(self.knots[n - 1].p);
+        }
+        out
+    }
+
     /// Arc length of the course, wingspans.
     pub fn length(&self) -> f64 {
         (self.knots.len() - 1) as f64 * self.ds

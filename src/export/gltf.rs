@@ -19,6 +19,9 @@
 //! without a jump. A loop ends on its closing key (the first frame again, one frame on), which
 //! a player cycling by time shows once; `frame_end` is the frame before it. LINEAR
 //! keys at every frame (`render.keys` = all) or only those [`keys::keep`] needs (reduced).
+//! An animation that followed a path also gets a node `flown_path` at the scene root: a line strip
+//! through the course as flown (turns widened), in the same metres and axes.
+//!
 //! Metadata in `extras`: the scene holds fps, wingspan_m, seed, species, birds, the stages and the
 //! bird model; each clip its stage, first frame and start time; each bird root its index.
 //!
@@ -519,6 +522,52 @@ pub fn glb_bytes_with(anim: &Animation, wingspan_m: f64, opts: &SceneOptions) ->
     });
     let mut scene_nodes = vec![flock];
     scene_nodes.extend(mesh_nodes);
+    // The course as flown (turns widened), for layout: a line strip (no material: a viewer
+    // draws it in its default colour; Blender imports it as a mesh of edges).
+    if let Some(path) = anim.path.as_ref().filter(|p| p.flown.len() >= 2) {
+        let pts: Vec<f32> = path
+            .flown
+            .iter()
+            .flat_map(|p| {
+                [
+                    (p[0] * wingspan_m) as f32,
+                    (p[2] * wingspan_m) as f32,
+                    -(p[1] * wingspan_m) as f32,
+                ]
+            })
+            .collect();
+        let pos = b.accessor(
+            &mut root,
+            &pts,
+            3,
+            json::accessor::Type::Vec3,
+            true,
+            Some(json::buffer::Target::ArrayBuffer),
+        );
+        let mut attributes = BTreeMap::new();
+        attributes.insert(Valid(json::mesh::Semantic::Positions), pos);
+        let mesh = root.push(json::Mesh {
+            extensions: None,
+            extras: Default::default(),
+            name: Some("flown_path".into()),
+            primitives: vec![json::mesh::Primitive {
+                attributes,
+                extensions: None,
+                extras: Default::default(),
+                indices: None,
+                material: None,
+                mode: Valid(json::mesh::Mode::LineStrip),
+                targets: None,
+            }],
+            weights: None,
+        });
+        scene_nodes.push(root.push(json::Node {
+            name: Some("flown_path".into()),
+            mesh: Some(mesh),
+            extras: extras(&serde_json::json!({"flown_path": true, "closed": path.closed})),
+            ..Default::default()
+        }));
+    }
     let scene = root.push(json::Scene {
         extensions: None,
         extras: extras(&scene_metadata(anim, wingspan_m, &asset, opts)),

@@ -113,6 +113,10 @@ pub struct RenderOptions {
     pub units: crate::animation::axes::Units,
     /// Up axis of the CSV and the written animation JSON: `z` (the world frame, default) or `y`.
     pub up: crate::animation::axes::Up,
+    /// Also write the path the flock flew ([`Animation::flown_path`]) to this `.json`, in the
+    /// path file format (`{"units": ..., "points": [[x, y, z], ...]}`, world frame, z up) in
+    /// `units`, which `--path` reads back.
+    pub path_out: Option<PathBuf>,
 }
 
 pub use crate::limits::MAX_START_FRAME;
@@ -140,6 +144,7 @@ impl Default for RenderOptions {
             subframes: 1,
             units: crate::animation::axes::Units::Wingspans,
             up: crate::animation::axes::Up::Z,
+            path_out: None,
         }
     }
 }
@@ -434,6 +439,23 @@ pub fn write_outputs(
             }
         }
     }
+    if let Some(p) = &opts.path_out {
+        OutputKind::for_flag("render.path_out", p, &[OutputKind::Json])?;
+        crate::io::check_output_dir("render.path_out", p)?;
+        let id = crate::io::output_identity(p);
+        if plan
+            .iter()
+            .any(|o| crate::io::output_identity(&o.path) == id)
+        {
+            return Err(Error::parameter(
+                "render.path_out",
+                format!(
+                    "{}: is also an output; the path needs a file of its own",
+                    p.display()
+                ),
+            ));
+        }
+    }
     let wingspan_m = opts.wingspan_m.unwrap_or(anim.wingspan_m);
     // The user's bird is checked before any output is written (exit 2 with the reason).
     let asset = match &opts.bird_model {
@@ -531,6 +553,22 @@ pub fn write_outputs(
                 )));
             }
         }
+    }
+    if let Some(p) = &opts.path_out {
+        let scale = match opts.units {
+            crate::animation::axes::Units::Wingspans => 1.0,
+            crate::animation::axes::Units::M => wingspan_m,
+        };
+        let points: Vec<[f64; 3]> = anim
+            .flown_path()
+            .into_iter()
+            .map(|q| q.map(|v| v * scale))
+            .collect();
+        let doc = serde_json::json!({
+            "units": opts.units.to_string(),
+            "points": points,
+        });
+        write_json_atomic(p, &doc)?;
     }
     Ok(())
 }

@@ -16,6 +16,9 @@
 //! `anim` (time-sampled joint `rotations`, constant `translations` and `scales`) to its `rig`
 //! through `skel:animationSource`.
 //!
+//! An animation that followed a path also gets `/flock/flown_path`, a linear `BasisCurves` (purpose
+//! `guide`, so renders leave it out) through the course as flown, turns widened.
+//!
 //! `render.keys` = reduced thins the flight samples within the tolerances of [`keys`] (the joint
 //! rotations, one array per time sample, keep every frame: the wingbeat needs nearly all of them).
 
@@ -235,6 +238,29 @@ pub fn write_usda(
         }
         out.write_all(b"            }\n        }\n    }\n\n")
             .map_err(io)?;
+    }
+    // The course as flown (turns widened), for layout: a linear curve in the flock's space.
+    if let Some(path) = anim.path.as_ref().filter(|p| !p.flown.is_empty()) {
+        let pts: Vec<String> = path
+            .flown
+            .iter()
+            .map(|p| {
+                vec3(Vec3::new(
+                    (p[0] * wingspan_m) as f32,
+                    (p[2] * wingspan_m) as f32,
+                    -(p[1] * wingspan_m) as f32,
+                ))
+            })
+            .collect();
+        let mut c = String::new();
+        let _ = writeln!(
+            c,
+            "    def BasisCurves \"flown_path\"\n    {{\n        uniform token type = \"linear\"\n        int[] curveVertexCounts = [{}]\n        point3f[] points = [{}]\n        float[] widths = [{}] (\n            interpolation = \"constant\"\n        )\n        uniform token purpose = \"guide\"\n    }}",
+            pts.len(),
+            pts.join(", "),
+            f(ws * 0.1)
+        );
+        out.write_all(c.as_bytes()).map_err(io)?;
     }
     out.write_all(b"}\n").map_err(io)?;
     Ok(())
