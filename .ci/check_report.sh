@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# `formation report` in headless Chromium (issue 16): the page of annotations, of a params file
+# `formation report` in headless Chromium: the page of annotations, of a params file
 # and of an animation must load without a console message (an error, a failed request: the page
 # is self-contained) and draw every chart it declares (`data-charts` = `data-charts-rendered`,
 # counted by the page's own script from the SVGs' boxes). With --screenshots DIR, also writes the

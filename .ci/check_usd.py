@@ -75,6 +75,16 @@ def main():
     check(stage.GetEndTimeCode() == start + n - 1,
           "endTimeCode %s, expected %d" % (stage.GetEndTimeCode(), start + n - 1))
 
+    crowd = stage.GetPrimAtPath("/flock/crowd")
+    if crowd and crowd.IsA(UsdGeom.PointInstancer):
+        check_instancer(stage, anim, start, failed, check)
+        if failed:
+            for f in failed[:20]:
+                print("FAILED", f)
+            sys.exit(1)
+        print("OK", usda)
+        return
+
     roots = [p for p in stage.Traverse() if p.IsA(UsdSkel.Root)]
     skels = [p for p in stage.Traverse() if p.IsA(UsdSkel.Skeleton)]
     anims = [p for p in stage.Traverse() if p.IsA(UsdSkel.Animation)]
@@ -141,6 +151,49 @@ def main():
             print("FAILED", f)
         sys.exit(1)
     print("OK", usda)
+
+
+def check_instancer(stage, anim, start, failed, check):
+    """A point-instanced crowd (--usd-mode instancer): one PointInstancer, its prototypes posed
+    meshes under it, one instance per bird; at 20 frames across the flight every instance within
+    1 mm of the JSON's position (x, z, -y) * wingspan_m, orientations unit quaternions, prototype
+    indices in range, and the wingbeat visible (the first bird shows several prototypes)."""
+    pi = UsdGeom.PointInstancer(stage.GetPrimAtPath("/flock/crowd"))
+    protos = pi.GetPrototypesRel().GetTargets()
+    birds, frames, ws = anim["birds"], anim["frames"], anim["wingspan_m"]
+    n = len(frames)
+    check(len(protos) >= 1 and all(stage.GetPrimAtPath(p).IsA(UsdGeom.Mesh) for p in protos),
+          "prototypes are not meshes")
+    check(len(pi.GetIdsAttr().Get()) == birds, "ids")
+    picks = sorted({round(i * (n - 1) / 19) for i in range(20)})
+    worst = 0.0
+    shown = set()
+    for k in picks:
+        t = Usd.TimeCode(start + round((frames[k]["t"] - frames[0]["t"]) * anim["fps"], 6))
+        pos = pi.GetPositionsAttr().Get(t)
+        rot = pi.GetOrientationsAttr().Get(t)
+        idx = pi.GetProtoIndicesAttr().Get(t)
+        check(len(pos) == birds and len(rot) == birds and len(idx) == birds, "frame %d: array lengths" % k)
+        fr = frames[k]
+        for b in range(birds):
+            want = (fr["x"][b] * ws, fr["z"][b] * ws, -fr["y"][b] * ws)
+            err = math.sqrt(sum((pos[b][i] - want[i]) ** 2 for i in range(3)))
+            worst = max(worst, err)
+            norm = math.sqrt(rot[b].GetReal() ** 2 + sum(v * v for v in rot[b].GetImaginary()))
+            if abs(norm - 1) > 3e-3:
+                failed.append("frame %d bird %d: orientation of norm %.4f" % (k, b, norm))
+            if not 0 <= idx[b] < len(protos):
+                failed.append("frame %d bird %d: prototype %d of %d" % (k, b, idx[b], len(protos)))
+        shown.add(idx[0])
+    # Every frame of the middle second: the first bird flaps through several prototypes.
+    mid = n // 2
+    for k in range(mid, min(n, mid + int(anim["fps"]))):
+        t = Usd.TimeCode(start + round((frames[k]["t"] - frames[0]["t"]) * anim["fps"], 6))
+        shown.add(pi.GetProtoIndicesAttr().Get(t)[0])
+    check(len(protos) == 1 or len(shown) > 3, "the first bird shows %d prototypes" % len(shown))
+    check(worst <= 1e-3, "instances %.3g m from the JSON" % worst)
+    print("instancer: %d prototypes, %d instances, %d frames checked, worst %.3g m, bird 0 shows %d poses"
+          % (len(protos), birds, len(picks), worst, len(shown)))
 
 
 if __name__ == "__main__":

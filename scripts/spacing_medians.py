@@ -2,7 +2,7 @@
 """Median lateral and longitudinal distance to the nearest bird ahead, in wingspans, of a
 footage's frames (a params file from `formation extract`) and of the key shapes of a steady
 flight (`formation steady`/`animate` JSON), to compare the spacing of generated flocks with the
-footage they learned from (issue 12, docs/model.md).
+footage they learned from (docs/model.md).
 
 Usage: python3 scripts/spacing_medians.py params.json [animation.json ...]
 """

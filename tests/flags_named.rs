@@ -156,6 +156,7 @@ fn commands() -> Vec<Command> {
         ("--units", "feet", None),
         ("--up", "x", None),
         ("--path-out", "OUT/path.txt", None),
+        ("--usd-mode", "pixie", None),
     ];
     let seed = ("--seed", "x", None);
     let o = |ext: &'static str| ("-o", ext, None);

@@ -194,6 +194,7 @@ pub const FLAGS: &[(&str, &str, &[Cmd])] = &[
     ("render.units", "--units", SCENE),
     ("render.up", "--up", SCENE),
     ("render.path_out", "--path-out", SCENE),
+    ("render.usd_mode", "--usd-mode", SCENE),
     ("render.animation_fps", "--fps", &[Render]),
     ("render.bird_model", "--bird-model", SCENE),
     ("render.camera", "--camera", PICTURES),

@@ -268,7 +268,7 @@ pub fn run(args: InitiateArgs, g: Global) -> Result<()> {
         initiate::check_steady(&steady, &args.steady)?;
     }
     let mut opts = args.initiate.options(g.seed, steady.birds)?;
-    // Issue 19: the take-off climbs to the path's first point, then the course step maps the
+    // The take-off climbs to the path's first point, then the course step maps the
     // whole flight onto the path.
     let course = super::course::course_config(&args.path, &steady, &args.steady, &mut opts)?;
     let mut rng = formation::rng::stream(g.seed, formation::rng::Stream::Initiate);

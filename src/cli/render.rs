@@ -129,6 +129,11 @@ pub struct SceneArgs {
     /// path the flock's centre once a second.
     #[arg(long, value_name = "FILE.json")]
     pub path_out: Option<PathBuf>,
+    /// How the .usda holds the birds: skel (one skinned bird each, the exact wingbeat) or
+    /// instancer (one point-instanced crowd of posed birds, quick to open) [default: instancer
+    /// from 200 birds, skel below].
+    #[arg(long, value_name = "skel|instancer")]
+    pub usd_mode: Option<formation::export::UsdMode>,
 }
 
 /// Parses `--start-frame`: a whole number from 0 to the largest first frame.
@@ -165,6 +170,7 @@ impl SceneArgs {
             units: self.units,
             up: self.up,
             path_out: self.path_out.clone(),
+            usd_mode: self.usd_mode,
             ..RenderOptions::default()
         }
     }

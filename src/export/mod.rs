@@ -17,6 +17,7 @@
 pub mod bird;
 pub mod bird_model;
 pub mod camera;
+pub mod crowd;
 pub mod gltf;
 pub mod keys;
 pub mod palette;
@@ -117,6 +118,43 @@ pub struct RenderOptions {
     /// path file format (`{"units": ..., "points": [[x, y, z], ...]}`, world frame, z up) in
     /// `units`, which `--path` reads back.
     pub path_out: Option<PathBuf>,
+    /// How the `.usda` holds the birds: one skinned bird each (`skel`) or a point-instanced
+    /// crowd of posed prototypes (`instancer`, see [`crowd`]); `None` = instancer from
+    /// [`crowd::INSTANCER_FROM`] birds, skel below.
+    pub usd_mode: Option<UsdMode>,
+}
+
+/// How the `.usda` holds the birds ([`RenderOptions::usd_mode`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum UsdMode {
+    /// One `SkelRoot` per bird with its own skeleton and joint animation (exact wingbeat).
+    Skel,
+    /// One `PointInstancer` of posed prototypes (fast to open for large flocks).
+    Instancer,
+}
+
+impl std::str::FromStr for UsdMode {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<UsdMode> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "skel" => Ok(UsdMode::Skel),
+            "instancer" => Ok(UsdMode::Instancer),
+            _ => Err(Error::parameter(
+                "render.usd_mode",
+                format!("unknown USD mode \"{s}\": expected skel or instancer"),
+            )),
+        }
+    }
+}
+
+impl std::fmt::Display for UsdMode {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            UsdMode::Skel => "skel",
+            UsdMode::Instancer => "instancer",
+        })
+    }
 }
 
 pub use crate::limits::MAX_START_FRAME;
@@ -145,6 +183,7 @@ impl Default for RenderOptions {
             units: crate::animation::axes::Units::Wingspans,
             up: crate::animation::axes::Up::Z,
             path_out: None,
+            usd_mode: None,
         }
     }
 }
@@ -523,8 +562,16 @@ pub fn write_outputs(
                 // Streamed into the temporary file (a 100-bird minute is tens of MB of text).
                 let mut f = AtomicFile::create(&o.path)?;
                 let (a, sc) = scene_anim()?;
-                usd::write_usda(&a, wingspan_m, &sc, f.writer())
-                    .map_err(|e| Error::io(&o.path, e))?;
+                let instancer = match opts.usd_mode {
+                    Some(m) => m == UsdMode::Instancer,
+                    None => anim.birds >= crowd::INSTANCER_FROM,
+                };
+                if instancer {
+                    crowd::write_usda_instancer(&a, wingspan_m, &sc, f.writer())
+                } else {
+                    usd::write_usda(&a, wingspan_m, &sc, f.writer())
+                }
+                .map_err(|e| Error::io(&o.path, e))?;
                 f.commit()?;
                 progress.advance(1);
                 progress.finish();

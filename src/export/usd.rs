@@ -34,7 +34,7 @@ use crate::animation::Animation;
 use crate::wingbeat::Flapper;
 
 /// Shortest text of an f32 that reads back to the same value.
-fn f(v: f32) -> String {
+pub(super) fn f(v: f32) -> String {
     if v == 0.0 {
         "0".into()
     } else {
@@ -42,7 +42,7 @@ fn f(v: f32) -> String {
     }
 }
 
-fn vec3(v: Vec3) -> String {
+pub(super) fn vec3(v: Vec3) -> String {
     format!("({}, {}, {})", f(v.x), f(v.y), f(v.z))
 }
 
@@ -70,7 +70,7 @@ fn string(s: &str) -> String {
 }
 
 /// Time code of sample `k`: the shot's frame number (fractional for a sub-frame sample).
-fn time_code(anim: &Animation, opts: &SceneOptions, k: usize) -> String {
+pub(super) fn time_code(anim: &Animation, opts: &SceneOptions, k: usize) -> String {
     let tc = opts.frame_of(anim, k);
     let r = (tc * 1e6).round() / 1e6;
     if r == r.round() {
@@ -109,28 +109,27 @@ fn dict_entries(v: &serde_json::Value, indent: &str, out: &mut String) {
     }
 }
 
-/// Writes the `.usda` text of `anim` with birds `wingspan_m` metres wide to `out`.
-pub fn write_usda(
+/// The stage's header: metadata (with `extra`'s entries) and the timeline.
+pub(super) fn stage_head(
     anim: &Animation,
     wingspan_m: f64,
+    asset: &BirdAsset,
     opts: &SceneOptions,
-    out: &mut impl Write,
-) -> std::io::Result<()> {
-    let ws = wingspan_m as f32;
-    let asset = asset_for(anim, opts);
-    let n = anim.frames.len();
-    let io = |e: std::io::Error| e;
+    extra: &serde_json::Value,
+) -> String {
     let mut head = String::new();
     let _ = writeln!(head, "#usda 1.0\n(");
     let _ = writeln!(
         head,
         "    customLayerData = {{\n        dictionary formation = {{"
     );
-    dict_entries(
-        &metadata(anim, wingspan_m, &asset, opts),
-        "            ",
-        &mut head,
-    );
+    let mut meta = metadata(anim, wingspan_m, asset, opts);
+    if let (Some(m), Some(e)) = (meta.as_object_mut(), extra.as_object()) {
+        for (k, v) in e {
+            m.insert(k.clone(), v.clone());
+        }
+    }
+    dict_entries(&meta, "            ", &mut head);
     let _ = writeln!(head, "        }}\n    }}");
     let _ = writeln!(head, "    defaultPrim = \"flock\"");
     let _ = writeln!(
@@ -146,6 +145,21 @@ pub fn write_usda(
     let _ = writeln!(head, "    startTimeCode = {}", opts.start_frame);
     let _ = writeln!(head, "    timeCodesPerSecond = {}", opts.rate(anim));
     let _ = writeln!(head, "    upAxis = \"Y\"\n)\n");
+    head
+}
+
+/// Writes the `.usda` text of `anim` with birds `wingspan_m` metres wide to `out`.
+pub fn write_usda(
+    anim: &Animation,
+    wingspan_m: f64,
+    opts: &SceneOptions,
+    out: &mut impl Write,
+) -> std::io::Result<()> {
+    let ws = wingspan_m as f32;
+    let asset = asset_for(anim, opts);
+    let n = anim.frames.len();
+    let io = |e: std::io::Error| e;
+    let head = stage_head(anim, wingspan_m, &asset, opts, &serde_json::json!({}));
     out.write_all(head.as_bytes()).map_err(io)?;
     out.write_all(prototype(&asset, ws).as_bytes())
         .map_err(io)?;
@@ -239,29 +253,8 @@ pub fn write_usda(
         out.write_all(b"            }\n        }\n    }\n\n")
             .map_err(io)?;
     }
-    // The course as flown (turns widened), for layout: a linear curve in the flock's space.
-    if let Some(path) = anim.path.as_ref().filter(|p| !p.flown.is_empty()) {
-        let pts: Vec<String> = path
-            .flown
-            .iter()
-            .map(|p| {
-                vec3(Vec3::new(
-                    (p[0] * wingspan_m) as f32,
-                    (p[2] * wingspan_m) as f32,
-                    -(p[1] * wingspan_m) as f32,
-                ))
-            })
-            .collect();
-        let mut c = String::new();
-        let _ = writeln!(
-            c,
-            "    def BasisCurves \"flown_path\"\n    {{\n        uniform token type = \"linear\"\n        int[] curveVertexCounts = [{}]\n        point3f[] points = [{}]\n        float[] widths = [{}] (\n            interpolation = \"constant\"\n        )\n        uniform token purpose = \"guide\"\n    }}",
-            pts.len(),
-            pts.join(", "),
-            f(ws * 0.1)
-        );
-        out.write_all(c.as_bytes()).map_err(io)?;
-    }
+    out.write_all(flown_path_prim(anim, wingspan_m).as_bytes())
+        .map_err(io)?;
     out.write_all(b"}\n").map_err(io)?;
     Ok(())
 }
@@ -383,4 +376,32 @@ fn prototype(asset: &BirdAsset, ws: f32) -> String {
         "        uniform token subdivisionScheme = \"none\"\n    }}\n}}\n"
     );
     s
+}
+
+/// The course as flown (turns widened), for layout: `/flock/flown_path`, a linear guide curve in
+/// the flock's space (empty without a path).
+pub(super) fn flown_path_prim(anim: &Animation, wingspan_m: f64) -> String {
+    let ws = wingspan_m as f32;
+    let mut c = String::new();
+    if let Some(path) = anim.path.as_ref().filter(|p| !p.flown.is_empty()) {
+        let pts: Vec<String> = path
+            .flown
+            .iter()
+            .map(|p| {
+                vec3(Vec3::new(
+                    (p[0] * wingspan_m) as f32,
+                    (p[2] * wingspan_m) as f32,
+                    -(p[1] * wingspan_m) as f32,
+                ))
+            })
+            .collect();
+        let _ = writeln!(
+            c,
+            "    def BasisCurves \"flown_path\"\n    {{\n        uniform token type = \"linear\"\n        int[] curveVertexCounts = [{}]\n        point3f[] points = [{}]\n        float[] widths = [{}] (\n            interpolation = \"constant\"\n        )\n        uniform token purpose = \"guide\"\n    }}",
+            pts.len(),
+            pts.join(", "),
+            f(ws * 0.1)
+        );
+    }
+    c
 }

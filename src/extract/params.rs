@@ -285,7 +285,7 @@ impl FormationParams {
                     ));
                 }
             }
-            // Issue 8 (found by fuzzing): huge finite values overflow the steady flight's ranges
+            // Found by fuzzing: huge finite values overflow the steady flight's ranges
             // to NaN. No formation has neighbours 100 wingspans apart.
             if let Some((name, v)) = nums
                 .iter()
