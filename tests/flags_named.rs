@@ -157,6 +157,7 @@ fn commands() -> Vec<Command> {
         ("--up", "x", None),
         ("--path-out", "OUT/path.txt", None),
         ("--usd-mode", "pixie", None),
+        ("--joint-map", "OUT/no-map.json", None),
     ];
     let seed = ("--seed", "x", None);
     let o = |ext: &'static str| ("-o", ext, None);

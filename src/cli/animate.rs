@@ -120,9 +120,12 @@ pub fn run(args: AnimateArgs, g: Global) -> Result<()> {
     // Everything that can be checked is checked before any work.
     config.validate()?;
     formation::export::plan_outputs(&args.output)?;
-    if let Some(p) = &config.render.bird_model {
-        formation::export::bird_model::load(p, config.wingbeat.species)?;
-    }
+    super::check_bird_model(
+        super::flags::Cmd::Animate,
+        g,
+        &config.render,
+        config.wingbeat.species,
+    )?;
     let progress = TermProgress::new(g.quiet);
     let (anim, report) = Pipeline::from_path(&args.input).run_with(&config, &progress)?;
     let warnings = report

@@ -197,6 +197,7 @@ pub const FLAGS: &[(&str, &str, &[Cmd])] = &[
     ("render.usd_mode", "--usd-mode", SCENE),
     ("render.animation_fps", "--fps", &[Render]),
     ("render.bird_model", "--bird-model", SCENE),
+    ("render.joint_map", "--joint-map", SCENE),
     ("render.camera", "--camera", PICTURES),
     ("render.camera.fixed", "--view", PICTURES),
     ("render.background", "--background", PICTURES),

@@ -190,13 +190,37 @@ pub fn install_signal_cleanup() {
     }
 }
 
+/// Loads the user's bird model (when given) before any work: a model that cannot be used is the
+/// error; a model the birds cannot flap with is a warning (the error with `--strict`).
+pub fn check_bird_model(
+    cmd: flags::Cmd,
+    g: Global,
+    opts: &formation::export::RenderOptions,
+    species: formation::wingbeat::Species,
+) -> Result<()> {
+    let Some(p) = &opts.bird_model else {
+        return Ok(());
+    };
+    let asset = formation::export::bird_model::load_with(p, species, opts.joint_map.as_deref())?;
+    match formation::export::bird_model::static_warning(&asset) {
+        Some(w) => warn_lines(cmd, g, &[w.as_str()]),
+        None => Ok(()),
+    }
+}
+
 /// Writes `anim` to every output (by extension: .json, .csv, .gif, DIR/, .glb), atomically, with
-/// a progress bar unless `--quiet`.
+/// a progress bar unless `--quiet`; a bird model is checked first ([`check_bird_model`]).
 pub fn write_animation(
     anim: &formation::Animation,
     outputs: &[std::path::PathBuf],
     opts: &formation::export::RenderOptions,
     g: Global,
 ) -> Result<()> {
+    check_bird_model(
+        flags::Cmd::Steady,
+        g,
+        opts,
+        formation::wingbeat::WingbeatOptions::for_animation(anim).species,
+    )?;
     formation::export::write_outputs(anim, outputs, opts, &progress::TermProgress::new(g.quiet))
 }

@@ -107,6 +107,10 @@ pub struct SceneArgs {
     /// skinned one whose joints follow the naming convention (docs/export.md) also flaps.
     #[arg(long, value_name = "FILE.glb")]
     pub bird_model: Option<PathBuf>,
+    /// A JSON file naming your bird model's joints by the convention's, e.g.
+    /// {"UpperArm.L": "upper_arm.L", "Hand.L": "hand.L", ...} (docs/export.md).
+    #[arg(long, value_name = "FILE.json")]
+    pub joint_map: Option<PathBuf>,
     /// Number of the first frame in every output that numbers frames: .glb keys and range, USD
     /// time codes, the CSV's frame column, PNG file names (e.g. 1001; default: the animation
     /// file's, else 0).
@@ -165,6 +169,7 @@ impl SceneArgs {
             keys: self.keys,
             clips: self.clips,
             bird_model: self.bird_model.clone(),
+            joint_map: self.joint_map.clone(),
             start_frame: self.start_frame,
             subframes: self.subframes,
             units: self.units,
@@ -253,6 +258,12 @@ pub fn run(args: RenderArgs, g: Global) -> Result<()> {
     formation::export::plan_outputs(&args.output)?;
     let anim = Animation::read(&args.animation)?;
     formation::export::sample::check_times(&anim, &args.animation)?;
+    super::check_bird_model(
+        super::flags::Cmd::Render,
+        g,
+        &opts,
+        formation::wingbeat::WingbeatOptions::for_animation(&anim).species,
+    )?;
     // `--seed` does not apply: rendering is deterministic, and the clouds take the animation's seed.
     let _ = g.seed;
     write_outputs(&anim, &args.output, &opts, &TermProgress::new(g.quiet))?;

@@ -46,6 +46,13 @@ fn bad(path: &Path, msg: impl Into<String>) -> Error {
 /// Reads and checks the user's bird model; `species` supplies the joints a static model does not
 /// have (metadata only).
 pub fn load(path: &Path, species: Species) -> Result<BirdAsset> {
+    load_with(path, species, None)
+}
+
+/// [`load`] with a joint map (`render.joint_map`, see [`read_joint_map`]) naming the model's
+/// joints by the convention's.
+pub fn load_with(path: &Path, species: Species, joint_map: Option<&Path>) -> Result<BirdAsset> {
+    let map = joint_map.map(read_joint_map).transpose()?;
     let meta = std::fs::metadata(path).map_err(|e| bad(path, format!("cannot read it: {e}")))?;
     if meta.is_dir() {
         return Err(bad(path, "is a directory, expected a .glb file"));
@@ -60,20 +67,134 @@ pub fn load(path: &Path, species: Species) -> Result<BirdAsset> {
         ));
     }
     let bytes = crate::io::read_bytes(path)?;
-    parse(path, &bytes, species)
+    parse_with(path, &bytes, species, map.as_ref())
 }
 
 /// Parses and checks the bytes of a bird model (`path` is only named in messages); what [`load`]
 /// does after reading the file.
 pub fn parse(path: &Path, bytes: &[u8], species: Species) -> Result<BirdAsset> {
+    parse_with(path, bytes, species, None)
+}
+
+/// [`parse`] with a joint map.
+pub fn parse_with(
+    path: &Path,
+    bytes: &[u8],
+    species: Species,
+    map: Option<&JointMap>,
+) -> Result<BirdAsset> {
     let (root, bin) = parse_glb(path, bytes)?;
     let r = Reader {
         path,
         root: &root,
         bin,
+        map,
     };
+    if let Some(m) = map {
+        // Every name the map gives must be a node of the model.
+        let names: std::collections::BTreeSet<String> = root
+            .nodes
+            .iter()
+            .filter_map(|n| n.name.as_deref().map(norm_name))
+            .collect();
+        if let Some((from, _)) = m
+            .entries
+            .iter()
+            .find(|(f, _)| !names.contains(&norm_name(f)))
+        {
+            return Err(Error::format(
+                &m.path,
+                format!(
+                    "render.joint_map: \"{from}\" is not a joint of {}; its names are the model's node names",
+                    path.display()
+                ),
+            ));
+        }
+    }
     r.asset(species)
 }
+
+/// A joint map: the model's joint names and the convention's joint each stands for.
+#[derive(Debug, Clone, PartialEq)]
+pub struct JointMap {
+    /// The file it was read from.
+    pub path: std::path::PathBuf,
+    /// (model's name, convention's name), in file order.
+    pub entries: Vec<(String, String)>,
+}
+
+impl JointMap {
+    /// The convention's joint the model's node `name` stands for.
+    fn target(&self, name: &str) -> Option<usize> {
+        let n = norm_name(name);
+        let (_, to) = self.entries.iter().find(|(f, _)| norm_name(f) == n)?;
+        let t = norm_name(to);
+        JOINTS.iter().position(|j| norm_name(j) == t)
+    }
+}
+
+/// Reads a joint map (`render.joint_map`): a JSON object from the model's joint names to the
+/// convention's (`{"UpperArm.L": "upper_arm.L", "Hand.L": "hand.L", ...}`), names compared as
+/// joint names are (case and separators ignored). Every target must be a joint of the
+/// convention, and at most one model joint may map to each.
+pub fn read_joint_map(path: &Path) -> Result<JointMap> {
+    let text = crate::io::read_text(path)?;
+    let v: serde_json::Value = crate::io::parse_json(path, &text)?;
+    let Some(obj) = v.as_object() else {
+        return Err(Error::format(
+            path,
+            "render.joint_map: expected a JSON object from your joint names to the convention's, e.g. {\"UpperArm.L\": \"upper_arm.L\"}",
+        ));
+    };
+    let mut entries = Vec::new();
+    let mut seen: BTreeMap<usize, String> = BTreeMap::new();
+    for (from, to) in obj {
+        let Some(to) = to.as_str() else {
+            return Err(Error::format(
+                path,
+                format!("render.joint_map: \"{from}\": expected the convention's joint name as a string"),
+            ));
+        };
+        let t = norm_name(to);
+        let Some(j) = JOINTS.iter().position(|n| norm_name(n) == t) else {
+            return Err(Error::format(
+                path,
+                format!(
+                    "render.joint_map: \"{from}\": \"{to}\" is not a joint of the convention ({})",
+                    JOINTS.join(", ")
+                ),
+            ));
+        };
+        if let Some(other) = seen.insert(j, from.clone()) {
+            return Err(Error::format(
+                path,
+                format!(
+                    "render.joint_map: \"{from}\" and \"{other}\" both map to {}; one joint each",
+                    JOINTS[j]
+                ),
+            ));
+        }
+        entries.push((from.clone(), to.to_string()));
+    }
+    Ok(JointMap {
+        path: path.to_path_buf(),
+        entries,
+    })
+}
+
+/// The warning for a model the birds cannot flap with (no skinned mesh), or `None`.
+pub fn static_warning(asset: &BirdAsset) -> Option<String> {
+    (!asset.wingbeat).then(|| {
+        format!(
+            "render.bird_model: {} has no animatable joints (no skinned mesh): the birds will fly and bank but not flap; give a skinned model with the joints {} (neck and tail optional), or map yours with render.joint_map",
+            asset.source,
+            REQUIRED.map(|j| JOINTS[j]).join(", ")
+        )
+    })
+}
+
+/// The joints a skinned model must have (neck and tail are optional).
+const REQUIRED: [usize; 5] = [bird::BODY, 3, 4, 5, 6];
 
 /// Splits a GLB container into its JSON root and binary chunk.
 fn parse_glb<'a>(path: &Path, bytes: &'a [u8]) -> Result<(json::Root, &'a [u8])> {
@@ -124,6 +245,7 @@ struct Reader<'a> {
     path: &'a Path,
     root: &'a json::Root,
     bin: &'a [u8],
+    map: Option<&'a JointMap>,
 }
 
 /// A skin mapped to the convention: our joint for every skin slot, and the bind (model-space)
@@ -439,8 +561,9 @@ impl Reader<'_> {
     }
 
     /// The skin of node `n` mapped to the convention: per skin slot our joint, and the bind
-    /// (model-space) matrix of each of our joints found. `None` when the convention is not met.
-    fn convention(&self, skin: &json::Skin) -> Result<Option<Convention>> {
+    /// (model-space) matrix of each of our joints found. `Err(missing)`, the required joints it
+    /// lacks, when the convention is not met.
+    fn convention(&self, skin: &json::Skin) -> Result<std::result::Result<Convention, Vec<usize>>> {
         let names: Vec<String> = JOINTS.iter().map(|n| norm_name(n)).collect();
         let ibm: Vec<Mat4> = match skin.inverse_bind_matrices {
             Some(a) => {
@@ -465,7 +588,11 @@ impl Reader<'_> {
             }
         }
         let ours = |node: usize| -> Option<usize> {
-            let nm = norm_name(self.root.nodes.get(node)?.name.as_deref()?);
+            let name = self.root.nodes.get(node)?.name.as_deref()?;
+            if let Some(j) = self.map.and_then(|m| m.target(name)) {
+                return Some(j);
+            }
+            let nm = norm_name(name);
             names.iter().position(|n| *n == nm)
         };
         let mut bind: [Option<Mat4>; 7] = [None; 7];
@@ -481,9 +608,13 @@ impl Reader<'_> {
                 bind[j] = Some(m);
             }
         }
-        let required = [bird::BODY, 3, 4, 5, 6];
-        if required.iter().any(|&j| bind[j].is_none()) {
-            return Ok(None);
+        let missing: Vec<usize> = REQUIRED
+            .iter()
+            .copied()
+            .filter(|&j| bind[j].is_none())
+            .collect();
+        if !missing.is_empty() {
+            return Ok(Err(missing));
         }
         let map = skin
             .joints
@@ -507,12 +638,13 @@ impl Reader<'_> {
                 }
             })
             .collect();
-        Ok(Some((map, bind)))
+        Ok(Ok((map, bind)))
     }
 
     fn asset(&self, species: Species) -> Result<BirdAsset> {
         let world = self.world()?;
         // A skinned mesh whose skin follows the convention?
+        let mut unmatched: Option<(json::Skin, Vec<usize>)> = None;
         for &ni in world.keys() {
             let n = &self.root.nodes[ni];
             let (Some(mi), Some(si)) = (n.mesh, n.skin) else {
@@ -523,10 +655,38 @@ impl Reader<'_> {
                 .skins
                 .get(si.value())
                 .ok_or_else(|| self.err(format!("skin {} does not exist", si.value())))?;
-            if let Some((map, bind)) = self.convention(skin)? {
-                let prims = self.prims(mi.value(), Some(&map))?;
-                return self.build(prims, Some(bind), species);
+            match self.convention(skin)? {
+                Ok((map, bind)) => {
+                    let prims = self.prims(mi.value(), Some(&map))?;
+                    return self.build(prims, Some(bind), species);
+                }
+                Err(missing) => {
+                    if unmatched.is_none() {
+                        unmatched = Some((skin.clone(), missing));
+                    }
+                }
             }
+        }
+        // A skinned model whose joints are named otherwise would silently not flap: refused.
+        if let Some((skin, missing)) = unmatched {
+            let found: Vec<&str> = skin
+                .joints
+                .iter()
+                .filter_map(|n| self.root.nodes.get(n.value())?.name.as_deref())
+                .take(12)
+                .collect();
+            let more = if skin.joints.len() > found.len() {
+                ", ..."
+            } else {
+                ""
+            };
+            return Err(self.err(format!(
+                "its skin has no joint{} {} (its joints: {}{more}); name them by the convention ({}) or map yours with render.joint_map",
+                if missing.len() == 1 { "" } else { "s" },
+                missing.iter().map(|&j| JOINTS[j]).collect::<Vec<_>>().join(", "),
+                if found.is_empty() { "unnamed".to_string() } else { found.join(", ") },
+                JOINTS.join(", ")
+            )));
         }
         // Static: every triangle mesh, placed by its node.
         let mut prims = Vec::new();

@@ -100,6 +100,9 @@ pub struct RenderOptions {
     pub clips: keys::ClipMode,
     /// The user's bird (`.glb`) for the `.glb` and `.usda`; `None` = the built-in bird.
     pub bird_model: Option<PathBuf>,
+    /// A JSON file naming the joints of `bird_model` by the convention's
+    /// ([`bird_model::read_joint_map`]).
+    pub joint_map: Option<PathBuf>,
     /// Number of the first frame in every output that numbers frames (glTF keys and range, USD
     /// time codes, the CSV's `frame`, PNG file names), e.g. 1001; `None` = the animation's own
     /// (`start_frame` of the file, else 0).
@@ -177,6 +180,7 @@ impl Default for RenderOptions {
             keys: keys::KeyMode::All,
             clips: keys::ClipMode::One,
             bird_model: None,
+            joint_map: None,
             start_frame: None,
             animation_fps: None,
             subframes: 1,
@@ -242,6 +246,12 @@ impl RenderOptions {
                     "{} samples per frame: give 1 (one per frame) to {MAX_SUBFRAMES}",
                     self.subframes
                 ),
+            ));
+        }
+        if self.joint_map.is_some() && self.bird_model.is_none() {
+            return Err(Error::parameter(
+                "render.joint_map",
+                "names the joints of a bird model; give render.bird_model too",
             ));
         }
         self.camera.validate()?;
@@ -498,9 +508,10 @@ pub fn write_outputs(
     let wingspan_m = opts.wingspan_m.unwrap_or(anim.wingspan_m);
     // The user's bird is checked before any output is written (exit 2 with the reason).
     let asset = match &opts.bird_model {
-        Some(p) => Some(bird_model::load(
+        Some(p) => Some(bird_model::load_with(
             p,
             crate::wingbeat::WingbeatOptions::for_animation(anim).species,
+            opts.joint_map.as_deref(),
         )?),
         None => None,
     };

@@ -1,0 +1,220 @@
+//! A user's bird model whose joints are named otherwise: refused with the missing joints and the
+//! convention's names, or mapped by `--joint-map` (then it flaps exactly as the convention's own
+//! names do); a model with no skin flies without flapping and says so (an error with `--strict`).
+
+mod support;
+
+use formation::export::bird_model;
+use formation::export::gltf::{glb_bytes, glb_bytes_with, SceneOptions};
+use formation::export::synthetic::{synthetic_flock, SyntheticParams};
+use formation::wingbeat::{assign_phases, Species, WingbeatOptions};
+use formation::Animation;
+use serde_json::Value;
+use support::{bin, code, s, scratch, stderr};
+
+fn flock() -> Animation {
+    let p = SyntheticParams {
+        seconds: 2.0,
+        fps: 20.0,
+        initiation_s: 0.7,
+        ..SyntheticParams::default()
+    };
+    let mut a = synthetic_flock(&mut formation::rng::seeded(3), &p);
+    assign_phases(&mut a, &WingbeatOptions::default()).unwrap();
+    a
+}
+
+/// The JSON and binary chunks of a GLB.
+fn split(bytes: &[u8]) -> (Value, Vec<u8>) {
+    let n = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+    let json = serde_json::from_slice(&bytes[20..20 + n]).unwrap();
+    (json, bytes[28 + n..].to_vec())
+}
+
+fn join(json: &Value, bin: &[u8]) -> Vec<u8> {
+    let mut j = serde_json::to_vec(json).unwrap();
+    while j.len() % 4 != 0 {
+        j.push(b' ');
+    }
+    let total = 12 + 8 + j.len() + 8 + bin.len();
+    let mut out = Vec::new();
+    out.extend_from_slice(b"glTF");
+    out.extend_from_slice(&2u32.to_le_bytes());
+    out.extend_from_slice(&(total as u32).to_le_bytes());
+    out.extend_from_slice(&(j.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"JSON");
+    out.extend_from_slice(&j);
+    out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"BIN\0");
+    out.extend_from_slice(bin);
+    out
+}
+
+/// Our own exported bird with its joints renamed as a rig from another tool would name them.
+const RENAMES: [(&str, &str); 7] = [
+    ("body", "Spine"),
+    ("neck", "Neck"),
+    ("tail", "Tail"),
+    ("upper_arm.L", "UpperArm.L"),
+    ("hand.L", "Forearm.L"),
+    ("upper_arm.R", "UpperArm.R"),
+    ("hand.R", "Forearm.R"),
+];
+
+fn renamed(anim: &Animation) -> Vec<u8> {
+    let (mut json, bin) = split(&glb_bytes(anim, 1.5).unwrap());
+    for n in json["nodes"].as_array_mut().unwrap() {
+        if let Some(name) = n["name"].as_str() {
+            if let Some((_, to)) = RENAMES.iter().find(|(from, _)| *from == name) {
+                n["name"] = Value::from(*to);
+            }
+        }
+    }
+    join(&json, &bin)
+}
+
+#[test]
+fn renamed_joints_are_refused_naming_them_and_mapped_by_a_joint_map() {
+    let d = scratch("rig-map");
+    let anim = flock();
+    let model = d.join("other.glb");
+    std::fs::write(&model, renamed(&anim)).unwrap();
+    let e = bird_model::load(&model, Species::Goose).unwrap_err();
+    let msg = e.to_string();
+    assert_eq!(e.exit_code(), 2);
+    assert!(!msg.contains('\n'), "{msg}");
+    for needle in [
+        "body",
+        "upper_arm.L",
+        "hand.R",
+        "UpperArm.L",
+        "Forearm.L",
+        "render.joint_map",
+    ] {
+        assert!(msg.contains(needle), "{needle}: {msg}");
+    }
+    // With the map, the model flaps exactly as our own (conventionally named) bird does.
+    let map = d.join("map.json");
+    let entries: serde_json::Map<String, Value> = RENAMES
+        .iter()
+        .map(|(to, from)| (from.to_string(), Value::from(*to)))
+        .collect();
+    std::fs::write(&map, serde_json::to_vec(&entries).unwrap()).unwrap();
+    let mapped = bird_model::load_with(&model, Species::Goose, Some(&map)).unwrap();
+    assert!(mapped.wingbeat);
+    let ours_path = d.join("ours.glb");
+    std::fs::write(&ours_path, glb_bytes(&anim, 1.5).unwrap()).unwrap();
+    let ours = bird_model::load(&ours_path, Species::Goose).unwrap();
+    let write = |asset| {
+        let opts = SceneOptions {
+            asset: Some(asset),
+            ..SceneOptions::default()
+        };
+        split(&glb_bytes_with(&anim, 1.5, &opts).unwrap())
+    };
+    let (ja, ba) = write(mapped);
+    let (jb, bb) = write(ours);
+    assert_eq!(ja["animations"], jb["animations"]);
+    assert_eq!(ba, bb, "the animation data differ");
+    // Bad maps: one line naming the file and the entry.
+    for (text, needle) in [
+        (
+            r#"{"UpperArm.L": "wing"}"#,
+            "\"wing\" is not a joint of the convention",
+        ),
+        (
+            r#"{"UpperArm.L": "upper_arm.L", "UpperArm.R": "upper_arm.L"}"#,
+            "both map to upper_arm.L",
+        ),
+        (r#"["body"]"#, "expected a JSON object"),
+        (
+            r#"{"Wing.L": "upper_arm.L"}"#,
+            "\"Wing.L\" is not a joint of",
+        ),
+    ] {
+        std::fs::write(&map, text).unwrap();
+        let e = bird_model::load_with(&model, Species::Goose, Some(&map)).unwrap_err();
+        let m = e.to_string();
+        assert_eq!(e.exit_code(), 2);
+        assert!(m.contains("map.json") && m.contains(needle), "{m}");
+    }
+}
+
+#[test]
+fn on_the_command_line() {
+    let d = scratch("rig-cli");
+    let anim = flock();
+    let json = d.join("a.json");
+    std::fs::write(&json, serde_json::to_vec(&anim).unwrap()).unwrap();
+    let model = d.join("other.glb");
+    std::fs::write(&model, renamed(&anim)).unwrap();
+    let out = d.join("r.glb");
+    let run = |extra: &[&str]| {
+        let mut args = vec!["render", s(&json), "-o", s(&out), "--bird-model", s(&model)];
+        args.extend_from_slice(extra);
+        bin().args(&args).output().unwrap()
+    };
+    let o = run(&[]);
+    assert_eq!(code(&o), 2);
+    let err = stderr(&o);
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    assert!(
+        err.contains("--bird-model") && err.contains("--joint-map"),
+        "{err}"
+    );
+    assert!(!out.exists());
+    let map = d.join("map.json");
+    let entries: serde_json::Map<String, Value> = RENAMES
+        .iter()
+        .map(|(to, from)| (from.to_string(), Value::from(*to)))
+        .collect();
+    std::fs::write(&map, serde_json::to_vec(&entries).unwrap()).unwrap();
+    let o = run(&["--joint-map", s(&map), "--quiet"]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    assert!(out.exists());
+    // A model without a skin: a warning, an error with --strict.
+    let (mut j, bin_chunk) = split(&renamed(&anim));
+    for n in j["nodes"].as_array_mut().unwrap() {
+        if let Some(o) = n.as_object_mut() {
+            o.remove("skin");
+        }
+    }
+    j.as_object_mut().unwrap().remove("skins");
+    let stat = d.join("static.glb");
+    std::fs::write(&stat, join(&j, &bin_chunk)).unwrap();
+    let _ = std::fs::remove_file(&out);
+    let o = bin()
+        .args([
+            "render",
+            s(&json),
+            "-o",
+            s(&out),
+            "--bird-model",
+            s(&stat),
+            "--quiet",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("no animatable joints"),
+        "{}",
+        stderr(&o)
+    );
+    let _ = std::fs::remove_file(&out);
+    let o = bin()
+        .args([
+            "--strict",
+            "render",
+            s(&json),
+            "-o",
+            s(&out),
+            "--bird-model",
+            s(&stat),
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(code(&o), 2);
+    assert!(stderr(&o).contains("no animatable joints"));
+    assert!(!out.exists());
+}
