@@ -20,6 +20,7 @@ const SWITCHES: &[&str] = &[
     "--sun",
     "--loop",
     "--strict",
+    "--pretty",
 ];
 
 /// The flags `formation ARGS --help` lists.

@@ -290,6 +290,12 @@ pub fn run(args: InitiateArgs, g: Global) -> Result<()> {
     super::course::warn(super::flags::Cmd::Initiate, g, &report)?;
     formation::wingbeat::rest::stand_on_ground(&mut anim, wing.species);
     formation::wingbeat::assign_phases(&mut anim, &wing)?;
+    super::check_bird_model(
+        super::flags::Cmd::Initiate,
+        g,
+        &args.scene.options(),
+        formation::wingbeat::WingbeatOptions::for_animation(&anim).species,
+    )?;
     super::write_animation(&anim, &args.output, &args.scene.options(), g)?;
     if args.json {
         let text = formation::finite::to_json_pretty("statistics", &stats)?;

@@ -209,18 +209,12 @@ pub fn check_bird_model(
 }
 
 /// Writes `anim` to every output (by extension: .json, .csv, .gif, DIR/, .glb), atomically, with
-/// a progress bar unless `--quiet`; a bird model is checked first ([`check_bird_model`]).
+/// a progress bar unless `--quiet`.
 pub fn write_animation(
     anim: &formation::Animation,
     outputs: &[std::path::PathBuf],
     opts: &formation::export::RenderOptions,
     g: Global,
 ) -> Result<()> {
-    check_bird_model(
-        flags::Cmd::Steady,
-        g,
-        opts,
-        formation::wingbeat::WingbeatOptions::for_animation(anim).species,
-    )?;
     formation::export::write_outputs(anim, outputs, opts, &progress::TermProgress::new(g.quiet))
 }

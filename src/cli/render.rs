@@ -138,6 +138,9 @@ pub struct SceneArgs {
     /// from 200 birds, skel below].
     #[arg(long, value_name = "skel|instancer")]
     pub usd_mode: Option<formation::export::UsdMode>,
+    /// Indent the written .json for reading (it is one compact line by default).
+    #[arg(long)]
+    pub pretty: bool,
 }
 
 /// Parses `--start-frame`: a whole number from 0 to the largest first frame.
@@ -176,6 +179,7 @@ impl SceneArgs {
             up: self.up,
             path_out: self.path_out.clone(),
             usd_mode: self.usd_mode,
+            pretty: self.pretty,
             ..RenderOptions::default()
         }
     }
@@ -267,6 +271,12 @@ pub fn run(args: RenderArgs, g: Global) -> Result<()> {
     // `--seed` does not apply: rendering is deterministic, and the clouds take the animation's seed.
     let _ = g.seed;
     write_outputs(&anim, &args.output, &opts, &TermProgress::new(g.quiet))?;
-    super::summary::render(g, &anim, &args.animation, &args.output);
+    let written: Vec<PathBuf> = args
+        .output
+        .iter()
+        .chain(opts.path_out.iter())
+        .cloned()
+        .collect();
+    super::summary::render(g, &anim, &args.animation, &written);
     Ok(())
 }

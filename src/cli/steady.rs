@@ -237,6 +237,12 @@ pub fn run(args: SteadyArgs, g: Global) -> Result<()> {
     let course = formation::pipeline::course_stage(&mut anim, path.as_ref(), &config)?;
     super::course::warn(super::flags::Cmd::Steady, g, &course)?;
     formation::wingbeat::assign_phases(&mut anim, &config.wingbeat)?;
+    super::check_bird_model(
+        super::flags::Cmd::Steady,
+        g,
+        &args.scene.options(),
+        formation::wingbeat::WingbeatOptions::for_animation(&anim).species,
+    )?;
     super::write_animation(&anim, &args.output, &args.scene.options(), g)?;
     if let Some(r) = &args.report {
         write_json_atomic(r, &outcome)?;

@@ -36,7 +36,7 @@ use std::path::{Path, PathBuf};
 
 use crate::animation::Animation;
 use crate::error::{Error, Result};
-use crate::io::{write_bytes_atomic, write_json_atomic, AtomicFile, OutputKind};
+use crate::io::{write_bytes_atomic, AtomicFile, OutputKind};
 use crate::progress::Progress;
 
 pub use camera::CameraKind;
@@ -119,12 +119,14 @@ pub struct RenderOptions {
     pub up: crate::animation::axes::Up,
     /// Also write the path the flock flew ([`Animation::flown_path`]) to this `.json`, in the
     /// path file format (`{"units": ..., "points": [[x, y, z], ...]}`, world frame, z up) in
-    /// `units`, which `--path` reads back.
+    /// `units`, which `course.path` reads back.
     pub path_out: Option<PathBuf>,
     /// How the `.usda` holds the birds: one skinned bird each (`skel`) or a point-instanced
     /// crowd of posed prototypes (`instancer`, see [`crowd`]); `None` = instancer from
     /// [`crowd::INSTANCER_FROM`] birds, skel below.
     pub usd_mode: Option<UsdMode>,
+    /// Indent the written animation JSON (and the flown path) for reading; compact by default.
+    pub pretty: bool,
 }
 
 /// How the `.usda` holds the birds ([`RenderOptions::usd_mode`]).
@@ -188,6 +190,7 @@ impl Default for RenderOptions {
             up: crate::animation::axes::Up::Z,
             path_out: None,
             usd_mode: None,
+            pretty: false,
         }
     }
 }
@@ -551,7 +554,7 @@ pub fn write_outputs(
                 if !(opts.units.is_default() && opts.up.is_default()) {
                     a = a.in_axes(opts.units, opts.up);
                 }
-                write_json_atomic(&o.path, &a)?;
+                crate::io::write_json_atomic_as(&o.path, &a, opts.pretty)?;
             }
             OutputKind::Csv => {
                 // Streamed into the temporary file (not built in memory: up to 1.4 GB).
@@ -626,7 +629,7 @@ pub fn write_outputs(
             "units": opts.units.to_string(),
             "points": points,
         });
-        write_json_atomic(p, &doc)?;
+        crate::io::write_json_atomic_as(p, &doc, opts.pretty)?;
     }
     Ok(())
 }
