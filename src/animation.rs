@@ -582,6 +582,36 @@ impl Animation {
                         format!("frames[{k}].{name}[{i}]: {:e} is beyond ±{bound:e}", arr[i]),
                     ));
                 }
+                if name == "speed" {
+                    if let Some(i) = arr.iter().position(|v| *v < 0.0) {
+                        return Err(Error::format(
+                            origin,
+                            format!(
+                                "frames[{k}].speed[{i}]: {} is negative; a speed is wingspans per second, 0 or more",
+                                arr[i]
+                            ),
+                        ));
+                    }
+                }
+            }
+        }
+        if let Some(sp) = &self.species {
+            if sp.parse::<wing::Species>().is_err() {
+                return Err(Error::format(
+                    origin,
+                    format!(
+                        "species: \"{sp}\" is not a species formation draws ({}); give one of them or leave the field out",
+                        wing::Species::ALL.map(|s| s.name()).join(", ")
+                    ),
+                ));
+            }
+        }
+        if let Some(p) = &self.path {
+            if !(p.length.is_finite() && p.length >= 0.0) {
+                return Err(Error::format(
+                    origin,
+                    format!("path.length: {} is not a length (0 or more)", p.length),
+                ));
             }
         }
         for (s, st) in self.stages.iter().enumerate() {
