@@ -26,7 +26,7 @@ use glam::{Quat, Vec3};
 
 use super::bird::{self, BirdAsset, PARENT};
 use super::gltf::{asset_for, SceneOptions};
-use super::usd::{f, flown_path_prim, stage_head, time_code, vec3};
+use super::usd::{flown_path_prim, stage_head, time_code, topology, vec3};
 use crate::animation::Animation;
 use crate::wingbeat::{Flapper, WingPose};
 
@@ -266,16 +266,7 @@ pub fn write_usda_instancer(
 /// The prototypes: one static mesh of the bird per pose, under `/flock/crowd/prototypes`.
 fn prototypes(asset: &BirdAsset, poses: &[WingPose], ws: f32) -> String {
     let m = &asset.mesh;
-    let mut counts = Vec::new();
-    let mut indices = Vec::new();
-    let mut colours = Vec::new();
-    for ((_, idx), rgb) in m.parts.iter().zip(&m.colours) {
-        for t in idx.chunks_exact(3) {
-            counts.push("3".to_string());
-            indices.extend(t.iter().map(|i| i.to_string()));
-            colours.push(format!("({}, {}, {})", f(rgb[0]), f(rgb[1]), f(rgb[2])));
-        }
-    }
+    let (counts, indices, colours) = topology(m);
     let (counts, indices, colours) = (counts.join(", "), indices.join(", "), colours.join(", "));
     let mut s = String::new();
     let _ = writeln!(s, "        def Scope \"prototypes\"\n        {{");

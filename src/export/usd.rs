@@ -278,6 +278,22 @@ fn mesh_attr<T: AsRef<str>>(s: &mut String, decl: &str, values: &[T], meta: &[&s
     let _ = writeln!(s);
 }
 
+/// The mesh's triangles as USD values: `faceVertexCounts` (all 3), `faceVertexIndices` and the
+/// per-face `displayColor` of each triangle's part.
+pub(super) fn topology(m: &bird::SkinnedMesh) -> (Vec<&'static str>, Vec<String>, Vec<String>) {
+    let mut counts = Vec::new();
+    let mut indices = Vec::new();
+    let mut colours = Vec::new();
+    for ((_, idx), rgb) in m.parts.iter().zip(&m.colours) {
+        for t in idx.chunks_exact(3) {
+            counts.push("3");
+            indices.extend(t.iter().map(|i| i.to_string()));
+            colours.push(format!("({}, {}, {})", f(rgb[0]), f(rgb[1]), f(rgb[2])));
+        }
+    }
+    (counts, indices, colours)
+}
+
 fn prototype(asset: &BirdAsset, ws: f32) -> String {
     let skel = &asset.skeleton;
     let paths = bird::usd_joint_paths();
@@ -303,16 +319,7 @@ fn prototype(asset: &BirdAsset, ws: f32) -> String {
         })
         .collect();
     let m = &asset.mesh;
-    let mut counts = Vec::new();
-    let mut indices = Vec::new();
-    let mut colours = Vec::new();
-    for ((_, idx), rgb) in m.parts.iter().zip(&m.colours) {
-        for t in idx.chunks_exact(3) {
-            counts.push("3");
-            indices.extend(t.iter().map(|i| i.to_string()));
-            colours.push(format!("({}, {}, {})", f(rgb[0]), f(rgb[1]), f(rgb[2])));
-        }
-    }
+    let (counts, indices, colours) = topology(m);
     let points: Vec<String> = m.positions.iter().map(|&p| vec3(p * ws)).collect();
     let normals: Vec<String> = m.normals.iter().map(|&p| vec3(p)).collect();
     let (lo, hi) = m.positions.iter().fold(
