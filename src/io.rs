@@ -102,6 +102,11 @@ pub fn read_text(path: &Path) -> Result<String> {
         if (buf.len() + n) as u64 > limit {
             return Err(too_big(path, None, limit));
         }
+        if buf.is_empty() {
+            if let Some(e) = utf16_text(path, &chunk[..n]) {
+                return Err(e);
+            }
+        }
         if let Some(k) = chunk[..n].iter().position(|&b| b == 0) {
             return Err(Error::format(
                 path,
@@ -123,6 +128,34 @@ pub fn read_text(path: &Path) -> Result<String> {
         return Err(not_utf8(path, valid));
     }
     String::from_utf8(buf).map_err(|e| not_utf8(path, e.utf8_error().valid_up_to()))
+}
+
+/// An error naming UTF-16 text (as Windows tools such as PowerShell's `>` and Excel's "Unicode
+/// text" write it) when `head`, the file's first bytes, starts with a UTF-16 byte-order mark or
+/// has the zero high bytes of ASCII in UTF-16; `None` otherwise.
+fn utf16_text(path: &Path, head: &[u8]) -> Option<Error> {
+    let order = match head {
+        [0xFF, 0xFE, ..] => Some("little-endian"),
+        [0xFE, 0xFF, ..] => Some("big-endian"),
+        _ => {
+            // Without a mark: ASCII characters with a zero byte beside each one.
+            let pairs: Vec<&[u8]> = head.chunks_exact(2).take(64).collect();
+            let ascii = |b: u8| b == b'\t' || b == b'\n' || b == b'\r' || (0x20..0x7F).contains(&b);
+            if pairs.len() >= 2 && pairs.iter().all(|p| p[1] == 0 && ascii(p[0])) {
+                Some("little-endian")
+            } else if pairs.len() >= 2 && pairs.iter().all(|p| p[0] == 0 && ascii(p[1])) {
+                Some("big-endian")
+            } else {
+                None
+            }
+        }
+    }?;
+    Some(Error::format(
+        path,
+        format!(
+            "UTF-16 text ({order}), expected UTF-8; save it as UTF-8 (e.g. `iconv -f UTF-16 -t UTF-8`)"
+        ),
+    ))
 }
 
 fn not_utf8(path: &Path, offset: usize) -> Error {
@@ -873,6 +906,32 @@ pub fn remove_open_temporaries() {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn utf16_text_is_named_with_or_without_a_mark() {
+        let p = Path::new("a.json");
+        let le: Vec<u8> = "{\"frames\": []}"
+            .encode_utf16()
+            .flat_map(|u| u.to_le_bytes())
+            .collect();
+        let be: Vec<u8> = "x,y\n1,2\n"
+            .encode_utf16()
+            .flat_map(|u| u.to_be_bytes())
+            .collect();
+        let marked = [&[0xFF, 0xFE][..], &le].concat();
+        for (head, order) in [(&marked, "little"), (&le, "little"), (&be, "big")] {
+            let e = utf16_text(p, head).expect("UTF-16").to_string();
+            assert!(e.contains("UTF-16 text") && e.contains(order), "{e}");
+        }
+        // UTF-8 text, binary data and a lone zero are not UTF-16 text.
+        for head in [
+            &b"{\"frames\": []}"[..],
+            &[0x89, b'P', b'N', b'G', 0, 0][..],
+            &[0u8][..],
+        ] {
+            assert!(utf16_text(p, head).is_none(), "{head:?}");
+        }
+    }
 
     #[test]
     fn uncommitted_file_leaves_nothing_and_keeps_existing() {

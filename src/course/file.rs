@@ -21,8 +21,10 @@ pub const MAX_POINTS: usize = 100_000;
 /// repeats a closed one).
 pub const MAX_LENGTH: f64 = 100_000.0;
 
-/// Two control points closer than this are the same point, wingspans.
-pub const REPEAT_DISTANCE: f64 = 1e-6;
+/// Two control points closer than this are the same point, wingspans (1.5 cm for a goose): one
+/// threshold for repeated points and for a closed path's last point returning to its first
+/// (a millionth of a wingspan before, so points a hair farther apart counted as distinct).
+pub const REPEAT_DISTANCE: f64 = 0.01;
 
 /// Units of a path's coordinates.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -293,7 +295,7 @@ fn check(path: &Path, raw: Vec<[f64; 3]>, scale: f64) -> Result<PathPoints> {
             return Err(Error::format(
                 path,
                 format!(
-                    "point {i}: repeats point {} ({}); remove it",
+                    "point {i}: repeats point {} ({}): closer than {REPEAT_DISTANCE} wingspans to it; remove it",
                     i - 1,
                     show(points[i])
                 ),

@@ -318,6 +318,7 @@ pub fn apply(
         depth = depth.max(hi - lo);
     }
     check_above_ground(points, &origin)?;
+    check_steepness(points, &origin)?;
     check_backwards(points, depth, &origin)?;
     let (r_min, why) = min_radius(d_lo, d_hi, flight.speed, g, opts);
     let dense = spline::spline_points(&points.points, points.closed);
@@ -571,6 +572,43 @@ fn check_above_ground(points: &PathPoints, origin: &Path) -> Result<()> {
         )),
         None => Ok(()),
     }
+}
+
+/// Steepest climb or descent of a leg between two control points, degrees: a formation of large
+/// birds climbs out at a few degrees and glides down at less than ten; past this a leg is
+/// a wall the flock cannot follow (our choice of a generous bound, so that stylised shots keep
+/// their steep climbs).
+pub const MAX_LEG_SLOPE_DEG: f64 = 45.0;
+
+/// Refuses a leg climbing or descending more steeply than [`MAX_LEG_SLOPE_DEG`], naming its
+/// points (the spline through such a leg folds back on itself, which the course used to report
+/// as a turn too tight to fly).
+fn check_steepness(points: &PathPoints, origin: &Path) -> Result<()> {
+    let p = &points.points;
+    let n = p.len();
+    let legs = if points.closed { n } else { n - 1 };
+    for i in 0..legs {
+        let (a, b) = (p[i], p[(i + 1) % n]);
+        let rise = b[2] - a[2];
+        let run = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt();
+        let slope = rise.abs().atan2(run).to_degrees();
+        if slope > MAX_LEG_SLOPE_DEG {
+            let need = rise.abs() / MAX_LEG_SLOPE_DEG.to_radians().tan();
+            return Err(Error::format(
+                origin,
+                format!(
+                    "points {i} ({}) to {} ({}): the path {} {:.1} wingspans over {:.1} wingspans of ground ({slope:.0}°), steeper than the {MAX_LEG_SLOPE_DEG:.0}° a flock can follow; spread the height change over at least {need:.0} wingspans",
+                    file::show(a),
+                    (i + 1) % n,
+                    file::show(b),
+                    if rise > 0.0 { "climbs" } else { "descends" },
+                    rise.abs(),
+                    run
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// The first control point where the path turns back by more than 150° (its index, the turn in

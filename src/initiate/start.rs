@@ -278,18 +278,54 @@ impl StartState {
                 ));
             }
         }
-        for i in 0..birds {
-            for j in 0..i {
-                if s.x[i] == s.x[j] && s.y[i] == s.y[j] {
-                    return Err(Error::format(
-                        path,
-                        format!("birds {j} and {i} start at the same position"),
-                    ));
-                }
-            }
+        if let Some((j, i, d)) = closest_pair_below(&s.x, &s.y, START_MIN_SEPARATION) {
+            return Err(Error::format(
+                path,
+                if d == 0.0 {
+                    format!(
+                        "birds {j} and {i} start at the same position ({}, {})",
+                        s.x[i], s.y[i]
+                    )
+                } else {
+                    format!(
+                        "birds {j} and {i} start {d:.2e} wingspans apart, closer than {START_MIN_SEPARATION} wingspans: their bodies overlap; move them apart"
+                    )
+                },
+            ));
         }
         Ok(s)
     }
+}
+
+/// Two birds of a start file closer than this, wingspans, overlap (a goose's body is about a
+/// fifth of its span across, so two bodies a tenth of a span apart already touch).
+pub const START_MIN_SEPARATION: f64 = 0.1;
+
+/// The first pair `(j, i, distance)`, `j < i`, of points `(x, y)` closer than `min` (in the
+/// order of `i`, then the closest `j`), found by a sweep along x: O(n log n) for spread points.
+fn closest_pair_below(x: &[f64], y: &[f64], min: f64) -> Option<(usize, usize, f64)> {
+    let mut order: Vec<usize> = (0..x.len()).collect();
+    order.sort_by(|&a, &b| x[a].total_cmp(&x[b]).then(a.cmp(&b)));
+    let mut found: Option<(usize, usize, f64)> = None;
+    for (k, &a) in order.iter().enumerate() {
+        for &b in &order[k + 1..] {
+            if x[b] - x[a] >= min {
+                break;
+            }
+            let d = (x[b] - x[a]).hypot(y[b] - y[a]);
+            if d < min {
+                let pair = (a.min(b), a.max(b), d);
+                let better = match found {
+                    None => true,
+                    Some((j, i, e)) => (pair.1, pair.2, pair.0) < (i, e, j),
+                };
+                if better {
+                    found = Some(pair);
+                }
+            }
+        }
+    }
+    found
 }
 
 /// Random start positions, headings and speeds (wingspans, radians, wingspans per second):
@@ -541,6 +577,7 @@ pub fn start_simulation(
                     format!("{} start positions for {n} birds", s.x.len()),
                 ));
             }
+            check_reach(s, params.max_speed, opts.max_time)?;
             let pos =
                 s.x.iter()
                     .zip(&s.y)
@@ -565,6 +602,35 @@ pub fn start_simulation(
     Ok((sim, plan))
 }
 
+/// Refuses a start file with a bird farther from the flock's middle (the median position) than
+/// it can fly within the time limit `max_time` at `max_speed` (wingspans per second): the
+/// take-off would run to the limit and fail to converge, as a distant bird did after a 300 s run.
+fn check_reach(s: &StartState, max_speed: f64, max_time: f64) -> Result<()> {
+    let median = |v: &[f64]| {
+        let mut v = v.to_vec();
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    if s.x.is_empty() {
+        return Ok(());
+    }
+    let (mx, my) = (median(&s.x), median(&s.y));
+    let reach = max_speed * max_time;
+    let far = (0..s.x.len())
+        .map(|i| (i, (s.x[i] - mx).hypot(s.y[i] - my)))
+        .max_by(|a, b| a.1.total_cmp(&b.1).then(b.0.cmp(&a.0)));
+    match far {
+        Some((i, d)) if d > reach => Err(Error::parameter(
+            "initiate.start",
+            format!(
+                "the start file's bird {i} is at ({}, {}), {d:.3e} wingspans from the middle of the flock ({mx}, {my}): more than the {reach:.0} wingspans it can fly within the time limit of {max_time} s; move it closer",
+                s.x[i], s.y[i]
+            ),
+        )),
+        _ => Ok(()),
+    }
+}
+
 /// The highest altitude a bird climbing from the ground at most `climb_rate` (wingspans per
 /// second, reached and shed at `vertical_accel`, wingspans per second squared) can reach and
 /// level off at within `seconds`: w (T − w/a), or a T²/4 when it never reaches the full rate.
@@ -574,5 +640,39 @@ pub fn reachable_altitude(climb_rate: f64, vertical_accel: f64, seconds: f64) ->
         w * (t - w / a)
     } else {
         a * t * t / 4.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_closest_pair_below_the_bound_is_found_by_the_sweep() {
+        let x = [0.0, 5.0, 1.0, 5.05, 9.0, 1.0];
+        let y = [0.0, 0.0, 3.0, 0.0, 0.0, 3.0];
+        // Birds 2 and 5 coincide; 1 and 3 are 0.05 apart: the pair with the lower second index
+        // comes first.
+        let (j, i, d) = closest_pair_below(&x, &y, 0.1).unwrap();
+        assert_eq!((j, i), (1, 3));
+        assert!((d - 0.05).abs() < 1e-12, "{d}");
+        assert_eq!(closest_pair_below(&x[..5], &y[..5], 0.01), None);
+        assert_eq!(closest_pair_below(&x, &y, 0.01), Some((2, 5, 0.0)));
+        // Against the brute force on a grid with near neighbours.
+        let n = 200;
+        let mut rng = <rand::rngs::StdRng as rand::SeedableRng>::seed_from_u64(7);
+        let xs: Vec<f64> = (0..n).map(|_| rng.random_range(0.0..20.0)).collect();
+        let ys: Vec<f64> = (0..n).map(|_| rng.random_range(0.0..20.0)).collect();
+        let d = |(j, i): (usize, usize)| (xs[i] - xs[j]).hypot(ys[i] - ys[j]);
+        let brute = (0..n)
+            .flat_map(|i| (0..i).map(move |j| (j, i)))
+            .filter(|&p| d(p) < 0.5)
+            .min_by(|&a, &b| {
+                a.1.cmp(&b.1)
+                    .then(d(a).total_cmp(&d(b)))
+                    .then(a.0.cmp(&b.0))
+            });
+        assert!(brute.is_some());
+        assert_eq!(closest_pair_below(&xs, &ys, 0.5).map(|p| (p.0, p.1)), brute);
     }
 }
