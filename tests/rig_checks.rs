@@ -218,3 +218,73 @@ fn on_the_command_line() {
     assert!(stderr(&o).contains("no animatable joints"));
     assert!(!out.exists());
 }
+
+/// Models that break the glTF rules in ways a reader could miss (found by probing): each is
+/// refused with one line naming the accessor, view, joint or extension, before any animation.
+#[test]
+fn models_breaking_the_gltf_rules_are_refused_naming_the_part() {
+    let d = scratch("rig-rules");
+    let anim = flock();
+    let (json, bin) = split(&glb_bytes(&anim, 1.5).unwrap());
+    let prim = json["meshes"][0]["primitives"][0].clone();
+    let pos = prim["attributes"]["POSITION"].as_u64().unwrap() as usize;
+    let idx = prim["indices"].as_u64().unwrap() as usize;
+    let pos_view = json["accessors"][pos]["bufferView"].as_u64().unwrap() as usize;
+    let node_of = |name: &str| {
+        json["nodes"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .position(|n| n["name"] == name)
+            .unwrap()
+    };
+    let edits: Vec<(&str, Box<dyn Fn(&mut Value)>, &str)> = vec![
+        (
+            "a required extension",
+            Box::new(|j| {
+                j["extensionsRequired"] = serde_json::json!(["KHR_draco_mesh_compression"])
+            }),
+            "requires the glTF extension KHR_draco_mesh_compression",
+        ),
+        (
+            "a stride shorter than the element",
+            Box::new(move |j| j["bufferViews"][pos_view]["byteStride"] = Value::from(4)),
+            "byteStride of 4 bytes, less than one element (12 bytes)",
+        ),
+        (
+            "byte positions",
+            Box::new(move |j| j["accessors"][pos]["componentType"] = Value::from(5121)),
+            "POSITION accessor",
+        ),
+        (
+            "float indices",
+            Box::new(move |j| j["accessors"][idx]["componentType"] = Value::from(5126)),
+            "index accessor",
+        ),
+        (
+            "a joint past the nodes",
+            Box::new(|j| j["skins"][0]["joints"][0] = Value::from(99_999)),
+            "skin: joint 0 is node 99999",
+        ),
+        (
+            "two joints named alike",
+            {
+                let arm = node_of("upper_arm.L");
+                Box::new(move |j| j["nodes"][arm]["name"] = Value::from("Hand_L"))
+            },
+            "both stand for the convention's joint \"hand.L\"",
+        ),
+    ];
+    for (what, edit, needle) in edits {
+        let mut j = json.clone();
+        edit(&mut j);
+        let model = d.join("bad.glb");
+        std::fs::write(&model, join(&j, &bin)).unwrap();
+        let e = bird_model::load(&model, Species::Goose).unwrap_err();
+        let msg = e.to_string();
+        assert_eq!(e.exit_code(), 2, "{what}: {msg}");
+        assert!(!msg.contains('\n'), "{what}: {msg}");
+        assert!(msg.contains(needle), "{what}: {msg}");
+    }
+    std::fs::remove_dir_all(&d).unwrap();
+}

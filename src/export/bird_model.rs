@@ -84,6 +84,14 @@ pub fn parse_with(
     map: Option<&JointMap>,
 ) -> Result<BirdAsset> {
     let (root, bin) = parse_glb(path, bytes)?;
+    if let Some(ext) = root.extensions_required.first() {
+        return Err(bad(
+            path,
+            format!(
+                "requires the glTF extension {ext}, which formation does not read; export the model without it (no mesh compression or quantization)"
+            ),
+        ));
+    }
     let r = Reader {
         path,
         root: &root,
@@ -325,6 +333,13 @@ impl Reader<'_> {
         let size = ct.size();
         let elem = size * width;
         let stride = view.byte_stride.map(|s| s.0).unwrap_or(elem);
+        if stride < elem {
+            return Err(self.err(format!(
+                "accessor {}: buffer view {} has a byteStride of {stride} bytes, less than one element ({elem} bytes)",
+                i.value(),
+                view_i.value()
+            )));
+        }
         // Offsets and lengths are the file's numbers (up to 2⁶⁴ − 1): checked arithmetic, so
         // that an absurd one is "past the end" rather than an overflow.
         let view_offset = view.byte_offset.map_or(0, |o| o.0 as usize);
@@ -482,7 +497,34 @@ impl Reader<'_> {
     }
 
     /// Triangle primitives of mesh `mi`; `joint_map` maps skin joint slots to the convention.
+    /// Refuses accessor `i` (a `what` accessor) unless its component type is one of `allowed`
+    /// (`expected` names them), as the glTF specification requires for that attribute.
+    fn component_types(
+        &self,
+        i: json::Index<json::Accessor>,
+        allowed: &[json::accessor::ComponentType],
+        what: &str,
+        expected: &str,
+    ) -> Result<()> {
+        let ct = self
+            .root
+            .accessors
+            .get(i.value())
+            .and_then(|a| match a.component_type {
+                json::validation::Checked::Valid(c) => Some(c.0),
+                _ => None,
+            });
+        match ct {
+            Some(c) if !allowed.contains(&c) => Err(self.err(format!(
+                "{what} accessor {}: component type {c:?}, expected {expected}",
+                i.value()
+            ))),
+            _ => Ok(()),
+        }
+    }
+
     fn prims(&self, mi: usize, joint_map: Option<&[usize]>) -> Result<Vec<Prim>> {
+        use json::accessor::ComponentType as C;
         let mesh = self
             .root
             .meshes
@@ -505,6 +547,12 @@ impl Reader<'_> {
             let Some(pos) = get(json::mesh::Semantic::Positions) else {
                 continue;
             };
+            self.component_types(
+                pos,
+                &[C::F32],
+                "POSITION",
+                "FLOAT (without the KHR_mesh_quantization extension)",
+            )?;
             let positions = self.vec3s(pos, "POSITION")?;
             let normals = match get(json::mesh::Semantic::Normals) {
                 Some(n) => Some(self.vec3s(n, "NORMAL")?),
@@ -512,7 +560,15 @@ impl Reader<'_> {
             };
             let nv = positions.len();
             let indices: Vec<u32> = match p.indices {
-                Some(i) => self.floats(i)?.0.into_iter().map(|v| v as u32).collect(),
+                Some(i) => {
+                    self.component_types(
+                        i,
+                        &[C::U8, C::U16, C::U32],
+                        "index",
+                        "UNSIGNED_BYTE, UNSIGNED_SHORT or UNSIGNED_INT",
+                    )?;
+                    self.floats(i)?.0.into_iter().map(|v| v as u32).collect()
+                }
                 None => (0..nv as u32).collect(),
             };
             if let Some(&bad_i) = indices.iter().find(|&&i| i as usize >= nv) {
@@ -575,6 +631,18 @@ impl Reader<'_> {
             }
             None => vec![Mat4::IDENTITY; skin.joints.len()],
         };
+        if let Some((slot, n)) = skin
+            .joints
+            .iter()
+            .enumerate()
+            .find(|(_, n)| n.value() >= self.root.nodes.len())
+        {
+            return Err(self.err(format!(
+                "skin: joint {slot} is node {}, but the model has {} nodes",
+                n.value(),
+                self.root.nodes.len()
+            )));
+        }
         let node_slot: BTreeMap<usize, usize> = skin
             .joints
             .iter()
@@ -595,6 +663,18 @@ impl Reader<'_> {
             let nm = norm_name(name);
             names.iter().position(|n| *n == nm)
         };
+        // Two joints standing for the same joint of the convention: one would silently win.
+        let mut seen: [Option<usize>; 7] = [None; 7];
+        for (slot, n) in skin.joints.iter().enumerate() {
+            if let Some(j) = ours(n.value()) {
+                if let Some(first) = seen[j].replace(slot) {
+                    return Err(self.err(format!(
+                        "skin: joints {first} and {slot} both stand for the convention's joint \"{}\" (names compare without case, namespace or separators); give every joint its own name or map them with --joint-map",
+                        JOINTS[j]
+                    )));
+                }
+            }
+        }
         let mut bind: [Option<Mat4>; 7] = [None; 7];
         for (slot, n) in skin.joints.iter().enumerate() {
             if let Some(j) = ours(n.value()) {
