@@ -478,6 +478,32 @@ impl Animation {
         Ok(a)
     }
 
+    /// Refuses an `fps` that contradicts the frame times: with three frames or more, the median
+    /// step between frames must be one frame at `fps` (within 1 %). Everything that samples an
+    /// animation (pictures, resampling, glTF keys, loops) takes the rate from `fps` and the
+    /// instants from `t`; a file whose two disagree would play at the wrong speed or repeat frames.
+    /// Two-frame files (a start and an end) have no rate to contradict.
+    fn check_fps(&self, origin: &Path) -> Result<()> {
+        if self.frames.len() < 3 {
+            return Ok(());
+        }
+        let mut steps: Vec<f64> = self.frames.windows(2).map(|w| w[1].t - w[0].t).collect();
+        steps.sort_by(f64::total_cmp);
+        let step = steps[steps.len() / 2];
+        if step > 0.0 && ((step * self.fps) - 1.0).abs() > 0.01 {
+            return Err(Error::format(
+                origin,
+                format!(
+                    "fps: {} contradicts the frame times, whose median step is {step:.6} s ({:.3} frames per second); give \"fps\": {:.3} or fix the times",
+                    self.fps,
+                    1.0 / step,
+                    1.0 / step
+                ),
+            ));
+        }
+        Ok(())
+    }
+
     /// Checks the format tag, array lengths, finiteness and stage ranges; `origin` names the file.
     pub fn validate(&self, origin: &Path) -> Result<()> {
         if self.format != ANIMATION_FORMAT {
@@ -595,6 +621,7 @@ impl Animation {
                 }
             }
         }
+        self.check_fps(origin)?;
         if let Some(sp) = &self.species {
             if sp.parse::<wing::Species>().is_err() {
                 return Err(Error::format(

@@ -1,6 +1,6 @@
 //! Animation files that contradict themselves are refused with one line naming the field: an
-//! unknown species, a negative speed, a negative path length. The same file without the fault
-//! renders.
+//! unknown species, a negative speed, a negative path length, an `fps` the frame times deny. The
+//! same file without the fault renders.
 
 mod support;
 
@@ -57,6 +57,11 @@ fn self_contradicting_animation_files_are_refused() {
                     "closed": false, "length": -5.0, "widened": false});
             }),
             "path.length",
+        ),
+        (
+            // Frames 1/30 s apart in a file claiming 60 fps.
+            Box::new(|v| v["fps"] = Value::from(60.0)),
+            "fps: 60 contradicts the frame times, whose median step is 0.033333 s (30.000 frames per second)",
         ),
     ];
     for (change, needle) in cases {
