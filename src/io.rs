@@ -649,6 +649,7 @@ impl AtomicFile {
     /// Creates the temporary file for `target`. Fails (naming `target`) if its directory is missing
     /// or not writable, or if `target` is a directory.
     pub fn create(target: &Path) -> Result<AtomicFile> {
+        set_current_output(target);
         if target.is_dir() {
             return Err(Error::format(
                 target,
@@ -770,6 +771,7 @@ pub struct AtomicDir {
 impl AtomicDir {
     /// Creates the temporary directory for `target`.
     pub fn create(target: &Path) -> Result<AtomicDir> {
+        set_current_output(target);
         let trimmed = without_trailing_slash(target);
         if fs::symlink_metadata(&trimmed).is_ok_and(|m| !m.is_dir()) {
             return Err(Error::format(&trimmed, "exists and is not a directory"));
@@ -881,6 +883,53 @@ static REGISTRY: std::sync::Mutex<Option<Registry>> = std::sync::Mutex::new(None
 fn with_registry<R>(f: impl FnOnce(&mut Registry) -> R) -> R {
     let mut guard = REGISTRY.lock().unwrap_or_else(|p| p.into_inner());
     f(guard.get_or_insert_with(Registry::default))
+}
+
+/// The output being written now (set by the writers), named when memory runs out.
+static CURRENT_OUTPUT: std::sync::Mutex<Option<PathBuf>> = std::sync::Mutex::new(None);
+
+/// Records `path` as the output being written, for [`out_of_memory`]'s message.
+pub fn set_current_output(path: &Path) {
+    let mut g = CURRENT_OUTPUT.lock().unwrap_or_else(|p| p.into_inner());
+    *g = Some(path.to_path_buf());
+}
+
+/// What the binary does when an allocation of `bytes` fails (its allocator calls this instead of
+/// aborting): removes the run's temporaries (the outputs it replaces are untouched until the
+/// final rename, so they stay as they were), writes one line on stderr naming the output being
+/// written and the size, and ends the process with exit code 2. Nothing here allocates except
+/// the removal of a temporary directory; locks are only tried, so an allocation that failed while
+/// one was held cannot deadlock.
+pub fn out_of_memory(bytes: usize) -> ! {
+    if let Ok(mut guard) = REGISTRY.try_lock() {
+        if let Some(r) = guard.as_mut() {
+            for p in r.open.iter() {
+                remove_any(p);
+            }
+        }
+        // Keep it locked: nothing is created or committed between the cleanup and the exit.
+        std::mem::forget(guard);
+    }
+    let mut line = [0u8; 1024];
+    let len = {
+        let mut w: &mut [u8] = &mut line;
+        let output = CURRENT_OUTPUT.try_lock().ok();
+        let what = output.as_ref().and_then(|g| g.as_deref());
+        let _ = match what {
+            Some(p) => write!(
+                w,
+                "error: {}: out of memory: {bytes} more bytes could not be allocated; lower --size, the frame rate, the flock or the length, or raise the memory limit; no output written\n",
+                p.display()
+            ),
+            None => write!(
+                w,
+                "error: out of memory: {bytes} more bytes could not be allocated; lower the flock, the length or --size, or raise the memory limit; no output written\n"
+            ),
+        };
+        1024 - w.len()
+    };
+    let _ = std::io::Write::write_all(&mut std::io::stderr(), &line[..len]);
+    std::process::exit(2)
 }
 
 /// Removes every temporary file or directory still open (called on a terminating signal, right

@@ -9,6 +9,70 @@ use std::process::ExitCode;
 
 use clap::Parser;
 
+/// The binary's allocator: the system's, except that an allocation that fails ends the run
+/// cleanly ([`formation::io::out_of_memory`]: temporaries removed, one line naming the output and
+/// the size, exit 2) instead of aborting with a backtrace and leaving temporaries behind.
+#[cfg(feature = "cli")]
+mod guarded_alloc {
+    use std::alloc::{GlobalAlloc, Layout, System};
+    use std::cell::Cell;
+    use std::sync::atomic::{AtomicBool, Ordering};
+
+    struct Guarded;
+
+    /// Set by the first thread that runs out of memory.
+    static FAILING: AtomicBool = AtomicBool::new(false);
+
+    thread_local! {
+        static HANDLING: Cell<bool> = const { Cell::new(false) };
+    }
+
+    #[cold]
+    fn failed(bytes: usize) -> ! {
+        if HANDLING.with(|h| h.replace(true)) {
+            // The handler itself could not allocate: nothing gentler is left.
+            std::process::abort();
+        }
+        if FAILING.swap(true, Ordering::SeqCst) {
+            // Another thread is reporting and ending the process: wait for it.
+            loop {
+                std::thread::sleep(std::time::Duration::from_secs(1));
+            }
+        }
+        formation::io::out_of_memory(bytes)
+    }
+
+    unsafe impl GlobalAlloc for Guarded {
+        unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+            let p = System.alloc(layout);
+            if p.is_null() {
+                failed(layout.size());
+            }
+            p
+        }
+        unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
+            let p = System.alloc_zeroed(layout);
+            if p.is_null() {
+                failed(layout.size());
+            }
+            p
+        }
+        unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+            System.dealloc(ptr, layout)
+        }
+        unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+            let p = System.realloc(ptr, layout, new_size);
+            if p.is_null() {
+                failed(new_size);
+            }
+            p
+        }
+    }
+
+    #[global_allocator]
+    static ALLOCATOR: Guarded = Guarded;
+}
+
 fn main() -> ExitCode {
     ExitCode::from(run_main(std::env::args_os()))
 }

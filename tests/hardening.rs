@@ -741,3 +741,88 @@ fn the_flag_or_file_at_fault_is_named() {
     assert!(names(&dir).is_empty(), "{:?}", names(&dir));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Running out of memory (under `ulimit -v`) ends in exit 2 and one line naming the output and
+/// the size, removes the run's temporaries and leaves the old outputs as they were: it was an
+/// abort (exit 134) with "memory allocation of 8294400 bytes failed", a backtrace and a
+/// temporary left behind.
+#[test]
+fn running_out_of_memory_is_one_line_and_leaves_the_old_outputs() {
+    let dir = scratch("oom");
+    let anim = repo_file("tests/data/flock_small.json")
+        .display()
+        .to_string();
+    let example = support::example_arg("barnacle_geese_v.json");
+    // A 10 MB animation for the report (it needs about 45 MB; the flock_small page fits in 20).
+    let o = run_in(
+        &dir,
+        &[
+            "animate",
+            &example,
+            "--birds",
+            "120",
+            "--seconds",
+            "5",
+            "-o",
+            "mid.json",
+        ],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    std::fs::rename(dir.join("mid.json"), dir.with_extension("mid.json")).unwrap();
+    let mid = dir.with_extension("mid.json").display().to_string();
+    let runs: [(&str, u64, Vec<&str>, &[&str]); 3] = [
+        (
+            "render to a 1920x1080 GIF and a .glb",
+            100_000,
+            vec![
+                "render",
+                &anim,
+                "--size",
+                "1920x1080",
+                "-o",
+                "a.gif",
+                "-o",
+                "a.glb",
+            ],
+            &["a.gif", "a.glb"],
+        ),
+        (
+            "animate 200 birds",
+            30_000,
+            vec!["animate", &example, "--birds", "200", "-o", "a.json"],
+            &["a.json"],
+        ),
+        (
+            "report on a 10 MB animation",
+            25_000,
+            vec!["report", &mid, "-o", "a.html"],
+            &["a.html"],
+        ),
+    ];
+    for (what, cap, args, outputs) in runs {
+        for o in outputs {
+            std::fs::write(dir.join(o), VICTIM).unwrap();
+        }
+        let (o, _) = run_capped(&dir, cap, None, &args);
+        let err = stderr(&o);
+        assert_eq!(support::code(&o), 2, "{what}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{what}: {err}");
+        assert!(
+            err.starts_with("error: ")
+                && err.contains("out of memory")
+                && err.contains("bytes could not be allocated"),
+            "{what}: {err}"
+        );
+        for o in outputs {
+            assert_eq!(std::fs::read(dir.join(o)).unwrap(), VICTIM, "{what}: {o}");
+        }
+        let mut want: Vec<String> = outputs.iter().map(|s| s.to_string()).collect();
+        want.sort();
+        assert_eq!(names(&dir), want, "{what}: temporaries left");
+        for o in outputs {
+            std::fs::remove_file(dir.join(o)).unwrap();
+        }
+    }
+    std::fs::remove_file(dir.with_extension("mid.json")).unwrap();
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -547,6 +547,7 @@ pub fn write_outputs(
     };
     let threads = pictures::worker_count(opts.threads);
     for o in &plan {
+        crate::io::set_current_output(&o.path);
         match o.kind {
             OutputKind::Json => {
                 let mut a = anim.clone();
