@@ -279,9 +279,21 @@ where
     })
 }
 
-/// GIF frames are drawn, differenced and compressed in batches of this many frames (bounded
-/// memory: a batch holds its RGBA pictures).
+/// GIF frames are drawn, differenced and compressed in batches of at most this many frames
+/// (bounded memory: a batch holds its RGBA pictures and sub-frames).
 const GIF_BATCH: usize = 16;
+
+/// Bytes of RGBA pictures a GIF batch may hold: 16 frames up to 1920×1080 (133 MB), fewer for
+/// larger pictures (two at 8K, where 16 held 2.1 GB and the run peaked at 3.1 GB).
+const GIF_BATCH_BYTES: usize = 136 << 20;
+
+/// Frames per GIF batch for `w × h` pictures and `threads` workers: as many as fit in
+/// [`GIF_BATCH_BYTES`], at least one per worker (and at least two), at most [`GIF_BATCH`]. The
+/// batch size changes nothing in the file: frames are differenced in order whatever the batches.
+fn gif_batch(w: usize, h: usize, threads: usize) -> usize {
+    let frame = (w * h * 4).max(1);
+    (GIF_BATCH_BYTES / frame).clamp(threads.clamp(2, GIF_BATCH), GIF_BATCH)
+}
 
 /// The part of `cur` that differs from `prev` as a GIF sub-frame: its bounding box, with
 /// unchanged pixels set to [`TRANSPARENT`] (shown through from the previous frame, which the
@@ -485,10 +497,11 @@ pub fn write_gif(film: &Film, path: &Path, threads: usize, progress: &dyn Progre
         let mut lookups: Vec<Lookup> = shown.chunks(band).map(|_| Lookup::new(&palette)).collect();
         // The previous frame's picture, the batch's sub-frames, and spare picture buffers.
         let mut last = vec![0u8; w * h * 4];
-        let mut deltas: Vec<Vec<u8>> = vec![vec![TRANSPARENT; w * h]; GIF_BATCH];
+        let batch = gif_batch(w, h, threads);
+        let mut deltas: Vec<Vec<u8>> = vec![vec![TRANSPARENT; w * h]; batch];
         let pool: std::sync::Mutex<Vec<Vec<u8>>> = std::sync::Mutex::new(Vec::new());
-        for start in (0..film.len()).step_by(GIF_BATCH) {
-            let count = GIF_BATCH.min(film.len() - start);
+        for start in (0..film.len()).step_by(batch) {
+            let count = batch.min(film.len() - start);
             // 1. Draw the batch in parallel (into buffers reused from earlier batches).
             let mut drawn: Vec<Vec<u8>> = Vec::with_capacity(count);
             run_frames(
