@@ -331,6 +331,7 @@ fn commands() -> Vec<Command> {
                 ("--frame", "100000", None),
                 ("--metric", "watts", None),
                 ("--formation", "5", None),
+                ("--dpi", "5000", None),
                 o("OUT/p.txt"),
                 seed.clone(),
             ],
@@ -338,7 +339,12 @@ fn commands() -> Vec<Command> {
         Command {
             name: &["plot", "xi"],
             base: strings(&["plot", "xi", &flock, "-o", "OUT/x.png"]),
-            cases: vec![("--formation", "5", None), o("OUT/x.txt"), seed.clone()],
+            cases: vec![
+                ("--formation", "5", None),
+                ("--dpi", "5000", None),
+                o("OUT/x.txt"),
+                seed.clone(),
+            ],
         },
         Command {
             name: &["plot", "shape"],
@@ -346,23 +352,38 @@ fn commands() -> Vec<Command> {
             cases: cat(vec![
                 read,
                 fit,
-                vec![("--frame", "999", None), o("OUT/s.txt"), seed.clone()],
+                vec![
+                    ("--frame", "999", None),
+                    ("--dpi", "0", None),
+                    o("OUT/s.txt"),
+                    seed.clone(),
+                ],
             ]),
         },
         Command {
             name: &["plot", "savings"],
             base: strings(&["plot", "savings", &flock, "-o", "OUT/s.png"]),
-            cases: vec![o("OUT/s.txt"), seed.clone()],
+            cases: vec![("--dpi", "nan", None), o("OUT/s.txt"), seed.clone()],
         },
         Command {
             name: &["plot", "paths"],
             base: strings(&["plot", "paths", &flock, "-o", "OUT/p.png"]),
-            cases: vec![("--formation", "5", None), o("OUT/p.txt"), seed.clone()],
+            cases: vec![
+                ("--formation", "5", None),
+                ("--dpi", "5000", None),
+                o("OUT/p.txt"),
+                seed.clone(),
+            ],
         },
         Command {
             name: &["plot", "wingbeat"],
             base: strings(&["plot", "wingbeat", "-o", "OUT/w.png"]),
-            cases: vec![("--species", "dodo", None), o("OUT/w.txt"), seed],
+            cases: vec![
+                ("--species", "dodo", None),
+                ("--dpi", "5000", None),
+                o("OUT/w.txt"),
+                seed,
+            ],
         },
     ]
 }

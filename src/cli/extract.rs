@@ -401,5 +401,5 @@ pub fn run_plot_shape(args: PlotShapeArgs, g: Global) -> Result<()> {
         threshold,
         &args.input,
     )?;
-    formation::plot::save(&chart, &args.output)
+    super::plot::save(&chart, &args.output)
 }

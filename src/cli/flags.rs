@@ -212,6 +212,18 @@ pub const FLAGS: &[(&str, &str, &[Cmd])] = &[
         &[PlotPower, PlotXi, PlotPaths],
     ),
     ("plot.frame", "--frame", &[PlotPower, PlotShape]),
+    (
+        "plot.dpi",
+        "--dpi",
+        &[
+            PlotPower,
+            PlotXi,
+            PlotShape,
+            PlotPaths,
+            PlotWingbeat,
+            PlotSavings,
+        ],
+    ),
 ];
 
 /// `text` with every option path that `cmd` has a flag for replaced by the flag. A path is

@@ -182,15 +182,46 @@ pub trait Chart {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult<DB>;
 }
 
+/// The resolution a chart's own size is meant for, dots per inch (a screen's).
+pub const SCREEN_DPI: f64 = 96.0;
+
+/// The resolutions a PNG chart may be drawn at, dots per inch (600 dpi is 6000 × 3750 pixels for
+/// the usual 960 × 600 chart).
+pub const DPI_RANGE: std::ops::RangeInclusive<f64> = 50.0..=600.0;
+
 /// Renders `chart` to `path` (`.png` or `.svg`, by extension), atomically.
 pub fn save<C: Chart>(chart: &C, path: &Path) -> Result<()> {
+    save_at(chart, path, None)
+}
+
+/// [`save`] with a PNG resolution: `Some(dpi)` draws the chart `dpi / 96` times larger on each
+/// side (the same layout, sharper: for print, 300 dpi) and records the resolution in the PNG;
+/// an SVG is resolution-free and unchanged.
+pub fn save_at<C: Chart>(chart: &C, path: &Path, dpi: Option<f64>) -> Result<()> {
     let kind = OutputKind::from_path(path, &[OutputKind::Png, OutputKind::Svg])?;
-    let bytes = render(chart, kind)?;
+    let bytes = render_at(chart, kind, dpi)?;
     write_bytes_atomic(path, &bytes)
 }
 
 /// Renders `chart` into the bytes of a PNG or SVG file.
 pub fn render<C: Chart>(chart: &C, kind: OutputKind) -> Result<Vec<u8>> {
+    render_at(chart, kind, None)
+}
+
+/// [`render`] at a PNG resolution (see [`save_at`]).
+pub fn render_at<C: Chart>(chart: &C, kind: OutputKind, dpi: Option<f64>) -> Result<Vec<u8>> {
+    if let Some(d) = dpi {
+        if !DPI_RANGE.contains(&d) {
+            return Err(Error::parameter(
+                "plot.dpi",
+                format!(
+                    "{d}: must be between {} and {} dots per inch",
+                    DPI_RANGE.start(),
+                    DPI_RANGE.end()
+                ),
+            ));
+        }
+    }
     register_font();
     let (w, h) = chart.size();
     let draw_err = |e: String| Error::Internal(format!("drawing chart: {e}"));
@@ -206,20 +237,69 @@ pub fn render<C: Chart>(chart: &C, kind: OutputKind) -> Result<Vec<u8>> {
             Ok(svg.into_bytes())
         }
         OutputKind::Png => {
+            let scale = dpi.map_or(1.0, |d| d / SCREEN_DPI);
+            let (w, h) = (
+                (f64::from(w) * scale).round() as u32,
+                (f64::from(h) * scale).round() as u32,
+            );
             let mut buf = vec![0u8; (w as usize) * (h as usize) * 3];
             {
                 let bitmap = BitMapBackend::with_buffer(&mut buf, (w, h));
-                let root = text::GlyphText::new(bitmap, FONT)
+                let root = text::GlyphText::with_scale(bitmap, FONT, scale)
                     .ok_or_else(|| Error::Internal("the bundled font does not load".into()))?
                     .into_drawing_area();
                 root.fill(&WHITE).map_err(|e| draw_err(e.to_string()))?;
                 chart.draw(&root).map_err(|e| draw_err(e.to_string()))?;
                 root.present().map_err(|e| draw_err(e.to_string()))?;
             }
-            encode_png_rgb(&buf, w, h)
+            let png = encode_png_rgb(&buf, w, h)?;
+            Ok(match dpi {
+                Some(d) => with_resolution(png, d),
+                None => png,
+            })
         }
         _ => Err(Error::Internal("charts are PNG or SVG".into())),
     }
+}
+
+/// `png` with a `pHYs` chunk after its header saying `dpi` dots per inch (as pixels per metre),
+/// so that layout and print software place it at its size.
+pub fn with_resolution(png: Vec<u8>, dpi: f64) -> Vec<u8> {
+    // Signature (8) + IHDR (4 length + 4 type + 13 data + 4 CRC) = 33 bytes.
+    const AFTER_IHDR: usize = 33;
+    if png.len() < AFTER_IHDR || &png[12..16] != b"IHDR" {
+        return png;
+    }
+    let ppm = (dpi / 0.0254).round() as u32;
+    let mut chunk = Vec::with_capacity(21);
+    chunk.extend_from_slice(&9u32.to_be_bytes());
+    chunk.extend_from_slice(b"pHYs");
+    chunk.extend_from_slice(&ppm.to_be_bytes());
+    chunk.extend_from_slice(&ppm.to_be_bytes());
+    chunk.push(1); // unit: metre
+    let crc = crc32(&chunk[4..]);
+    chunk.extend_from_slice(&crc.to_be_bytes());
+    let mut out = Vec::with_capacity(png.len() + chunk.len());
+    out.extend_from_slice(&png[..AFTER_IHDR]);
+    out.extend_from_slice(&chunk);
+    out.extend_from_slice(&png[AFTER_IHDR..]);
+    out
+}
+
+/// The CRC-32 of PNG chunks (ISO 3309, reflected, polynomial 0xEDB88320).
+fn crc32(bytes: &[u8]) -> u32 {
+    let mut c = 0xFFFF_FFFFu32;
+    for &b in bytes {
+        c ^= u32::from(b);
+        for _ in 0..8 {
+            c = if c & 1 != 0 {
+                0xEDB8_8320 ^ (c >> 1)
+            } else {
+                c >> 1
+            };
+        }
+    }
+    !c
 }
 
 /// Encodes an RGB8 buffer as PNG bytes.

@@ -6,6 +6,11 @@
 //! `ab_glyph` (the rasteriser plotters uses), at the same layout box plotters measures (the sum
 //! of advances and kerning, so chart layout does not move), with the bearing kept. Everything
 //! else is passed to the wrapped backend.
+//!
+//! With a scale (a chart drawn at more than its screen resolution, `plot --dpi 300`), the chart
+//! is laid out at its usual size and everything is drawn `scale` times larger on the wrapped
+//! backend: coordinates, line widths, circle radii and text (glyphs rasterised at the larger
+//! size, so they stay sharp). At scale 1 the drawing is exactly the unscaled one.
 
 use ab_glyph::{Font, FontRef, ScaleFont};
 use plotters_backend::text_anchor::{HPos, VPos};
@@ -13,18 +18,62 @@ use plotters_backend::{
     BackendColor, BackendCoord, BackendStyle, BackendTextStyle, DrawingBackend, DrawingErrorKind,
 };
 
-/// A bitmap backend whose text is drawn by [`draw_glyphs`].
+/// A bitmap backend whose text is drawn by [`draw_glyphs`], optionally at a scale.
 pub struct GlyphText<DB> {
     inner: DB,
     font: FontRef<'static>,
+    scale: f64,
 }
 
 impl<DB: DrawingBackend> GlyphText<DB> {
     /// Wraps `inner`; `font` is the one font every chart uses.
     pub fn new(inner: DB, font: &'static [u8]) -> Option<Self> {
-        FontRef::try_from_slice(font)
-            .ok()
-            .map(|font| GlyphText { inner, font })
+        Self::with_scale(inner, font, 1.0)
+    }
+
+    /// Wraps `inner`, which is `scale` times the chart's size on each side.
+    pub fn with_scale(inner: DB, font: &'static [u8], scale: f64) -> Option<Self> {
+        FontRef::try_from_slice(font).ok().map(|font| GlyphText {
+            inner,
+            font,
+            scale: if scale.is_finite() && scale > 0.0 {
+                scale
+            } else {
+                1.0
+            },
+        })
+    }
+
+    fn at(&self, p: BackendCoord) -> BackendCoord {
+        if self.scale == 1.0 {
+            return p;
+        }
+        (
+            (f64::from(p.0) * self.scale).round() as i32,
+            (f64::from(p.1) * self.scale).round() as i32,
+        )
+    }
+
+    fn len(&self, v: u32) -> u32 {
+        if self.scale == 1.0 {
+            return v;
+        }
+        (f64::from(v) * self.scale).round().max(1.0) as u32
+    }
+}
+
+/// A style with its line width scaled.
+struct Wider<'a, S> {
+    style: &'a S,
+    width: u32,
+}
+
+impl<S: BackendStyle> BackendStyle for Wider<'_, S> {
+    fn color(&self) -> BackendColor {
+        self.style.color()
+    }
+    fn stroke_width(&self) -> u32 {
+        self.width
     }
 }
 
@@ -55,7 +104,14 @@ impl<DB: DrawingBackend> DrawingBackend for GlyphText<DB> {
     type ErrorType = DB::ErrorType;
 
     fn get_size(&self) -> (u32, u32) {
-        self.inner.get_size()
+        let (w, h) = self.inner.get_size();
+        if self.scale == 1.0 {
+            return (w, h);
+        }
+        (
+            (f64::from(w) / self.scale).round() as u32,
+            (f64::from(h) / self.scale).round() as u32,
+        )
     }
     fn ensure_prepared(&mut self) -> Result<(), DrawingErrorKind<Self::ErrorType>> {
         self.inner.ensure_prepared()
@@ -68,7 +124,17 @@ impl<DB: DrawingBackend> DrawingBackend for GlyphText<DB> {
         point: BackendCoord,
         color: BackendColor,
     ) -> Result<(), DrawingErrorKind<Self::ErrorType>> {
-        self.inner.draw_pixel(point, color)
+        if self.scale == 1.0 {
+            return self.inner.draw_pixel(point, color);
+        }
+        // One chart pixel is a square of the scaled size.
+        let a = self.at(point);
+        let b = self.at((point.0 + 1, point.1 + 1));
+        let fill = Wider {
+            style: &color,
+            width: 1,
+        };
+        self.inner.draw_rect(a, (b.0 - 1, b.1 - 1), &fill, true)
     }
     fn draw_line<S: BackendStyle>(
         &mut self,
@@ -76,7 +142,12 @@ impl<DB: DrawingBackend> DrawingBackend for GlyphText<DB> {
         to: BackendCoord,
         style: &S,
     ) -> Result<(), DrawingErrorKind<Self::ErrorType>> {
-        self.inner.draw_line(from, to, style)
+        let wide = Wider {
+            style,
+            width: self.len(style.stroke_width()),
+        };
+        let (from, to) = (self.at(from), self.at(to));
+        self.inner.draw_line(from, to, &wide)
     }
     fn draw_rect<S: BackendStyle>(
         &mut self,
@@ -85,14 +156,24 @@ impl<DB: DrawingBackend> DrawingBackend for GlyphText<DB> {
         style: &S,
         fill: bool,
     ) -> Result<(), DrawingErrorKind<Self::ErrorType>> {
-        self.inner.draw_rect(upper_left, bottom_right, style, fill)
+        let wide = Wider {
+            style,
+            width: self.len(style.stroke_width()),
+        };
+        let (a, b) = (self.at(upper_left), self.at(bottom_right));
+        self.inner.draw_rect(a, b, &wide, fill)
     }
     fn draw_path<S: BackendStyle, I: IntoIterator<Item = BackendCoord>>(
         &mut self,
         path: I,
         style: &S,
     ) -> Result<(), DrawingErrorKind<Self::ErrorType>> {
-        self.inner.draw_path(path, style)
+        let wide = Wider {
+            style,
+            width: self.len(style.stroke_width()),
+        };
+        let path: Vec<BackendCoord> = path.into_iter().map(|p| self.at(p)).collect();
+        self.inner.draw_path(path, &wide)
     }
     fn draw_circle<S: BackendStyle>(
         &mut self,
@@ -101,13 +182,19 @@ impl<DB: DrawingBackend> DrawingBackend for GlyphText<DB> {
         style: &S,
         fill: bool,
     ) -> Result<(), DrawingErrorKind<Self::ErrorType>> {
-        self.inner.draw_circle(center, radius, style, fill)
+        let wide = Wider {
+            style,
+            width: self.len(style.stroke_width()),
+        };
+        let (c, r) = (self.at(center), self.len(radius));
+        self.inner.draw_circle(c, r, &wide, fill)
     }
     fn fill_polygon<S: BackendStyle, I: IntoIterator<Item = BackendCoord>>(
         &mut self,
         vert: I,
         style: &S,
     ) -> Result<(), DrawingErrorKind<Self::ErrorType>> {
+        let vert: Vec<BackendCoord> = vert.into_iter().map(|p| self.at(p)).collect();
         self.inner.fill_polygon(vert, style)
     }
     fn blit_bitmap(
@@ -116,7 +203,22 @@ impl<DB: DrawingBackend> DrawingBackend for GlyphText<DB> {
         size: (u32, u32),
         src: &[u8],
     ) -> Result<(), DrawingErrorKind<Self::ErrorType>> {
-        self.inner.blit_bitmap(pos, size, src)
+        if self.scale == 1.0 {
+            return self.inner.blit_bitmap(pos, size, src);
+        }
+        // Each source pixel (RGB) as a square of the scaled size.
+        for (k, px) in src.chunks_exact(3).enumerate() {
+            let (x, y) = (
+                (k as u32 % size.0) as i32,
+                (k as u32 / size.0.max(1)) as i32,
+            );
+            let c = BackendColor {
+                alpha: 1.0,
+                rgb: (px[0], px[1], px[2]),
+            };
+            self.draw_pixel((pos.0 + x, pos.1 + y), c)?;
+        }
+        Ok(())
     }
     fn estimate_text_size<S: BackendTextStyle>(
         &self,
@@ -140,6 +242,16 @@ impl<DB: DrawingBackend> DrawingBackend for GlyphText<DB> {
         let ((min_x, min_y), (max_x, max_y)) = style
             .layout_box(text)
             .map_err(|e| DrawingErrorKind::FontError(Box::new(e)))?;
+        // The layout box at the scaled size (plotters measures at the chart's own size).
+        let k = |v: i32| {
+            if self.scale == 1.0 {
+                v
+            } else {
+                (f64::from(v) * self.scale).round() as i32
+            }
+        };
+        let (min_x, min_y, max_x, max_y) = (k(min_x), k(min_y), k(max_x), k(max_y));
+        let pos = self.at(pos);
         let (width, height) = (max_x - min_x, max_y - min_y);
         let dx = match style.anchor().h_pos {
             HPos::Left => 0,
@@ -154,7 +266,7 @@ impl<DB: DrawingBackend> DrawingBackend for GlyphText<DB> {
         let trans = style.transform();
         let (w, h) = self.inner.get_size();
         let mut pixels = Vec::new();
-        draw_glyphs(&self.font, style.size(), text, |x, y, a| {
+        draw_glyphs(&self.font, style.size() * self.scale, text, |x, y, a| {
             pixels.push((x, y, a))
         });
         for (x, y, a) in pixels {
