@@ -75,6 +75,8 @@ fn commands() -> Vec<Command> {
         ("--heading", "sideways", None),
         ("--wingspan-px", "-3", None),
         ("--y-origin", "middle", None),
+        // The examples are native annotations: one point per bird, no body parts.
+        ("--bodypart", "head", None),
     ];
     let fit: Vec<(&str, &str, Option<String>)> = vec![
         ("--threshold", "-1", None),

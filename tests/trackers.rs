@@ -206,3 +206,73 @@ fn damaged_tracker_files_exit_2_naming_file_and_row() {
     assert_eq!(code, 0, "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `--bodypart`: the SLEAP node or DeepLabCut body part giving each bird's position, matched
+/// without case; a name the file lacks is refused listing the file's, and a format with one point
+/// per bird refuses the option.
+#[test]
+fn a_body_part_is_chosen_by_name() {
+    for (name, text, part, dx) in [
+        ("sleap.csv", sleap(), "tail", -8.0),
+        ("sleap.csv", sleap(), "HEAD", 0.0),
+        ("dlc.csv", dlc(), "beak", 6.0),
+        ("dlc.csv", dlc(), "Body", 0.0),
+    ] {
+        let opts = ReadOptions {
+            wingspan_px: Some(20.0),
+            bodypart: Some(part.to_string()),
+            ..ReadOptions::default()
+        };
+        let a = parse_str(Path::new(name), &text, &opts).unwrap_or_else(|e| panic!("{name}: {e}"));
+        for (k, f) in a.frames.iter().enumerate() {
+            assert_eq!(f.birds.len(), BIRDS, "{name} {part}");
+            for i in 0..BIRDS {
+                let (x, y) = bird(k, i);
+                assert!(
+                    f.birds
+                        .iter()
+                        .any(|b| (b.px - (x + dx)).abs() < 1e-9 && (b.py - y).abs() < 1e-9),
+                    "{name} {part}: frame {k}: no bird at ({}, {y})",
+                    x + dx
+                );
+            }
+        }
+    }
+    let d = scratch("bodypart");
+    std::fs::write(d.join("dlc.csv"), dlc()).unwrap();
+    std::fs::write(d.join("sleap.csv"), sleap()).unwrap();
+    std::fs::write(d.join("gt.txt"), mot()).unwrap();
+    for (file, part, needles) in [
+        (
+            "dlc.csv",
+            "wing",
+            &["--bodypart", "no body part \"wing\"", "body, beak"][..],
+        ),
+        (
+            "sleap.csv",
+            "wing",
+            &["--bodypart", "no node \"wing\"", "head, tail"][..],
+        ),
+        ("gt.txt", "head", &["--bodypart", "one point per bird"][..]),
+    ] {
+        let f = d.join(file);
+        let out = d.join("p.json");
+        let (code, err) = run_quiet(&[
+            "extract",
+            s(&f),
+            "--wingspan-px",
+            "20",
+            "--bodypart",
+            part,
+            "-o",
+            s(&out),
+        ]);
+        assert_eq!(code, 2, "{file}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{file}: {err}");
+        for n in needles {
+            assert!(err.contains(n), "{file}: {n}: {err}");
+        }
+        assert!(!out.exists());
+    }
+    std::fs::remove_dir_all(&d).unwrap();
+}

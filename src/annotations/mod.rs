@@ -99,7 +99,7 @@ impl FromStr for YOrigin {
 }
 
 /// Options of [`read`]; each `Some` overrides what the file says.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct ReadOptions {
     /// Flight direction in the image (default: the file's, else up).
@@ -108,6 +108,9 @@ pub struct ReadOptions {
     pub wingspan_px: Option<f64>,
     /// Origin of pixel y in CSV files (default: top for long CSV, bottom for DLTdv).
     pub y_origin: Option<YOrigin>,
+    /// The body part (DeepLabCut) or node (SLEAP) giving each bird's position (default: the
+    /// first the file lists); an error for other formats.
+    pub bodypart: Option<String>,
 }
 
 /// The input formats of docs/formats.md §4.1.
@@ -401,6 +404,15 @@ fn detect_text(path: &Path, text: &str) -> Result<Format> {
 /// resolving heading, scale and bird ids.
 pub fn read(path: &Path, opts: &ReadOptions) -> Result<Annotations> {
     if path.is_dir() {
+        if opts.bodypart.is_some() {
+            return Err(Error::parameter(
+                "read.bodypart",
+                format!(
+                    "{}: is a directory of Labelme files, which have one point per bird; a body part is chosen only in SLEAP and DeepLabCut files",
+                    path.display()
+                ),
+            ));
+        }
         let raw = labelme::read_dir(path)?;
         return finish(path, raw, opts);
     }
@@ -411,14 +423,23 @@ pub fn read(path: &Path, opts: &ReadOptions) -> Result<Annotations> {
 /// Parses annotation text as if read from `path` (which only names the file in messages).
 pub fn parse_str(path: &Path, text: &str, opts: &ReadOptions) -> Result<Annotations> {
     let format = detect_text(path, text)?;
+    if opts.bodypart.is_some() && !matches!(format, Format::Sleap | Format::Dlc) {
+        return Err(Error::parameter(
+            "read.bodypart",
+            format!(
+                "{}: is {}, which has one point per bird; a body part is chosen only in SLEAP and DeepLabCut files",
+                path.display(),
+                format.name()
+            ),
+        ));
+    }
     let t = text.trim_start_matches('\u{feff}');
     let raw = match format {
         Format::Native => native::parse(path, t)?,
         Format::Labelme => labelme::parse_file(path, t)?,
         Format::LongCsv | Format::Dltdv => csv_formats::parse(path, t, format)?,
-        Format::Sleap | Format::Dlc | Format::Mot | Format::IdTracker => {
-            trackers::parse(path, t, format)?
-        }
+        Format::Sleap | Format::Dlc => trackers::parse(path, t, format, opts.bodypart.as_deref())?,
+        Format::Mot | Format::IdTracker => trackers::parse(path, t, format, None)?,
         Format::LabelmeDir => return Err(Error::Internal("directory detected for text".into())),
     };
     finish(path, raw, opts)

@@ -148,10 +148,15 @@ impl Frames {
 }
 
 /// Parses a tracker file of the detected `format`.
-pub(crate) fn parse(path: &Path, text: &str, format: Format) -> Result<RawAnnotations> {
+pub(crate) fn parse(
+    path: &Path,
+    text: &str,
+    format: Format,
+    bodypart: Option<&str>,
+) -> Result<RawAnnotations> {
     match format {
-        Format::Sleap => sleap(path, text),
-        Format::Dlc => dlc(path, text),
+        Format::Sleap => sleap(path, text, bodypart),
+        Format::Dlc => dlc(path, text, bodypart),
         Format::Mot => mot(path, text),
         Format::IdTracker => idtracker(path, text),
         _ => Err(Error::Internal(format!(
@@ -181,7 +186,7 @@ fn track_id(name: &str, named: &mut HashMap<String, usize>) -> usize {
     1_000_000 + *named.entry(name.to_string()).or_insert(k)
 }
 
-fn sleap(path: &Path, text: &str) -> Result<RawAnnotations> {
+fn sleap(path: &Path, text: &str, bodypart: Option<&str>) -> Result<RawAnnotations> {
     let mut it = lines(text);
     let (_, head) = it.next().ok_or_else(|| Error::format(path, "empty file"))?;
     let h: Vec<String> = fields(head)
@@ -191,10 +196,23 @@ fn sleap(path: &Path, text: &str) -> Result<RawAnnotations> {
     let col = |n: &str| h.iter().position(|c| c == n);
     let cf = col("frame_idx").ok_or_else(|| Error::format(path, "header: no frame_idx"))?;
     let ct = col("track");
-    let cx = h
-        .iter()
-        .position(|c| c.ends_with(".x"))
-        .ok_or_else(|| Error::format(path, "header: no NODE.x column"))?;
+    let cx = match bodypart {
+        None => h
+            .iter()
+            .position(|c| c.ends_with(".x"))
+            .ok_or_else(|| Error::format(path, "header: no NODE.x column"))?,
+        Some(b) => col(&format!("{}.x", b.to_ascii_lowercase())).ok_or_else(|| {
+            let nodes: Vec<&str> = h.iter().filter_map(|c| c.strip_suffix(".x")).collect();
+            Error::parameter(
+                "read.bodypart",
+                format!(
+                    "{}: no node \"{b}\"; its nodes are {}",
+                    path.display(),
+                    nodes.join(", ")
+                ),
+            )
+        })?,
+    };
     let node = h[cx].trim_end_matches(".x").to_string();
     let cy = col(&format!("{node}.y"))
         .ok_or_else(|| Error::format(path, format!("header: {node}.x without {node}.y")))?;
@@ -242,7 +260,7 @@ fn sleap(path: &Path, text: &str) -> Result<RawAnnotations> {
     out.done(path, Format::Sleap)
 }
 
-fn dlc(path: &Path, text: &str) -> Result<RawAnnotations> {
+fn dlc(path: &Path, text: &str, bodypart: Option<&str>) -> Result<RawAnnotations> {
     let mut it = lines(text);
     let mut head: Vec<Vec<String>> = Vec::new();
     for name in ["scorer", "individuals", "bodyparts", "coords"] {
@@ -259,10 +277,33 @@ fn dlc(path: &Path, text: &str) -> Result<RawAnnotations> {
         head.push(r);
     }
     let (inds, parts, coords) = (&head[1], &head[2], &head[3]);
-    let part = parts
-        .get(1)
-        .cloned()
-        .ok_or_else(|| Error::format(path, "header: no body part"))?;
+    let part = match bodypart {
+        None => parts
+            .get(1)
+            .cloned()
+            .ok_or_else(|| Error::format(path, "header: no body part"))?,
+        Some(b) => parts
+            .iter()
+            .skip(1)
+            .find(|p| p.eq_ignore_ascii_case(b))
+            .cloned()
+            .ok_or_else(|| {
+                let mut known: Vec<&str> = Vec::new();
+                for p in parts.iter().skip(1) {
+                    if !known.contains(&p.as_str()) {
+                        known.push(p);
+                    }
+                }
+                Error::parameter(
+                    "read.bodypart",
+                    format!(
+                        "{}: no body part \"{b}\"; its body parts are {}",
+                        path.display(),
+                        known.join(", ")
+                    ),
+                )
+            })?,
+    };
     // Each individual's x and y columns for the first body part.
     let mut order: Vec<String> = Vec::new();
     let mut cols: Vec<(usize, Option<usize>, Option<usize>)> = Vec::new();

@@ -27,6 +27,10 @@ pub struct ReadArgs {
     /// Where pixel y = 0 is in CSV input: top (long CSV default) or bottom (DLTdv default).
     #[arg(long = "y-origin", value_name = "top|bottom")]
     pub y_origin: Option<YOrigin>,
+    /// The body part (DeepLabCut) or node (SLEAP) that gives each bird's position in a tracker's
+    /// file (default: the first the file lists).
+    #[arg(long, value_name = "NAME")]
+    pub bodypart: Option<String>,
 }
 
 /// Fitting options (shared by `extract` and `plot shape`).
@@ -72,6 +76,7 @@ impl ReadArgs {
             heading: self.heading,
             wingspan_px: self.wingspan_px,
             y_origin: self.y_origin,
+            bodypart: self.bodypart.clone(),
         }
     }
 }

@@ -71,6 +71,7 @@ pub const FLAGS: &[(&str, &str, &[Cmd])] = &[
     ("read.heading", "--heading", READ),
     ("read.wingspan_px", "--wingspan-px", READ),
     ("read.y_origin", "--y-origin", READ),
+    ("read.bodypart", "--bodypart", READ),
     ("extract.inlier_threshold", "--threshold", FIT),
     ("extract.kind", "--kind", FIT),
     ("extract.max_samples", "--max-samples", FIT),
