@@ -478,8 +478,8 @@ impl Animation {
         Ok(a)
     }
 
-    /// Refuses an `fps` that contradicts the frame times: with three frames or more, the median
-    /// step between frames must be one frame at `fps` (within 1 %). Everything that samples an
+    /// Refuses an `fps` that contradicts the frame times: with three frames or more, the (lower)
+    /// median step between frames must be one frame at `fps` (within 1 %). Everything that samples an
     /// animation (pictures, resampling, glTF keys, loops) takes the rate from `fps` and the
     /// instants from `t`; a file whose two disagree would play at the wrong speed or repeat frames.
     /// Two-frame files (a start and an end) have no rate to contradict.
@@ -489,7 +489,8 @@ impl Animation {
         }
         let mut steps: Vec<f64> = self.frames.windows(2).map(|w| w[1].t - w[0].t).collect();
         steps.sort_by(f64::total_cmp);
-        let step = steps[steps.len() / 2];
+        // The lower median: a file with one long pause keeps its rate.
+        let step = steps[(steps.len() - 1) / 2];
         if step > 0.0 && ((step * self.fps) - 1.0).abs() > 0.01 {
             return Err(Error::format(
                 origin,

@@ -918,12 +918,12 @@ pub fn out_of_memory(bytes: usize) -> ! {
         let _ = match what {
             Some(p) => write!(
                 w,
-                "error: {}: out of memory: {bytes} more bytes could not be allocated; lower --size, the frame rate, the flock or the length, or raise the memory limit; no output written\n",
+                "error: {}: out of memory: {bytes} more bytes could not be allocated; lower the picture size, the frame rate, the flock or the length, or raise the memory limit; no output written\n",
                 p.display()
             ),
             None => write!(
                 w,
-                "error: out of memory: {bytes} more bytes could not be allocated; lower the flock, the length or --size, or raise the memory limit; no output written\n"
+                "error: out of memory: {bytes} more bytes could not be allocated; lower the flock, the length or the picture size, or raise the memory limit; no output written\n"
             ),
         };
         1024 - w.len()

@@ -406,5 +406,5 @@ pub fn run_plot_shape(args: PlotShapeArgs, g: Global) -> Result<()> {
         threshold,
         &args.input,
     )?;
-    super::plot::save(&chart, &args.output)
+    super::chart::save(&chart, &args.output)
 }

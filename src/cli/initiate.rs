@@ -326,5 +326,5 @@ pub fn run_plot_paths(args: PlotPathsArgs, _g: Global) -> Result<()> {
     let mut chart = formation::plot::paths::PathsChart::from_animation(&a)
         .map_err(|e| Error::format(&args.input, e.to_string()))?;
     chart.title.push_str(which.as_deref().unwrap_or(""));
-    super::plot::save(&chart, &args.output)
+    super::chart::save(&chart, &args.output)
 }

@@ -6,6 +6,7 @@ use clap::{Parser, Subcommand};
 use formation::Result;
 
 mod animate;
+mod chart;
 mod course;
 mod extract;
 pub mod flags;

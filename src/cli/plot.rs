@@ -17,14 +17,6 @@ pub struct PlotArgs {
     kind: PlotKind,
 }
 
-/// The `--dpi` of this run (set once by [`run`]).
-static DPI: std::sync::OnceLock<f64> = std::sync::OnceLock::new();
-
-/// Saves a chart of `formation plot` at the run's `--dpi`.
-pub fn save<C: formation::plot::Chart>(chart: &C, path: &std::path::Path) -> Result<()> {
-    formation::plot::save_at(chart, path, DPI.get().copied())
-}
-
 #[derive(Debug, Subcommand)]
 enum PlotKind {
     /// Per-bird power reduction of a shape, key shape or frame, with feasible ranges.
@@ -57,7 +49,7 @@ fn run_plot_savings(args: SavingsArgs) -> Result<()> {
     OutputKind::from_path(&args.output, &[OutputKind::Png, OutputKind::Svg])?;
     let anim = formation::Animation::read(&args.input)?;
     let chart = formation::plot::savings::SavingsChart::from_animation(&anim, &args.input)?;
-    save(&chart, &args.output)
+    super::chart::save(&chart, &args.output)
 }
 
 impl PlotArgs {
@@ -79,7 +71,7 @@ impl PlotArgs {
 pub fn run(args: PlotArgs, g: Global) -> Result<()> {
     use std::path::PathBuf;
     if let Some(d) = args.dpi {
-        let _ = DPI.set(d);
+        super::chart::set_dpi(d);
     }
     let (what, input, output): (String, PathBuf, PathBuf) = match &args.kind {
         PlotKind::Power(a) => (

@@ -358,7 +358,7 @@ pub fn run_plot_power(args: PlotPowerArgs, _g: Global) -> Result<()> {
         (None, k) => k.map(PowerOf::Key),
     };
     let chart = PowerChart::from_file(&args.input, args.formation.formation, of, metric)?;
-    super::plot::save(&chart, &args.output)
+    super::chart::save(&chart, &args.output)
 }
 
 /// Arguments of `formation plot xi`.
@@ -381,5 +381,5 @@ pub fn run_plot_xi(args: PlotXiArgs, _g: Global) -> Result<()> {
         .pick(Animation::read(&args.input)?, &args.input)?;
     let mut chart = XiChart::from_animation(&anim, &args.input)?;
     chart.title.push_str(which.as_deref().unwrap_or(""));
-    super::plot::save(&chart, &args.output)
+    super::chart::save(&chart, &args.output)
 }

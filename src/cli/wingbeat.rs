@@ -23,7 +23,7 @@ pub struct PlotWingbeatArgs {
 /// Runs `formation plot wingbeat`.
 pub fn run_plot_wingbeat(args: PlotWingbeatArgs, _g: Global) -> Result<()> {
     let species: Species = args.species.parse()?;
-    super::plot::save(&WingbeatChart::new(species), &args.output)
+    super::chart::save(&WingbeatChart::new(species), &args.output)
 }
 
 /// Wingbeat flags shared by `steady`, `initiate` and `animate` (the wing phases written into the

@@ -669,7 +669,7 @@ impl Reader<'_> {
             if let Some(j) = ours(n.value()) {
                 if let Some(first) = seen[j].replace(slot) {
                     return Err(self.err(format!(
-                        "skin: joints {first} and {slot} both stand for the convention's joint \"{}\" (names compare without case, namespace or separators); give every joint its own name or map them with --joint-map",
+                        "skin: joints {first} and {slot} both stand for the convention's joint \"{}\" (names compare without case, namespace or separators); give every joint its own name or map them with a joint map",
                         JOINTS[j]
                     )));
                 }

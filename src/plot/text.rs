@@ -7,7 +7,7 @@
 //! of advances and kerning, so chart layout does not move), with the bearing kept. Everything
 //! else is passed to the wrapped backend.
 //!
-//! With a scale (a chart drawn at more than its screen resolution, `plot --dpi 300`), the chart
+//! With a scale (a chart drawn at more than its screen resolution, 300 dpi for print), the chart
 //! is laid out at its usual size and everything is drawn `scale` times larger on the wrapped
 //! backend: coordinates, line widths, circle radii and text (glyphs rasterised at the larger
 //! size, so they stay sharp). At scale 1 the drawing is exactly the unscaled one.
