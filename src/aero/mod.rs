@@ -61,6 +61,7 @@ use serde::{Deserialize, Serialize};
 mod far;
 mod field;
 pub mod flight;
+pub mod lissaman;
 mod tree;
 mod wake3d;
 pub use field::{ApproxField, Field};
@@ -122,6 +123,64 @@ pub struct AeroOptions {
     /// level). Only [`Wake::ThreeD`] uses it. Left out of serialised options when 0.
     #[serde(skip_serializing_if = "is_zero")]
     pub wake_descent: f64,
+    /// Which model gives the reported savings ([`AeroModel::Hummel`], the default, or
+    /// [`AeroModel::Lissaman`]). Only the shape-level savings of [`AeroOptions::power_reduction_3d`]
+    /// and [`AeroOptions::power_lenient_3d`] (what `power`, the frames of an animation and the
+    /// report show) follow it; the key-shape solve, g and every planar sum are Hummel's, which
+    /// is what Klotsman & Tal's method is built on. Left out of serialised options when Hummel.
+    #[serde(skip_serializing_if = "AeroModel::is_hummel")]
+    pub model: AeroModel,
+}
+
+/// The aerodynamic model that turns positions into savings.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum AeroModel {
+    /// Hummel's horseshoe vortices (span π/4, a vortex core), as printed in Klotsman & Tal.
+    #[default]
+    #[serde(rename = "hummel")]
+    Hummel,
+    /// Elliptically loaded lifting lines with continuous trailing sheets, of the kind Lissaman &
+    /// Shollenberger introduced and the field studies used ([`lissaman`]).
+    #[serde(rename = "lissaman")]
+    Lissaman,
+}
+
+impl AeroModel {
+    /// `"hummel"` or `"lissaman"`, as in JSON and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            AeroModel::Hummel => "hummel",
+            AeroModel::Lissaman => "lissaman",
+        }
+    }
+
+    /// True for [`AeroModel::Hummel`] (the default, left out of serialised options).
+    pub fn is_hummel(&self) -> bool {
+        *self == AeroModel::Hummel
+    }
+
+    /// How the model is named in summaries and the report.
+    pub fn describe(self) -> &'static str {
+        match self {
+            AeroModel::Hummel => "Hummel's horseshoe model",
+            AeroModel::Lissaman => "Lissaman & Shollenberger-type lifting lines",
+        }
+    }
+}
+
+impl std::str::FromStr for AeroModel {
+    type Err = Error;
+
+    fn from_str(s: &str) -> Result<AeroModel> {
+        match s {
+            "hummel" => Ok(AeroModel::Hummel),
+            "lissaman" => Ok(AeroModel::Lissaman),
+            other => Err(Error::parameter(
+                "aero.model",
+                format!("{other:?}: the model is \"hummel\" or \"lissaman\""),
+            )),
+        }
+    }
 }
 
 /// Largest accepted [`AeroOptions::wake_descent`]: a slope of 0.2, far beyond a bird's wake
@@ -140,6 +199,7 @@ impl Default for AeroOptions {
             collision_chord: DEFAULT_COLLISION_CHORD,
             wake: Wake::Planar,
             wake_descent: 0.0,
+            model: AeroModel::Hummel,
         }
     }
 }
@@ -817,6 +877,7 @@ mod tests {
         collision_chord: DEFAULT_COLLISION_CHORD,
         wake: Wake::Planar,
         wake_descent: 0.0,
+        model: AeroModel::Hummel,
     };
 
     /// The formula exactly as printed, with absolute values inside the logarithms, evaluated
