@@ -84,19 +84,60 @@ pub struct Animation {
 /// The model behind an animation's savings.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SavingsModel {
-    /// `"planar"` (Hummel's horseshoe wakes in the plane) or `"3d"`.
+    /// `"planar"` (wakes in the plane, heights ignored) or `"3d"`.
     pub wake: String,
-    /// Vortex core radius, wingspans.
+    /// Vortex core radius, wingspans (Hummel's model only).
     pub core_radius: f64,
+    /// `"hummel"` (horseshoe vortices with a core; absent means this) or `"lissaman"`
+    /// (elliptically loaded lifting lines, no core).
+    #[serde(default = "hummel", skip_serializing_if = "is_hummel")]
+    pub model: String,
+}
+
+fn hummel() -> String {
+    "hummel".into()
+}
+
+fn is_hummel(s: &str) -> bool {
+    s == "hummel"
+}
+
+impl SavingsModel {
+    /// The record of `opts`.
+    pub fn of(opts: &crate::aero::AeroOptions) -> SavingsModel {
+        SavingsModel {
+            wake: opts.wake.name().into(),
+            core_radius: opts.core_radius,
+            model: opts.model.name().into(),
+        }
+    }
+
+    /// The savings options this record stands for (defaults for anything it does not say).
+    pub fn options(&self) -> crate::aero::AeroOptions {
+        crate::aero::AeroOptions {
+            core_radius: self.core_radius,
+            wake: self.wake.parse().unwrap_or_default(),
+            model: self.model.parse().unwrap_or_default(),
+            ..crate::aero::AeroOptions::default()
+        }
+    }
 }
 
 impl std::fmt::Display for SavingsModel {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(
-            f,
-            "Hummel's model, {} wake, core {} wingspans",
-            self.wake, self.core_radius
-        )
+        if self.model == "lissaman" {
+            write!(
+                f,
+                "Lissaman & Shollenberger-type lifting lines, {} wake, no core",
+                self.wake
+            )
+        } else {
+            write!(
+                f,
+                "Hummel's model, {} wake, core {} wingspans",
+                self.wake, self.core_radius
+            )
+        }
     }
 }
 

@@ -868,6 +868,19 @@ pub fn fill_frame_savings(anim: &mut Animation, opts: &AeroOptions) {
     }
 }
 
+/// Recomputes `e` and `xi` of every frame of `anim` with `opts` (another model, wake or core
+/// than the one the animation was made with), as [`fill_frame_savings`] does for the take-off:
+/// in the formation frame of the leader's heading. Records `opts` as the animation's savings
+/// model.
+pub fn recompute_frame_savings(anim: &mut Animation, opts: &AeroOptions) {
+    for f in &mut anim.frames {
+        f.e = None;
+        f.xi = None;
+    }
+    fill_frame_savings(anim, opts);
+    anim.savings_model = Some(crate::animation::SavingsModel::of(opts));
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
