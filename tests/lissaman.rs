@@ -2,7 +2,10 @@
 //! lone bird, savings that fall with distance, Munk's stagger theorem, agreement with Hummel's
 //! model far apart, and the shape-level sums behind `--aero-model lissaman`.
 
+mod support;
+
 use formation::aero::{lissaman, AeroModel, AeroOptions, Wake};
+use support::{code, data, example_arg, run, s, scratch, stderr, stdout};
 
 fn hummel() -> AeroOptions {
     AeroOptions::default()
@@ -155,4 +158,76 @@ fn shape_sums_follow_the_model_and_the_wake() {
         assert_eq!(m.name().parse::<AeroModel>().unwrap(), m);
     }
     assert!("sideways".parse::<AeroModel>().is_err());
+}
+
+#[test]
+fn the_flag_changes_the_savings_not_the_motion() {
+    let dir = scratch("lissaman-cli");
+    let params = data("steady_v9_params.json");
+    let steady = |model: &str, out: &std::path::Path| {
+        let o = run(&[
+            "steady",
+            s(&params),
+            "--birds",
+            "9",
+            "--frames",
+            "40",
+            "--aero-model",
+            model,
+            "-o",
+            s(out),
+        ]);
+        assert_eq!(code(&o), 0, "{}", stderr(&o));
+        let v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out).unwrap()).unwrap();
+        (v, stderr(&o) + &stdout(&o))
+    };
+    let (h, _) = steady("hummel", &dir.join("h.json"));
+    let (l, said) = steady("lissaman", &dir.join("l.json"));
+    assert!(said.contains("Lissaman & Shollenberger-type lifting lines, planar wake, no core"));
+    assert_eq!(l["savings_model"]["model"], "lissaman");
+    assert!(h["savings_model"].get("model").is_none(), "Hummel's is the default");
+    let (hf, lf) = (h["frames"].as_array().unwrap(), l["frames"].as_array().unwrap());
+    assert_eq!(hf.len(), lf.len());
+    let mut differ = 0;
+    for (a, b) in hf.iter().zip(lf) {
+        assert_eq!(a["x"], b["x"]);
+        assert_eq!(a["y"], b["y"]);
+        // Each frame's savings are the model's at the frame's positions.
+        let e = b["e"].as_array().unwrap();
+        let sum: f64 = e.iter().map(|v| v.as_f64().unwrap()).sum();
+        let xi0 = b["xi"][0].as_f64().unwrap();
+        assert!((xi0 - e[0].as_f64().unwrap() / sum).abs() < 1e-12);
+        differ += usize::from(a["e"] != b["e"]);
+    }
+    assert_eq!(differ, hf.len());
+    // `power`: the main numbers are the lifting lines', named; the band holds both models.
+    let o = run(&[
+        "power",
+        &example_arg("v9_shape.json"),
+        "--aero-model",
+        "lissaman",
+        "--json",
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    assert_eq!(v["model"]["name"], "lissaman");
+    assert!(v["model"].get("core_radius").is_none());
+    assert_eq!(v["sensitivity"].as_array().unwrap().len(), 0);
+    let band = v["band"].as_array().unwrap();
+    assert_eq!(band.len(), 12, "5 cores x 2 wakes of Hummel's, 2 wakes of the lifting lines");
+    let shape: formation::Shape = serde_json::from_str(
+        &std::fs::read_to_string(support::example("v9_shape.json")).unwrap(),
+    )
+    .unwrap();
+    let lib = ls()
+        .power_reduction_3d(&shape.xs(), &shape.ys(), &shape.zs())
+        .unwrap();
+    for (b, e) in v["birds"].as_array().unwrap().iter().zip(&lib.e) {
+        assert_eq!(b["saving"].as_f64().unwrap(), *e);
+    }
+    assert!(band
+        .iter()
+        .any(|b| b["model"] == "lissaman" && b["flock_saving"] == v["flock_saving"]));
+    let _ = std::fs::remove_dir_all(&dir);
 }
