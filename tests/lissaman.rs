@@ -18,7 +18,9 @@ fn ls() -> AeroOptions {
     }
 }
 
-const XS: &[f64] = &[0.0, 0.4, 0.9, 1.0, 1.05, 1.2, 1.5, 2.0, 3.0, 5.0, 10.0, 40.0];
+const XS: &[f64] = &[
+    0.0, 0.4, 0.9, 1.0, 1.05, 1.2, 1.5, 2.0, 3.0, 5.0, 10.0, 40.0,
+];
 const YS: &[f64] = &[-30.0, -2.0, -0.5, -0.13, 0.13, 0.5, 1.24, 5.0, 100.0];
 
 #[test]
@@ -152,7 +154,9 @@ fn shape_sums_follow_the_model_and_the_wake() {
     let h = hummel().power_reduction_3d(&x, &y, &z).unwrap();
     assert!((h.total - planar.total).abs() > 1e-3, "the models differ");
     // A colliding shape is refused by both.
-    assert!(ls().power_reduction_3d(&[0.0, 0.5], &[0.0, 0.01], &[0.0; 2]).is_err());
+    assert!(ls()
+        .power_reduction_3d(&[0.0, 0.5], &[0.0, 0.01], &[0.0; 2])
+        .is_err());
     // The model's name round-trips.
     for m in [AeroModel::Hummel, AeroModel::Lissaman] {
         assert_eq!(m.name().parse::<AeroModel>().unwrap(), m);
@@ -186,8 +190,14 @@ fn the_flag_changes_the_savings_not_the_motion() {
     let (l, said) = steady("lissaman", &dir.join("l.json"));
     assert!(said.contains("Lissaman & Shollenberger-type lifting lines, planar wake, no core"));
     assert_eq!(l["savings_model"]["model"], "lissaman");
-    assert!(h["savings_model"].get("model").is_none(), "Hummel's is the default");
-    let (hf, lf) = (h["frames"].as_array().unwrap(), l["frames"].as_array().unwrap());
+    assert!(
+        h["savings_model"].get("model").is_none(),
+        "Hummel's is the default"
+    );
+    let (hf, lf) = (
+        h["frames"].as_array().unwrap(),
+        l["frames"].as_array().unwrap(),
+    );
     assert_eq!(hf.len(), lf.len());
     let mut differ = 0;
     for (a, b) in hf.iter().zip(lf) {
@@ -215,11 +225,14 @@ fn the_flag_changes_the_savings_not_the_motion() {
     assert!(v["model"].get("core_radius").is_none());
     assert_eq!(v["sensitivity"].as_array().unwrap().len(), 0);
     let band = v["band"].as_array().unwrap();
-    assert_eq!(band.len(), 12, "5 cores x 2 wakes of Hummel's, 2 wakes of the lifting lines");
-    let shape: formation::Shape = serde_json::from_str(
-        &std::fs::read_to_string(support::example("v9_shape.json")).unwrap(),
-    )
-    .unwrap();
+    assert_eq!(
+        band.len(),
+        12,
+        "5 cores x 2 wakes of Hummel's, 2 wakes of the lifting lines"
+    );
+    let shape: formation::Shape =
+        serde_json::from_str(&std::fs::read_to_string(support::example("v9_shape.json")).unwrap())
+            .unwrap();
     let lib = ls()
         .power_reduction_3d(&shape.xs(), &shape.ys(), &shape.zs())
         .unwrap();

@@ -268,7 +268,9 @@ mod tests {
         // at least a collision chord apart fore and aft).
         let (fi, fo) = (inner(48, 8), composite(0.0, 1.0, 12, 8));
         let mut worst: f64 = 0.0;
-        for &x in &[0.0, 0.3, 0.7, 0.95, 1.0, 1.02, 1.3, 2.0, 2.9, 3.1, 6.0, 20.0] {
+        for &x in &[
+            0.0, 0.3, 0.7, 0.95, 1.0, 1.02, 1.3, 2.0, 2.9, 3.1, 6.0, 20.0,
+        ] {
             for &y in &[-8.0, -1.0, -0.13, 0.13, 0.5, 1.24, 6.0, 50.0] {
                 for &z in &[0.0, 0.03, -0.14] {
                     let (a, b) = (saving(x, y, z), saving_with(x, y, z, &fi, &fo));

@@ -103,15 +103,33 @@ fn num(v: f64, prec: usize) -> String {
     format!("{v:.prec$}")
 }
 
-/// Error bars, one row per quantity, each on its own axis (its interval in the middle half):
-/// (label, point estimate, lo, hi, decimals, unit).
-fn intervals_svg(rows: &[(String, Option<f64>, f64, f64, usize, &str)]) -> String {
+/// One error bar: a quantity's interval and point estimate.
+struct Bar {
+    label: String,
+    point: Option<f64>,
+    lo: f64,
+    hi: f64,
+    /// Decimals printed.
+    prec: usize,
+    unit: &'static str,
+}
+
+/// Error bars, one row per quantity, each on its own axis (its interval in the middle half).
+fn intervals_svg(rows: &[Bar]) -> String {
     let (w, row_h, left, right) = (760.0, 44.0, 250.0, 730.0);
     let h = 16.0 + row_h * rows.len() as f64;
     let mut out = format!(
         "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" viewBox=\"0 0 {w} {h}\" font-family=\"sans-serif\" font-size=\"12\"><rect width=\"{w}\" height=\"{h}\" fill=\"white\"/>"
     );
-    for (k, (label, point, lo, hi, prec, unit)) in rows.iter().enumerate() {
+    for (k, bar) in rows.iter().enumerate() {
+        let Bar {
+            label,
+            point,
+            lo,
+            hi,
+            prec,
+            unit,
+        } = bar;
         let y = 24.0 + row_h * k as f64;
         let span = (hi - lo).abs().max(1e-9);
         let (a, b) = (lo - 0.5 * span, hi + 0.5 * span);
@@ -160,7 +178,10 @@ fn intervals_svg(rows: &[(String, Option<f64>, f64, f64, usize, &str)]) -> Strin
 fn band_svg(entries: &[crate::report::BandEntry], main: Option<f64>) -> String {
     let (w, row_h, left, right) = (760.0, 20.0, 250.0, 730.0);
     let h = 70.0 + row_h * entries.len() as f64;
-    let lo = entries.iter().map(|e| e.saving).fold(f64::INFINITY, f64::min);
+    let lo = entries
+        .iter()
+        .map(|e| e.saving)
+        .fold(f64::INFINITY, f64::min);
     let hi = entries
         .iter()
         .map(|e| e.saving)
@@ -234,15 +255,26 @@ fn band_section(
     if entries.is_empty() {
         return;
     }
-    let lo = entries.iter().map(|e| e.saving).fold(f64::INFINITY, f64::min);
+    let lo = entries
+        .iter()
+        .map(|e| e.saving)
+        .fold(f64::INFINITY, f64::min);
     let hi = entries
         .iter()
         .map(|e| e.saving)
         .fold(f64::NEG_INFINITY, f64::max);
     page.p(&format!(
-        "Sensitivity of the flock saving to modelling choices no measurement fixes ({what}): {} to {} of induced power over Hummel's model at vortex cores of 0.02 to 0.32 wingspans and the lifting-line model (Lissaman & Shollenberger's kind, no core){}.",
+        "Sensitivity of the flock saving to modelling choices no measurement fixes ({what}): {} to {} of induced power over Hummel's model at vortex cores of 0.02 to 0.32 wingspans{}{}.",
         pct(lo),
         pct(hi),
+        if entries.iter().any(|e| !e.aero.model.is_hummel()) {
+            " and the lifting-line model (Lissaman & Shollenberger's kind, no core)".to_string()
+        } else {
+            format!(
+                " (the lifting-line model is left out for flocks of more than {} birds: too slow)",
+                crate::report::BAND_LIFTING_LINE_BIRDS
+            )
+        },
         if entries.iter().any(|e| !e.aero.wake.is_planar()) {
             ", each with the planar and the 3-D wake"
         } else {
@@ -270,10 +302,17 @@ fn intervals_figure(page: &mut Page, p: &FormationParams, ci: &crate::extract::p
         }
     }
     let med = |v: &mut Vec<f64>| crate::extract::bootstrap::median(v);
-    let mut rows: Vec<(String, Option<f64>, f64, f64, usize, &str)> = Vec::new();
+    let mut rows: Vec<Bar> = Vec::new();
     let mut push = |label: &str, point: Option<f64>, iv: Option<[f64; 2]>, prec, unit| {
         if let Some([lo, hi]) = iv {
-            rows.push((label.to_string(), point, lo, hi, prec, unit));
+            rows.push(Bar {
+                label: label.to_string(),
+                point,
+                lo,
+                hi,
+                prec,
+                unit,
+            });
         }
     };
     push(
@@ -557,7 +596,9 @@ fn animation_sections(page: &mut Page, a: &Animation, s: &Subject<'_>) -> Result
     }
     if let Some(t) = crate::aero::flight::steady_saving_total(a) {
         rows.push(vec![
-            format!("flock saving in steady flight (of total power, {used}, Pennycuick's power curve)"),
+            format!(
+                "flock saving in steady flight (of total power, {used}, Pennycuick's power curve)"
+            ),
             pct(t),
         ]);
     }

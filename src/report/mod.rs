@@ -45,6 +45,10 @@ pub const BAND_CORES: [f64; 5] = [0.02, 0.04, 0.08, 0.16, 0.32];
 /// steady flight): the lifting-line model costs about 20 µs per pair.
 pub const BAND_FRAMES: usize = 24;
 
+/// Flocks of more birds leave the lifting-line model out of an animation's band (its pairs cost
+/// about 20 µs each: a 60-bird band takes a few seconds).
+pub const BAND_LIFTING_LINE_BIRDS: usize = 60;
+
 /// One entry of the saving's sensitivity band: a model, wake and core, and the flock's mean
 /// saving (fraction of induced power) with them.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -139,6 +143,7 @@ pub fn animation_band(a: &Animation) -> Vec<BandEntry> {
     });
     band_options(heights)
         .into_iter()
+        .filter(|o| o.model.is_hummel() || a.birds <= BAND_LIFTING_LINE_BIRDS)
         .filter_map(|aero| {
             crate::aero::recompute_frame_savings(&mut b, &aero);
             let per: Vec<f64> = b
