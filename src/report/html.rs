@@ -609,7 +609,7 @@ fn animation_sections(page: &mut Page, a: &Animation, s: &Subject<'_>) -> Result
         &crate::report::animation_band(a),
         st.steady_saving,
         &format!(
-            "steady flight, {} frames evenly spaced",
+            "steady flight, up to {} frames evenly spaced",
             crate::report::BAND_FRAMES
         ),
     );

@@ -116,7 +116,8 @@ pub fn footage_band(p: &FormationParams) -> Vec<BandEntry> {
 }
 
 /// An animation's flock saving in steady flight (all frames without a steady stage) with every
-/// option of [`band_options`], on at most [`BAND_FRAMES`] evenly spaced frames, each evaluated
+/// option of [`band_options`], on at most [`BAND_FRAMES`] evenly spaced frames (fewer, down to 3,
+/// for flocks of more than 200 birds), each evaluated
 /// in the formation frame of the leader's heading as [`crate::aero::fill_frame_savings`] does.
 pub fn animation_band(a: &Animation) -> Vec<BandEntry> {
     let range = a
@@ -127,11 +128,17 @@ pub fn animation_band(a: &Animation) -> Vec<BandEntry> {
     if len == 0 || a.birds < 2 {
         return Vec::new();
     }
-    let picks: Vec<usize> = if len <= BAND_FRAMES {
+    // Big flocks: fewer frames (the sums are O(N²) per frame), at least 3.
+    let budget = if a.birds <= 200 {
+        BAND_FRAMES
+    } else {
+        (BAND_FRAMES * 200 * 200 / (a.birds * a.birds)).max(3)
+    };
+    let picks: Vec<usize> = if len <= budget {
         range.collect()
     } else {
-        (0..BAND_FRAMES)
-            .map(|k| range.start + k * (len - 1) / (BAND_FRAMES - 1))
+        (0..budget)
+            .map(|k| range.start + k * (len - 1) / (budget - 1))
             .collect()
     };
     let mut b = a.clone();
