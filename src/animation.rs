@@ -102,27 +102,6 @@ fn is_hummel(s: &str) -> bool {
     s == "hummel"
 }
 
-impl SavingsModel {
-    /// The record of `opts`.
-    pub fn of(opts: &crate::aero::AeroOptions) -> SavingsModel {
-        SavingsModel {
-            wake: opts.wake.name().into(),
-            core_radius: opts.core_radius,
-            model: opts.model.name().into(),
-        }
-    }
-
-    /// The savings options this record stands for (defaults for anything it does not say).
-    pub fn options(&self) -> crate::aero::AeroOptions {
-        crate::aero::AeroOptions {
-            core_radius: self.core_radius,
-            wake: self.wake.parse().unwrap_or_default(),
-            model: self.model.parse().unwrap_or_default(),
-            ..crate::aero::AeroOptions::default()
-        }
-    }
-}
-
 impl std::fmt::Display for SavingsModel {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         if self.model == "lissaman" {

@@ -27,7 +27,7 @@
 //! The outer integral along i's span is split at j's wingtips (where u_∞ is singular) and each
 //! piece is mapped by a smoothstep so that the square-root ends become smooth; Gauss–Legendre
 //! again. There is no vortex core: the continuous sheet is finite off its edges, so the model's
-//! numbers do not depend on `--core-radius`. Pairs whose wings overlap side by side collide, as in
+//! numbers do not depend on `aero.core_radius`. Pairs whose wings overlap side by side collide, as in
 //! Hummel's model.
 //!
 //! **Properties** (tested in `tests/lissaman.rs`): mirror symmetry in x; 0 for a lone bird;

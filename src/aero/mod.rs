@@ -868,6 +868,28 @@ pub fn fill_frame_savings(anim: &mut Animation, opts: &AeroOptions) {
     }
 }
 
+impl AeroOptions {
+    /// The record of these options in an animation file (`savings_model`).
+    pub fn record(&self) -> crate::animation::SavingsModel {
+        crate::animation::SavingsModel {
+            wake: self.wake.name().into(),
+            core_radius: self.core_radius,
+            model: self.model.name().into(),
+        }
+    }
+
+    /// The options an animation's `savings_model` stands for (defaults for anything it does not
+    /// say).
+    pub fn from_record(m: &crate::animation::SavingsModel) -> AeroOptions {
+        AeroOptions {
+            core_radius: m.core_radius,
+            wake: m.wake.parse().unwrap_or_default(),
+            model: m.model.parse().unwrap_or_default(),
+            ..AeroOptions::default()
+        }
+    }
+}
+
 /// Recomputes `e` and `xi` of every frame of `anim` with `opts` (another model, wake or core
 /// than the one the animation was made with), as [`fill_frame_savings`] does for the take-off:
 /// in the formation frame of the leader's heading. Records `opts` as the animation's savings
@@ -878,7 +900,7 @@ pub fn recompute_frame_savings(anim: &mut Animation, opts: &AeroOptions) {
         f.xi = None;
     }
     fill_frame_savings(anim, opts);
-    anim.savings_model = Some(crate::animation::SavingsModel::of(opts));
+    anim.savings_model = Some(opts.record());
 }
 
 #[cfg(test)]

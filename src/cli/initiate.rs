@@ -288,7 +288,7 @@ pub fn run(args: InitiateArgs, g: Global) -> Result<()> {
     let aero = anim
         .savings_model
         .as_ref()
-        .map(|m| m.options())
+        .map(formation::aero::AeroOptions::from_record)
         .unwrap_or_default();
     formation::aero::fill_frame_savings(&mut anim, &aero);
     let report = formation::pipeline::course_stage(&mut anim, course.1.as_ref(), &course.0)?;

@@ -110,7 +110,7 @@ pub fn run(args: PlotArgs, g: Global) -> Result<()> {
             match a.savings.aero(None).ok().flatten() {
                 Some(o) => format!(
                     "each bird's saving against its rank, and the flock's saving over time ({})",
-                    formation::animation::SavingsModel::of(&o)
+                    o.record()
                 ),
                 None => {
                     "each bird's saving against its rank, and the flock's saving over time".into()

@@ -73,7 +73,7 @@ pub fn run(args: ReportArgs, g: Global) -> Result<()> {
             "a page on {} annotated frames (shape {}, fits, spacing, savings by {})",
             p.frames.len(),
             super::summary::dominant(p),
-            formation::animation::SavingsModel::of(&footage_aero.unwrap_or_default())
+            footage_aero.unwrap_or_default().record()
         ),
         (None, Some(a)) => format!(
             "a page on an animation of {} birds, {} frames (savings by {}, take-off, steady flight)",

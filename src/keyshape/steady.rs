@@ -817,7 +817,7 @@ pub fn steady_flight_in(
 
     let mut anim = Animation::new(opts.seed, opts.fps, opts.wingspan_m, n);
     anim.flight = (!opts.flight.is_empty()).then_some(opts.flight);
-    anim.savings_model = Some(crate::animation::SavingsModel::of(&opts.aero));
+    anim.savings_model = Some(opts.aero.record());
     anim.stages.push(Stage {
         name: "steady".into(),
         start: 0,

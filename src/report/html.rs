@@ -363,7 +363,7 @@ fn intervals_figure(page: &mut Page, p: &FormationParams, ci: &crate::extract::p
 
 /// Describes a savings model for the page.
 fn model_text(a: &crate::aero::AeroOptions) -> String {
-    crate::animation::SavingsModel::of(a).to_string()
+    a.record().to_string()
 }
 
 /// The whole page.
