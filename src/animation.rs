@@ -84,19 +84,39 @@ pub struct Animation {
 /// The model behind an animation's savings.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SavingsModel {
-    /// `"planar"` (Hummel's horseshoe wakes in the plane) or `"3d"`.
+    /// `"planar"` (wakes in the plane, heights ignored) or `"3d"`.
     pub wake: String,
-    /// Vortex core radius, wingspans.
+    /// Vortex core radius, wingspans (Hummel's model only).
     pub core_radius: f64,
+    /// `"hummel"` (horseshoe vortices with a core; absent means this) or `"lissaman"`
+    /// (elliptically loaded lifting lines, no core).
+    #[serde(default = "hummel", skip_serializing_if = "is_hummel")]
+    pub model: String,
+}
+
+fn hummel() -> String {
+    "hummel".into()
+}
+
+fn is_hummel(s: &str) -> bool {
+    s == "hummel"
 }
 
 impl std::fmt::Display for SavingsModel {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(
-            f,
-            "Hummel's model, {} wake, core {} wingspans",
-            self.wake, self.core_radius
-        )
+        if self.model == "lissaman" {
+            write!(
+                f,
+                "Lissaman & Shollenberger-type lifting lines, {} wake, no core",
+                self.wake
+            )
+        } else {
+            write!(
+                f,
+                "Hummel's model, {} wake, core {} wingspans",
+                self.wake, self.core_radius
+            )
+        }
     }
 }
 

@@ -14,6 +14,7 @@ const IDEAL: AeroOptions = AeroOptions {
     collision_chord: aero::DEFAULT_COLLISION_CHORD,
     wake: aero::Wake::Planar,
     wake_descent: 0.0,
+    model: aero::AeroModel::Hummel,
 };
 
 fn cored() -> AeroOptions {

@@ -102,6 +102,7 @@ fn commands() -> Vec<Command> {
         ("--mass-kg", "0", None),
         ("--speed-ms", "-3", None),
         ("--wake", "sideways", None),
+        ("--aero-model", "sideways", None),
         ("--formations", "0", None),
         ("--formation-size", "1", None),
         ("--clearance", "-1", None),
@@ -162,6 +163,14 @@ fn commands() -> Vec<Command> {
         ("--usd-mode", "pixie", None),
         ("--joint-map", "OUT/no-map.json", None),
     ];
+    // The savings flags of `report` and `plot savings`.
+    let savings: Vec<(&str, &str, Option<String>)> = vec![
+        ("--aero-model", "sideways", None),
+        ("--wake", "sideways", None),
+        ("--core-radius", "nan", None),
+        ("--mass-kg", "0", None),
+        ("--speed-ms", "-3", None),
+    ];
     let seed = ("--seed", "x", None);
     let o = |ext: &'static str| ("-o", ext, None);
     let cat = |parts: Vec<Vec<(&'static str, &'static str, Option<String>)>>| {
@@ -188,6 +197,7 @@ fn commands() -> Vec<Command> {
             cases: cat(vec![
                 read.clone(),
                 fit.clone(),
+                savings.clone(),
                 vec![
                     ("--wingspan-m", "-1", None),
                     ("--footage-fps", "nan", None),
@@ -222,6 +232,7 @@ fn commands() -> Vec<Command> {
                 ("--core-radius", "nan", None),
                 ("--wake", "sideways", None),
                 ("--wake-descent", "nan", None),
+                ("--aero-model", "sideways", None),
                 ("--mass-kg", "0", None),
                 ("--speed-ms", "-3", None),
                 ("--species", "owl", None),
@@ -365,7 +376,10 @@ fn commands() -> Vec<Command> {
         Command {
             name: &["plot", "savings"],
             base: strings(&["plot", "savings", &flock, "-o", "OUT/s.png"]),
-            cases: vec![("--dpi", "nan", None), o("OUT/s.txt"), seed.clone()],
+            cases: cat(vec![
+                savings,
+                vec![("--dpi", "nan", None), o("OUT/s.txt"), seed.clone()],
+            ]),
         },
         Command {
             name: &["plot", "paths"],

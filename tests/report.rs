@@ -52,7 +52,15 @@ fn the_page_of_annotations_has_parameters_fits_savings_and_the_field() {
     let c = charts(&page);
     assert_eq!(
         c,
-        ["geometry", "fit-0", "fit-10", "fit-19", "footage-savings"],
+        [
+            "geometry",
+            "fit-0",
+            "fit-10",
+            "fit-19",
+            "intervals",
+            "saving-band",
+            "footage-savings"
+        ],
         "{c:?}"
     );
     for needle in [
@@ -92,7 +100,7 @@ fn the_page_of_an_animation_has_savings_take_off_and_its_charts() {
     assert_eq!(code(&o), 0, "{}", stderr(&o));
     let page = report(s(&json), &dir.join("a.html"), &[]);
     self_contained(&page);
-    assert_eq!(charts(&page), ["savings", "xi", "paths"]);
+    assert_eq!(charts(&page), ["saving-band", "savings", "xi", "paths"]);
     for needle in [
         "flock saving in steady flight",
         "Take-off (§6)",
@@ -120,5 +128,61 @@ fn the_page_of_an_animation_has_savings_take_off_and_its_charts() {
     let page = report(s(&p), &dir.join("p.html"), &[]);
     self_contained(&page);
     assert!(page.contains("J in 24 of 24"));
+    // The savings flags: the animation's savings recomputed with another model, named on the
+    // page; the band holds both models.
+    let other = report(
+        s(&json),
+        &dir.join("c.html"),
+        &["--aero-model", "lissaman", "--wake", "3d", "--mass-kg", "3"],
+    );
+    self_contained(&other);
+    assert!(other.contains("Lissaman &amp; Shollenberger-type lifting lines, 3d wake, no core"));
+    assert!(!page.contains("Lissaman &amp; Shollenberger-type lifting lines, 3d wake"));
+    assert!(other.contains("3.00 kg"));
+    for label in ["hummel, planar, core 0.04", "lissaman, planar"] {
+        assert!(other.contains(label), "band lacks {label}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn error_bars_come_from_the_params_intervals() {
+    let dir = scratch("report-ci");
+    let p = dir.join("p.json");
+    assert_eq!(
+        code(&run(&[
+            "extract",
+            &example_arg("barnacle_geese_v.json"),
+            "-o",
+            s(&p),
+            "-q"
+        ])),
+        0
+    );
+    let params: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&p).unwrap()).unwrap();
+    let ci = &params["ci"];
+    let page = report(s(&p), &dir.join("p.html"), &[]);
+    let fig = page
+        .split("data-chart=\"intervals\"")
+        .nth(1)
+        .and_then(|r| r.split("</figure>").next())
+        .expect("an intervals figure");
+    // Every interval's ends are printed on its error bar (two decimals; degrees with one).
+    for (key, prec, unit) in [
+        ("apex_deg", 1, "°"),
+        ("lateral", 2, ""),
+        ("behind", 2, ""),
+        ("depth", 2, ""),
+        ("wts", 2, ""),
+    ] {
+        let iv = ci[key].as_array().unwrap_or_else(|| panic!("ci.{key}"));
+        for end in iv {
+            let text = format!(">{:.*}{unit}<", prec, end.as_f64().unwrap());
+            assert!(fig.contains(&text), "ci.{key}: {text} not drawn");
+        }
+    }
+    // Five error bars: three lines each (bar and two caps).
+    assert_eq!(fig.matches("stroke=\"#1f5fa8\"").count(), 15);
     let _ = std::fs::remove_dir_all(&dir);
 }

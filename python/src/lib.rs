@@ -665,7 +665,7 @@ fn extract(
 type PowerOut<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>, f64);
 
 /// e, ξ and E of a shape (see `formation.power`): the planar wake, or with heights `z` and the
-/// option `wake` = `3d` the 3-D one.
+/// option `wake` = `3d` the 3-D one; the option `model` = `lissaman` for the lifting-line model.
 #[pyfunction]
 #[pyo3(signature = (x, y, z, options))]
 fn power<'py>(
@@ -686,7 +686,8 @@ fn power<'py>(
     let pr = py
         .detach(|| match &z {
             Some(z) => aero.power_reduction_3d(&x, &y, z),
-            None => aero.power_reduction(&x, &y),
+            // Without heights: planar, but with the model the options name.
+            None => aero.power_reduction_3d(&x, &y, &vec![0.0; x.len()]),
         })
         .map_err(py_err)?;
     Ok((pr.e.into_pyarray(py), pr.xi.into_pyarray(py), pr.total))

@@ -61,6 +61,7 @@ use serde::{Deserialize, Serialize};
 mod far;
 mod field;
 pub mod flight;
+pub mod lissaman;
 mod tree;
 mod wake3d;
 pub use field::{ApproxField, Field};
@@ -122,6 +123,64 @@ pub struct AeroOptions {
     /// level). Only [`Wake::ThreeD`] uses it. Left out of serialised options when 0.
     #[serde(skip_serializing_if = "is_zero")]
     pub wake_descent: f64,
+    /// Which model gives the reported savings ([`AeroModel::Hummel`], the default, or
+    /// [`AeroModel::Lissaman`]). Only the shape-level savings of [`AeroOptions::power_reduction_3d`]
+    /// and [`AeroOptions::power_lenient_3d`] (what `power`, the frames of an animation and the
+    /// report show) follow it; the key-shape solve, g and every planar sum are Hummel's, which
+    /// is what Klotsman & Tal's method is built on. Left out of serialised options when Hummel.
+    #[serde(skip_serializing_if = "AeroModel::is_hummel")]
+    pub model: AeroModel,
+}
+
+/// The aerodynamic model that turns positions into savings.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum AeroModel {
+    /// Hummel's horseshoe vortices (span π/4, a vortex core), as printed in Klotsman & Tal.
+    #[default]
+    #[serde(rename = "hummel")]
+    Hummel,
+    /// Elliptically loaded lifting lines with continuous trailing sheets, of the kind Lissaman &
+    /// Shollenberger introduced and the field studies used ([`lissaman`]).
+    #[serde(rename = "lissaman")]
+    Lissaman,
+}
+
+impl AeroModel {
+    /// `"hummel"` or `"lissaman"`, as in JSON and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            AeroModel::Hummel => "hummel",
+            AeroModel::Lissaman => "lissaman",
+        }
+    }
+
+    /// True for [`AeroModel::Hummel`] (the default, left out of serialised options).
+    pub fn is_hummel(&self) -> bool {
+        *self == AeroModel::Hummel
+    }
+
+    /// How the model is named in summaries and the report.
+    pub fn describe(self) -> &'static str {
+        match self {
+            AeroModel::Hummel => "Hummel's horseshoe model",
+            AeroModel::Lissaman => "Lissaman & Shollenberger-type lifting lines",
+        }
+    }
+}
+
+impl std::str::FromStr for AeroModel {
+    type Err = Error;
+
+    fn from_str(s: &str) -> Result<AeroModel> {
+        match s {
+            "hummel" => Ok(AeroModel::Hummel),
+            "lissaman" => Ok(AeroModel::Lissaman),
+            other => Err(Error::parameter(
+                "aero.model",
+                format!("{other:?}: the model is \"hummel\" or \"lissaman\""),
+            )),
+        }
+    }
 }
 
 /// Largest accepted [`AeroOptions::wake_descent`]: a slope of 0.2, far beyond a bird's wake
@@ -140,6 +199,7 @@ impl Default for AeroOptions {
             collision_chord: DEFAULT_COLLISION_CHORD,
             wake: Wake::Planar,
             wake_descent: 0.0,
+            model: AeroModel::Hummel,
         }
     }
 }
@@ -808,6 +868,41 @@ pub fn fill_frame_savings(anim: &mut Animation, opts: &AeroOptions) {
     }
 }
 
+impl AeroOptions {
+    /// The record of these options in an animation file (`savings_model`).
+    pub fn record(&self) -> crate::animation::SavingsModel {
+        crate::animation::SavingsModel {
+            wake: self.wake.name().into(),
+            core_radius: self.core_radius,
+            model: self.model.name().into(),
+        }
+    }
+
+    /// The options an animation's `savings_model` stands for (defaults for anything it does not
+    /// say).
+    pub fn from_record(m: &crate::animation::SavingsModel) -> AeroOptions {
+        AeroOptions {
+            core_radius: m.core_radius,
+            wake: m.wake.parse().unwrap_or_default(),
+            model: m.model.parse().unwrap_or_default(),
+            ..AeroOptions::default()
+        }
+    }
+}
+
+/// Recomputes `e` and `xi` of every frame of `anim` with `opts` (another model, wake or core
+/// than the one the animation was made with), as [`fill_frame_savings`] does for the take-off:
+/// in the formation frame of the leader's heading. Records `opts` as the animation's savings
+/// model.
+pub fn recompute_frame_savings(anim: &mut Animation, opts: &AeroOptions) {
+    for f in &mut anim.frames {
+        f.e = None;
+        f.xi = None;
+    }
+    fill_frame_savings(anim, opts);
+    anim.savings_model = Some(opts.record());
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -817,6 +912,7 @@ mod tests {
         collision_chord: DEFAULT_COLLISION_CHORD,
         wake: Wake::Planar,
         wake_descent: 0.0,
+        model: AeroModel::Hummel,
     };
 
     /// The formula exactly as printed, with absolute values inside the logarithms, evaluated

@@ -293,6 +293,20 @@ impl AeroOptions {
                 "height is not a finite number",
             ));
         }
+        if self.model == super::AeroModel::Lissaman {
+            self.validate()?;
+            if x.len() < 2 {
+                return Err(Error::parameter(
+                    "birds",
+                    format!("{} bird(s) given, at least 2 needed", x.len()),
+                ));
+            }
+            self.check_shape(x, y)?;
+            let e = self.power_lenient_3d(x, y, z);
+            let total: f64 = e.iter().sum();
+            let xi = e.iter().map(|v| v / total).collect();
+            return Ok(PowerReduction { e, xi, total });
+        }
         if self.wake == Wake::Planar {
             return self.power_reduction(x, y);
         }
@@ -357,7 +371,17 @@ impl AeroOptions {
     /// [`AeroOptions::power_lenient`] with heights: every frame of an animation gets finite
     /// savings (a pair closer than a chord is evaluated at the collision distance). The planar
     /// wake ignores `z`.
+    /// With [`super::AeroModel::Lissaman`], the lifting-line model's sums
+    /// ([`super::lissaman::power`]; heights only with [`Wake::ThreeD`]).
     pub fn power_lenient_3d(&self, x: &[f64], y: &[f64], z: &[f64]) -> Vec<f64> {
+        if self.model == super::AeroModel::Lissaman {
+            let zs: &[f64] = if self.wake == Wake::ThreeD && z.len() == x.len() {
+                z
+            } else {
+                &[]
+            };
+            return super::lissaman::power(x, y, zs, self.collision_chord);
+        }
         if self.wake == Wake::Planar || z.len() != x.len() {
             return self.power_lenient(x, y);
         }

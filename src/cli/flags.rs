@@ -93,6 +93,8 @@ pub const FLAGS: &[(&str, &str, &[Cmd])] = &[
     ("steady.flight.mass_kg", "--mass-kg", STEADY),
     ("steady.flight.speed_ms", "--speed-ms", STEADY),
     ("aero.core_radius", "--core-radius", STEADY),
+    ("aero.model", "--aero-model", STEADY),
+    ("aero.wake", "--wake", STEADY),
     ("steady.keys.max_jump", "--max-jump", STEADY),
     ("steady.jostle.scale", "--jostle", STEADY),
     (

@@ -285,7 +285,12 @@ pub fn run(args: InitiateArgs, g: Global) -> Result<()> {
         initiate::initiate(&steady, &opts, &mut rng, &progress)?
     };
     // Savings (e, ξ) in the take-off frames too.
-    formation::aero::fill_frame_savings(&mut anim, &Default::default());
+    let aero = anim
+        .savings_model
+        .as_ref()
+        .map(formation::aero::AeroOptions::from_record)
+        .unwrap_or_default();
+    formation::aero::fill_frame_savings(&mut anim, &aero);
     let report = formation::pipeline::course_stage(&mut anim, course.1.as_ref(), &course.0)?;
     super::course::warn(super::flags::Cmd::Initiate, g, &report)?;
     formation::wingbeat::rest::stand_on_ground(&mut anim, wing.species);

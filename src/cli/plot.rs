@@ -42,12 +42,16 @@ pub struct SavingsArgs {
     /// Output chart (.png or .svg).
     #[arg(short = 'o', long = "output")]
     pub output: std::path::PathBuf,
+    #[command(flatten)]
+    pub savings: super::wake::SavingsFlags,
 }
 
 fn run_plot_savings(args: SavingsArgs) -> Result<()> {
     use formation::io::OutputKind;
     OutputKind::from_path(&args.output, &[OutputKind::Png, OutputKind::Svg])?;
-    let anim = formation::Animation::read(&args.input)?;
+    args.savings.aero(None)?;
+    let mut anim = formation::Animation::read(&args.input)?;
+    args.savings.apply(&mut anim)?;
     let chart = formation::plot::savings::SavingsChart::from_animation(&anim, &args.input)?;
     super::chart::save(&chart, &args.output)
 }
@@ -111,7 +115,15 @@ pub fn run(args: PlotArgs, g: Global) -> Result<()> {
             a.output.clone(),
         ),
         PlotKind::Savings(a) => (
-            "each bird's saving against its rank, and the flock's saving over time".into(),
+            match a.savings.aero(None).ok().flatten() {
+                Some(o) => format!(
+                    "each bird's saving against its rank, and the flock's saving over time ({})",
+                    o.record()
+                ),
+                None => {
+                    "each bird's saving against its rank, and the flock's saving over time".into()
+                }
+            },
             a.input.clone(),
             a.output.clone(),
         ),

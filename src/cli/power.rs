@@ -6,7 +6,7 @@ use clap::Args;
 use formation::{aero, Error, Result, Shape};
 use serde::Serialize;
 
-use super::wake::WakeArg;
+use super::wake::{ModelArg, WakeArg};
 use super::Global;
 
 /// Arguments of `formation power`.
@@ -34,6 +34,11 @@ pub struct PowerArgs {
         default_value_t = 0.0
     )]
     pub wake_descent: f64,
+    /// Model of the savings: hummel (Hummel's horseshoes with a vortex core) or lissaman
+    /// (elliptically loaded lifting lines, the kind Hainsworth and Cutts & Speakman used; no
+    /// core); docs/model.md.
+    #[arg(long = "aero-model", value_enum, value_name = "MODEL", default_value_t = ModelArg::Hummel)]
+    pub aero_model: ModelArg,
     #[command(flatten)]
     pub flight: FlightArgs,
 }
@@ -129,6 +134,27 @@ struct CoreJson {
     flock_saving_total: f64,
 }
 
+/// One entry of the band over models, wakes and cores.
+#[derive(Serialize)]
+struct BandJson {
+    model: &'static str,
+    wake: &'static str,
+    /// Absent for the lifting-line model, which has no core.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    core_radius: Option<f64>,
+    flock_saving: f64,
+    flock_saving_total: f64,
+}
+
+/// The model that gave the main numbers.
+#[derive(Serialize)]
+struct ModelJson {
+    name: &'static str,
+    wake: &'static str,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    core_radius: Option<f64>,
+}
+
 #[derive(Serialize)]
 struct FlightJson {
     species: String,
@@ -145,8 +171,10 @@ struct PowerJson {
     total: f64,
     flock_saving: f64,
     flock_saving_total: f64,
+    model: ModelJson,
     flight: FlightJson,
     sensitivity: Vec<CoreJson>,
+    band: Vec<BandJson>,
     birds: Vec<BirdJson>,
 }
 
@@ -196,6 +224,7 @@ pub fn run(args: PowerArgs, _g: Global) -> Result<()> {
         core_radius: args.core_radius,
         wake: args.wake.into(),
         wake_descent: args.wake_descent,
+        model: args.aero_model.into(),
         ..aero::AeroOptions::default()
     };
     model.validate().map_err(|e| match e {
@@ -211,7 +240,9 @@ pub fn run(args: PowerArgs, _g: Global) -> Result<()> {
         .map_err(|e| in_file(&args.shape, e))?;
     let flock_saving = pr.total / shape.len() as f64;
     // How much the number depends on the core radius (the model's one free length).
-    let sensitivity: Vec<CoreJson> = CORES
+    // (The lifting-line model has no core: no entries.)
+    let cores: &[f64] = if model.model.is_hummel() { &CORES } else { &[] };
+    let sensitivity: Vec<CoreJson> = cores
         .iter()
         .filter_map(|&c| {
             let m = aero::AeroOptions {
@@ -227,12 +258,50 @@ pub fn run(args: PowerArgs, _g: Global) -> Result<()> {
             })
         })
         .collect();
+    // The band over both models, both wakes and (Hummel's) cores: how much the number depends
+    // on modelling choices no measurement fixes.
+    let mut band: Vec<BandJson> = Vec::new();
+    for m in [aero::AeroModel::Hummel, aero::AeroModel::Lissaman] {
+        for w in [aero::Wake::Planar, aero::Wake::ThreeD] {
+            let cores: &[f64] = if m.is_hummel() { &CORES } else { &[0.0] };
+            for &c in cores {
+                let o = aero::AeroOptions {
+                    core_radius: if m.is_hummel() { c } else { model.core_radius },
+                    wake: w,
+                    wake_descent: if w == aero::Wake::ThreeD {
+                        model.wake_descent
+                    } else {
+                        0.0
+                    },
+                    model: m,
+                    ..model
+                };
+                let Ok(p) = o.power_reduction_3d(&x, &y, &z) else {
+                    continue;
+                };
+                let f = p.total / shape.len() as f64;
+                band.push(BandJson {
+                    model: m.name(),
+                    wake: w.name(),
+                    core_radius: m.is_hummel().then_some(c),
+                    flock_saving: f,
+                    flock_saving_total: f * share,
+                });
+            }
+        }
+    }
+    let core_used = model.model.is_hummel().then_some(model.core_radius);
     let mut out = String::new();
     if args.json {
         let doc = PowerJson {
             total: pr.total,
             flock_saving,
             flock_saving_total: flock_saving * share,
+            model: ModelJson {
+                name: model.model.name(),
+                wake: model.wake.name(),
+                core_radius: core_used,
+            },
             flight: FlightJson {
                 species: flight.species.to_string(),
                 mass_kg: flight.curve.bird.mass_kg,
@@ -243,6 +312,7 @@ pub fn run(args: PowerArgs, _g: Global) -> Result<()> {
                 method: "Pennycuick 2008",
             },
             sensitivity,
+            band,
             birds: shape
                 .birds
                 .iter()
@@ -302,9 +372,22 @@ pub fn run(args: PowerArgs, _g: Global) -> Result<()> {
                     .join(", ")
             ));
         }
+        if let (Some(lo), Some(hi)) = (
+            band.iter().map(|c| c.flock_saving).reduce(f64::min),
+            band.iter().map(|c| c.flock_saving).reduce(f64::max),
+        ) {
+            out.push_str(&format!(
+                "over both models (hummel, lissaman), both wakes (planar, 3d) and the cores above: flock saving {:.1} to {:.1}% of induced power, {:.1} to {:.1}% of total power\n",
+                100.0 * lo,
+                100.0 * hi,
+                100.0 * lo * share,
+                100.0 * hi * share
+            ));
+        }
         let bird = &flight.curve.bird;
         out.push_str(&format!(
-            "model: Hummel's horseshoe wake{}, core {} wingspans; power curve after Pennycuick (2008) for a {} of {:.2} kg, {:.2} m span at {:.1} m/s: induced power is {:.0}% of the total\n",
+            "model: {}{}, {}; power curve after Pennycuick (2008) for a {} of {:.2} kg, {:.2} m span at {:.1} m/s: induced power is {:.0}% of the total\n",
+            model.model.describe(),
             match model.wake {
                 aero::Wake::Planar => String::new(),
                 aero::Wake::ThreeD if model.wake_descent == 0.0 => {
@@ -315,7 +398,10 @@ pub fn run(args: PowerArgs, _g: Global) -> Result<()> {
                     model.wake_descent
                 ),
             },
-            args.core_radius,
+            match core_used {
+                Some(c) => format!("core {c} wingspans"),
+                None => "no core (a continuous vortex sheet; --core-radius is not used)".into(),
+            },
             flight.species,
             bird.mass_kg,
             bird.span_m,

@@ -25,6 +25,8 @@ pub struct ReportArgs {
     pub output: PathBuf,
     #[command(flatten)]
     pub extraction: ExtractionArgs,
+    #[command(flatten)]
+    pub savings: super::wake::SavingsFlags,
 }
 
 /// Runs `formation report`.
@@ -32,11 +34,17 @@ pub fn run(args: ReportArgs, g: Global) -> Result<()> {
     OutputKind::for_flag("-o", &args.output, &[OutputKind::Html])?;
     let extract = args.extraction.options();
     extract.validate()?;
+    // The savings flags are checked before any work.
+    let footage_aero = args.savings.aero(None)?;
     formation::io::check_output_dir("-o", &args.output)?;
     let kind = formation::sniff::path_kind(&args.input)?;
     let (params, animation, threshold): (Option<FormationParams>, Option<Animation>, _) = match kind
     {
-        Kind::Animation => (None, Some(Animation::read(&args.input)?), None),
+        Kind::Animation => {
+            let mut a = Animation::read(&args.input)?;
+            args.savings.apply(&mut a)?;
+            (None, Some(a), None)
+        }
         Kind::Params => (Some(FormationParams::read(&args.input)?), None, None),
         _ => {
             let (_, p, _) = super::extract::read_and_extract(
@@ -57,18 +65,23 @@ pub fn run(args: ReportArgs, g: Global) -> Result<()> {
         params: params.as_ref(),
         threshold,
         animation: animation.as_ref(),
+        aero: footage_aero,
     })?;
     write_bytes_atomic(&args.output, page.as_bytes())?;
     let what = match (&params, &animation) {
         (Some(p), _) => format!(
-            "a page on {} annotated frames (shape {}, fits, spacing, savings)",
+            "a page on {} annotated frames (shape {}, fits, spacing, savings by {})",
             p.frames.len(),
-            super::summary::dominant(p)
+            super::summary::dominant(p),
+            footage_aero.unwrap_or_default().record()
         ),
         (None, Some(a)) => format!(
-            "a page on an animation of {} birds, {} frames (savings, take-off, steady flight)",
+            "a page on an animation of {} birds, {} frames (savings by {}, take-off, steady flight)",
             a.birds,
-            a.frames.len()
+            a.frames.len(),
+            a.savings_model
+                .as_ref()
+                .map_or("Hummel's model".to_string(), |m| m.to_string())
         ),
         (None, None) => "a page".to_string(),
     };

@@ -107,7 +107,14 @@ pub fn run(args: SolveArgs, g: Global) -> Result<()> {
         total: rep.total,
     };
     write_json_atomic(&args.output, &out)?;
-    super::summary::solve(g, target.x.len(), &rep, opts.tolerance, &args.output);
+    super::summary::solve(
+        g,
+        target.x.len(),
+        &rep,
+        opts.tolerance,
+        &opts.aero,
+        &args.output,
+    );
     if !rep.converged {
         return Err(Error::NotConverged(format!(
             "{}: not converged (residual {:.3e}); shape written to {} with \"converged\": false",

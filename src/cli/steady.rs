@@ -118,6 +118,11 @@ pub struct SteadyFlags {
     /// in every frame; the key shapes are still solved in the plane).
     #[arg(long, value_enum, default_value_t = super::wake::WakeArg::Planar)]
     pub wake: super::wake::WakeArg,
+    /// Model of the frames' savings: hummel (horseshoes with a core, the default) or lissaman
+    /// (elliptic lifting lines, the kind the field studies used); the key shapes are solved with
+    /// Hummel's model either way (docs/model.md).
+    #[arg(long = "aero-model", value_enum, value_name = "MODEL", default_value_t = super::wake::ModelArg::Hummel)]
+    pub aero_model: super::wake::ModelArg,
     /// Body mass of a bird, kg, for its power curve (savings of total power; default: the
     /// species' typical mass scaled to --wingspan-m).
     #[arg(long = "mass-kg", value_name = "KG", allow_negative_numbers = true)]
@@ -159,6 +164,7 @@ impl SteadyFlags {
             aero: formation::aero::AeroOptions {
                 core_radius: self.core_radius,
                 wake: self.wake.into(),
+                model: self.aero_model.into(),
                 ..formation::aero::AeroOptions::default()
             },
             flight: formation::animation::FlightSettings {

@@ -160,6 +160,7 @@ pub fn solve(
     birds: usize,
     rep: &formation::keyshape::solve::SolveReport,
     tolerance: f64,
+    aero: &formation::aero::AeroOptions,
     output: &std::path::Path,
 ) {
     if g.quiet {
@@ -167,12 +168,13 @@ pub fn solve(
     }
     defer(
         format!(
-            "solve: {birds} birds, {} (residual ‖ξ − ξ̂‖ = {:.2e}, tolerance {:.1e}) after {} evaluations; E = {:.4}",
+            "solve: {birds} birds, {} (residual ‖ξ − ξ̂‖ = {:.2e}, tolerance {:.1e}) after {} evaluations; E = {:.4} by Hummel's model, core {} wingspans (the key shape lies in one plane, where both wakes agree)",
             if rep.converged { "converged" } else { "NOT converged" },
             rep.residual,
             tolerance,
             rep.evaluations,
-            rep.total
+            rep.total,
+            aero.core_radius
         ),
         &[output.to_path_buf()],
     );

@@ -756,7 +756,13 @@ pub fn steady_flight_in(
         }
         // Between two collision-free keys a pair can pass within a chord: evaluated at the
         // collision distance there, so every frame has finite savings.
-        let (e, total_t) = if aero.wake.is_planar() {
+        let (e, total_t) = if !aero.model.is_hummel() {
+            // Another model's savings: ξ against its own total (the ranges below stay
+            // Hummel's, checked on Hummel's ξ).
+            let e = aero.power_lenient_3d(&fr.x, &ys, &fr.z);
+            let t: f64 = e.iter().sum();
+            (e, if t.is_finite() && t > 0.0 { t } else { total })
+        } else if aero.wake.is_planar() {
             let t = match aero.munk_total(&fr.x) {
                 Ok(t) if t > 0.0 => t,
                 _ => total,
@@ -769,6 +775,19 @@ pub fn steady_flight_in(
             (aero.power_lenient_3d(&fr.x, &ys, &fr.z), t)
         };
         let xi: Vec<f64> = e.iter().map(|v| v / total_t).collect();
+        // The feasible ranges are Hummel's: another model's ξ is checked as Hummel's.
+        let hummel_xi: Option<Vec<f64>> = (!aero.model.is_hummel()).then(|| {
+            let h = crate::aero::AeroOptions {
+                model: crate::aero::AeroModel::Hummel,
+                ..*aero
+            };
+            let t = match h.munk_total(&fr.x) {
+                Ok(t) if t > 0.0 => t,
+                _ => total,
+            };
+            h.power_lenient(&fr.x, &ys).iter().map(|v| v / t).collect()
+        });
+        let check = hummel_xi.as_ref().unwrap_or(&xi);
         // Ranges belong to slots: each bird's ξ against its slot's (the one it left, during an
         // exchange).
         let excess = if reorganised {
@@ -776,14 +795,14 @@ pub fn steady_flight_in(
             for (b, &s) in plan.slots_at(t).iter().enumerate() {
                 // A bird still flying in is not in its slot: its ξ is not the slot's.
                 by_slot[s] = if plan.joining(b, t) {
-                    xi[b].clamp(feasible.min[s], feasible.max[s])
+                    check[b].clamp(feasible.min[s], feasible.max[s])
                 } else {
-                    xi[b]
+                    check[b]
                 };
             }
             feasible.excess(&by_slot)
         } else {
-            feasible.excess(&xi)
+            feasible.excess(check)
         };
         if excess > 1e-12 {
             frames_outside_range += 1;
@@ -798,10 +817,7 @@ pub fn steady_flight_in(
 
     let mut anim = Animation::new(opts.seed, opts.fps, opts.wingspan_m, n);
     anim.flight = (!opts.flight.is_empty()).then_some(opts.flight);
-    anim.savings_model = Some(crate::animation::SavingsModel {
-        wake: opts.aero.wake.name().into(),
-        core_radius: opts.aero.core_radius,
-    });
+    anim.savings_model = Some(opts.aero.record());
     anim.stages.push(Stage {
         name: "steady".into(),
         start: 0,

@@ -46,9 +46,12 @@ impl SavingsChart {
         let name = super::power::file_name(origin);
         Ok(SavingsChart {
             title: format!(
-                "{name}: savings of {} birds ({})",
+                "{name}: savings of {} birds ({}), {}",
                 anim.birds,
-                stages_title(anim)
+                stages_title(anim),
+                anim.savings_model
+                    .as_ref()
+                    .map_or("Hummel's model".to_string(), |m| m.to_string())
             ),
             stats,
             takeoff,
