@@ -1019,6 +1019,40 @@ mod tests {
     }
 
     #[test]
+    fn bird_scales_are_clipped_seeded_and_one_without_variation() {
+        assert!(bird_scales(7, 50, 0.0).iter().all(|&s| s == 1.0));
+        let a = bird_scales(7, 2000, 0.1);
+        assert_eq!(a, bird_scales(7, 2000, 0.1));
+        assert_ne!(a, bird_scales(8, 2000, 0.1));
+        // Bird k's size does not depend on the flock's size.
+        assert_eq!(bird_scales(7, 10, 0.1)[..], a[..10]);
+        assert!(a.iter().all(|&s| (0.7 - 1e-6..=1.3 + 1e-6).contains(&s)));
+        let mean = a.iter().map(|&s| f64::from(s)).sum::<f64>() / a.len() as f64;
+        let sd = (a
+            .iter()
+            .map(|&s| (f64::from(s) - mean).powi(2))
+            .sum::<f64>()
+            / a.len() as f64)
+            .sqrt();
+        assert!(
+            (mean - 1.0).abs() < 0.01 && (sd - 0.1).abs() < 0.01,
+            "{mean} {sd}"
+        );
+    }
+
+    #[test]
+    fn a_scaled_bird_keeps_its_sitting_ground_point() {
+        for sp in Species::ALL {
+            let sit = crate::wingbeat::rest::stance(sp).sit as f32;
+            let ground = Vec3::new(0.0, -sit, 0.0);
+            for s in [0.85_f32, 1.0, 1.12] {
+                let moved = s * (size_pivot(sp, s) + ground);
+                assert!((moved - ground).length() < 1e-6, "{sp} {s}: {moved}");
+            }
+        }
+    }
+
+    #[test]
     fn usd_paths_follow_the_hierarchy() {
         let p = usd_joint_paths();
         assert_eq!(p[0], "body");

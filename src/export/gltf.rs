@@ -385,7 +385,7 @@ pub fn glb_bytes_with(anim: &Animation, wingspan_m: f64, opts: &SceneOptions) ->
         .collect::<Result<_>>()?;
     // One time accessor per clip for every channel keyed at every frame (made when first needed).
     let mut shared_t: Vec<Option<json::Index<json::Accessor>>> = vec![None; clips.len()];
-    for bird in 0..anim.birds {
+    for (bird, &scale) in scales.iter().enumerate() {
         let track = bird_track(anim, &flapper, &asset, bird, wingspan_m);
         // Skeleton nodes, children before parents so indices are known.
         let mut joint_nodes: [Option<json::Index<json::Node>>; 7] = [None; 7];
@@ -395,8 +395,8 @@ pub fn glb_bytes_with(anim: &Animation, wingspan_m: f64, opts: &SceneOptions) ->
                 .filter_map(|c| joint_nodes[c])
                 .collect();
             let mut rest = asset.skeleton.rest_translation(j);
-            if j == bird::BODY && scales[bird] != 1.0 {
-                rest += bird::size_pivot(species, scales[bird]);
+            if j == bird::BODY && scale != 1.0 {
+                rest += bird::size_pivot(species, scale);
             }
             let node = root.push(json::Node {
                 name: Some(bird::JOINTS[j].to_string()),
@@ -418,10 +418,10 @@ pub fn glb_bytes_with(anim: &Animation, wingspan_m: f64, opts: &SceneOptions) ->
             rotation: Some(json::scene::UnitQuaternion(track.flight.yaw[0].to_array())),
             // The bird's size: the scale scales its skeleton and so its skinned mesh, not its
             // place (a scale of exactly 1 is left out, as glTF's default).
-            scale: (scales[bird] != 1.0).then(|| [scales[bird]; 3]),
+            scale: (scale != 1.0).then_some([scale; 3]),
             children: Some(vec![joints[bird::BODY]]),
-            extras: extras(&if scales[bird] != 1.0 {
-                serde_json::json!({"bird": bird, "scale": short(scales[bird])})
+            extras: extras(&if scale != 1.0 {
+                serde_json::json!({"bird": bird, "scale": short(scale)})
             } else {
                 serde_json::json!({"bird": bird})
             }),

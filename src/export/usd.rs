@@ -185,15 +185,15 @@ pub fn write_usda(
         .collect();
     out.write_all(b"def Xform \"flock\" (\n    kind = \"assembly\"\n)\n{\n")
         .map_err(io)?;
-    for b in 0..anim.birds {
+    for (b, &scale) in scales.iter().enumerate() {
         let track = bird_track(anim, &flapper, &asset, b, wingspan_m);
         let name = format!("bird_{b:0digits$}");
         let mut s = String::new();
         let _ = writeln!(
             s,
             "    def SkelRoot \"{name}\" (\n        prepend references = </_bird>\n        customData = {{\n            int bird = {b}{}\n        }}\n    )\n    {{",
-            if scales[b] != 1.0 {
-                format!("\n            double scale = {}", f(scales[b]))
+            if scale != 1.0 {
+                format!("\n            double scale = {}", f(scale))
             } else {
                 String::new()
             }
@@ -232,8 +232,8 @@ pub fn write_usda(
         }
         // The bird's size scales it about its root, after the flight (a scale of exactly 1 is
         // left out).
-        if scales[b] != 1.0 {
-            let sc = f(scales[b]);
+        if scale != 1.0 {
+            let sc = f(scale);
             let _ = writeln!(s, "        }}\n        float3 xformOp:scale = ({sc}, {sc}, {sc})\n        uniform token[] xformOpOrder = [\"xformOp:translate\", \"xformOp:orient\", \"xformOp:scale\"]\n");
         } else {
             let _ = writeln!(s, "        }}\n        uniform token[] xformOpOrder = [\"xformOp:translate\", \"xformOp:orient\"]\n");
@@ -246,8 +246,8 @@ pub fn write_usda(
         let rest: Vec<String> = (0..bird::JOINTS.len())
             .map(|j| {
                 let mut t = asset.skeleton.rest_translation(j);
-                if j == bird::BODY && scales[b] != 1.0 {
-                    t += bird::size_pivot(species, scales[b]);
+                if j == bird::BODY && scale != 1.0 {
+                    t += bird::size_pivot(species, scale);
                 }
                 vec3(t * ws)
             })
