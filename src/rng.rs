@@ -39,6 +39,8 @@ pub enum Stream {
     SteadyJostle,
     /// Steady flight: leader changes and swaps (when, which birds).
     SteadyEvents,
+    /// 3D exports: each bird's size (`render.size_variation`).
+    BirdSizes,
 }
 
 impl Stream {
@@ -57,6 +59,7 @@ impl Stream {
             Stream::SkeinLayout => "skein/layout",
             Stream::SteadyJostle => "steady.jostle",
             Stream::SteadyEvents => "steady.events",
+            Stream::BirdSizes => "export.sizes",
         }
     }
 }

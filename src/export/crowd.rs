@@ -136,6 +136,11 @@ pub fn write_usda_instancer(
     opts: &SceneOptions,
     out: &mut impl Write,
 ) -> std::io::Result<()> {
+    // The crowd's instances all have the bird's own size: its metadata records no variation.
+    let opts = &SceneOptions {
+        size_variation: 0.0,
+        ..opts.clone()
+    };
     let ws = wingspan_m as f32;
     let asset = asset_for(anim, opts);
     let flapper = Flapper::from_animation(anim);

@@ -61,6 +61,9 @@ pub struct SceneOptions {
     /// blur): frame numbers and the scene's rate are in these frames; `None` = the animation's
     /// own rate.
     pub frame_rate: Option<f64>,
+    /// Spread of the birds' sizes, the F of [`bird::bird_scales`] (0 = every bird the same size,
+    /// this struct's default; `render.size_variation` defaults to the species').
+    pub size_variation: f64,
 }
 
 impl SceneOptions {
@@ -178,6 +181,11 @@ pub fn metadata(
         "bird_model": asset.source,
         "joints": bird::JOINTS,
         "keys": opts.keys.to_string(),
+        "size_variation": opts.size_variation,
+        "bird_scales": bird::bird_scales(anim.seed, anim.birds, opts.size_variation)
+            .iter()
+            .map(|&s| short(s))
+            .collect::<Vec<_>>(),
     });
     if opts.frame_rate.is_some() {
         if let Some(o) = m.as_object_mut() {
@@ -188,6 +196,15 @@ pub fn metadata(
         }
     }
     m
+}
+
+/// An f32 as the JSON number of its shortest text (`1.0365741`, not its f64 widening).
+fn short(v: f32) -> serde_json::Value {
+    format!("{v}")
+        .parse::<f64>()
+        .ok()
+        .and_then(serde_json::Number::from_f64)
+        .map_or(serde_json::Value::Null, serde_json::Value::Number)
 }
 
 /// A frame number as JSON: an integer when whole (every frame), else the fractional number
@@ -355,6 +372,8 @@ pub fn glb_bytes_with(anim: &Animation, wingspan_m: f64, opts: &SceneOptions) ->
     let clips = clips(anim, opts.clips);
     let flapper = Flapper::from_animation(anim);
     let digits = bird_digits(anim.birds);
+    let scales = bird::bird_scales(anim.seed, anim.birds, opts.size_variation);
+    let species = WingbeatOptions::for_animation(anim).species;
     let mut bird_nodes = Vec::with_capacity(anim.birds);
     let mut mesh_nodes = Vec::with_capacity(anim.birds);
     // Per clip: channels and samplers.
@@ -366,7 +385,7 @@ pub fn glb_bytes_with(anim: &Animation, wingspan_m: f64, opts: &SceneOptions) ->
         .collect::<Result<_>>()?;
     // One time accessor per clip for every channel keyed at every frame (made when first needed).
     let mut shared_t: Vec<Option<json::Index<json::Accessor>>> = vec![None; clips.len()];
-    for bird in 0..anim.birds {
+    for (bird, &scale) in scales.iter().enumerate() {
         let track = bird_track(anim, &flapper, &asset, bird, wingspan_m);
         // Skeleton nodes, children before parents so indices are known.
         let mut joint_nodes: [Option<json::Index<json::Node>>; 7] = [None; 7];
@@ -375,9 +394,13 @@ pub fn glb_bytes_with(anim: &Animation, wingspan_m: f64, opts: &SceneOptions) ->
                 .filter(|&c| bird::PARENT[c] == Some(j))
                 .filter_map(|c| joint_nodes[c])
                 .collect();
+            let mut rest = asset.skeleton.rest_translation(j);
+            if j == bird::BODY && scale != 1.0 {
+                rest += bird::size_pivot(species, scale);
+            }
             let node = root.push(json::Node {
                 name: Some(bird::JOINTS[j].to_string()),
-                translation: Some((asset.skeleton.rest_translation(j) * ws).to_array()),
+                translation: Some((rest * ws).to_array()),
                 rotation: Some(json::scene::UnitQuaternion(track.joints[0][j].to_array())),
                 children: (!children.is_empty()).then_some(children),
                 ..Default::default()
@@ -393,8 +416,15 @@ pub fn glb_bytes_with(anim: &Animation, wingspan_m: f64, opts: &SceneOptions) ->
             name: Some(name.clone()),
             translation: Some(track.flight.translation[0].to_array()),
             rotation: Some(json::scene::UnitQuaternion(track.flight.yaw[0].to_array())),
+            // The bird's size: the scale scales its skeleton and so its skinned mesh, not its
+            // place (a scale of exactly 1 is left out, as glTF's default).
+            scale: (scale != 1.0).then_some([scale; 3]),
             children: Some(vec![joints[bird::BODY]]),
-            extras: extras(&serde_json::json!({"bird": bird})),
+            extras: extras(&if scale != 1.0 {
+                serde_json::json!({"bird": bird, "scale": short(scale)})
+            } else {
+                serde_json::json!({"bird": bird})
+            }),
             ..Default::default()
         });
         bird_nodes.push(bird_node);

@@ -103,6 +103,13 @@ pub struct RenderOptions {
     /// A JSON file naming the joints of `bird_model` by the convention's
     /// ([`bird_model::read_joint_map`]).
     pub joint_map: Option<PathBuf>,
+    /// Spread of the birds' sizes in the `.glb` and `.usda`, a fraction (the coefficient of
+    /// variation of the wingspan, 0 to [`bird::MAX_SIZE_VARIATION`]): each bird is scaled by
+    /// `1 + F·z`, z a standard normal clipped to ±3, drawn from the animation's seed
+    /// ([`bird::bird_scales`]). `None` = the species' default
+    /// ([`bird::DEFAULT_SIZE_VARIATION`]); 0 = every bird the same size. Positions (and the
+    /// `.json` and `.csv`) do not change.
+    pub size_variation: Option<f64>,
     /// Number of the first frame in every output that numbers frames (glTF keys and range, USD
     /// time codes, the CSV's `frame`, PNG file names), e.g. 1001; `None` = the animation's own
     /// (`start_frame` of the file, else 0).
@@ -183,6 +190,7 @@ impl Default for RenderOptions {
             clips: keys::ClipMode::One,
             bird_model: None,
             joint_map: None,
+            size_variation: None,
             start_frame: None,
             animation_fps: None,
             subframes: 1,
@@ -269,6 +277,18 @@ impl RenderOptions {
                 "render.gif_tolerance",
                 format!("{} is outside 0..=64 colour levels", self.gif_tolerance),
             ));
+        }
+        if let Some(f) = self.size_variation {
+            if !(f.is_finite() && (0.0..=bird::MAX_SIZE_VARIATION).contains(&f)) {
+                return Err(Error::parameter(
+                    "render.size_variation",
+                    format!(
+                        "{f} is not a size variation; give a fraction from 0 (every bird the same size) to {} (default {}: wingspans spread by about 4 %)",
+                        bird::MAX_SIZE_VARIATION,
+                        bird::DEFAULT_SIZE_VARIATION
+                    ),
+                ));
+            }
         }
         if let Some(w) = self.wingspan_m {
             if !(w.is_finite() && (crate::limits::MIN_WINGSPAN_M..=100.0).contains(&w)) {
@@ -525,6 +545,11 @@ pub fn write_outputs(
         asset,
         start_frame: anim.start_frame,
         frame_rate: None,
+        size_variation: opts.size_variation.unwrap_or_else(|| {
+            bird::default_size_variation(
+                crate::wingbeat::WingbeatOptions::for_animation(anim).species,
+            )
+        }),
     };
     // The 3-D outputs' samples: the animation (a loop with its closing frame), at
     // `subframes` samples a frame.

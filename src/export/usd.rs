@@ -100,6 +100,10 @@ fn dict_entries(v: &serde_json::Value, indent: &str, out: &mut String) {
                         a.iter().map(|x| string(x.as_str().unwrap_or(""))).collect();
                     let _ = writeln!(out, "{indent}string[] {k} = [{}]", items.join(", "));
                 }
+                serde_json::Value::Array(a) if !a.is_empty() && a.iter().all(|x| x.is_number()) => {
+                    let items: Vec<String> = a.iter().map(|x| x.to_string()).collect();
+                    let _ = writeln!(out, "{indent}double[] {k} = [{}]", items.join(", "));
+                }
                 // Anything else (e.g. the stages) as its JSON text.
                 other => {
                     let _ = writeln!(out, "{indent}string {k} = {}", string(&other.to_string()));
@@ -172,6 +176,8 @@ pub fn write_usda(
         .join(", ");
     let flapper = Flapper::from_animation(anim);
     let digits = bird_digits(anim.birds);
+    let scales = bird::bird_scales(anim.seed, anim.birds, opts.size_variation);
+    let species = crate::wingbeat::WingbeatOptions::for_animation(anim).species;
     let times: Vec<f32> = anim
         .frames
         .iter()
@@ -179,13 +185,18 @@ pub fn write_usda(
         .collect();
     out.write_all(b"def Xform \"flock\" (\n    kind = \"assembly\"\n)\n{\n")
         .map_err(io)?;
-    for b in 0..anim.birds {
+    for (b, &scale) in scales.iter().enumerate() {
         let track = bird_track(anim, &flapper, &asset, b, wingspan_m);
         let name = format!("bird_{b:0digits$}");
         let mut s = String::new();
         let _ = writeln!(
             s,
-            "    def SkelRoot \"{name}\" (\n        prepend references = </_bird>\n        customData = {{\n            int bird = {b}\n        }}\n    )\n    {{"
+            "    def SkelRoot \"{name}\" (\n        prepend references = </_bird>\n        customData = {{\n            int bird = {b}{}\n        }}\n    )\n    {{",
+            if scale != 1.0 {
+                format!("\n            double scale = {}", f(scale))
+            } else {
+                String::new()
+            }
         );
         let tol = opts.tolerance;
         let kt = keys::keep(
@@ -219,14 +230,27 @@ pub fn write_usda(
                 quat(track.flight.yaw[k])
             );
         }
-        let _ = writeln!(s, "        }}\n        uniform token[] xformOpOrder = [\"xformOp:translate\", \"xformOp:orient\"]\n");
+        // The bird's size scales it about its root, after the flight (a scale of exactly 1 is
+        // left out).
+        if scale != 1.0 {
+            let sc = f(scale);
+            let _ = writeln!(s, "        }}\n        float3 xformOp:scale = ({sc}, {sc}, {sc})\n        uniform token[] xformOpOrder = [\"xformOp:translate\", \"xformOp:orient\", \"xformOp:scale\"]\n");
+        } else {
+            let _ = writeln!(s, "        }}\n        uniform token[] xformOpOrder = [\"xformOp:translate\", \"xformOp:orient\"]\n");
+        }
         let _ = writeln!(
             s,
             "        over \"rig\"\n        {{\n            rel skel:animationSource = </flock/{name}/anim>\n        }}\n"
         );
         let _ = writeln!(s, "        def SkelAnimation \"anim\"\n        {{\n            uniform token[] joints = [{joints_tokens}]");
         let rest: Vec<String> = (0..bird::JOINTS.len())
-            .map(|j| vec3(asset.skeleton.rest_translation(j) * ws))
+            .map(|j| {
+                let mut t = asset.skeleton.rest_translation(j);
+                if j == bird::BODY && scale != 1.0 {
+                    t += bird::size_pivot(species, scale);
+                }
+                vec3(t * ws)
+            })
             .collect();
         let _ = writeln!(
             s,
