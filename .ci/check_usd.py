@@ -168,6 +168,19 @@ def check_instancer(stage, anim, start, failed, check):
     picks = sorted({round(i * (n - 1) / 19) for i in range(20)})
     worst = 0.0
     shown = set()
+    # Birds of different sizes (--size-variation): an instance scales its prototype about the
+    # root, and the size is taken about the point size_pivot_m below it, so the instance sits
+    # (s - 1) * size_pivot_m up the bird's own vertical from the JSON position.
+    meta = stage.GetRootLayer().customLayerData.get("formation", {})
+    scales_attr = pi.GetScalesAttr().Get()
+    scales = [1.0] * birds
+    if scales_attr:
+        check(len(scales_attr) == birds, "scales: %d for %d birds" % (len(scales_attr), birds))
+        scales = [v[0] for v in scales_attr]
+        recorded = list(meta.get("bird_scales", []))
+        check(len(recorded) == birds and all(abs(a - b) < 1e-6 for a, b in zip(scales, recorded)),
+              "instancer scales differ from customLayerData bird_scales")
+    pivot = meta.get("size_pivot_m", 0.0)
     for k in picks:
         t = Usd.TimeCode(start + round((frames[k]["t"] - frames[0]["t"]) * anim["fps"], 6))
         pos = pi.GetPositionsAttr().Get(t)
@@ -177,6 +190,15 @@ def check_instancer(stage, anim, start, failed, check):
         fr = frames[k]
         for b in range(birds):
             want = (fr["x"][b] * ws, fr["z"][b] * ws, -fr["y"][b] * ws)
+            if scales[b] != 1.0:
+                # The bird's vertical (0, h, 0) turned by its pitch (nose up, about +X: Rx(-pitch))
+                # and then its heading (about +Y: Ry(pi - heading)), as the exporter does.
+                h = (scales[b] - 1.0) * pivot
+                a = -(fr["pitch"][b] if "pitch" in fr else 0.0)
+                phi = math.pi - fr["heading"][b]
+                y, z = h * math.cos(a), h * math.sin(a)
+                up = (z * math.sin(phi), y, z * math.cos(phi))
+                want = tuple(want[i] + up[i] for i in range(3))
             err = math.sqrt(sum((pos[b][i] - want[i]) ** 2 for i in range(3)))
             worst = max(worst, err)
             norm = math.sqrt(rot[b].GetReal() ** 2 + sum(v * v for v in rot[b].GetImaginary()))
@@ -192,8 +214,8 @@ def check_instancer(stage, anim, start, failed, check):
         shown.add(pi.GetProtoIndicesAttr().Get(t)[0])
     check(len(protos) == 1 or len(shown) > 3, "the first bird shows %d prototypes" % len(shown))
     check(worst <= 1e-3, "instances %.3g m from the JSON" % worst)
-    print("instancer: %d prototypes, %d instances, %d frames checked, worst %.3g m, bird 0 shows %d poses"
-          % (len(protos), birds, len(picks), worst, len(shown)))
+    print("instancer: %d prototypes, %d instances (scales %.3f-%.3f), %d frames checked, worst %.3g m, bird 0 shows %d poses"
+          % (len(protos), birds, min(scales), max(scales), len(picks), worst, len(shown)))
 
 
 if __name__ == "__main__":

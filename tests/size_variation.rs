@@ -195,3 +195,91 @@ fn a_size_variation_out_of_range_is_refused_naming_the_flag() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The numbers of the line `prefix[...]` of `text` (a static array of scalars or tuples).
+fn numbers_after(text: &str, prefix: &str) -> Vec<f64> {
+    let line = text
+        .lines()
+        .find_map(|l| l.trim().strip_prefix(prefix))
+        .unwrap_or_else(|| panic!("no {prefix}"));
+    line.split([',', '(', ')', '[', ']'])
+        .filter(|x| !x.trim().is_empty())
+        .map(|x| x.trim().parse().unwrap())
+        .collect()
+}
+
+#[test]
+fn the_point_instanced_crowd_scales_its_birds_like_the_rig() {
+    let dir = scratch("sizes-crowd");
+    let geese = example_arg("barnacle_geese_v.json");
+    let p = |n: &str| s(&dir.join(n)).to_string();
+    let (glb, usda, json) = (p("c.glb"), p("c.usda"), p("c.json"));
+    ok(&[
+        "animate",
+        &geese,
+        "--birds",
+        "12",
+        "--seconds",
+        "2",
+        "--seed",
+        "5",
+        "--quiet",
+        "--usd-mode",
+        "instancer",
+        "--size-variation",
+        "0.05",
+        "-o",
+        &glb,
+        "-o",
+        &usda,
+        "-o",
+        &json,
+    ]);
+    let (nodes, _, _) = scales(Path::new(&glb));
+    let text = std::fs::read_to_string(&usda).unwrap();
+    // One uniform scale per instance, the glTF birds' own.
+    let sc = numbers_after(&text, "float3[] scales = ");
+    assert_eq!(sc.len(), 3 * 12);
+    for (b, n) in nodes.iter().enumerate() {
+        let v = &sc[3 * b..3 * b + 3];
+        assert!(
+            v.iter().all(|x| (x - n).abs() < 1e-6),
+            "bird {b}: {v:?} vs {n}"
+        );
+    }
+    assert!(nodes.iter().any(|&n| n > 1.01) && nodes.iter().any(|&n| n < 0.99));
+    let recorded = numbers_after(&text, "double[] bird_scales = ");
+    assert_eq!(recorded.len(), 12);
+    let pivot = numbers_after(&text, "double size_pivot_m = ")[0];
+    assert!(pivot > 0.05 && pivot < 0.2, "{pivot}");
+    // Each instance sits (s − 1)·pivot along its bird's vertical from the animation's position:
+    // a bigger bird at rest still sits on the ground.
+    let anim: Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    let ws = anim["wingspan_m"].as_f64().unwrap();
+    let start = text.find("positions.timeSamples = {").unwrap();
+    let lines: Vec<&str> = text[start..]
+        .lines()
+        .skip(1)
+        .take_while(|l| !l.trim_start().starts_with('}'))
+        .collect();
+    let frames = anim["frames"].as_array().unwrap();
+    assert_eq!(lines.len(), frames.len());
+    let mut worst: f64 = 0.0;
+    for (k, line) in lines.iter().enumerate() {
+        let pos = numbers_after(line, &format!("{k}: "));
+        let f = &frames[k];
+        let at = |key: &str, b: usize| f[key][b].as_f64().unwrap();
+        for (b, s) in nodes.iter().enumerate() {
+            let want = [at("x", b) * ws, at("z", b) * ws, -at("y", b) * ws];
+            let d: Vec<f64> = (0..3).map(|i| pos[3 * b + i] - want[i]).collect();
+            let len = d.iter().map(|x| x * x).sum::<f64>().sqrt();
+            worst = worst.max((len - (s - 1.0).abs() * pivot).abs());
+            if k == 0 {
+                // Sitting, level: straight up or down.
+                assert!((d[1] - (s - 1.0) * pivot).abs() < 1e-3, "bird {b}: {d:?}");
+            }
+        }
+    }
+    assert!(worst < 1e-3, "{worst} m");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -136,11 +136,6 @@ pub fn write_usda_instancer(
     opts: &SceneOptions,
     out: &mut impl Write,
 ) -> std::io::Result<()> {
-    // The crowd's instances all have the bird's own size: its metadata records no variation.
-    let opts = &SceneOptions {
-        size_variation: 0.0,
-        ..opts.clone()
-    };
     let ws = wingspan_m as f32;
     let asset = asset_for(anim, opts);
     let flapper = Flapper::from_animation(anim);
@@ -197,6 +192,14 @@ pub fn write_usda_instancer(
         .map(|b| bird::flight(anim, b, wingspan_m))
         .collect();
     let pivot = asset.skeleton.bind_pos[bird::BODY] * ws;
+    // Each bird's size, taken about the same point as on the skeletal birds: an instance scales
+    // its prototype about the root, so its position carries the skeleton's shift of `body`.
+    let scales = bird::bird_scales(anim.seed, birds, opts.size_variation);
+    let species = crate::wingbeat::WingbeatOptions::for_animation(anim).species;
+    let shifts: Vec<Vec3> = scales
+        .iter()
+        .map(|&s| (pivot + bird::size_pivot(species, s) * ws) * s)
+        .collect();
     let mut pos = String::new();
     let mut rot = String::new();
     let mut idx = String::new();
@@ -206,8 +209,10 @@ pub fn write_usda_instancer(
     for k in 0..n {
         pos.clear();
         for (b, fl) in flights.iter().enumerate() {
+            // The skeleton's world point of a prototype point x: t + yaw·s·(b + d + bank·(x − b))
+            // (b the body joint, d its size shift); the instance's: p + yaw·bank·s·x.
             let bank = Quat::from_rotation_z(fl.bank[k]);
-            let p = fl.translation[k] + fl.yaw[k] * (pivot - bank * pivot);
+            let p = fl.translation[k] + fl.yaw[k] * (shifts[b] - bank * (pivot * scales[b]));
             lo = lo.min(p);
             hi = hi.max(p);
             let sep = if b == 0 { "" } else { "," };
@@ -251,8 +256,14 @@ pub fn write_usda_instancer(
         writeln!(out, "            {}: [{idx}],", time_code(anim, opts, k))?;
     }
     out.write_all(b"        }\n")?;
-    // The instances' extent over the whole shot, grown by a wingspan for the birds' own size.
-    let pad = Vec3::splat(ws);
+    // The birds' sizes (left out when every bird has size 1).
+    if scales.iter().any(|&s| s != 1.0) {
+        let items: Vec<String> = scales.iter().map(|&s| format!("({s},{s},{s})")).collect();
+        writeln!(out, "        float3[] scales = [{}]", items.join(","))?;
+    }
+    // The instances' extent over the whole shot, grown by the largest bird's wingspan.
+    let largest = scales.iter().fold(1.0f32, |a, &s| a.max(s));
+    let pad = Vec3::splat(ws * largest);
     if n > 0 && birds > 0 {
         writeln!(
             out,

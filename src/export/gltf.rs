@@ -186,6 +186,8 @@ pub fn metadata(
             .iter()
             .map(|&s| short(s))
             .collect::<Vec<_>>(),
+        // How far below the root (in the bird's frame) sizes are taken about.
+        "size_pivot_m": short(crate::wingbeat::rest::stance(species).sit as f32 * wingspan_m as f32),
     });
     if opts.frame_rate.is_some() {
         if let Some(o) = m.as_object_mut() {
