@@ -41,6 +41,8 @@ pub enum Stream {
     SteadyEvents,
     /// 3D exports: each bird's size (`render.size_variation`).
     BirdSizes,
+    /// 3D exports: which of several bird models each bird wears (`render.bird_model`).
+    BirdModels,
 }
 
 impl Stream {
@@ -60,6 +62,7 @@ impl Stream {
             Stream::SteadyJostle => "steady.jostle",
             Stream::SteadyEvents => "steady.events",
             Stream::BirdSizes => "export.sizes",
+            Stream::BirdModels => "export.models",
         }
     }
 }

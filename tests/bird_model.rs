@@ -105,7 +105,7 @@ fn a_static_model_is_scaled_to_the_wingspan_and_bound_to_the_body() {
     assert!(asset.mesh.joints.iter().all(|j| j[0] == 0));
     let anim = flock();
     let opts = SceneOptions {
-        asset: Some(asset),
+        assets: vec![asset],
         ..SceneOptions::default()
     };
     let g = parse(&glb_bytes_with(&anim, 1.5, &opts).unwrap());
@@ -134,7 +134,7 @@ fn a_skinned_model_with_the_convention_flaps_like_the_built_in_bird() {
     let asset = bird_model::load(&path, Species::Goose).unwrap();
     assert!(asset.wingbeat);
     let opts = SceneOptions {
-        asset: Some(asset),
+        assets: vec![asset],
         ..SceneOptions::default()
     };
     let theirs = parse(&glb_bytes_with(&anim, 1.5, &opts).unwrap());

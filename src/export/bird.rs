@@ -851,6 +851,24 @@ pub fn bird_scales(seed: u64, birds: usize, variation: f64) -> Vec<f32> {
         .collect()
 }
 
+/// Which of `models` bird models each of `birds` birds wears: every model on the same number
+/// of birds (to one), which birds at random (a Fisher–Yates shuffle of `0, 1, …, models − 1,
+/// 0, 1, …` drawn from the stream `export.models` of the animation's `seed`). One model (or
+/// none) gives every bird model 0.
+pub fn model_assignment(seed: u64, birds: usize, models: usize) -> Vec<usize> {
+    use rand::Rng;
+    let mut out: Vec<usize> = (0..birds).map(|b| b % models.max(1)).collect();
+    if models <= 1 {
+        return out;
+    }
+    let mut rng = crate::rng::stream(seed, crate::rng::Stream::BirdModels);
+    for i in (1..birds).rev() {
+        let j = rng.random_range(0..=i);
+        out.swap(i, j);
+    }
+    out
+}
+
 /// Where the size of a bird of `scale` is taken about, as a shift of its `body` joint in the
 /// root's frame (wingspans, before the root's scale): the point on the ground under a sitting
 /// bird of `species` (its sitting height below the root, `wingbeat::rest::stance`). The root's
@@ -1038,6 +1056,22 @@ mod tests {
             (mean - 1.0).abs() < 0.01 && (sd - 0.1).abs() < 0.01,
             "{mean} {sd}"
         );
+    }
+
+    #[test]
+    fn models_are_shared_out_evenly_at_random_and_seeded() {
+        assert_eq!(model_assignment(3, 5, 1), vec![0; 5]);
+        assert_eq!(model_assignment(3, 5, 0), vec![0; 5]);
+        let a = model_assignment(3, 100, 3);
+        assert_eq!(a, model_assignment(3, 100, 3));
+        assert_ne!(a, model_assignment(4, 100, 3));
+        let count = |m: usize| a.iter().filter(|&&x| x == m).count();
+        assert_eq!((count(0), count(1), count(2)), (34, 33, 33));
+        // Shuffled, not in turn.
+        assert_ne!(a, (0..100).map(|b| b % 3).collect::<Vec<_>>());
+        // Fewer birds than models: each bird a different model.
+        let few = model_assignment(9, 2, 3);
+        assert!(few[0] != few[1] && few.iter().all(|&m| m < 3));
     }
 
     #[test]

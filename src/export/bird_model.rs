@@ -23,7 +23,7 @@
 //! moved so that the box's centre is the bird's centre.
 
 use std::collections::BTreeMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use glam::{Mat4, Quat, Vec3};
 use gltf_json as json;
@@ -68,6 +68,26 @@ pub fn load_with(path: &Path, species: Species, joint_map: Option<&Path>) -> Res
     }
     let bytes = crate::io::read_bytes(path)?;
     parse_with(path, &bytes, species, map.as_ref())
+}
+
+/// Most bird models one export shares out over its birds.
+pub const MAX_MODELS: usize = 16;
+
+/// Loads and checks every model of `paths` ([`load_with`]) with its joint map: `maps` is empty,
+/// one map for every model, or one per model in order (checked by the caller's options).
+pub fn load_all(paths: &[PathBuf], maps: &[PathBuf], species: Species) -> Result<Vec<BirdAsset>> {
+    paths
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let map = match maps {
+                [] => None,
+                [one] => Some(one.as_path()),
+                each => each.get(i).map(PathBuf::as_path),
+            };
+            load_with(p, species, map)
+        })
+        .collect()
 }
 
 /// Parses and checks the bytes of a bird model (`path` is only named in messages); what [`load`]

@@ -51,8 +51,9 @@ pub struct SceneOptions {
     pub tolerance: Tolerance,
     /// One clip over every stage, or one per stage.
     pub clips: ClipMode,
-    /// The bird placed on every bird; `None` = the built-in bird of the animation's species.
-    pub asset: Option<BirdAsset>,
+    /// The user's bird models, shared out over the birds ([`bird::model_assignment`]); empty =
+    /// the built-in bird of the animation's species on every bird.
+    pub assets: Vec<BirdAsset>,
     /// Number of the animation's first frame (e.g. 1001): the one clip's keys start at
     /// `start_frame / fps` seconds, and the frame numbers in the metadata and USD time codes
     /// count from it.
@@ -67,6 +68,23 @@ pub struct SceneOptions {
 }
 
 impl SceneOptions {
+    /// The bird models of `anim`: the user's, else the built-in bird of its species (at least
+    /// one).
+    pub fn models(&self, anim: &Animation) -> Vec<BirdAsset> {
+        if self.assets.is_empty() {
+            vec![BirdAsset::builtin(
+                WingbeatOptions::for_animation(anim).species,
+            )]
+        } else {
+            self.assets.clone()
+        }
+    }
+
+    /// Each bird's model: an index into [`SceneOptions::models`].
+    pub fn model_of(&self, anim: &Animation) -> Vec<usize> {
+        bird::model_assignment(anim.seed, anim.birds, self.assets.len())
+    }
+
     /// The shot's frame rate of `anim`'s samples.
     pub fn rate(&self, anim: &Animation) -> f64 {
         self.frame_rate.unwrap_or(anim.fps)
@@ -155,7 +173,7 @@ pub fn clips(anim: &Animation, mode: ClipMode) -> Vec<Clip> {
 pub fn metadata(
     anim: &Animation,
     wingspan_m: f64,
-    asset: &BirdAsset,
+    assets: &[BirdAsset],
     opts: &SceneOptions,
 ) -> serde_json::Value {
     let species = WingbeatOptions::for_animation(anim).species;
@@ -178,7 +196,10 @@ pub fn metadata(
         "birds": anim.birds,
         "frames": opts.frame_end(anim) - opts.start_frame + 1,
         "stages": anim.stages.iter().map(|s| serde_json::json!({"name": s.name, "start": stage_frame(s.start), "end": stage_frame(s.end)})).collect::<Vec<_>>(),
-        "bird_model": asset.source,
+        "bird_model": match assets {
+            [one] => serde_json::Value::from(one.source.clone()),
+            several => several.iter().map(|a| a.source.clone()).collect(),
+        },
         "joints": bird::JOINTS,
         "keys": opts.keys.to_string(),
         "size_variation": opts.size_variation,
@@ -189,6 +210,9 @@ pub fn metadata(
         // How far below the root (in the bird's frame) sizes are taken about.
         "size_pivot_m": short(crate::wingbeat::rest::stance(species).sit as f32 * wingspan_m as f32),
     });
+    if let (Some(o), true) = (m.as_object_mut(), assets.len() > 1) {
+        o.insert("bird_model_of".into(), opts.model_of(anim).into());
+    }
     if opts.frame_rate.is_some() {
         if let Some(o) = m.as_object_mut() {
             o.insert(
@@ -225,10 +249,10 @@ fn frame_value(f: f64) -> serde_json::Value {
 fn scene_metadata(
     anim: &Animation,
     wingspan_m: f64,
-    asset: &BirdAsset,
+    assets: &[BirdAsset],
     opts: &SceneOptions,
 ) -> serde_json::Value {
-    let mut m = metadata(anim, wingspan_m, asset, opts);
+    let mut m = metadata(anim, wingspan_m, assets, opts);
     if let Some(o) = m.as_object_mut() {
         o.insert("frame_start".into(), opts.start_frame.into());
         o.insert("frame_end".into(), opts.frame_end(anim).into());
@@ -268,14 +292,6 @@ fn clip_metadata(anim: &Animation, c: &Clip, opts: &SceneOptions) -> serde_json:
 
 fn extras(v: &serde_json::Value) -> json::Extras {
     serde_json::value::RawValue::from_string(v.to_string()).ok()
-}
-
-/// The bird asset of an export: the user's if given, else the built-in bird of the species.
-pub fn asset_for(anim: &Animation, opts: &SceneOptions) -> BirdAsset {
-    match &opts.asset {
-        Some(a) => a.clone(),
-        None => BirdAsset::builtin(WingbeatOptions::for_animation(anim).species),
-    }
 }
 
 /// Key times of clip `c`: from the clip's first frame, and for the one clip over every stage
@@ -353,7 +369,8 @@ pub fn bird_track(
 pub fn glb_bytes_with(anim: &Animation, wingspan_m: f64, opts: &SceneOptions) -> Result<Vec<u8>> {
     let mut b = Builder::default();
     let ws = wingspan_m as f32;
-    let asset = asset_for(anim, opts);
+    let assets = opts.models(anim);
+    let model_of = opts.model_of(anim);
     let mut root = json::Root {
         asset: json::Asset {
             version: "2.0".into(),
@@ -365,11 +382,24 @@ pub fn glb_bytes_with(anim: &Animation, wingspan_m: f64, opts: &SceneOptions) ->
         },
         ..Default::default()
     };
-    let mesh = b.skinned_mesh(&mut root, &asset, ws);
-    let ibm: Vec<f32> = (0..bird::JOINTS.len())
-        .flat_map(|j| asset.skeleton.inverse_bind(j, ws).to_cols_array())
+    // Each model's mesh and inverse bind matrices, shared by the birds that wear it.
+    let shared: Vec<(json::Index<json::Mesh>, json::Index<json::Accessor>)> = assets
+        .iter()
+        .enumerate()
+        .map(|(m, asset)| {
+            let name = if assets.len() == 1 {
+                "bird".to_string()
+            } else {
+                format!("bird_model_{m}")
+            };
+            let mesh = b.skinned_mesh(&mut root, asset, ws, &name);
+            let ibm: Vec<f32> = (0..bird::JOINTS.len())
+                .flat_map(|j| asset.skeleton.inverse_bind(j, ws).to_cols_array())
+                .collect();
+            let ibm_acc = b.accessor(&mut root, &ibm, 16, json::accessor::Type::Mat4, false, None);
+            (mesh, ibm_acc)
+        })
         .collect();
-    let ibm_acc = b.accessor(&mut root, &ibm, 16, json::accessor::Type::Mat4, false, None);
 
     let clips = clips(anim, opts.clips);
     let flapper = Flapper::from_animation(anim);
@@ -388,7 +418,10 @@ pub fn glb_bytes_with(anim: &Animation, wingspan_m: f64, opts: &SceneOptions) ->
     // One time accessor per clip for every channel keyed at every frame (made when first needed).
     let mut shared_t: Vec<Option<json::Index<json::Accessor>>> = vec![None; clips.len()];
     for (bird, &scale) in scales.iter().enumerate() {
-        let track = bird_track(anim, &flapper, &asset, bird, wingspan_m);
+        let model = model_of[bird];
+        let asset = &assets[model];
+        let (mesh, ibm_acc) = shared[model];
+        let track = bird_track(anim, &flapper, asset, bird, wingspan_m);
         // Skeleton nodes, children before parents so indices are known.
         let mut joint_nodes: [Option<json::Index<json::Node>>; 7] = [None; 7];
         for j in (0..bird::JOINTS.len()).rev() {
@@ -422,10 +455,15 @@ pub fn glb_bytes_with(anim: &Animation, wingspan_m: f64, opts: &SceneOptions) ->
             // place (a scale of exactly 1 is left out, as glTF's default).
             scale: (scale != 1.0).then_some([scale; 3]),
             children: Some(vec![joints[bird::BODY]]),
-            extras: extras(&if scale != 1.0 {
-                serde_json::json!({"bird": bird, "scale": short(scale)})
-            } else {
-                serde_json::json!({"bird": bird})
+            extras: extras(&{
+                let mut e = serde_json::json!({"bird": bird});
+                if scale != 1.0 {
+                    e["scale"] = short(scale);
+                }
+                if assets.len() > 1 {
+                    e["bird_model"] = model.into();
+                }
+                e
             }),
             ..Default::default()
         });
@@ -602,7 +640,7 @@ pub fn glb_bytes_with(anim: &Animation, wingspan_m: f64, opts: &SceneOptions) ->
     }
     let scene = root.push(json::Scene {
         extensions: None,
-        extras: extras(&scene_metadata(anim, wingspan_m, &asset, opts)),
+        extras: extras(&scene_metadata(anim, wingspan_m, &assets, opts)),
         name: Some("flock".into()),
         nodes: scene_nodes,
     });
@@ -912,6 +950,7 @@ impl Builder {
         root: &mut json::Root,
         asset: &BirdAsset,
         ws: f32,
+        name: &str,
     ) -> json::Index<json::Mesh> {
         let m = &asset.mesh;
         let pos: Vec<f32> = m
@@ -977,7 +1016,7 @@ impl Builder {
         root.push(json::Mesh {
             extensions: None,
             extras: Default::default(),
-            name: Some("bird".into()),
+            name: Some(name.into()),
             primitives,
             weights: None,
         })
