@@ -264,3 +264,64 @@ fn the_cli_takes_several_models_and_refuses_mismatched_maps() {
     assert!(!out.exists());
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The floats of accessor `i` of a `.glb`.
+fn floats(bytes: &[u8], j: &Value, i: &Value) -> Vec<f32> {
+    let acc = &j["accessors"][i.as_u64().unwrap() as usize];
+    let view = &j["bufferViews"][acc["bufferView"].as_u64().unwrap() as usize];
+    let jlen = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+    let bin = &bytes[20 + jlen + 8..];
+    let o = view["byteOffset"].as_u64().unwrap_or(0) as usize;
+    let l = view["byteLength"].as_u64().unwrap() as usize;
+    bin[o..o + l]
+        .chunks_exact(4)
+        .map(|b| f32::from_le_bytes(b.try_into().unwrap()))
+        .collect()
+}
+
+#[test]
+fn the_built_in_bird_is_one_primitive_coloured_by_its_vertices() {
+    let a = flock();
+    let bytes = glb_bytes_with(&a, a.wingspan_m, &SceneOptions::default()).unwrap();
+    let j = parse(&bytes);
+    let goose = BirdAsset::builtin(Species::Goose);
+    assert_eq!(j["meshes"].as_array().unwrap().len(), 1);
+    let prims = j["meshes"][0]["primitives"].as_array().unwrap();
+    assert_eq!(prims.len(), 1, "one draw call a bird");
+    assert_eq!(j["materials"].as_array().unwrap().len(), 1);
+    let p = &prims[0];
+    let triangles: usize = goose.mesh.parts.iter().map(|(_, i)| i.len()).sum();
+    assert_eq!(
+        j["accessors"][p["indices"].as_u64().unwrap() as usize]["count"],
+        json!(triangles)
+    );
+    let pos = floats(&bytes, &j, &p["attributes"]["POSITION"]);
+    let col = floats(&bytes, &j, &p["attributes"]["COLOR_0"]);
+    assert_eq!(pos.len(), col.len());
+    assert!(pos.len() / 3 >= goose.mesh.positions.len());
+    // The colours are the parts' own, and each part's triangles show its colour.
+    let mut seen: Vec<[f32; 3]> = col.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+    seen.sort_by(|x, y| x.partial_cmp(y).unwrap());
+    seen.dedup();
+    let mut want = goose.mesh.colours.clone();
+    want.sort_by(|x, y| x.partial_cmp(y).unwrap());
+    want.dedup();
+    assert_eq!(seen, want);
+    let acc = &j["accessors"][p["indices"].as_u64().unwrap() as usize];
+    assert_eq!(acc["componentType"], 5123, "u16 indices");
+    let view = &j["bufferViews"][acc["bufferView"].as_u64().unwrap() as usize];
+    let jlen = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+    let o = 20 + jlen + 8 + view["byteOffset"].as_u64().unwrap() as usize;
+    let idx: Vec<usize> = bytes[o..o + 2 * triangles]
+        .chunks_exact(2)
+        .map(|b| u16::from_le_bytes([b[0], b[1]]) as usize)
+        .collect();
+    let mut k = 0;
+    for ((_, part), rgb) in goose.mesh.parts.iter().zip(&goose.mesh.colours) {
+        for _ in 0..part.len() {
+            let v = idx[k];
+            assert_eq!(&col[3 * v..3 * v + 3], rgb, "index {k}");
+            k += 1;
+        }
+    }
+}

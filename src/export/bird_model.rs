@@ -4,7 +4,8 @@
 //! The file must be a binary glTF 2.0 (`.glb`) with its buffer inside (no external files), at
 //! most [`MAX_BYTES`] bytes and [`MAX_VERTICES`] vertices, with at least one triangle mesh in its
 //! default scene. Textures, UVs and extensions are not carried over: each primitive keeps its
-//! geometry and its material's base colour.
+//! geometry and its material's base colour (times its `COLOR_0` vertex colours, when it has
+//! them: the triangles are grouped by the colour of their first vertex).
 //!
 //! - **Skinned** (a mesh node with a skin whose joints include `body`, `upper_arm.L`, `hand.L`,
 //!   `upper_arm.R`, `hand.R`, optionally `neck` and `tail`; names compared case-insensitively,
@@ -278,6 +279,8 @@ struct Prim {
     normals: Option<Vec<Vec3>>,
     indices: Vec<u32>,
     colour: [f32; 3],
+    /// Per vertex colour (`COLOR_0`, multiplied into `colour`), when the primitive has one.
+    vertex_colours: Option<Vec<[f32; 3]>>,
     /// Per vertex, up to four (joint of the convention, weight).
     influences: Vec<Vec<(usize, f32)>>,
 }
@@ -541,6 +544,18 @@ impl Reader<'_> {
                 )));
             }
             let indices: Vec<u32> = indices[..indices.len() / 3 * 3].to_vec();
+            let vertex_colours = match get(json::mesh::Semantic::Colors(0)) {
+                Some(c) => {
+                    let (v, w) = self.floats(c)?;
+                    if !(w == 3 || w == 4) || v.len() < nv * w {
+                        return Err(self.err(format!(
+                            "mesh {mi} primitive {pi}: COLOR_0 is not one RGB or RGBA colour per vertex"
+                        )));
+                    }
+                    Some(v.chunks_exact(w).map(|c| [c[0], c[1], c[2]]).collect())
+                }
+                None => None,
+            };
             let mut influences = vec![vec![(bird::BODY, 1.0)]; nv];
             if let Some(map) = joint_map {
                 if let (Some(j), Some(w)) = (
@@ -574,6 +589,7 @@ impl Reader<'_> {
                 normals,
                 indices,
                 colour: self.colour(p),
+                vertex_colours,
                 influences,
             });
         }
@@ -792,8 +808,32 @@ impl Reader<'_> {
                 mesh.face_normals(&idx);
             }
             // Materials are numbered by primitive; the part tag only names them.
-            parts.push((Part::ALL[k % Part::ALL.len()], idx));
-            colours.push(p.colour);
+            let part = Part::ALL[k % Part::ALL.len()];
+            match &p.vertex_colours {
+                // Vertex colours: the triangles grouped by the colour of their first vertex
+                // (times the material's), one part per colour in order of appearance.
+                Some(vc) => {
+                    let mut groups: Vec<([f32; 3], Vec<u32>)> = Vec::new();
+                    let mut group_of: BTreeMap<[u32; 3], usize> = BTreeMap::new();
+                    for (t, local) in idx.chunks_exact(3).zip(p.indices.chunks_exact(3)) {
+                        let c = vc[local[0] as usize];
+                        let rgb = [c[0] * p.colour[0], c[1] * p.colour[1], c[2] * p.colour[2]];
+                        let g = *group_of.entry(rgb.map(f32::to_bits)).or_insert_with(|| {
+                            groups.push((rgb, Vec::new()));
+                            groups.len() - 1
+                        });
+                        groups[g].1.extend_from_slice(t);
+                    }
+                    for (rgb, tris) in groups {
+                        parts.push((part, tris));
+                        colours.push(rgb);
+                    }
+                }
+                None => {
+                    parts.push((part, idx));
+                    colours.push(p.colour);
+                }
+            }
         }
         mesh.set_parts(parts, colours);
         let mut skel = Skeleton::of(species);

@@ -6,7 +6,8 @@
 //! heading). Under each root, the bird's skeleton: joints named by the convention of
 //! [`bird::JOINTS`] (`body` → `neck`, `tail`, `upper_arm.L` → `hand.L`, `upper_arm.R` →
 //! `hand.R`); bank turns `body`, the wingbeat turns the wing and tail joints. Every bird shares one
-//! skinned mesh (`JOINTS_0`/`WEIGHTS_0`, one primitive per material) and one inverse-bind-matrix
+//! skinned mesh (`JOINTS_0`/`WEIGHTS_0`, one primitive and one material, the parts' colours as
+//! `COLOR_0`: one draw call a bird) and one inverse-bind-matrix
 //! accessor; each bird's mesh node `bird_000_mesh` sits at the scene root, untransformed, as glTF
 //! asks of skinned meshes (only the joints place it), with its own skin `bird_000_skin`.
 //!
@@ -829,6 +830,37 @@ fn material(name: &str, rgb: [f32; 3]) -> json::Material {
     }
 }
 
+/// The parts of `m` as one primitive: the vertices to write (indices into `m`, in order), each
+/// one's colour (its part's) and the triangles over them. A vertex shared by parts of different
+/// colours is written once per colour; a vertex no triangle uses is white.
+fn one_primitive(m: &bird::SkinnedMesh) -> (Vec<usize>, Vec<[f32; 3]>, Vec<u32>) {
+    let n = m.positions.len();
+    let mut order: Vec<usize> = (0..n).collect();
+    let mut colours: Vec<Option<[f32; 3]>> = vec![None; n];
+    let mut copies: BTreeMap<(u32, [u32; 3]), u32> = BTreeMap::new();
+    let mut idx = Vec::with_capacity(m.parts.iter().map(|(_, i)| i.len()).sum());
+    for ((_, part), &rgb) in m.parts.iter().zip(&m.colours) {
+        for &v in part {
+            let i = v as usize;
+            let out = match colours[i] {
+                None => {
+                    colours[i] = Some(rgb);
+                    v
+                }
+                Some(c) if c == rgb => v,
+                Some(_) => *copies.entry((v, rgb.map(f32::to_bits))).or_insert_with(|| {
+                    order.push(i);
+                    colours.push(Some(rgb));
+                    (order.len() - 1) as u32
+                }),
+            };
+            idx.push(out);
+        }
+    }
+    let colours = colours.into_iter().map(|c| c.unwrap_or([1.0; 3])).collect();
+    (order, colours, idx)
+}
+
 /// Collects binary data, 4-byte aligned, one buffer view per accessor.
 #[derive(Default)]
 struct Builder {
@@ -943,8 +975,9 @@ impl Builder {
         })
     }
 
-    /// The asset's skinned mesh in metres: shared vertex attributes, one primitive (and
-    /// material) per part.
+    /// The asset's skinned mesh in metres, as one primitive with one material (one draw call a
+    /// bird): each part's colour is its vertices' `COLOR_0`, which glTF multiplies into the
+    /// white base colour (see [`one_primitive`]).
     fn skinned_mesh(
         &mut self,
         root: &mut json::Root,
@@ -953,57 +986,64 @@ impl Builder {
         name: &str,
     ) -> json::Index<json::Mesh> {
         let m = &asset.mesh;
-        let pos: Vec<f32> = m
-            .positions
+        let (order, colours, idx) = one_primitive(m);
+        let pos: Vec<f32> = order
             .iter()
-            .flat_map(|p| (*p * ws).to_array())
+            .flat_map(|&v| (m.positions[v] * ws).to_array())
             .collect();
-        let nor: Vec<f32> = m.normals.iter().flat_map(|n| n.to_array()).collect();
+        let nor: Vec<f32> = order
+            .iter()
+            .flat_map(|&v| m.normals[v].to_array())
+            .collect();
+        let col: Vec<f32> = colours.iter().flatten().copied().collect();
         let target = Some(json::buffer::Target::ArrayBuffer);
         let pos = self.accessor(root, &pos, 3, json::accessor::Type::Vec3, true, target);
         let nor = self.accessor(root, &nor, 3, json::accessor::Type::Vec3, false, target);
-        let jb: Vec<u8> = m.joints.iter().flatten().copied().collect();
+        let col = self.accessor(root, &col, 3, json::accessor::Type::Vec3, false, target);
+        let jb: Vec<u8> = order.iter().flat_map(|&v| m.joints[v]).collect();
         let joints = self.raw_accessor(
             root,
             &jb,
-            m.joints.len(),
+            order.len(),
             json::accessor::ComponentType::U8,
             json::accessor::Type::Vec4,
             false,
             target,
         );
-        let wf: Vec<f32> = m.weights.iter().flatten().copied().collect();
+        let wf: Vec<f32> = order.iter().flat_map(|&v| m.weights[v]).collect();
         let weights = self.accessor(root, &wf, 4, json::accessor::Type::Vec4, false, target);
-        let mut primitives = Vec::new();
-        let big = m.positions.len() > u16::MAX as usize;
-        for ((part, idx), rgb) in m.parts.iter().zip(&m.colours) {
-            let mat = root.push(material(part.name(), *rgb));
-            let (bytes, ct): (Vec<u8>, _) = if big {
-                (
-                    idx.iter().flat_map(|v| v.to_le_bytes()).collect(),
-                    json::accessor::ComponentType::U32,
-                )
-            } else {
-                (
-                    idx.iter().flat_map(|&v| (v as u16).to_le_bytes()).collect(),
-                    json::accessor::ComponentType::U16,
-                )
-            };
-            let ia = self.raw_accessor(
-                root,
-                &bytes,
-                idx.len(),
-                ct,
-                json::accessor::Type::Scalar,
-                false,
-                Some(json::buffer::Target::ElementArrayBuffer),
-            );
-            let mut attributes = BTreeMap::new();
-            attributes.insert(Valid(json::mesh::Semantic::Positions), pos);
-            attributes.insert(Valid(json::mesh::Semantic::Normals), nor);
-            attributes.insert(Valid(json::mesh::Semantic::Joints(0)), joints);
-            attributes.insert(Valid(json::mesh::Semantic::Weights(0)), weights);
-            primitives.push(json::mesh::Primitive {
+        let mat = root.push(material(name, [1.0, 1.0, 1.0]));
+        let (bytes, ct): (Vec<u8>, _) = if order.len() > u16::MAX as usize {
+            (
+                idx.iter().flat_map(|v| v.to_le_bytes()).collect(),
+                json::accessor::ComponentType::U32,
+            )
+        } else {
+            (
+                idx.iter().flat_map(|&v| (v as u16).to_le_bytes()).collect(),
+                json::accessor::ComponentType::U16,
+            )
+        };
+        let ia = self.raw_accessor(
+            root,
+            &bytes,
+            idx.len(),
+            ct,
+            json::accessor::Type::Scalar,
+            false,
+            Some(json::buffer::Target::ElementArrayBuffer),
+        );
+        let mut attributes = BTreeMap::new();
+        attributes.insert(Valid(json::mesh::Semantic::Positions), pos);
+        attributes.insert(Valid(json::mesh::Semantic::Normals), nor);
+        attributes.insert(Valid(json::mesh::Semantic::Colors(0)), col);
+        attributes.insert(Valid(json::mesh::Semantic::Joints(0)), joints);
+        attributes.insert(Valid(json::mesh::Semantic::Weights(0)), weights);
+        root.push(json::Mesh {
+            extensions: None,
+            extras: Default::default(),
+            name: Some(name.into()),
+            primitives: vec![json::mesh::Primitive {
                 attributes,
                 extensions: None,
                 extras: Default::default(),
@@ -1011,13 +1051,7 @@ impl Builder {
                 material: Some(mat),
                 mode: Valid(json::mesh::Mode::Triangles),
                 targets: None,
-            });
-        }
-        root.push(json::Mesh {
-            extensions: None,
-            extras: Default::default(),
-            name: Some(name.into()),
-            primitives,
+            }],
             weights: None,
         })
     }
