@@ -130,27 +130,40 @@ def main():
             if err > tol:
                 failed.append("%s frame %d: %.3g m from the JSON" % (root.GetPath(), k, err))
                 break
-        if b == 0:
-            q = cache.GetSkelQuery(skel)
-            arm = JOINTS.index("body/upper_arm_L")
-            ys = []
-            # 60 frames from the middle of the flight (a take-off begins with the birds
-            # sitting, wings folded, not flapping).
-            k0 = max(0, n // 2 - 30)
-            for k in range(k0, min(n, k0 + 60)):
-                local = q.ComputeJointLocalTransforms(Usd.TimeCode(start + k))[arm]
-                ys.append(round(local.ExtractRotationQuat().GetImaginary()[2], 4))
-            if static:
-                check(len(set(ys)) == 1, "upper_arm_L turns although the model is static")
-            else:
-                check(len(set(ys)) > 10, "upper_arm_L does not turn over 60 frames in the middle of the flight")
-            print("upper_arm_L: %d distinct rotations over 60 frames mid-flight" % len(set(ys)))
+    # The wingbeat: the first bird turns its upper_arm_L (with several bird models, the first
+    # bird wearing a model that flaps: the birds are tried in order).
+    arm = JOINTS.index("body/upper_arm_L")
+    k0 = max(0, n // 2 - 30)
+    distinct = 0
+    for b, root in enumerate(roots):
+        q = cache.GetSkelQuery(UsdSkel.Skeleton(root.GetChild("rig")))
+        ys = []
+        # 60 frames from the middle of the flight (a take-off begins with the birds
+        # sitting, wings folded, not flapping).
+        for k in range(k0, min(n, k0 + 60)):
+            local = q.ComputeJointLocalTransforms(Usd.TimeCode(start + k))[arm]
+            ys.append(round(local.ExtractRotationQuat().GetImaginary()[2], 4))
+        distinct = len(set(ys))
+        if static or distinct > 10:
+            break
+    if static:
+        check(distinct == 1, "upper_arm_L turns although the model is static")
+    else:
+        check(distinct > 10, "upper_arm_L does not turn over 60 frames in the middle of the flight")
+    print("upper_arm_L of %s: %d distinct rotations over 60 frames mid-flight" % (root.GetName(), distinct))
     print("root vs JSON: worst %.3g m (tolerance %g m)" % (worst, tol))
     if failed:
         for f in failed[:20]:
             print("FAILED", f)
         sys.exit(1)
     print("OK", usda)
+
+
+def yawed(v, a, phi):
+    """v turned by the bird's pitch (nose up, about +X: Rx(a), a = -pitch) and then its heading
+    (about +Y: Ry(phi), phi = pi - heading), as the exporter's yaw quaternion does."""
+    x, y, z = v[0], v[1] * math.cos(a) - v[2] * math.sin(a), v[1] * math.sin(a) + v[2] * math.cos(a)
+    return (x * math.cos(phi) + z * math.sin(phi), y, -x * math.sin(phi) + z * math.cos(phi))
 
 
 def check_instancer(stage, anim, start, failed, check):
@@ -168,6 +181,22 @@ def check_instancer(stage, anim, start, failed, check):
     picks = sorted({round(i * (n - 1) / 19) for i in range(20)})
     worst = 0.0
     shown = set()
+    # Birds of different sizes (--size-variation): an instance scales its prototype about the
+    # root, and the size is taken about the point size_pivot_m below it, so the instance sits
+    # (s - 1) * size_pivot_m up the bird's own vertical from the JSON position.
+    meta = stage.GetRootLayer().customLayerData.get("formation", {})
+    scales_attr = pi.GetScalesAttr().Get()
+    scales = [1.0] * birds
+    if scales_attr:
+        check(len(scales_attr) == birds, "scales: %d for %d birds" % (len(scales_attr), birds))
+        scales = [v[0] for v in scales_attr]
+        recorded = list(meta.get("bird_scales", []))
+        check(len(recorded) == birds and all(abs(a - b) < 1e-6 for a, b in zip(scales, recorded)),
+              "instancer scales differ from customLayerData bird_scales")
+    pivot = meta.get("size_pivot_m", 0.0)
+    bodies = json.loads(meta["body_m"]) if "body_m" in meta else None
+    model_of = list(meta.get("bird_model_of", [0] * birds))
+    model_of = [int(m) for m in model_of]
     for k in picks:
         t = Usd.TimeCode(start + round((frames[k]["t"] - frames[0]["t"]) * anim["fps"], 6))
         pos = pi.GetPositionsAttr().Get(t)
@@ -177,6 +206,17 @@ def check_instancer(stage, anim, start, failed, check):
         fr = frames[k]
         for b in range(birds):
             want = (fr["x"][b] * ws, fr["z"][b] * ws, -fr["y"][b] * ws)
+            # The instance's offset from the bird's root: yaw * s * (body + shift) - q * s * body
+            # (body the model's body joint, shift the size's; q the instance's orientation).
+            s_b = scales[b]
+            body = bodies[model_of[b]] if bodies else (0.0, 0.0, 0.0)
+            shift = (0.0, (s_b - 1.0) / s_b * pivot if s_b else 0.0, 0.0)
+            a = -(fr["pitch"][b] if "pitch" in fr else 0.0)
+            phi = math.pi - fr["heading"][b]
+            yaw_part = yawed(tuple(s_b * (body[i] + shift[i]) for i in range(3)), a, phi)
+            q = Gf.Rotation(Gf.Quatd(rot[b].GetReal(), Gf.Vec3d(rot[b].GetImaginary())))
+            bank_part = q.TransformDir(Gf.Vec3d(*(s_b * v for v in body)))
+            want = tuple(want[i] + yaw_part[i] - bank_part[i] for i in range(3))
             err = math.sqrt(sum((pos[b][i] - want[i]) ** 2 for i in range(3)))
             worst = max(worst, err)
             norm = math.sqrt(rot[b].GetReal() ** 2 + sum(v * v for v in rot[b].GetImaginary()))
@@ -184,16 +224,19 @@ def check_instancer(stage, anim, start, failed, check):
                 failed.append("frame %d bird %d: orientation of norm %.4f" % (k, b, norm))
             if not 0 <= idx[b] < len(protos):
                 failed.append("frame %d bird %d: prototype %d of %d" % (k, b, idx[b], len(protos)))
-        shown.add(idx[0])
-    # Every frame of the middle second: the first bird flaps through several prototypes.
+    # Every frame of the middle second: the first bird flaps through several prototypes (with
+    # several bird models, the first bird that shows more than one).
     mid = n // 2
+    seen = [set() for _ in range(birds)]
     for k in range(mid, min(n, mid + int(anim["fps"]))):
         t = Usd.TimeCode(start + round((frames[k]["t"] - frames[0]["t"]) * anim["fps"], 6))
-        shown.add(pi.GetProtoIndicesAttr().Get(t)[0])
-    check(len(protos) == 1 or len(shown) > 3, "the first bird shows %d prototypes" % len(shown))
+        for b, i in enumerate(pi.GetProtoIndicesAttr().Get(t)):
+            seen[b].add(i)
+    shown = next((s for s in seen if len(s) > 1), seen[0] if seen else set())
+    check(len(protos) == 1 or len(shown) > 3, "the first flapping bird shows %d prototypes" % len(shown))
     check(worst <= 1e-3, "instances %.3g m from the JSON" % worst)
-    print("instancer: %d prototypes, %d instances, %d frames checked, worst %.3g m, bird 0 shows %d poses"
-          % (len(protos), birds, len(picks), worst, len(shown)))
+    print("instancer: %d prototypes, %d instances (scales %.3f-%.3f), %d frames checked, worst %.3g m, the first flapping bird shows %d poses"
+          % (len(protos), birds, min(scales), max(scales), len(picks), worst, len(shown)))
 
 
 if __name__ == "__main__":

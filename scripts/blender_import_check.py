@@ -47,7 +47,18 @@ for a in arms:
 # The default .glb has one clip per bird over the whole flight: it must play on import, with no
 # NLA change. With a CSV of the same animation: every bird at 10 frames across the flight where
 # the CSV puts it (within 1 mm); the wings flap and the birds move over a second of steady flight.
-a0 = arms[0]
+def _actions(a):
+    ad = a.animation_data
+    if ad is None:
+        return []
+    acts = [ad.action] if ad.action else []
+    return acts + [s.action for t in ad.nla_tracks for s in t.strips if s.action]
+
+
+# The bird watched for the wingbeat: the first whose wing bones are animated (with several bird
+# models, the first bird may wear a static one).
+a0 = next((a for a in arms if any('"upper_arm.L"' in fc.data_path for act in _actions(a)
+                                  for fc in act.fcurves)), arms[0])
 if "flight" in clips:
     for a in arms:
         ad = a.animation_data

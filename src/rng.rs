@@ -39,6 +39,10 @@ pub enum Stream {
     SteadyJostle,
     /// Steady flight: leader changes and swaps (when, which birds).
     SteadyEvents,
+    /// 3D exports: each bird's size (`render.size_variation`).
+    BirdSizes,
+    /// 3D exports: which of several bird models each bird wears (`render.bird_model`).
+    BirdModels,
 }
 
 impl Stream {
@@ -57,6 +61,8 @@ impl Stream {
             Stream::SkeinLayout => "skein/layout",
             Stream::SteadyJostle => "steady.jostle",
             Stream::SteadyEvents => "steady.events",
+            Stream::BirdSizes => "export.sizes",
+            Stream::BirdModels => "export.models",
         }
     }
 }

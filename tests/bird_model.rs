@@ -105,10 +105,11 @@ fn a_static_model_is_scaled_to_the_wingspan_and_bound_to_the_body() {
     assert!(asset.mesh.joints.iter().all(|j| j[0] == 0));
     let anim = flock();
     let opts = SceneOptions {
-        asset: Some(asset),
+        assets: vec![asset],
         ..SceneOptions::default()
     };
-    let g = parse(&glb_bytes_with(&anim, 1.5, &opts).unwrap());
+    let bytes = glb_bytes_with(&anim, 1.5, &opts).unwrap();
+    let g = parse(&bytes);
     let pos = &g["accessors"][g["meshes"][0]["primitives"][0]["attributes"]["POSITION"]
         .as_u64()
         .unwrap() as usize];
@@ -118,10 +119,24 @@ fn a_static_model_is_scaled_to_the_wingspan_and_bound_to_the_body() {
     for a in g["animations"].as_array().unwrap() {
         assert_eq!(a["channels"].as_array().unwrap().len(), 3 * anim.birds);
     }
-    let red = g["materials"][0]["pbrMetallicRoughness"]["baseColorFactor"][0]
-        .as_f64()
-        .unwrap();
-    assert!((red - 0.8).abs() < 1e-6, "{red}");
+    // The model's colour as the vertices' COLOR_0 under one white material (one draw call).
+    assert_eq!(g["materials"].as_array().unwrap().len(), 1);
+    assert_eq!(
+        g["materials"][0]["pbrMetallicRoughness"]["baseColorFactor"],
+        json!([1.0, 1.0, 1.0, 1.0])
+    );
+    let acc = &g["accessors"][g["meshes"][0]["primitives"][0]["attributes"]["COLOR_0"]
+        .as_u64()
+        .unwrap() as usize];
+    let view = &g["bufferViews"][acc["bufferView"].as_u64().unwrap() as usize];
+    let jlen = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+    let bin = &bytes[20 + jlen + 8..];
+    let o = view["byteOffset"].as_u64().unwrap() as usize;
+    let rgb: Vec<f32> = bin[o..o + 12]
+        .chunks_exact(4)
+        .map(|b| f32::from_le_bytes(b.try_into().unwrap()))
+        .collect();
+    assert_eq!(rgb, [0.8, 0.1, 0.1]);
     std::fs::remove_dir_all(&d).unwrap();
 }
 
@@ -134,7 +149,7 @@ fn a_skinned_model_with_the_convention_flaps_like_the_built_in_bird() {
     let asset = bird_model::load(&path, Species::Goose).unwrap();
     assert!(asset.wingbeat);
     let opts = SceneOptions {
-        asset: Some(asset),
+        assets: vec![asset],
         ..SceneOptions::default()
     };
     let theirs = parse(&glb_bytes_with(&anim, 1.5, &opts).unwrap());

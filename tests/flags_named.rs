@@ -155,6 +155,7 @@ fn commands() -> Vec<Command> {
         ("--keys", "some", None),
         ("--clips", "reel", None),
         ("--bird-model", "OUT/no-bird.glb", None),
+        ("--size-variation", "3", None),
         ("--start-frame", "-5", None),
         ("--subframes", "0", None),
         ("--units", "feet", None),

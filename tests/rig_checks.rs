@@ -107,7 +107,7 @@ fn renamed_joints_are_refused_naming_them_and_mapped_by_a_joint_map() {
     let ours = bird_model::load(&ours_path, Species::Goose).unwrap();
     let write = |asset| {
         let opts = SceneOptions {
-            asset: Some(asset),
+            assets: vec![asset],
             ..SceneOptions::default()
         };
         split(&glb_bytes_with(&anim, 1.5, &opts).unwrap())

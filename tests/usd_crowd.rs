@@ -52,13 +52,17 @@ fn instances_follow_the_birds_and_flap_through_the_prototypes() {
     let dir = scratch("usd-crowd");
     let a = flock(14, 3.0);
     let usda = dir.join("c.usda");
+    // Birds of one size: an instance's position is then the bird's own (sizes shift it, see
+    // tests/size_variation.rs).
     let opts = RenderOptions {
         usd_mode: Some(UsdMode::Instancer),
+        size_variation: Some(0.0),
         ..RenderOptions::default()
     };
     write_outputs(&a, std::slice::from_ref(&usda), &opts, &Silent).unwrap();
     let text = std::fs::read_to_string(&usda).unwrap();
     assert!(text.contains("def PointInstancer \"crowd\""));
+    assert!(!text.contains("float3[] scales"));
     assert!(!text.contains("SkelRoot"));
     let protos = text.matches("def Mesh \"pose_").count();
     assert_eq!(protos, crowd::PROTOTYPES);

@@ -197,7 +197,7 @@ pub fn bird_model(data: &[u8]) {
     };
     let anim = &path_flights()[0];
     let opts = gltf::SceneOptions {
-        asset: Some(asset),
+        assets: vec![asset],
         ..gltf::SceneOptions::default()
     };
     let _ = gltf::glb_bytes_with(anim, 1.5, &opts);

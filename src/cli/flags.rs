@@ -201,6 +201,7 @@ pub const FLAGS: &[(&str, &str, &[Cmd])] = &[
     ("render.animation_fps", "--fps", &[Render]),
     ("render.bird_model", "--bird-model", SCENE),
     ("render.joint_map", "--joint-map", SCENE),
+    ("render.size_variation", "--size-variation", SCENE),
     ("render.camera", "--camera", PICTURES),
     ("render.camera.fixed", "--view", PICTURES),
     ("render.background", "--background", PICTURES),

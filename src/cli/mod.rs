@@ -191,7 +191,7 @@ pub fn install_signal_cleanup() {
     }
 }
 
-/// Loads the user's bird model (when given) before any work: a model that cannot be used is the
+/// Loads the user's bird models (when given) before any work: a model that cannot be used is the
 /// error; a model the birds cannot flap with is a warning (the error with `--strict`).
 pub fn check_bird_model(
     cmd: flags::Cmd,
@@ -199,14 +199,17 @@ pub fn check_bird_model(
     opts: &formation::export::RenderOptions,
     species: formation::wingbeat::Species,
 ) -> Result<()> {
-    let Some(p) = &opts.bird_model else {
+    let assets =
+        formation::export::bird_model::load_all(&opts.bird_model, &opts.joint_map, species)?;
+    let warnings: Vec<String> = assets
+        .iter()
+        .filter_map(formation::export::bird_model::static_warning)
+        .collect();
+    if warnings.is_empty() {
         return Ok(());
-    };
-    let asset = formation::export::bird_model::load_with(p, species, opts.joint_map.as_deref())?;
-    match formation::export::bird_model::static_warning(&asset) {
-        Some(w) => warn_lines(cmd, g, &[w.as_str()]),
-        None => Ok(()),
     }
+    let lines: Vec<&str> = warnings.iter().map(String::as_str).collect();
+    warn_lines(cmd, g, &lines)
 }
 
 /// Writes `anim` to every output (by extension: .json, .csv, .gif, DIR/, .glb), atomically, with

@@ -104,13 +104,20 @@ pub struct SceneArgs {
     #[arg(long, value_name = "one|stages", default_value_t = RenderOptions::default().clips)]
     pub clips: formation::export::keys::ClipMode,
     /// Your own bird (.glb) on every bird of the .glb and .usda: a static mesh flies and banks, a
-    /// skinned one whose joints follow the naming convention (docs/export.md) also flaps.
+    /// skinned one whose joints follow the naming convention (docs/export.md) also flaps. Give it
+    /// up to 16 times: the models are shared out over the birds at random (seeded).
     #[arg(long, value_name = "FILE.glb")]
-    pub bird_model: Option<PathBuf>,
+    pub bird_model: Vec<PathBuf>,
     /// A JSON file naming your bird model's joints by the convention's, e.g.
-    /// {"UpperArm.L": "upper_arm.L", "Hand.L": "hand.L", ...} (docs/export.md).
+    /// {"UpperArm.L": "upper_arm.L", "Hand.L": "hand.L", ...} (docs/export.md); once for every
+    /// model, or once per --bird-model in the same order.
     #[arg(long, value_name = "FILE.json")]
-    pub joint_map: Option<PathBuf>,
+    pub joint_map: Vec<PathBuf>,
+    /// Spread of the birds' sizes in the .glb and .usda: each bird is scaled by 1 + F·z, z a
+    /// normal draw clipped to ±3, from the seed of the animation; 0 to 0.3, 0 = all the same
+    /// size [default: 0.04, our choice]. Positions (.json, .csv) do not change.
+    #[arg(long, value_name = "F", allow_negative_numbers = true)]
+    pub size_variation: Option<f64>,
     /// Number of the first frame in every output that numbers frames: .glb keys and range, USD
     /// time codes, the CSV's frame column, PNG file names (e.g. 1001; default: the animation
     /// file's, else 0).
@@ -173,6 +180,7 @@ impl SceneArgs {
             clips: self.clips,
             bird_model: self.bird_model.clone(),
             joint_map: self.joint_map.clone(),
+            size_variation: self.size_variation,
             start_frame: self.start_frame,
             subframes: self.subframes,
             units: self.units,

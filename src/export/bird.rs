@@ -817,6 +817,70 @@ impl BirdAsset {
     }
 }
 
+/// Default spread of the birds' sizes (`render.size_variation`): the coefficient of variation of
+/// the wingspan, the same for every species. Our choice, not a measurement (the project's field
+/// data has no within-flock wingspan spread): a few per cent, so that a flock does not look cloned
+/// while no bird looks like another species.
+pub const DEFAULT_SIZE_VARIATION: f64 = 0.04;
+/// Largest accepted `render.size_variation`.
+pub const MAX_SIZE_VARIATION: f64 = 0.3;
+/// How far the normal draw of a bird's size is clipped, standard deviations.
+pub const SIZE_CLIP_SIGMA: f64 = 3.0;
+
+/// The default size variation of `species` ([`DEFAULT_SIZE_VARIATION`] for every species).
+pub fn default_size_variation(species: Species) -> f64 {
+    let _ = species;
+    DEFAULT_SIZE_VARIATION
+}
+
+/// Each bird's uniform scale for a size variation `variation` (F): `s = 1 + F·z`, z a standard
+/// normal draw clipped to ±[`SIZE_CLIP_SIGMA`], drawn for birds 0, 1, … in order from the
+/// stream `export.sizes` of the animation's `seed` (so bird k's size does not depend on the
+/// flock's size). `variation` 0 gives every bird scale 1 exactly.
+pub fn bird_scales(seed: u64, birds: usize, variation: f64) -> Vec<f32> {
+    use rand::Rng;
+    if variation == 0.0 {
+        return vec![1.0; birds];
+    }
+    let mut rng = crate::rng::stream(seed, crate::rng::Stream::BirdSizes);
+    (0..birds)
+        .map(|_| {
+            let z: f64 = rng.sample(rand_distr::StandardNormal);
+            (1.0 + variation * z.clamp(-SIZE_CLIP_SIGMA, SIZE_CLIP_SIGMA)) as f32
+        })
+        .collect()
+}
+
+/// Which of `models` bird models each of `birds` birds wears: every model on the same number
+/// of birds (to one), which birds at random (a Fisher–Yates shuffle of `0, 1, …, models − 1,
+/// 0, 1, …` drawn from the stream `export.models` of the animation's `seed`). One model (or
+/// none) gives every bird model 0.
+pub fn model_assignment(seed: u64, birds: usize, models: usize) -> Vec<usize> {
+    use rand::Rng;
+    let mut out: Vec<usize> = (0..birds).map(|b| b % models.max(1)).collect();
+    if models <= 1 {
+        return out;
+    }
+    let mut rng = crate::rng::stream(seed, crate::rng::Stream::BirdModels);
+    for i in (1..birds).rev() {
+        let j = rng.random_range(0..=i);
+        out.swap(i, j);
+    }
+    out
+}
+
+/// Where the size of a bird of `scale` is taken about, as a shift of its `body` joint in the
+/// root's frame (wingspans, before the root's scale): the point on the ground under a sitting
+/// bird of `species` (its sitting height below the root, `wingbeat::rest::stance`). The root's
+/// scale alone would grow a bird about its centre and push a larger one's belly into the ground
+/// at rest; with this shift `s·(b + p) = p` for that point p, so every bird sits on the ground as
+/// the built-in one of scale 1 does, and a flying bird's centre moves by (s − 1)·h_sit, under
+/// 0.01 wingspans for the default spread.
+pub fn size_pivot(species: Species, scale: f32) -> Vec3 {
+    let sit = crate::wingbeat::rest::stance(species).sit as f32;
+    Vec3::new(0.0, sit * (1.0 - 1.0 / scale), 0.0)
+}
+
 /// The flight of one bird on export axes: per frame the root translation (metres, `(x, z, −y)`),
 /// the yaw quaternion of the root and the bank angle of `body` (radians).
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -970,6 +1034,56 @@ mod tests {
         };
         assert!(tip(1.0) > 0.15, "left tip {}", tip(1.0));
         assert!(tip(-1.0) > 0.15, "right tip (mirrored pose) {}", tip(-1.0));
+    }
+
+    #[test]
+    fn bird_scales_are_clipped_seeded_and_one_without_variation() {
+        assert!(bird_scales(7, 50, 0.0).iter().all(|&s| s == 1.0));
+        let a = bird_scales(7, 2000, 0.1);
+        assert_eq!(a, bird_scales(7, 2000, 0.1));
+        assert_ne!(a, bird_scales(8, 2000, 0.1));
+        // Bird k's size does not depend on the flock's size.
+        assert_eq!(bird_scales(7, 10, 0.1)[..], a[..10]);
+        assert!(a.iter().all(|&s| (0.7 - 1e-6..=1.3 + 1e-6).contains(&s)));
+        let mean = a.iter().map(|&s| f64::from(s)).sum::<f64>() / a.len() as f64;
+        let sd = (a
+            .iter()
+            .map(|&s| (f64::from(s) - mean).powi(2))
+            .sum::<f64>()
+            / a.len() as f64)
+            .sqrt();
+        assert!(
+            (mean - 1.0).abs() < 0.01 && (sd - 0.1).abs() < 0.01,
+            "{mean} {sd}"
+        );
+    }
+
+    #[test]
+    fn models_are_shared_out_evenly_at_random_and_seeded() {
+        assert_eq!(model_assignment(3, 5, 1), vec![0; 5]);
+        assert_eq!(model_assignment(3, 5, 0), vec![0; 5]);
+        let a = model_assignment(3, 100, 3);
+        assert_eq!(a, model_assignment(3, 100, 3));
+        assert_ne!(a, model_assignment(4, 100, 3));
+        let count = |m: usize| a.iter().filter(|&&x| x == m).count();
+        assert_eq!((count(0), count(1), count(2)), (34, 33, 33));
+        // Shuffled, not in turn.
+        assert_ne!(a, (0..100).map(|b| b % 3).collect::<Vec<_>>());
+        // Fewer birds than models: each bird a different model.
+        let few = model_assignment(9, 2, 3);
+        assert!(few[0] != few[1] && few.iter().all(|&m| m < 3));
+    }
+
+    #[test]
+    fn a_scaled_bird_keeps_its_sitting_ground_point() {
+        for sp in Species::ALL {
+            let sit = crate::wingbeat::rest::stance(sp).sit as f32;
+            let ground = Vec3::new(0.0, -sit, 0.0);
+            for s in [0.85_f32, 1.0, 1.12] {
+                let moved = s * (size_pivot(sp, s) + ground);
+                assert!((moved - ground).length() < 1e-6, "{sp} {s}: {moved}");
+            }
+        }
     }
 
     #[test]

@@ -4,7 +4,8 @@
 //! The file must be a binary glTF 2.0 (`.glb`) with its buffer inside (no external files), at
 //! most [`MAX_BYTES`] bytes and [`MAX_VERTICES`] vertices, with at least one triangle mesh in its
 //! default scene. Textures, UVs and extensions are not carried over: each primitive keeps its
-//! geometry and its material's base colour.
+//! geometry and its material's base colour (times its `COLOR_0` vertex colours, when it has
+//! them: the triangles are grouped by the colour of their first vertex).
 //!
 //! - **Skinned** (a mesh node with a skin whose joints include `body`, `upper_arm.L`, `hand.L`,
 //!   `upper_arm.R`, `hand.R`, optionally `neck` and `tail`; names compared case-insensitively,
@@ -23,7 +24,7 @@
 //! moved so that the box's centre is the bird's centre.
 
 use std::collections::BTreeMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use glam::{Mat4, Quat, Vec3};
 use gltf_json as json;
@@ -68,6 +69,26 @@ pub fn load_with(path: &Path, species: Species, joint_map: Option<&Path>) -> Res
     }
     let bytes = crate::io::read_bytes(path)?;
     parse_with(path, &bytes, species, map.as_ref())
+}
+
+/// Most bird models one export shares out over its birds.
+pub const MAX_MODELS: usize = 16;
+
+/// Loads and checks every model of `paths` ([`load_with`]) with its joint map: `maps` is empty,
+/// one map for every model, or one per model in order (checked by the caller's options).
+pub fn load_all(paths: &[PathBuf], maps: &[PathBuf], species: Species) -> Result<Vec<BirdAsset>> {
+    paths
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let map = match maps {
+                [] => None,
+                [one] => Some(one.as_path()),
+                each => each.get(i).map(PathBuf::as_path),
+            };
+            load_with(p, species, map)
+        })
+        .collect()
 }
 
 /// Parses and checks the bytes of a bird model (`path` is only named in messages); what [`load`]
@@ -266,6 +287,8 @@ struct Prim {
     normals: Option<Vec<Vec3>>,
     indices: Vec<u32>,
     colour: [f32; 3],
+    /// Per vertex colour (`COLOR_0`, multiplied into `colour`), when the primitive has one.
+    vertex_colours: Option<Vec<[f32; 3]>>,
     /// Per vertex, up to four (joint of the convention, weight).
     influences: Vec<Vec<(usize, f32)>>,
 }
@@ -577,6 +600,18 @@ impl Reader<'_> {
                 )));
             }
             let indices: Vec<u32> = indices[..indices.len() / 3 * 3].to_vec();
+            let vertex_colours = match get(json::mesh::Semantic::Colors(0)) {
+                Some(c) => {
+                    let (v, w) = self.floats(c)?;
+                    if !(w == 3 || w == 4) || v.len() < nv * w {
+                        return Err(self.err(format!(
+                            "mesh {mi} primitive {pi}: COLOR_0 is not one RGB or RGBA colour per vertex"
+                        )));
+                    }
+                    Some(v.chunks_exact(w).map(|c| [c[0], c[1], c[2]]).collect())
+                }
+                None => None,
+            };
             let mut influences = vec![vec![(bird::BODY, 1.0)]; nv];
             if let Some(map) = joint_map {
                 if let (Some(j), Some(w)) = (
@@ -610,6 +645,7 @@ impl Reader<'_> {
                 normals,
                 indices,
                 colour: self.colour(p),
+                vertex_colours,
                 influences,
             });
         }
@@ -852,8 +888,32 @@ impl Reader<'_> {
                 mesh.face_normals(&idx);
             }
             // Materials are numbered by primitive; the part tag only names them.
-            parts.push((Part::ALL[k % Part::ALL.len()], idx));
-            colours.push(p.colour);
+            let part = Part::ALL[k % Part::ALL.len()];
+            match &p.vertex_colours {
+                // Vertex colours: the triangles grouped by the colour of their first vertex
+                // (times the material's), one part per colour in order of appearance.
+                Some(vc) => {
+                    let mut groups: Vec<([f32; 3], Vec<u32>)> = Vec::new();
+                    let mut group_of: BTreeMap<[u32; 3], usize> = BTreeMap::new();
+                    for (t, local) in idx.chunks_exact(3).zip(p.indices.chunks_exact(3)) {
+                        let c = vc[local[0] as usize];
+                        let rgb = [c[0] * p.colour[0], c[1] * p.colour[1], c[2] * p.colour[2]];
+                        let g = *group_of.entry(rgb.map(f32::to_bits)).or_insert_with(|| {
+                            groups.push((rgb, Vec::new()));
+                            groups.len() - 1
+                        });
+                        groups[g].1.extend_from_slice(t);
+                    }
+                    for (rgb, tris) in groups {
+                        parts.push((part, tris));
+                        colours.push(rgb);
+                    }
+                }
+                None => {
+                    parts.push((part, idx));
+                    colours.push(p.colour);
+                }
+            }
         }
         mesh.set_parts(parts, colours);
         let mut skel = Skeleton::of(species);

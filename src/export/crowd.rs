@@ -25,7 +25,7 @@ use std::io::Write;
 use glam::{Quat, Vec3};
 
 use super::bird::{self, BirdAsset, PARENT};
-use super::gltf::{asset_for, SceneOptions};
+use super::gltf::SceneOptions;
 use super::usd::{flown_path_prim, stage_head, time_code, topology, vec3};
 use crate::animation::Animation;
 use crate::wingbeat::{Flapper, WingPose};
@@ -137,22 +137,46 @@ pub fn write_usda_instancer(
     out: &mut impl Write,
 ) -> std::io::Result<()> {
     let ws = wingspan_m as f32;
-    let asset = asset_for(anim, opts);
+    let assets = opts.models(anim);
+    let model_of = opts.model_of(anim);
     let flapper = Flapper::from_animation(anim);
-    let poses = if asset.wingbeat {
+    let poses = if assets.iter().any(|a| a.wingbeat) {
         choose(anim, &flapper, PROTOTYPES)
     } else {
         vec![WingPose::EXTENDED]
     };
+    // Each model's prototypes: every pose for a model that flaps, the bind pose for a static
+    // one; model m's come after those of the models before it.
+    let model_poses: Vec<Vec<WingPose>> = assets
+        .iter()
+        .map(|a| {
+            if a.wingbeat {
+                poses.clone()
+            } else {
+                vec![WingPose::EXTENDED]
+            }
+        })
+        .collect();
+    let offsets: Vec<usize> = model_poses
+        .iter()
+        .scan(0, |acc, p| {
+            let o = *acc;
+            *acc += p.len();
+            Some(o)
+        })
+        .collect();
+    let total: usize = model_poses.iter().map(Vec::len).sum();
     let pose_angles: Vec<[f64; 7]> = poses.iter().map(angles).collect();
     let n = anim.frames.len();
     let birds = anim.birds;
     // Each bird-frame's prototype and the error it makes.
-    let mut index = vec![0u16; n * birds];
+    let mut index: Vec<u16> = (0..n * birds)
+        .map(|i| offsets[model_of[i % birds.max(1)]] as u16)
+        .collect();
     let (mut worst, mut sum) = (0.0f64, 0.0f64);
     if poses.len() > 1 {
         for k in 0..n {
-            for b in 0..birds {
+            for b in (0..birds).filter(|&b| assets[model_of[b]].wingbeat) {
                 let a = angles(&flapper.pose(k, b));
                 let (i, d) = pose_angles
                     .iter()
@@ -160,7 +184,7 @@ pub fn write_usda_instancer(
                     .map(|(i, p)| (i, distance(&a, p)))
                     .min_by(|x, y| x.1.total_cmp(&y.1))
                     .unwrap_or((0, 0.0));
-                index[k * birds + b] = i as u16;
+                index[k * birds + b] = (offsets[model_of[b]] + i) as u16;
                 worst = worst.max(d);
                 sum += d;
             }
@@ -170,19 +194,34 @@ pub fn write_usda_instancer(
     let head = stage_head(
         anim,
         wingspan_m,
-        &asset,
+        &assets,
         opts,
         &serde_json::json!({
             "usd_mode": "instancer",
-            "prototypes": poses.len(),
+            "prototypes": total,
+            // Each model's body joint in the bird's frame, metres (the bank's pivot).
+            "body_m": assets
+                .iter()
+                .map(|a| (a.skeleton.bind_pos[bird::BODY] * ws).to_array().to_vec())
+                .collect::<Vec<_>>(),
             "pose_error_rad": format!("worst {worst:.4}, mean {mean:.4}"),
         }),
     );
     out.write_all(head.as_bytes())?;
     out.write_all(b"def Xform \"flock\" (\n    kind = \"assembly\"\n)\n{\n")?;
     out.write_all(b"    def PointInstancer \"crowd\"\n    {\n")?;
-    let protos: Vec<String> = (0..poses.len())
-        .map(|i| format!("</flock/crowd/prototypes/pose_{i:02}>"))
+    let protos: Vec<String> = model_poses
+        .iter()
+        .enumerate()
+        .flat_map(|(m, p)| {
+            let several = assets.len() > 1;
+            (0..p.len()).map(move |i| {
+                format!(
+                    "</flock/crowd/prototypes/{}>",
+                    proto_name(several.then_some(m), i)
+                )
+            })
+        })
         .collect();
     writeln!(out, "        rel prototypes = [{}]", protos.join(", "))?;
     let ids: Vec<String> = (0..birds).map(|b| b.to_string()).collect();
@@ -191,7 +230,18 @@ pub fn write_usda_instancer(
     let flights: Vec<bird::Flight> = (0..birds)
         .map(|b| bird::flight(anim, b, wingspan_m))
         .collect();
-    let pivot = asset.skeleton.bind_pos[bird::BODY] * ws;
+    let pivots: Vec<Vec3> = (0..birds)
+        .map(|b| assets[model_of[b]].skeleton.bind_pos[bird::BODY] * ws)
+        .collect();
+    // Each bird's size, taken about the same point as on the skeletal birds: an instance scales
+    // its prototype about the root, so its position carries the skeleton's shift of `body`.
+    let scales = bird::bird_scales(anim.seed, birds, opts.size_variation);
+    let species = crate::wingbeat::WingbeatOptions::for_animation(anim).species;
+    let shifts: Vec<Vec3> = scales
+        .iter()
+        .zip(&pivots)
+        .map(|(&s, &pivot)| (pivot + bird::size_pivot(species, s) * ws) * s)
+        .collect();
     let mut pos = String::new();
     let mut rot = String::new();
     let mut idx = String::new();
@@ -201,8 +251,10 @@ pub fn write_usda_instancer(
     for k in 0..n {
         pos.clear();
         for (b, fl) in flights.iter().enumerate() {
+            // The skeleton's world point of a prototype point x: t + yaw·s·(b + d + bank·(x − b))
+            // (b the body joint, d its size shift); the instance's: p + yaw·bank·s·x.
             let bank = Quat::from_rotation_z(fl.bank[k]);
-            let p = fl.translation[k] + fl.yaw[k] * (pivot - bank * pivot);
+            let p = fl.translation[k] + fl.yaw[k] * (shifts[b] - bank * (pivots[b] * scales[b]));
             lo = lo.min(p);
             hi = hi.max(p);
             let sep = if b == 0 { "" } else { "," };
@@ -246,8 +298,14 @@ pub fn write_usda_instancer(
         writeln!(out, "            {}: [{idx}],", time_code(anim, opts, k))?;
     }
     out.write_all(b"        }\n")?;
-    // The instances' extent over the whole shot, grown by a wingspan for the birds' own size.
-    let pad = Vec3::splat(ws);
+    // The birds' sizes (left out when every bird has size 1).
+    if scales.iter().any(|&s| s != 1.0) {
+        let items: Vec<String> = scales.iter().map(|&s| format!("({s},{s},{s})")).collect();
+        writeln!(out, "        float3[] scales = [{}]", items.join(","))?;
+    }
+    // The instances' extent over the whole shot, grown by the largest bird's wingspan.
+    let largest = scales.iter().fold(1.0f32, |a, &s| a.max(s));
+    let pad = Vec3::splat(ws * largest);
     if n > 0 && birds > 0 {
         writeln!(
             out,
@@ -256,20 +314,33 @@ pub fn write_usda_instancer(
             vec3(hi + pad)
         )?;
     }
-    out.write_all(prototypes(&asset, &poses, ws).as_bytes())?;
+    let several = assets.len() > 1;
+    out.write_all(b"        def Scope \"prototypes\"\n        {\n")?;
+    for (m, (asset, p)) in assets.iter().zip(&model_poses).enumerate() {
+        out.write_all(prototypes(asset, p, ws, several.then_some(m)).as_bytes())?;
+    }
+    out.write_all(b"        }\n")?;
     out.write_all(b"    }\n")?;
     out.write_all(flown_path_prim(anim, wingspan_m).as_bytes())?;
     out.write_all(b"}\n")?;
     Ok(())
 }
 
-/// The prototypes: one static mesh of the bird per pose, under `/flock/crowd/prototypes`.
-fn prototypes(asset: &BirdAsset, poses: &[WingPose], ws: f32) -> String {
+/// The name of prototype `i` (of model `model` when there are several models).
+fn proto_name(model: Option<usize>, i: usize) -> String {
+    match model {
+        Some(m) => format!("model_{m}_pose_{i:02}"),
+        None => format!("pose_{i:02}"),
+    }
+}
+
+/// The prototypes of one model: one static mesh of the bird per pose, to go under
+/// `/flock/crowd/prototypes`.
+fn prototypes(asset: &BirdAsset, poses: &[WingPose], ws: f32, model: Option<usize>) -> String {
     let m = &asset.mesh;
     let (counts, indices, colours) = topology(m);
     let (counts, indices, colours) = (counts.join(", "), indices.join(", "), colours.join(", "));
     let mut s = String::new();
-    let _ = writeln!(s, "        def Scope \"prototypes\"\n        {{");
     for (i, pose) in poses.iter().enumerate() {
         let pts = posed(asset, pose, ws);
         let (lo, hi) = pts.iter().fold(
@@ -277,7 +348,11 @@ fn prototypes(asset: &BirdAsset, poses: &[WingPose], ws: f32) -> String {
             |(a, b), &p| (a.min(p), b.max(p)),
         );
         let points: Vec<String> = pts.iter().map(|&p| vec3(p)).collect();
-        let _ = writeln!(s, "            def Mesh \"pose_{i:02}\"\n            {{");
+        let _ = writeln!(
+            s,
+            "            def Mesh \"{}\"\n            {{",
+            proto_name(model, i)
+        );
         let _ = writeln!(s, "                uniform bool doubleSided = 1");
         let _ = writeln!(
             s,
@@ -301,7 +376,6 @@ fn prototypes(asset: &BirdAsset, poses: &[WingPose], ws: f32) -> String {
             "                uniform token subdivisionScheme = \"none\"\n            }}"
         );
     }
-    let _ = writeln!(s, "        }}");
     s
 }
 

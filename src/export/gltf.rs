@@ -6,7 +6,8 @@
 //! heading). Under each root, the bird's skeleton: joints named by the convention of
 //! [`bird::JOINTS`] (`body` → `neck`, `tail`, `upper_arm.L` → `hand.L`, `upper_arm.R` →
 //! `hand.R`); bank turns `body`, the wingbeat turns the wing and tail joints. Every bird shares one
-//! skinned mesh (`JOINTS_0`/`WEIGHTS_0`, one primitive per material) and one inverse-bind-matrix
+//! skinned mesh (`JOINTS_0`/`WEIGHTS_0`, one primitive and one material, the parts' colours as
+//! `COLOR_0`: one draw call a bird) and one inverse-bind-matrix
 //! accessor; each bird's mesh node `bird_000_mesh` sits at the scene root, untransformed, as glTF
 //! asks of skinned meshes (only the joints place it), with its own skin `bird_000_skin`.
 //!
@@ -51,8 +52,9 @@ pub struct SceneOptions {
     pub tolerance: Tolerance,
     /// One clip over every stage, or one per stage.
     pub clips: ClipMode,
-    /// The bird placed on every bird; `None` = the built-in bird of the animation's species.
-    pub asset: Option<BirdAsset>,
+    /// The user's bird models, shared out over the birds ([`bird::model_assignment`]); empty =
+    /// the built-in bird of the animation's species on every bird.
+    pub assets: Vec<BirdAsset>,
     /// Number of the animation's first frame (e.g. 1001): the one clip's keys start at
     /// `start_frame / fps` seconds, and the frame numbers in the metadata and USD time codes
     /// count from it.
@@ -61,9 +63,29 @@ pub struct SceneOptions {
     /// blur): frame numbers and the scene's rate are in these frames; `None` = the animation's
     /// own rate.
     pub frame_rate: Option<f64>,
+    /// Spread of the birds' sizes, the F of [`bird::bird_scales`] (0 = every bird the same size,
+    /// this struct's default; `render.size_variation` defaults to the species').
+    pub size_variation: f64,
 }
 
 impl SceneOptions {
+    /// The bird models of `anim`: the user's, else the built-in bird of its species (at least
+    /// one).
+    pub fn models(&self, anim: &Animation) -> Vec<BirdAsset> {
+        if self.assets.is_empty() {
+            vec![BirdAsset::builtin(
+                WingbeatOptions::for_animation(anim).species,
+            )]
+        } else {
+            self.assets.clone()
+        }
+    }
+
+    /// Each bird's model: an index into [`SceneOptions::models`].
+    pub fn model_of(&self, anim: &Animation) -> Vec<usize> {
+        bird::model_assignment(anim.seed, anim.birds, self.assets.len())
+    }
+
     /// The shot's frame rate of `anim`'s samples.
     pub fn rate(&self, anim: &Animation) -> f64 {
         self.frame_rate.unwrap_or(anim.fps)
@@ -152,7 +174,7 @@ pub fn clips(anim: &Animation, mode: ClipMode) -> Vec<Clip> {
 pub fn metadata(
     anim: &Animation,
     wingspan_m: f64,
-    asset: &BirdAsset,
+    assets: &[BirdAsset],
     opts: &SceneOptions,
 ) -> serde_json::Value {
     let species = WingbeatOptions::for_animation(anim).species;
@@ -175,10 +197,23 @@ pub fn metadata(
         "birds": anim.birds,
         "frames": opts.frame_end(anim) - opts.start_frame + 1,
         "stages": anim.stages.iter().map(|s| serde_json::json!({"name": s.name, "start": stage_frame(s.start), "end": stage_frame(s.end)})).collect::<Vec<_>>(),
-        "bird_model": asset.source,
+        "bird_model": match assets {
+            [one] => serde_json::Value::from(one.source.clone()),
+            several => several.iter().map(|a| a.source.clone()).collect(),
+        },
         "joints": bird::JOINTS,
         "keys": opts.keys.to_string(),
+        "size_variation": opts.size_variation,
+        "bird_scales": bird::bird_scales(anim.seed, anim.birds, opts.size_variation)
+            .iter()
+            .map(|&s| short(s))
+            .collect::<Vec<_>>(),
+        // How far below the root (in the bird's frame) sizes are taken about.
+        "size_pivot_m": short(crate::wingbeat::rest::stance(species).sit as f32 * wingspan_m as f32),
     });
+    if let (Some(o), true) = (m.as_object_mut(), assets.len() > 1) {
+        o.insert("bird_model_of".into(), opts.model_of(anim).into());
+    }
     if opts.frame_rate.is_some() {
         if let Some(o) = m.as_object_mut() {
             o.insert(
@@ -188,6 +223,15 @@ pub fn metadata(
         }
     }
     m
+}
+
+/// An f32 as the JSON number of its shortest text (`1.0365741`, not its f64 widening).
+fn short(v: f32) -> serde_json::Value {
+    format!("{v}")
+        .parse::<f64>()
+        .ok()
+        .and_then(serde_json::Number::from_f64)
+        .map_or(serde_json::Value::Null, serde_json::Value::Number)
 }
 
 /// A frame number as JSON: an integer when whole (every frame), else the fractional number
@@ -206,10 +250,10 @@ fn frame_value(f: f64) -> serde_json::Value {
 fn scene_metadata(
     anim: &Animation,
     wingspan_m: f64,
-    asset: &BirdAsset,
+    assets: &[BirdAsset],
     opts: &SceneOptions,
 ) -> serde_json::Value {
-    let mut m = metadata(anim, wingspan_m, asset, opts);
+    let mut m = metadata(anim, wingspan_m, assets, opts);
     if let Some(o) = m.as_object_mut() {
         o.insert("frame_start".into(), opts.start_frame.into());
         o.insert("frame_end".into(), opts.frame_end(anim).into());
@@ -249,14 +293,6 @@ fn clip_metadata(anim: &Animation, c: &Clip, opts: &SceneOptions) -> serde_json:
 
 fn extras(v: &serde_json::Value) -> json::Extras {
     serde_json::value::RawValue::from_string(v.to_string()).ok()
-}
-
-/// The bird asset of an export: the user's if given, else the built-in bird of the species.
-pub fn asset_for(anim: &Animation, opts: &SceneOptions) -> BirdAsset {
-    match &opts.asset {
-        Some(a) => a.clone(),
-        None => BirdAsset::builtin(WingbeatOptions::for_animation(anim).species),
-    }
 }
 
 /// Key times of clip `c`: from the clip's first frame, and for the one clip over every stage
@@ -334,7 +370,8 @@ pub fn bird_track(
 pub fn glb_bytes_with(anim: &Animation, wingspan_m: f64, opts: &SceneOptions) -> Result<Vec<u8>> {
     let mut b = Builder::default();
     let ws = wingspan_m as f32;
-    let asset = asset_for(anim, opts);
+    let assets = opts.models(anim);
+    let model_of = opts.model_of(anim);
     let mut root = json::Root {
         asset: json::Asset {
             version: "2.0".into(),
@@ -346,15 +383,30 @@ pub fn glb_bytes_with(anim: &Animation, wingspan_m: f64, opts: &SceneOptions) ->
         },
         ..Default::default()
     };
-    let mesh = b.skinned_mesh(&mut root, &asset, ws);
-    let ibm: Vec<f32> = (0..bird::JOINTS.len())
-        .flat_map(|j| asset.skeleton.inverse_bind(j, ws).to_cols_array())
+    // Each model's mesh and inverse bind matrices, shared by the birds that wear it.
+    let shared: Vec<(json::Index<json::Mesh>, json::Index<json::Accessor>)> = assets
+        .iter()
+        .enumerate()
+        .map(|(m, asset)| {
+            let name = if assets.len() == 1 {
+                "bird".to_string()
+            } else {
+                format!("bird_model_{m}")
+            };
+            let mesh = b.skinned_mesh(&mut root, asset, ws, &name);
+            let ibm: Vec<f32> = (0..bird::JOINTS.len())
+                .flat_map(|j| asset.skeleton.inverse_bind(j, ws).to_cols_array())
+                .collect();
+            let ibm_acc = b.accessor(&mut root, &ibm, 16, json::accessor::Type::Mat4, false, None);
+            (mesh, ibm_acc)
+        })
         .collect();
-    let ibm_acc = b.accessor(&mut root, &ibm, 16, json::accessor::Type::Mat4, false, None);
 
     let clips = clips(anim, opts.clips);
     let flapper = Flapper::from_animation(anim);
     let digits = bird_digits(anim.birds);
+    let scales = bird::bird_scales(anim.seed, anim.birds, opts.size_variation);
+    let species = WingbeatOptions::for_animation(anim).species;
     let mut bird_nodes = Vec::with_capacity(anim.birds);
     let mut mesh_nodes = Vec::with_capacity(anim.birds);
     // Per clip: channels and samplers.
@@ -366,8 +418,11 @@ pub fn glb_bytes_with(anim: &Animation, wingspan_m: f64, opts: &SceneOptions) ->
         .collect::<Result<_>>()?;
     // One time accessor per clip for every channel keyed at every frame (made when first needed).
     let mut shared_t: Vec<Option<json::Index<json::Accessor>>> = vec![None; clips.len()];
-    for bird in 0..anim.birds {
-        let track = bird_track(anim, &flapper, &asset, bird, wingspan_m);
+    for (bird, &scale) in scales.iter().enumerate() {
+        let model = model_of[bird];
+        let asset = &assets[model];
+        let (mesh, ibm_acc) = shared[model];
+        let track = bird_track(anim, &flapper, asset, bird, wingspan_m);
         // Skeleton nodes, children before parents so indices are known.
         let mut joint_nodes: [Option<json::Index<json::Node>>; 7] = [None; 7];
         for j in (0..bird::JOINTS.len()).rev() {
@@ -375,9 +430,13 @@ pub fn glb_bytes_with(anim: &Animation, wingspan_m: f64, opts: &SceneOptions) ->
                 .filter(|&c| bird::PARENT[c] == Some(j))
                 .filter_map(|c| joint_nodes[c])
                 .collect();
+            let mut rest = asset.skeleton.rest_translation(j);
+            if j == bird::BODY && scale != 1.0 {
+                rest += bird::size_pivot(species, scale);
+            }
             let node = root.push(json::Node {
                 name: Some(bird::JOINTS[j].to_string()),
-                translation: Some((asset.skeleton.rest_translation(j) * ws).to_array()),
+                translation: Some((rest * ws).to_array()),
                 rotation: Some(json::scene::UnitQuaternion(track.joints[0][j].to_array())),
                 children: (!children.is_empty()).then_some(children),
                 ..Default::default()
@@ -393,8 +452,20 @@ pub fn glb_bytes_with(anim: &Animation, wingspan_m: f64, opts: &SceneOptions) ->
             name: Some(name.clone()),
             translation: Some(track.flight.translation[0].to_array()),
             rotation: Some(json::scene::UnitQuaternion(track.flight.yaw[0].to_array())),
+            // The bird's size: the scale scales its skeleton and so its skinned mesh, not its
+            // place (a scale of exactly 1 is left out, as glTF's default).
+            scale: (scale != 1.0).then_some([scale; 3]),
             children: Some(vec![joints[bird::BODY]]),
-            extras: extras(&serde_json::json!({"bird": bird})),
+            extras: extras(&{
+                let mut e = serde_json::json!({"bird": bird});
+                if scale != 1.0 {
+                    e["scale"] = short(scale);
+                }
+                if assets.len() > 1 {
+                    e["bird_model"] = model.into();
+                }
+                e
+            }),
             ..Default::default()
         });
         bird_nodes.push(bird_node);
@@ -570,7 +641,7 @@ pub fn glb_bytes_with(anim: &Animation, wingspan_m: f64, opts: &SceneOptions) ->
     }
     let scene = root.push(json::Scene {
         extensions: None,
-        extras: extras(&scene_metadata(anim, wingspan_m, &asset, opts)),
+        extras: extras(&scene_metadata(anim, wingspan_m, &assets, opts)),
         name: Some("flock".into()),
         nodes: scene_nodes,
     });
@@ -759,6 +830,37 @@ fn material(name: &str, rgb: [f32; 3]) -> json::Material {
     }
 }
 
+/// The parts of `m` as one primitive: the vertices to write (indices into `m`, in order), each
+/// one's colour (its part's) and the triangles over them. A vertex shared by parts of different
+/// colours is written once per colour; a vertex no triangle uses is white.
+fn one_primitive(m: &bird::SkinnedMesh) -> (Vec<usize>, Vec<[f32; 3]>, Vec<u32>) {
+    let n = m.positions.len();
+    let mut order: Vec<usize> = (0..n).collect();
+    let mut colours: Vec<Option<[f32; 3]>> = vec![None; n];
+    let mut copies: BTreeMap<(u32, [u32; 3]), u32> = BTreeMap::new();
+    let mut idx = Vec::with_capacity(m.parts.iter().map(|(_, i)| i.len()).sum());
+    for ((_, part), &rgb) in m.parts.iter().zip(&m.colours) {
+        for &v in part {
+            let i = v as usize;
+            let out = match colours[i] {
+                None => {
+                    colours[i] = Some(rgb);
+                    v
+                }
+                Some(c) if c == rgb => v,
+                Some(_) => *copies.entry((v, rgb.map(f32::to_bits))).or_insert_with(|| {
+                    order.push(i);
+                    colours.push(Some(rgb));
+                    (order.len() - 1) as u32
+                }),
+            };
+            idx.push(out);
+        }
+    }
+    let colours = colours.into_iter().map(|c| c.unwrap_or([1.0; 3])).collect();
+    (order, colours, idx)
+}
+
 /// Collects binary data, 4-byte aligned, one buffer view per accessor.
 #[derive(Default)]
 struct Builder {
@@ -873,66 +975,75 @@ impl Builder {
         })
     }
 
-    /// The asset's skinned mesh in metres: shared vertex attributes, one primitive (and
-    /// material) per part.
+    /// The asset's skinned mesh in metres, as one primitive with one material (one draw call a
+    /// bird): each part's colour is its vertices' `COLOR_0`, which glTF multiplies into the
+    /// white base colour (see [`one_primitive`]).
     fn skinned_mesh(
         &mut self,
         root: &mut json::Root,
         asset: &BirdAsset,
         ws: f32,
+        name: &str,
     ) -> json::Index<json::Mesh> {
         let m = &asset.mesh;
-        let pos: Vec<f32> = m
-            .positions
+        let (order, colours, idx) = one_primitive(m);
+        let pos: Vec<f32> = order
             .iter()
-            .flat_map(|p| (*p * ws).to_array())
+            .flat_map(|&v| (m.positions[v] * ws).to_array())
             .collect();
-        let nor: Vec<f32> = m.normals.iter().flat_map(|n| n.to_array()).collect();
+        let nor: Vec<f32> = order
+            .iter()
+            .flat_map(|&v| m.normals[v].to_array())
+            .collect();
+        let col: Vec<f32> = colours.iter().flatten().copied().collect();
         let target = Some(json::buffer::Target::ArrayBuffer);
         let pos = self.accessor(root, &pos, 3, json::accessor::Type::Vec3, true, target);
         let nor = self.accessor(root, &nor, 3, json::accessor::Type::Vec3, false, target);
-        let jb: Vec<u8> = m.joints.iter().flatten().copied().collect();
+        let col = self.accessor(root, &col, 3, json::accessor::Type::Vec3, false, target);
+        let jb: Vec<u8> = order.iter().flat_map(|&v| m.joints[v]).collect();
         let joints = self.raw_accessor(
             root,
             &jb,
-            m.joints.len(),
+            order.len(),
             json::accessor::ComponentType::U8,
             json::accessor::Type::Vec4,
             false,
             target,
         );
-        let wf: Vec<f32> = m.weights.iter().flatten().copied().collect();
+        let wf: Vec<f32> = order.iter().flat_map(|&v| m.weights[v]).collect();
         let weights = self.accessor(root, &wf, 4, json::accessor::Type::Vec4, false, target);
-        let mut primitives = Vec::new();
-        let big = m.positions.len() > u16::MAX as usize;
-        for ((part, idx), rgb) in m.parts.iter().zip(&m.colours) {
-            let mat = root.push(material(part.name(), *rgb));
-            let (bytes, ct): (Vec<u8>, _) = if big {
-                (
-                    idx.iter().flat_map(|v| v.to_le_bytes()).collect(),
-                    json::accessor::ComponentType::U32,
-                )
-            } else {
-                (
-                    idx.iter().flat_map(|&v| (v as u16).to_le_bytes()).collect(),
-                    json::accessor::ComponentType::U16,
-                )
-            };
-            let ia = self.raw_accessor(
-                root,
-                &bytes,
-                idx.len(),
-                ct,
-                json::accessor::Type::Scalar,
-                false,
-                Some(json::buffer::Target::ElementArrayBuffer),
-            );
-            let mut attributes = BTreeMap::new();
-            attributes.insert(Valid(json::mesh::Semantic::Positions), pos);
-            attributes.insert(Valid(json::mesh::Semantic::Normals), nor);
-            attributes.insert(Valid(json::mesh::Semantic::Joints(0)), joints);
-            attributes.insert(Valid(json::mesh::Semantic::Weights(0)), weights);
-            primitives.push(json::mesh::Primitive {
+        let mat = root.push(material(name, [1.0, 1.0, 1.0]));
+        let (bytes, ct): (Vec<u8>, _) = if order.len() > u16::MAX as usize {
+            (
+                idx.iter().flat_map(|v| v.to_le_bytes()).collect(),
+                json::accessor::ComponentType::U32,
+            )
+        } else {
+            (
+                idx.iter().flat_map(|&v| (v as u16).to_le_bytes()).collect(),
+                json::accessor::ComponentType::U16,
+            )
+        };
+        let ia = self.raw_accessor(
+            root,
+            &bytes,
+            idx.len(),
+            ct,
+            json::accessor::Type::Scalar,
+            false,
+            Some(json::buffer::Target::ElementArrayBuffer),
+        );
+        let mut attributes = BTreeMap::new();
+        attributes.insert(Valid(json::mesh::Semantic::Positions), pos);
+        attributes.insert(Valid(json::mesh::Semantic::Normals), nor);
+        attributes.insert(Valid(json::mesh::Semantic::Colors(0)), col);
+        attributes.insert(Valid(json::mesh::Semantic::Joints(0)), joints);
+        attributes.insert(Valid(json::mesh::Semantic::Weights(0)), weights);
+        root.push(json::Mesh {
+            extensions: None,
+            extras: Default::default(),
+            name: Some(name.into()),
+            primitives: vec![json::mesh::Primitive {
                 attributes,
                 extensions: None,
                 extras: Default::default(),
@@ -940,13 +1051,7 @@ impl Builder {
                 material: Some(mat),
                 mode: Valid(json::mesh::Mode::Triangles),
                 targets: None,
-            });
-        }
-        root.push(json::Mesh {
-            extensions: None,
-            extras: Default::default(),
-            name: Some("bird".into()),
-            primitives,
+            }],
             weights: None,
         })
     }

@@ -98,11 +98,20 @@ pub struct RenderOptions {
     pub keys: keys::KeyMode,
     /// Clips of the .glb: one over every stage (default) or one per stage.
     pub clips: keys::ClipMode,
-    /// The user's bird (`.glb`) for the `.glb` and `.usda`; `None` = the built-in bird.
-    pub bird_model: Option<PathBuf>,
-    /// A JSON file naming the joints of `bird_model` by the convention's
-    /// ([`bird_model::read_joint_map`]).
-    pub joint_map: Option<PathBuf>,
+    /// The user's birds (`.glb`) for the `.glb` and `.usda`, shared out over the flock at random
+    /// ([`bird::model_assignment`]); empty = the built-in bird. At most
+    /// [`bird_model::MAX_MODELS`].
+    pub bird_model: Vec<PathBuf>,
+    /// JSON files naming the joints of the `bird_model`s by the convention's
+    /// ([`bird_model::read_joint_map`]): none, one for every model, or one per model in order.
+    pub joint_map: Vec<PathBuf>,
+    /// Spread of the birds' sizes in the `.glb` and `.usda`, a fraction (the coefficient of
+    /// variation of the wingspan, 0 to [`bird::MAX_SIZE_VARIATION`]): each bird is scaled by
+    /// `1 + F·z`, z a standard normal clipped to ±3, drawn from the animation's seed
+    /// ([`bird::bird_scales`]). `None` = the species' default
+    /// ([`bird::DEFAULT_SIZE_VARIATION`]); 0 = every bird the same size. Positions (and the
+    /// `.json` and `.csv`) do not change.
+    pub size_variation: Option<f64>,
     /// Number of the first frame in every output that numbers frames (glTF keys and range, USD
     /// time codes, the CSV's `frame`, PNG file names), e.g. 1001; `None` = the animation's own
     /// (`start_frame` of the file, else 0).
@@ -181,8 +190,9 @@ impl Default for RenderOptions {
             gif_tolerance: 10.0,
             keys: keys::KeyMode::All,
             clips: keys::ClipMode::One,
-            bird_model: None,
-            joint_map: None,
+            bird_model: Vec::new(),
+            joint_map: Vec::new(),
+            size_variation: None,
             start_frame: None,
             animation_fps: None,
             subframes: 1,
@@ -251,10 +261,30 @@ impl RenderOptions {
                 ),
             ));
         }
-        if self.joint_map.is_some() && self.bird_model.is_none() {
+        if !self.joint_map.is_empty() && self.bird_model.is_empty() {
             return Err(Error::parameter(
                 "render.joint_map",
                 "names the joints of a bird model; give render.bird_model too",
+            ));
+        }
+        if self.bird_model.len() > bird_model::MAX_MODELS {
+            return Err(Error::parameter(
+                "render.bird_model",
+                format!(
+                    "{} bird models: give at most {}",
+                    self.bird_model.len(),
+                    bird_model::MAX_MODELS
+                ),
+            ));
+        }
+        if self.joint_map.len() > 1 && self.joint_map.len() != self.bird_model.len() {
+            return Err(Error::parameter(
+                "render.joint_map",
+                format!(
+                    "{} joint maps for {} bird models: give one map for every model, or one per model in the order of the models",
+                    self.joint_map.len(),
+                    self.bird_model.len()
+                ),
             ));
         }
         self.camera.validate()?;
@@ -269,6 +299,18 @@ impl RenderOptions {
                 "render.gif_tolerance",
                 format!("{} is outside 0..=64 colour levels", self.gif_tolerance),
             ));
+        }
+        if let Some(f) = self.size_variation {
+            if !(f.is_finite() && (0.0..=bird::MAX_SIZE_VARIATION).contains(&f)) {
+                return Err(Error::parameter(
+                    "render.size_variation",
+                    format!(
+                        "{f} is not a size variation; give a fraction from 0 (every bird the same size) to {} (default {}: wingspans spread by about 4 %)",
+                        bird::MAX_SIZE_VARIATION,
+                        bird::DEFAULT_SIZE_VARIATION
+                    ),
+                ));
+            }
         }
         if let Some(w) = self.wingspan_m {
             if !(w.is_finite() && (crate::limits::MIN_WINGSPAN_M..=100.0).contains(&w)) {
@@ -509,22 +551,24 @@ pub fn write_outputs(
         }
     }
     let wingspan_m = opts.wingspan_m.unwrap_or(anim.wingspan_m);
-    // The user's bird is checked before any output is written (exit 2 with the reason).
-    let asset = match &opts.bird_model {
-        Some(p) => Some(bird_model::load_with(
-            p,
-            crate::wingbeat::WingbeatOptions::for_animation(anim).species,
-            opts.joint_map.as_deref(),
-        )?),
-        None => None,
-    };
+    // The user's birds are checked before any output is written (exit 2 with the reason).
+    let assets = bird_model::load_all(
+        &opts.bird_model,
+        &opts.joint_map,
+        crate::wingbeat::WingbeatOptions::for_animation(anim).species,
+    )?;
     let scene = gltf::SceneOptions {
         keys: opts.keys,
         tolerance: keys::Tolerance::default(),
         clips: opts.clips,
-        asset,
+        assets,
         start_frame: anim.start_frame,
         frame_rate: None,
+        size_variation: opts.size_variation.unwrap_or_else(|| {
+            bird::default_size_variation(
+                crate::wingbeat::WingbeatOptions::for_animation(anim).species,
+            )
+        }),
     };
     // The 3-D outputs' samples: the animation (a loop with its closing frame), at
     // `subframes` samples a frame.

@@ -14,7 +14,8 @@
 //! `/flock/bird_000` … is a `SkelRoot` that references `/_bird`, carries the flight as
 //! time-sampled `xformOp:translate` and `xformOp:orient`, and binds its own `SkelAnimation`
 //! `anim` (time-sampled joint `rotations`, constant `translations` and `scales`) to its `rig`
-//! through `skel:animationSource`.
+//! through `skel:animationSource`. With several bird models, model m > 0 is the class
+//! `/_bird_m` and each bird references its own model's class (`customData` `bird_model`).
 //!
 //! An animation that followed a path also gets `/flock/flown_path`, a linear `BasisCurves` (purpose
 //! `guide`, so renders leave it out) through the course as flown, turns widened.
@@ -28,7 +29,7 @@ use std::io::Write;
 use glam::{Mat4, Quat, Vec3};
 
 use super::bird::{self, BirdAsset};
-use super::gltf::{asset_for, bird_digits, bird_track, metadata, SceneOptions};
+use super::gltf::{bird_digits, bird_track, metadata, SceneOptions};
 use super::keys::{self, Curve};
 use crate::animation::Animation;
 use crate::wingbeat::Flapper;
@@ -100,6 +101,10 @@ fn dict_entries(v: &serde_json::Value, indent: &str, out: &mut String) {
                         a.iter().map(|x| string(x.as_str().unwrap_or(""))).collect();
                     let _ = writeln!(out, "{indent}string[] {k} = [{}]", items.join(", "));
                 }
+                serde_json::Value::Array(a) if !a.is_empty() && a.iter().all(|x| x.is_number()) => {
+                    let items: Vec<String> = a.iter().map(|x| x.to_string()).collect();
+                    let _ = writeln!(out, "{indent}double[] {k} = [{}]", items.join(", "));
+                }
                 // Anything else (e.g. the stages) as its JSON text.
                 other => {
                     let _ = writeln!(out, "{indent}string {k} = {}", string(&other.to_string()));
@@ -113,7 +118,7 @@ fn dict_entries(v: &serde_json::Value, indent: &str, out: &mut String) {
 pub(super) fn stage_head(
     anim: &Animation,
     wingspan_m: f64,
-    asset: &BirdAsset,
+    assets: &[BirdAsset],
     opts: &SceneOptions,
     extra: &serde_json::Value,
 ) -> String {
@@ -123,7 +128,7 @@ pub(super) fn stage_head(
         head,
         "    customLayerData = {{\n        dictionary formation = {{"
     );
-    let mut meta = metadata(anim, wingspan_m, asset, opts);
+    let mut meta = metadata(anim, wingspan_m, assets, opts);
     if let (Some(m), Some(e)) = (meta.as_object_mut(), extra.as_object()) {
         for (k, v) in e {
             m.insert(k.clone(), v.clone());
@@ -156,13 +161,16 @@ pub fn write_usda(
     out: &mut impl Write,
 ) -> std::io::Result<()> {
     let ws = wingspan_m as f32;
-    let asset = asset_for(anim, opts);
+    let assets = opts.models(anim);
+    let model_of = opts.model_of(anim);
     let n = anim.frames.len();
     let io = |e: std::io::Error| e;
-    let head = stage_head(anim, wingspan_m, &asset, opts, &serde_json::json!({}));
+    let head = stage_head(anim, wingspan_m, &assets, opts, &serde_json::json!({}));
     out.write_all(head.as_bytes()).map_err(io)?;
-    out.write_all(prototype(&asset, ws).as_bytes())
-        .map_err(io)?;
+    for (m, asset) in assets.iter().enumerate() {
+        out.write_all(prototype(asset, ws, &class_name(m)).as_bytes())
+            .map_err(io)?;
+    }
 
     let paths = bird::usd_joint_paths();
     let joints_tokens = paths
@@ -172,6 +180,8 @@ pub fn write_usda(
         .join(", ");
     let flapper = Flapper::from_animation(anim);
     let digits = bird_digits(anim.birds);
+    let scales = bird::bird_scales(anim.seed, anim.birds, opts.size_variation);
+    let species = crate::wingbeat::WingbeatOptions::for_animation(anim).species;
     let times: Vec<f32> = anim
         .frames
         .iter()
@@ -179,13 +189,25 @@ pub fn write_usda(
         .collect();
     out.write_all(b"def Xform \"flock\" (\n    kind = \"assembly\"\n)\n{\n")
         .map_err(io)?;
-    for b in 0..anim.birds {
-        let track = bird_track(anim, &flapper, &asset, b, wingspan_m);
+    for (b, &scale) in scales.iter().enumerate() {
+        let asset = &assets[model_of[b]];
+        let track = bird_track(anim, &flapper, asset, b, wingspan_m);
         let name = format!("bird_{b:0digits$}");
         let mut s = String::new();
         let _ = writeln!(
             s,
-            "    def SkelRoot \"{name}\" (\n        prepend references = </_bird>\n        customData = {{\n            int bird = {b}\n        }}\n    )\n    {{"
+            "    def SkelRoot \"{name}\" (\n        prepend references = </{}>\n        customData = {{\n            int bird = {b}{}{}\n        }}\n    )\n    {{",
+            class_name(model_of[b]),
+            if assets.len() > 1 {
+                format!("\n            int bird_model = {}", model_of[b])
+            } else {
+                String::new()
+            },
+            if scale != 1.0 {
+                format!("\n            double scale = {}", f(scale))
+            } else {
+                String::new()
+            }
         );
         let tol = opts.tolerance;
         let kt = keys::keep(
@@ -219,14 +241,27 @@ pub fn write_usda(
                 quat(track.flight.yaw[k])
             );
         }
-        let _ = writeln!(s, "        }}\n        uniform token[] xformOpOrder = [\"xformOp:translate\", \"xformOp:orient\"]\n");
+        // The bird's size scales it about its root, after the flight (a scale of exactly 1 is
+        // left out).
+        if scale != 1.0 {
+            let sc = f(scale);
+            let _ = writeln!(s, "        }}\n        float3 xformOp:scale = ({sc}, {sc}, {sc})\n        uniform token[] xformOpOrder = [\"xformOp:translate\", \"xformOp:orient\", \"xformOp:scale\"]\n");
+        } else {
+            let _ = writeln!(s, "        }}\n        uniform token[] xformOpOrder = [\"xformOp:translate\", \"xformOp:orient\"]\n");
+        }
         let _ = writeln!(
             s,
             "        over \"rig\"\n        {{\n            rel skel:animationSource = </flock/{name}/anim>\n        }}\n"
         );
         let _ = writeln!(s, "        def SkelAnimation \"anim\"\n        {{\n            uniform token[] joints = [{joints_tokens}]");
         let rest: Vec<String> = (0..bird::JOINTS.len())
-            .map(|j| vec3(asset.skeleton.rest_translation(j) * ws))
+            .map(|j| {
+                let mut t = asset.skeleton.rest_translation(j);
+                if j == bird::BODY && scale != 1.0 {
+                    t += bird::size_pivot(species, scale);
+                }
+                vec3(t * ws)
+            })
             .collect();
         let _ = writeln!(
             s,
@@ -259,7 +294,6 @@ pub fn write_usda(
     Ok(())
 }
 
-/// The class `/_bird`: skeleton and skinned mesh, shared by reference.
 /// Per-vertex interpolation of a mesh attribute.
 const VERTEX: &str = "interpolation = \"vertex\"";
 
@@ -294,7 +328,18 @@ pub(super) fn topology(m: &bird::SkinnedMesh) -> (Vec<&'static str>, Vec<String>
     (counts, indices, colours)
 }
 
-fn prototype(asset: &BirdAsset, ws: f32) -> String {
+/// The class of bird model `m`: `_bird` for the first (or only) model, `_bird_1`, `_bird_2`, …
+/// for the others.
+fn class_name(m: usize) -> String {
+    if m == 0 {
+        "_bird".into()
+    } else {
+        format!("_bird_{m}")
+    }
+}
+
+/// The class `/_bird` (or `class`): skeleton and skinned mesh, shared by reference.
+fn prototype(asset: &BirdAsset, ws: f32, class: &str) -> String {
     let skel = &asset.skeleton;
     let paths = bird::usd_joint_paths();
     let joints = paths
@@ -329,7 +374,7 @@ fn prototype(asset: &BirdAsset, ws: f32) -> String {
     let ji: Vec<String> = m.joints.iter().flatten().map(|j| j.to_string()).collect();
     let jw: Vec<String> = m.weights.iter().flatten().map(|&w| f(w)).collect();
     let mut s = String::new();
-    let _ = writeln!(s, "class SkelRoot \"_bird\"\n{{");
+    let _ = writeln!(s, "class SkelRoot \"{class}\"\n{{");
     let _ = writeln!(
         s,
         "    def Skeleton \"rig\" (\n        prepend apiSchemas = [\"SkelBindingAPI\"]\n    )\n    {{"
@@ -377,7 +422,7 @@ fn prototype(asset: &BirdAsset, ws: f32) -> String {
         &jw,
         &["elementSize = 4", VERTEX],
     );
-    let _ = writeln!(s, "        rel skel:skeleton = </_bird/rig>");
+    let _ = writeln!(s, "        rel skel:skeleton = </{class}/rig>");
     let _ = writeln!(
         s,
         "        uniform token subdivisionScheme = \"none\"\n    }}\n}}\n"
