@@ -62,23 +62,34 @@ pub fn stance(species: Species) -> Stance {
 /// for a bird high up (below 1e-17 wingspans from 10 wingspans up). Run it after the course
 /// (whose pitch comes from the height change, so the body stays level while the bird stands
 /// up) and before the wingbeats. Animations without a take-off are left as they are.
+///
+/// The `landing` stage is treated the same way (the flare ends standing, the running steps slow
+/// to sitting), except on water, where the root comes down to
+/// [`crate::initiate::landing::FLOAT_HEIGHT`] above the waterline at any speed.
 pub fn stand_on_ground(anim: &mut Animation, species: Species) {
-    let Some(stage) = anim.stage("initiation").cloned() else {
-        return;
-    };
     let st = stance(species);
     let ws = anim.wingspan_m;
     if !(ws.is_finite() && ws > 0.0) {
         return;
     }
-    let end = stage.end.min(anim.frames.len());
-    for f in &mut anim.frames[stage.start.min(end)..end] {
-        for (z, &v) in f.z.iter_mut().zip(&f.speed) {
-            let u = (v * ws / STAND_UP_SPEED_MS).clamp(0.0, 1.0);
-            let h = st.sit + (st.stand - st.sit) * u * u * (3.0 - 2.0 * u);
-            let lift = h * (-z.max(0.0) / st.stand).exp();
-            if z.is_finite() && lift.is_finite() {
-                *z += lift;
+    let water = anim
+        .landing
+        .as_ref()
+        .is_some_and(|l| l.surface == crate::initiate::landing::Surface::Water);
+    for name in ["initiation", "landing"] {
+        let Some(stage) = anim.stage(name).cloned() else {
+            continue;
+        };
+        let float = (name == "landing" && water).then_some(crate::initiate::landing::FLOAT_HEIGHT);
+        let end = stage.end.min(anim.frames.len());
+        for f in &mut anim.frames[stage.start.min(end)..end] {
+            for (z, &v) in f.z.iter_mut().zip(&f.speed) {
+                let u = (v * ws / STAND_UP_SPEED_MS).clamp(0.0, 1.0);
+                let h = float.unwrap_or(st.sit + (st.stand - st.sit) * u * u * (3.0 - 2.0 * u));
+                let lift = h * (-z.max(0.0) / st.stand).exp();
+                if z.is_finite() && lift.is_finite() {
+                    *z += lift;
+                }
             }
         }
     }
