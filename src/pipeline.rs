@@ -211,6 +211,21 @@ impl Config {
         self.initiate_options()?;
         self.wingbeat.validate()?;
         self.course.validate()?;
+        if self.land {
+            self.landing.validate()?;
+            if self.steady.looped {
+                return Err(Error::parameter(
+                    "land",
+                    "a loop cycles for ever and cannot end in a landing; give one of --land and --loop",
+                ));
+            }
+            if self.shot_seconds.is_some() && self.course.path.is_some() {
+                return Err(Error::parameter(
+                    "shot_seconds",
+                    "a landing on a path ends where the path ends, so the path sets the shot's length; give no shot length, or no path",
+                ));
+            }
+        }
         if self.steady.looped && self.initiation {
             return Err(Error::parameter(
                 "steady.loop",
@@ -231,21 +246,6 @@ impl Config {
                         format!("{shot} s is not longer than the {takeoff} s take-off asked for; give a longer shot, a shorter take-off, or no take-off"),
                     ));
                 }
-            }
-        }
-        if self.land {
-            self.landing.validate()?;
-            if self.steady.looped {
-                return Err(Error::parameter(
-                    "land",
-                    "a loop cycles for ever and cannot end in a landing; give one of --land and --loop",
-                ));
-            }
-            if self.shot_seconds.is_some() && self.course.path.is_some() {
-                return Err(Error::parameter(
-                    "shot_seconds",
-                    "a landing on a path ends where the path ends, so the path sets the shot's length; give no shot length, or no path",
-                ));
             }
         }
         if self.steady.reorganise.joiners > 0 && self.initiation {
@@ -635,10 +635,19 @@ pub fn land_stage(
             let length =
                 crate::course::apply(&mut anim.clone(), Some(p), &config.course, flight)?.length;
             let s0 = crate::course::start_along(anim, takeoff);
-            let reach = landing::front_distance(anim, &config.landing, &site)?;
             let front = |f: &crate::animation::Frame| f.y.iter().copied().fold(f64::MIN, f64::max);
-            let target = s0 + length - reach;
-            let k = anim.frames.iter().rposition(|f| front(f) <= target);
+            // The landing's reach depends a little on the birds' state where it starts: find
+            // the start frame, then refine it from the reach planned there.
+            let mut reach = landing::front_distance(anim, &config.landing, &site)?;
+            let mut target = s0 + length - reach - speed / fps;
+            let mut k = anim.frames.iter().rposition(|f| front(f) <= target);
+            for _ in 0..3 {
+                let Some(at) = k else { break };
+                reach =
+                    landing::front_distance_from(anim, &anim.frames[at], &config.landing, &site)?;
+                target = s0 + length - reach - speed / fps;
+                k = anim.frames.iter().rposition(|f| front(f) <= target);
+            }
             let first_steady = anim.stage("steady").map_or(0, |s| s.start);
             let origin = config.course.path.clone().unwrap_or_default();
             let last = anim.frames.last().map_or(f64::MIN, front);

@@ -411,11 +411,21 @@ pub struct LandingStats {
 
 /// The plan of a landing that starts from frame `anim.frames.last()` advanced by one frame.
 fn plan(anim: &Animation, opts: &LandingOptions, site: &Site) -> Result<(Plan, f64)> {
-    let n = anim.birds;
     let last = anim
         .frames
         .last()
         .ok_or_else(|| Error::Internal("a landing after no flight".into()))?;
+    plan_from(anim, last, opts, site)
+}
+
+/// The plan of a landing that starts one frame after `last`, a frame of `anim`.
+fn plan_from(
+    anim: &Animation,
+    last: &Frame,
+    opts: &LandingOptions,
+    site: &Site,
+) -> Result<(Plan, f64)> {
+    let n = anim.birds;
     let ws = anim.wingspan_m;
     let dt = 1.0 / anim.fps;
     let v = site.speed;
@@ -505,7 +515,21 @@ fn plan(anim: &Animation, opts: &LandingOptions, site: &Site) -> Result<(Plan, f
 /// flock's front (its farthest resting place), wingspans, for `anim` as it is: what a course
 /// that must end where the flock lands needs.
 pub fn front_distance(anim: &Animation, opts: &LandingOptions, site: &Site) -> Result<f64> {
-    let (p, _) = plan(anim, opts, site)?;
+    let last = anim
+        .frames
+        .last()
+        .ok_or_else(|| Error::Internal("a landing after no flight".into()))?;
+    front_distance_from(anim, last, opts, site)
+}
+
+/// [`front_distance`] for a landing that starts one frame after `last`, a frame of `anim`.
+pub fn front_distance_from(
+    anim: &Animation,
+    last: &Frame,
+    opts: &LandingOptions,
+    site: &Site,
+) -> Result<f64> {
+    let (p, _) = plan_from(anim, last, opts, site)?;
     let y_front = p.birds.iter().map(|b| b.y0).fold(f64::MIN, f64::max);
     let far = p
         .birds
