@@ -95,6 +95,7 @@ pub fn footage_savings(p: &FormationParams) -> AnimationStats {
     AnimationStats {
         formations: 1,
         takeoff_s: None,
+        landing_s: None,
         steady_s: None,
         steady_saving: flock,
         saving_over_time: over_time,
