@@ -304,3 +304,36 @@ fn bad_landings_are_refused_in_one_line() {
         assert!(!out.exists(), "{extra:?} left a file");
     }
 }
+
+#[test]
+fn on_a_path_the_flock_comes_to_rest_at_its_end() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/path_turn_climb.json");
+    let mut c = Config {
+        seed: 2,
+        seconds: Some(1.0),
+        land: true,
+        ..Config::default()
+    };
+    c.steady.birds = 9;
+    c.course.path = Some(path);
+    let geese = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples_data/barnacle_geese_v.json");
+    let (anim, report) = Pipeline::from_path(geese).run(&c).expect("lands");
+    assert!(
+        report.course.warnings.is_empty(),
+        "{:?}",
+        report.course.warnings
+    );
+    // The path ends at (450, 350), heading east, 30 wingspans up: the front bird rests under it.
+    let last = anim.frames.last().unwrap();
+    let front = (0..9)
+        .max_by(|&a, &b| last.x[a].total_cmp(&last.x[b]))
+        .unwrap();
+    assert!(
+        (last.x[front] - 450.0).abs() < 1.0,
+        "front at {}",
+        last.x[front]
+    );
+    assert!(last.x.iter().all(|&x| x <= 450.0 + 1e-6));
+    assert!(last.y.iter().all(|&y| (y - 350.0).abs() < 5.0));
+    check_on_the_rig(&anim, Species::Goose);
+}
