@@ -8,6 +8,7 @@ use std::path::Path;
 use crate::error::{Error, Result};
 
 pub mod axes;
+pub mod landing;
 pub mod relative;
 pub mod resample;
 pub mod stats;
@@ -79,7 +80,7 @@ pub struct Animation {
     pub events: Vec<Event>,
     /// The landing's touch-downs, when the animation ends in a `landing` stage.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub landing: Option<crate::initiate::landing::LandingRecord>,
+    pub landing: Option<landing::LandingRecord>,
     /// One entry per frame.
     pub frames: Vec<Frame>,
 }

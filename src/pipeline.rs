@@ -216,7 +216,7 @@ impl Config {
             if self.steady.looped {
                 return Err(Error::parameter(
                     "land",
-                    "a loop cycles for ever and cannot end in a landing; give one of --land and --loop",
+                    "a loop cycles for ever and cannot end in a landing; fly without steady.loop, or without the landing",
                 ));
             }
             if self.shot_seconds.is_some() && self.course.path.is_some() {

@@ -65,7 +65,7 @@ pub fn stance(species: Species) -> Stance {
 ///
 /// The `landing` stage is treated the same way (the flare ends standing, the running steps slow
 /// to sitting), except on water, where a bird skis on its feet with the root at half its
-/// standing height and floats, root [`crate::initiate::landing::FLOAT_HEIGHT`] above the
+/// standing height and floats, root [`crate::animation::landing::FLOAT_HEIGHT`] above the
 /// waterline, once slow.
 pub fn stand_on_ground(anim: &mut Animation, species: Species) {
     let st = stance(species);
@@ -76,12 +76,12 @@ pub fn stand_on_ground(anim: &mut Animation, species: Species) {
     let water = anim
         .landing
         .as_ref()
-        .is_some_and(|l| l.surface == crate::initiate::landing::Surface::Water);
+        .is_some_and(|l| l.surface == crate::animation::landing::Surface::Water);
     for name in ["initiation", "landing"] {
         let Some(stage) = anim.stage(name).cloned() else {
             continue;
         };
-        let float = (name == "landing" && water).then_some(crate::initiate::landing::FLOAT_HEIGHT);
+        let float = (name == "landing" && water).then_some(crate::animation::landing::FLOAT_HEIGHT);
         let end = stage.end.min(anim.frames.len());
         for f in &mut anim.frames[stage.start.min(end)..end] {
             for (z, &v) in f.z.iter_mut().zip(&f.speed) {
@@ -179,7 +179,7 @@ pub const FLARE: WingPose = WingPose {
 };
 
 /// Flare weight of every bird in every frame (frame-major) from the animation's landing record
-/// ([`crate::initiate::landing::LandingRecord::flare_weight`]); empty without a landing.
+/// ([`crate::animation::landing::LandingRecord::flare_weight`]); empty without a landing.
 pub fn flare_weights(anim: &Animation) -> Vec<f64> {
     let Some(rec) = anim.landing.as_ref() else {
         return Vec::new();
