@@ -5,7 +5,10 @@
 //!   the grid, drives, avoidance) and the integration steps up to the next decision, i.e. one
 //!   reaction time (1/30 s) of flight;
 //! - a whole ground take-off of 100 and of 300 birds, from rest to convergence (or the time
-//!   limit), into a V at real spacing (0.7 wingspans across, 0.35 back).
+//!   limit), into a V at real spacing (0.7 wingspans across, 0.35 back);
+//! - the landing of 100 birds flying a V at 10 wingspans up: the whole landing stage (glide,
+//!   flare, touch-downs, running steps, 30 fps), then the birds put on the ground and the
+//!   wingbeats assigned (fold and flare included).
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use formation::initiate::{
@@ -109,5 +112,47 @@ fn whole(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, perception, step_1000, whole);
+fn landing(c: &mut Criterion) {
+    use formation::animation::{Animation, Frame, Stage, StageName};
+    use formation::initiate::landing::{self, LandingOptions, Site};
+    let n = 100;
+    let shape = v_shape(n);
+    let mut flight = Animation::new(0, 30.0, 1.5, n);
+    for k in 0..30 {
+        let t = k as f64 / 30.0;
+        flight.frames.push(Frame {
+            t,
+            x: shape.iter().map(|p| p.x).collect(),
+            y: shape.iter().map(|p| 10.0 * t - p.y).collect(),
+            z: vec![10.0; n],
+            heading: vec![0.0; n],
+            speed: vec![10.0; n],
+            ..Frame::default()
+        });
+    }
+    flight.stages.push(Stage {
+        name: StageName::Steady,
+        start: 0,
+        end: 30,
+    });
+    let site = Site {
+        speed: 10.0,
+        altitude: 10.0,
+        world_height: 10.0,
+    };
+    let mut group = c.benchmark_group("landing");
+    group.sample_size(10);
+    group.bench_function("whole_100_birds", |b| {
+        b.iter(|| {
+            let mut a = flight.clone();
+            landing::land(&mut a, &LandingOptions::default(), &site, None).expect("lands");
+            formation::wingbeat::rest::stand_on_ground(&mut a, formation::wingbeat::Species::Goose);
+            formation::wingbeat::assign_phases(&mut a, &Default::default()).expect("wingbeats");
+            black_box(a.frames.len())
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, perception, step_1000, whole, landing);
 criterion_main!(benches);

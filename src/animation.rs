@@ -8,6 +8,7 @@ use std::path::Path;
 use crate::error::{Error, Result};
 
 pub mod axes;
+pub mod landing;
 pub mod relative;
 pub mod resample;
 pub mod stats;
@@ -77,6 +78,9 @@ pub struct Animation {
     /// Reorganisations of the steady flight (leader changes, swaps, joins), in time order.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub events: Vec<Event>,
+    /// The landing's touch-downs, when the animation ends in a `landing` stage.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub landing: Option<landing::LandingRecord>,
     /// One entry per frame.
     pub frames: Vec<Frame>,
 }
@@ -182,7 +186,7 @@ pub struct FormationRecord {
 /// A named range of frames.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Stage {
-    /// `"initiation"` or `"steady"` in the file.
+    /// `"initiation"`, `"steady"` or `"landing"` in the file.
     pub name: StageName,
     /// First frame, inclusive.
     pub start: usize,
@@ -199,6 +203,8 @@ pub enum StageName {
     Initiation,
     /// §5: the steady flight through the key shapes.
     Steady,
+    /// After the steady flight: descent, flare, touch-down and stop (docs/landing.md).
+    Landing,
     /// Any other name.
     Other(String),
 }
@@ -209,6 +215,7 @@ impl StageName {
         match self {
             StageName::Initiation => "initiation",
             StageName::Steady => "steady",
+            StageName::Landing => "landing",
             StageName::Other(s) => s,
         }
     }
@@ -219,6 +226,7 @@ impl From<&str> for StageName {
         match s {
             "initiation" => StageName::Initiation,
             "steady" => StageName::Steady,
+            "landing" => StageName::Landing,
             other => StageName::Other(other.to_string()),
         }
     }
@@ -469,6 +477,7 @@ impl Animation {
             flight: None,
             savings_model: None,
             events: Vec::new(),
+            landing: None,
             frames: Vec::new(),
         }
     }

@@ -30,6 +30,7 @@ use crate::course::{CourseOptions, CourseReport, PathPoints};
 use crate::error::{Error, Result};
 use crate::export::RenderOptions;
 use crate::extract::{self, ExtractOptions, FormationParams, FrameReport};
+use crate::initiate::landing::{self, LandingOptions, LandingStats};
 use crate::initiate::{self, InitiateOptions, InitiateStats};
 use crate::keyshape::{steady_flight_report, SteadyOptions, SteadyReport};
 use crate::progress::{Progress, Silent};
@@ -57,6 +58,10 @@ pub struct Config {
     pub shot_seconds: Option<f64>,
     /// Fly the §6 take-off before the steady flight; `false`: the steady flight alone.
     pub initiation: bool,
+    /// End the flight with a landing (docs/landing.md); with an open path, where the path ends.
+    pub land: bool,
+    /// How the flock lands (used when [`Config::land`]).
+    pub landing: LandingOptions,
     /// How annotation files are read (ignored for params and for annotations in memory).
     pub read: ReadOptions,
     /// §4 parameter extraction (ignored when the input is formation parameters).
@@ -82,6 +87,8 @@ impl Default for Config {
             seconds: Some(DEFAULT_SECONDS),
             shot_seconds: None,
             initiation: true,
+            land: false,
+            landing: LandingOptions::default(),
             read: ReadOptions::default(),
             extract: ExtractOptions::default(),
             steady: SteadyOptions::default(),
@@ -204,6 +211,21 @@ impl Config {
         self.initiate_options()?;
         self.wingbeat.validate()?;
         self.course.validate()?;
+        if self.land {
+            self.landing.validate()?;
+            if self.steady.looped {
+                return Err(Error::parameter(
+                    "land",
+                    "a loop cycles for ever and cannot end in a landing; fly without steady.loop, or without the landing",
+                ));
+            }
+            if self.shot_seconds.is_some() && self.course.path.is_some() {
+                return Err(Error::parameter(
+                    "shot_seconds",
+                    "a landing on a path ends where the path ends, so the path sets the shot's length; give no shot length, or no path",
+                ));
+            }
+        }
         if self.steady.looped && self.initiation {
             return Err(Error::parameter(
                 "steady.loop",
@@ -255,6 +277,8 @@ pub struct Report {
     /// Each formation's reports and the arrangement, when the flock flew as several formations
     /// (then `steady` is formation 0's).
     pub skein: Option<SkeinReport>,
+    /// What the landing did (`None` without one).
+    pub landing: Option<LandingStats>,
 }
 
 /// What a pipeline starts from.
@@ -334,7 +358,8 @@ impl Pipeline {
                 progress,
             );
         }
-        let (steady, steady_report) = steady_stage(&params, config, progress)?;
+        let long = landing_config(config, path.as_ref());
+        let (steady, steady_report) = steady_stage(&params, &long, progress)?;
         let (mut anim, initiate_report) = if config.initiation {
             initiate::check_steady(&steady, self.origin())?;
             let config = takeoff_config(config, path.as_ref())?;
@@ -343,12 +368,12 @@ impl Pipeline {
         } else {
             (steady, None)
         };
+        let landing = land_stage(&mut anim, config, path.as_ref())?;
         // Savings (e, ξ) in the take-off frames too.
         crate::aero::fill_frame_savings(&mut anim, &config.steady_options()?.aero);
         let course = course_stage(&mut anim, path.as_ref(), config)?;
         fit_shot(&mut anim, config)?;
-        wingbeat::rest::stand_on_ground(&mut anim, config.wingbeat.species);
-        wingbeat::assign_phases(&mut anim, &config.wingbeat)?;
+        finish(&mut anim, config)?;
         Ok((
             anim,
             Report {
@@ -358,6 +383,7 @@ impl Pipeline {
                 initiate: initiate_report,
                 course,
                 skein: None,
+                landing,
             },
         ))
     }
@@ -469,7 +495,8 @@ pub fn course_stage(
     path: Option<&PathPoints>,
     config: &Config,
 ) -> Result<CourseReport> {
-    let takeoff_altitude = anim.stage("initiation").is_some().then(|| match path {
+    let grounded = anim.stage("initiation").is_some() || anim.stage("landing").is_some();
+    let takeoff_altitude = grounded.then(|| match path {
         Some(p) => p.points[0][2],
         None => config.initiate.cruise_altitude,
     });
@@ -483,11 +510,15 @@ pub fn course_stage(
 
 /// Cuts `anim` to the shot's length when [`Config::shot_seconds`] is set: exactly
 /// round(shot_seconds · fps) frames, the steady flight taking what the take-off leaves; an error
-/// names `shot_seconds` when the take-off alone is as long as the shot.
+/// names `shot_seconds` when the take-off alone is as long as the shot. A landing has already
+/// been fitted into the shot ([`land_stage`]).
 pub fn fit_shot(anim: &mut Animation, config: &Config) -> Result<()> {
     let Some(shot) = config.shot_seconds else {
         return Ok(());
     };
+    if anim.stage("landing").is_some() {
+        return Ok(());
+    }
     let frames = (shot * anim.fps).round() as usize;
     let takeoff = anim
         .stages
@@ -510,6 +541,168 @@ pub fn fit_shot(anim: &mut Animation, config: &Config) -> Result<()> {
     Ok(())
 }
 
+/// The last steps of every run, after the course and the shot's length: birds on the ground
+/// stand or sit, birds in their flare pitch up, and the wingbeats.
+pub fn finish(anim: &mut Animation, config: &Config) -> Result<()> {
+    wingbeat::rest::stand_on_ground(anim, config.wingbeat.species);
+    landing::flare_pitch(anim, landing::FLARE_PITCH);
+    wingbeat::assign_phases(anim, &config.wingbeat)
+}
+
+/// The config whose steady flight is long enough for a landing at the end of an open path: its
+/// `seconds` at least the path's length at cruise speed plus a margin (the landing then cuts the
+/// flight where it must start, [`land_stage`]). Any other config as it is.
+pub fn landing_config(config: &Config, path: Option<&PathPoints>) -> Config {
+    let mut c = config.clone();
+    if let (true, Some(p), None) = (config.land, path, config.shot_seconds) {
+        if !p.closed && config.steady.speed > 0.0 {
+            let dense = crate::course::spline::spline_points(&p.points, false);
+            let len: f64 = dense
+                .windows(2)
+                .map(|w| crate::course::file::dist(w[0], w[1]))
+                .sum();
+            let need = len / config.steady.speed + LANDING_MARGIN_S;
+            c.seconds = Some(c.seconds.unwrap_or(0.0).max(need));
+        }
+    }
+    c
+}
+
+/// Seconds of steady flight added beyond an open path's length at cruise speed, so that the
+/// flight reaches the place where its landing must start.
+const LANDING_MARGIN_S: f64 = 3.0;
+
+/// The course-frame cruise altitude of `anim`'s flight: the path's first point, the take-off's
+/// cruise altitude, or for a steady flight alone `course.cruise_altitude` (default: the
+/// take-off's default cruise altitude).
+fn course_altitude(config: &Config, path: Option<&PathPoints>, takeoff: bool) -> f64 {
+    match path {
+        Some(p) => p.points[0][2],
+        None if takeoff => config.initiate.cruise_altitude,
+        None => config
+            .course
+            .cruise_altitude
+            .unwrap_or(InitiateOptions::default().cruise_altitude),
+    }
+}
+
+/// The landing stage, when [`Config::land`]: appends a `landing` stage to `anim` (course frame,
+/// before [`course_stage`]). A steady flight alone is first raised to its cruise altitude. On an
+/// open path the flight is cut where the landing must start for the flock's front to come to
+/// rest at the path's end; with [`Config::shot_seconds`] the steady flight is cut so that the
+/// landing ends the shot.
+pub fn land_stage(
+    anim: &mut Animation,
+    config: &Config,
+    path: Option<&PathPoints>,
+) -> Result<Option<LandingStats>> {
+    if !config.land {
+        return Ok(None);
+    }
+    config.landing.validate()?;
+    let takeoff = anim.stage("initiation").is_some();
+    if let Some(p) = path {
+        let origin = config.course.path.clone().unwrap_or_default();
+        crate::course::takeoff_altitude(p, &origin)?;
+    }
+    let altitude = course_altitude(config, path, takeoff);
+    if !takeoff {
+        for f in &mut anim.frames {
+            for z in &mut f.z {
+                *z += altitude;
+            }
+        }
+    }
+    let speed = config.steady.speed;
+    let world_height = match path {
+        Some(p) if !p.closed => p.points.last().map_or(altitude, |q| q[2]),
+        _ => altitude,
+    }
+    .max(1.0);
+    let site = landing::Site {
+        speed,
+        altitude,
+        world_height,
+    };
+    let fps = anim.fps;
+    match (path, config.shot_seconds) {
+        (Some(p), _) if !p.closed => {
+            let flight = crate::course::Flight {
+                speed,
+                takeoff_altitude: Some(altitude),
+                looped: false,
+            };
+            let length =
+                crate::course::apply(&mut anim.clone(), Some(p), &config.course, flight)?.length;
+            let s0 = crate::course::start_along(anim, takeoff);
+            let front = |f: &crate::animation::Frame| f.y.iter().copied().fold(f64::MIN, f64::max);
+            // The landing's reach depends a little on the birds' state where it starts: find
+            // the start frame, then refine it from the reach planned there.
+            let mut reach = landing::front_distance(anim, &config.landing, &site)?;
+            let mut target = s0 + length - reach - speed / fps;
+            let mut k = anim.frames.iter().rposition(|f| front(f) <= target);
+            for _ in 0..3 {
+                let Some(at) = k else { break };
+                reach =
+                    landing::front_distance_from(anim, &anim.frames[at], &config.landing, &site)?;
+                target = s0 + length - reach - speed / fps;
+                k = anim.frames.iter().rposition(|f| front(f) <= target);
+            }
+            let first_steady = anim.stage("steady").map_or(0, |s| s.start);
+            let origin = config.course.path.clone().unwrap_or_default();
+            let last = anim.frames.last().map_or(f64::MIN, front);
+            match k {
+                Some(k) if k >= first_steady && k + 1 < anim.frames.len() => {
+                    anim.truncate(k + 1)
+                }
+                Some(k) if k + 1 == anim.frames.len() && last + speed / fps < target => {
+                    return Err(Error::format(
+                        &origin,
+                        format!(
+                            "the flight ends {:.0} wingspans before it must start landing to come to rest at the path's end; make the steady flight longer or the path shorter",
+                            target - last
+                        ),
+                    ));
+                }
+                Some(k) if k >= first_steady => {}
+                _ => {
+                    return Err(Error::format(
+                        &origin,
+                        format!(
+                            "the path ({length:.0} wingspans) is too short to take off, reach the formation and land ({reach:.0} wingspans from the start of the landing to rest); make it longer"
+                        ),
+                    ))
+                }
+            }
+            landing::land(anim, &config.landing, &site, None).map(Some)
+        }
+        (_, Some(shot)) => {
+            let total = (shot * fps).round() as usize;
+            // The landing's own length, planned from the end of the flight as it is; the
+            // flight is cut so that the landing ends the shot.
+            let mut probe = anim.clone();
+            let stats = landing::land(&mut probe, &config.landing, &site, None)?;
+            let need =
+                ((stats.seconds + config.landing.rest_seconds.min(0.5)) * fps).ceil() as usize + 1;
+            let first_steady = anim.stage("steady").map_or(0, |s| s.start);
+            let keep = total.saturating_sub(need);
+            if keep <= first_steady {
+                return Err(Error::parameter(
+                    "shot_seconds",
+                    format!(
+                        "{shot} s is shorter than the take-off ({:.1} s) and the landing ({:.1} s); give a longer shot",
+                        first_steady as f64 / fps,
+                        need as f64 / fps
+                    ),
+                ));
+            }
+            anim.truncate(keep);
+            landing::land(anim, &config.landing, &site, Some(total)).map(Some)
+        }
+        _ => landing::land(anim, &config.landing, &site, None).map(Some),
+    }
+}
+
 /// The whole run of a flock of several formations of `sizes` birds: steady flights, take-offs
 /// (when `config.initiation`), arrangement, savings and wingbeats.
 fn flock_run(
@@ -520,7 +713,8 @@ fn flock_run(
     path: Option<&PathPoints>,
     progress: &dyn Progress,
 ) -> Result<(Animation, Report)> {
-    let steady = config.steady_options()?;
+    let long = landing_config(config, path);
+    let steady = long.steady_options()?;
     let initiate = config
         .initiation
         .then(|| takeoff_config(config, path)?.initiate_options())
@@ -536,10 +730,10 @@ fn flock_run(
         },
         progress,
     )?;
+    let landing = land_stage(&mut anim, config, path)?;
     let course = course_stage(&mut anim, path, config)?;
     fit_shot(&mut anim, config)?;
-    wingbeat::rest::stand_on_ground(&mut anim, config.wingbeat.species);
-    wingbeat::assign_phases(&mut anim, &config.wingbeat)?;
+    finish(&mut anim, config)?;
     let first = report
         .formations
         .first()
@@ -554,6 +748,7 @@ fn flock_run(
             initiate: skein::flock_stats(&report),
             course,
             skein: Some(report),
+            landing,
         },
     ))
 }

@@ -21,6 +21,7 @@ const SWITCHES: &[&str] = &[
     "--loop",
     "--strict",
     "--pretty",
+    "--land",
 ];
 
 /// The flags `formation ARGS --help` lists.
@@ -110,6 +111,7 @@ fn commands() -> Vec<Command> {
     let course: Vec<(&str, &str, Option<String>)> = vec![
         ("--path", "OUT/no-path.json", Some("no-path.json".into())),
         ("--path-units", "feet", None),
+        ("--land-on", "lava", None),
     ];
     let wingbeat: Vec<(&str, &str, Option<String>)> = vec![
         ("--species", "dodo", None),

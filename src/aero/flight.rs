@@ -33,6 +33,11 @@ pub const INDUCED_FACTOR: f64 = 1.2;
 /// Pennycuick's body drag coefficient C_Db for a bird's body (2008, from wind-tunnel wakes).
 pub const BODY_DRAG_COEF: f64 = 0.1;
 
+/// Ratio of a large bird's largest sustained flight power to its power at the minimum-power
+/// speed, for the power-limited climb ([`PowerCurve::climb_rate`]); our choice (large birds have
+/// a small power margin, which is why they run to take off), see docs/initiation.md.
+pub const CLIMB_POWER_MARGIN: f64 = 1.6;
+
 /// A bird's size: what the power curve needs.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Morphology {
@@ -211,6 +216,19 @@ impl PowerCurve {
         p.induced / p.total()
     }
 
+    /// Power-limited climb rate at airspeed `v` (m/s), m/s: the excess of the available power
+    /// over the power needed for level flight, divided by the weight,
+    /// ```math
+    /// w = \frac{P_\text{avail} - P(v)}{m g}, \qquad P_\text{avail} = M \, P(V_\text{mp}),
+    /// ```
+    /// with M = `margin`, the ratio of the largest sustained power to the power at the
+    /// minimum-power speed (M = [`CLIMB_POWER_MARGIN`] is our choice; docs/initiation.md). 0 when
+    /// no power is left.
+    pub fn climb_rate(&self, v: f64, margin: f64) -> f64 {
+        let avail = margin * self.at(self.minimum_power_speed()).total();
+        ((avail - self.at(v).total()) / self.weight()).max(0.0)
+    }
+
     /// The minimum-power speed of the total curve (with profile power constant, the same as
     /// [`PowerCurve::minimum_power_speed`]).
     pub fn cruise_default(&self) -> f64 {
@@ -346,6 +364,25 @@ pub fn validate_speed(v: f64) -> Result<()> {
 
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn the_power_limited_climb_is_slow_for_large_birds_and_zero_without_a_margin() {
+        for (sp, lo, hi) in [
+            (Species::Goose, 0.5, 1.2),
+            (Species::Crane, 0.5, 1.5),
+            (Species::Pelican, 0.3, 1.5),
+        ] {
+            let c = PowerCurve::new(Morphology::of(sp));
+            let v = c.minimum_power_speed();
+            let w = c.climb_rate(v, CLIMB_POWER_MARGIN);
+            assert!((lo..hi).contains(&w), "{sp:?}: {w} m/s");
+            // Faster or slower than V_mp climbs less; no margin, no climb.
+            assert!(c.climb_rate(1.5 * v, CLIMB_POWER_MARGIN) < w);
+            assert!(c.climb_rate(0.6 * v, CLIMB_POWER_MARGIN) < w);
+            assert_eq!(c.climb_rate(v, 1.0), 0.0);
+        }
+    }
+
     use super::*;
 
     #[test]

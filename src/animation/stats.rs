@@ -36,6 +36,8 @@ pub struct AnimationStats {
     pub takeoff_s: Option<f64>,
     /// Length of the `steady` stage, seconds.
     pub steady_s: Option<f64>,
+    /// Length of the `landing` stage, seconds.
+    pub landing_s: Option<f64>,
     /// Mean flock saving (E/N) over the steady frames.
     pub steady_saving: Option<f64>,
     /// `(t, E/N)` at every frame with savings.
@@ -103,6 +105,7 @@ impl AnimationStats {
             formations: leaders.len().max(1),
             takeoff_s: secs("initiation"),
             steady_s: secs("steady"),
+            landing_s: secs("landing"),
             steady_saving: (frames > 0 && anim.stage("steady").is_some())
                 .then(|| flock / frames as f64),
             saving_over_time,

@@ -73,6 +73,8 @@ pub struct AnimateArgs {
     #[command(flatten)]
     pub path: super::course::PathFlags,
     #[command(flatten)]
+    pub land: super::course::LandFlags,
+    #[command(flatten)]
     pub skein: super::steady::SkeinFlags,
     #[command(flatten)]
     pub initiate: InitiateFlags,
@@ -105,6 +107,7 @@ pub fn run(args: AnimateArgs, g: Global) -> Result<()> {
     let takeoff_birds = config.takeoff_birds();
     config.initiate = args.initiate.options(g.seed, takeoff_birds)?;
     config.course = args.path.options();
+    args.land.apply(&mut config);
     if args.no_initiation {
         // Without a take-off the steady flight itself flies at the cruise altitude.
         config.course.cruise_altitude = Some(config.initiate.cruise_altitude);

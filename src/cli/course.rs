@@ -1,11 +1,12 @@
 //! Course flags shared by `steady`, `initiate` and `animate`: the path the flock
 //! follows and its units (the `course` section of the library's `Config`), and the warnings the
-//! course step reports.
+//! course step reports; `--land` and `--land-on`, the landing at the course's end.
 
 use std::path::PathBuf;
 
 use clap::Args;
 use formation::course::{CourseOptions, CourseReport, PathUnits};
+use formation::initiate::landing::Surface;
 
 /// `--path` and `--path-units`.
 #[derive(Debug, Clone, Args)]
@@ -60,4 +61,32 @@ pub fn course_config(
     Option<formation::course::PathPoints>,
 )> {
     formation::pipeline::takeoff_course(flags.options(), steady, origin, opts)
+}
+
+/// `--land` and `--land-on`, shared by `steady`, `initiate` and `animate`.
+#[derive(Debug, Clone, Args)]
+pub struct LandFlags {
+    /// End the flight with a landing: the formation loosens, glides down, flares, touches down
+    /// bird after bird and stops, wings folded (docs/landing.md); with --path, where the path
+    /// ends.
+    #[arg(long)]
+    pub land: bool,
+    /// Where to land: ground (a few running steps, then sitting) or water (the body settles at
+    /// the waterline); implies --land.
+    #[arg(long = "land-on", value_name = "SURFACE", value_parser = parse_surface)]
+    pub land_on: Option<Surface>,
+}
+
+fn parse_surface(s: &str) -> Result<Surface, String> {
+    Surface::parse(s).map_err(|_| format!("unknown surface \"{s}\"; use ground or water"))
+}
+
+impl LandFlags {
+    /// Sets `config.land` and `config.landing` from the flags.
+    pub fn apply(&self, config: &mut formation::pipeline::Config) {
+        config.land = self.land || self.land_on.is_some();
+        if let Some(s) = self.land_on {
+            config.landing.surface = s;
+        }
+    }
 }

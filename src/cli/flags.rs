@@ -110,6 +110,8 @@ pub const FLAGS: &[(&str, &str, &[Cmd])] = &[
         &[Extract, Report, Animate],
     ),
     ("steady.loop", "--loop", STEADY),
+    ("land", "--land", SCENE_COURSE),
+    ("landing.surface", "--land-on", SCENE_COURSE),
     ("course.path", "--path", SCENE_COURSE),
     ("course.units", "--path-units", SCENE_COURSE),
     ("course.cruise_altitude", "--cruise-altitude", STEADY),

@@ -39,6 +39,8 @@ pub struct InitiateArgs {
     #[command(flatten)]
     pub path: super::course::PathFlags,
     #[command(flatten)]
+    pub land: super::course::LandFlags,
+    #[command(flatten)]
     pub wingbeat: super::wingbeat::WingbeatFlags,
     #[command(flatten)]
     pub scene: super::render::SceneArgs,
@@ -270,7 +272,20 @@ pub fn run(args: InitiateArgs, g: Global) -> Result<()> {
     let mut opts = args.initiate.options(g.seed, steady.birds)?;
     // The take-off climbs to the path's first point, then the course step maps the
     // whole flight onto the path.
-    let course = super::course::course_config(&args.path, &steady, &args.steady, &mut opts)?;
+    let mut course = super::course::course_config(&args.path, &steady, &args.steady, &mut opts)?;
+    args.land.apply(&mut course.0);
+    if course.0.land {
+        course.0.landing.validate()?;
+        if steady.looped {
+            return Err(Error::parameter(
+                "land",
+                format!(
+                    "{}: this steady flight is a loop, which cycles for ever and cannot end in a landing; make it without --loop",
+                    args.steady.display()
+                ),
+            ));
+        }
+    }
     let mut rng = formation::rng::stream(g.seed, formation::rng::Stream::Initiate);
     let progress = TermProgress::new(g.quiet);
     let (mut anim, stats) = if steady.formations.is_some() {
@@ -284,6 +299,7 @@ pub fn run(args: InitiateArgs, g: Global) -> Result<()> {
     } else {
         initiate::initiate(&steady, &opts, &mut rng, &progress)?
     };
+    formation::pipeline::land_stage(&mut anim, &course.0, course.1.as_ref())?;
     // Savings (e, ξ) in the take-off frames too.
     let aero = anim
         .savings_model
@@ -294,6 +310,7 @@ pub fn run(args: InitiateArgs, g: Global) -> Result<()> {
     let report = formation::pipeline::course_stage(&mut anim, course.1.as_ref(), &course.0)?;
     super::course::warn(super::flags::Cmd::Initiate, g, &report)?;
     formation::wingbeat::rest::stand_on_ground(&mut anim, wing.species);
+    formation::initiate::landing::flare_pitch(&mut anim, formation::initiate::landing::FLARE_PITCH);
     formation::wingbeat::assign_phases(&mut anim, &wing)?;
     super::check_bird_model(
         super::flags::Cmd::Initiate,

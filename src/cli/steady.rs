@@ -39,6 +39,8 @@ pub struct SteadyArgs {
     pub steady: SteadyFlags,
     #[command(flatten)]
     pub path: super::course::PathFlags,
+    #[command(flatten)]
+    pub land: super::course::LandFlags,
     /// Height of the flight above the ground without a path, wingspans (without it the flight
     /// keeps the course frame's height, ready for `formation initiate`, which climbs to its own
     /// --cruise-altitude and adds this).
@@ -212,7 +214,7 @@ pub fn run(args: SteadyArgs, g: Global) -> Result<()> {
             "give the length of the steady flight: --frames F or --seconds S",
         ));
     }
-    let config = Config {
+    let mut config = Config {
         seed: g.seed,
         seconds: args.seconds,
         steady: SteadyOptions {
@@ -228,9 +230,19 @@ pub fn run(args: SteadyArgs, g: Global) -> Result<()> {
         skein: args.skein.options(),
         ..Config::default()
     };
+    args.land.apply(&mut config);
     config.steady_options()?;
     config.wingbeat.validate()?;
     config.course.validate()?;
+    if config.land {
+        config.landing.validate()?;
+        if config.steady.looped {
+            return Err(Error::parameter(
+                "land",
+                "a loop cycles for ever and cannot end in a landing; give one of --land and --loop",
+            ));
+        }
+    }
     let plan = formation::export::plan_outputs(&args.output)?;
     if let Some(r) = &args.report {
         formation::export::plan_report(r, &plan)?;
@@ -239,10 +251,12 @@ pub fn run(args: SteadyArgs, g: Global) -> Result<()> {
     let params = FormationParams::read(&args.params)?;
     super::warn_params(g, &params)?;
     let progress = TermProgress::new(g.quiet);
-    let (mut anim, outcome) = flock_steady_stage(&params, &config, &progress)?;
+    let long = formation::pipeline::landing_config(&config, path.as_ref());
+    let (mut anim, outcome) = flock_steady_stage(&params, &long, &progress)?;
+    formation::pipeline::land_stage(&mut anim, &config, path.as_ref())?;
     let course = formation::pipeline::course_stage(&mut anim, path.as_ref(), &config)?;
     super::course::warn(super::flags::Cmd::Steady, g, &course)?;
-    formation::wingbeat::assign_phases(&mut anim, &config.wingbeat)?;
+    formation::pipeline::finish(&mut anim, &config)?;
     super::check_bird_model(
         super::flags::Cmd::Steady,
         g,

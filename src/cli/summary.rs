@@ -103,6 +103,9 @@ pub fn animation_text(what: &str, anim: &Animation, params: Option<&FormationPar
     if let Some(t) = s.steady_s {
         parts.push(format!("steady flight {t:.1} s"));
     }
+    if let Some(t) = s.landing_s {
+        parts.push(format!("landing {t:.1} s"));
+    }
     if let Some(e) = s.steady_saving {
         let total = formation::aero::flight::steady_saving_total(anim).map_or(String::new(), |t| {
             format!(" ({:.1} % of total power)", 100.0 * t)

@@ -299,12 +299,7 @@ pub fn apply(
     let f_ref = &anim.frames[steady.start.min(anim.frames.len() - 1)];
     let leader = reference_leader(&anim.leaders(), f_ref);
     let x_ref = f_ref.x[leader];
-    let f0 = &anim.frames[0];
-    let s0 = if flight.takeoff_altitude.is_some() {
-        f0.y.iter().sum::<f64>() / n as f64
-    } else {
-        f0.y[leader]
-    };
+    let s0 = start_along(anim, flight.takeoff_altitude.is_some());
     // The flock's lateral extent and the formation's length (course frame).
     let (mut d_lo, mut d_hi, mut depth) = (0.0f64, 0.0f64, 1.0f64);
     for f in &anim.frames[steady.clone()] {
@@ -446,6 +441,13 @@ pub fn apply(
     }
     let z0 = points.points[0][2];
     let alt = flight.takeoff_altitude;
+    // In a landing the course-frame height maps linearly onto the height of the path above
+    // the ground (the smoothstep of the take-off would not be monotonic for a path that ends
+    // far below where it starts), blended in over the landing's first LANDING_BLEND_S.
+    let landing_t0 = anim
+        .stage("landing")
+        .and_then(|s| anim.frames.get(s.start))
+        .map(|f| f.t);
     let mut s_max = f64::MIN;
     for f in anim.frames.iter_mut() {
         for i in 0..n {
@@ -458,7 +460,12 @@ pub fn apply(
             let z = match alt {
                 Some(a) => {
                     let u = (zc / a).clamp(0.0, 1.0);
-                    zc + u * u * (3.0 - 2.0 * u) * (c.p[2] - z0)
+                    let mut w = u * u * (3.0 - 2.0 * u);
+                    if let Some(t0) = landing_t0 {
+                        let b = ((f.t - t0) / LANDING_BLEND_S).clamp(0.0, 1.0);
+                        w += b * b * (3.0 - 2.0 * b) * (u - w);
+                    }
+                    zc + w * (c.p[2] - z0)
                 }
                 None => c.p[2] + zc,
             };
@@ -506,6 +513,28 @@ pub fn apply(
         flown: course.points(1.0, FLOWN_POINTS),
     });
     Ok(report)
+}
+
+/// Seconds over which a landing's height mapping turns from the take-off's smoothstep to linear.
+const LANDING_BLEND_S: f64 = 1.0;
+
+/// The course-frame along-track position that the path's start is mapped to: the flock's mean
+/// at the first frame when it takes off (or lands) from the ground, else the reference leader's.
+pub fn start_along(anim: &Animation, grounded: bool) -> f64 {
+    let Some(f0) = anim.frames.first() else {
+        return 0.0;
+    };
+    let n = anim.birds.max(1);
+    if grounded {
+        return f0.y.iter().sum::<f64>() / n as f64;
+    }
+    let steady = anim
+        .stage("steady")
+        .map(|s| s.start)
+        .unwrap_or(0)
+        .min(anim.frames.len() - 1);
+    let leader = reference_leader(&anim.leaders(), &anim.frames[steady]);
+    f0.y.get(leader).copied().unwrap_or(0.0)
 }
 
 /// Largest number of points of the recorded flown course ([`PathRecord::flown`]).

@@ -31,6 +31,7 @@
 
 mod handover;
 pub mod hull;
+pub mod landing;
 mod options;
 pub mod perception;
 pub mod sim;

@@ -235,6 +235,7 @@ pub fn footage_savings_with(p: &FormationParams, aero: &AeroOptions) -> Animatio
     AnimationStats {
         formations: 1,
         takeoff_s: None,
+        landing_s: None,
         steady_s: None,
         steady_saving: flock,
         saving_over_time: over_time,

@@ -33,7 +33,7 @@ use crate::rng::{stream, FlockRng};
 
 pub use crate::animation::wing::{Glide, PhaseMode, Species, WingbeatOptions};
 pub use kinematics::{blend_weight, g1, g2, pose, PhaseMap, Stroke, Strokes, Timing};
-pub use rest::FOLDED;
+pub use rest::{FLARE, FOLDED};
 pub use species::SpeciesPreset;
 
 /// Joint angles of one wing (both wings mirror each other), radians.
@@ -546,9 +546,10 @@ fn simulate(anim: &Animation, opts: &WingbeatOptions) -> Run {
             };
         }
         if !fold.is_empty() {
-            // A bird at rest holds its phase (folded wings, no wingbeat).
+            // A bird at rest holds its phase (no wingbeat below the rest speed; the wings fold
+            // from the pose they stopped in).
             for i in 0..n {
-                if fold[k * n + i] >= 1.0 {
+                if fold[k * n + i] >= 1.0 || rest::at_rest(anim, k, i) {
                     rate[i] = 0.0;
                 }
             }
@@ -734,6 +735,8 @@ pub struct Flapper {
     unwrapped: Vec<f64>,
     /// Fold weight per frame and bird (frame-major; empty: never at rest).
     fold: Vec<f64>,
+    /// Flare weight per frame and bird (frame-major; empty: no landing).
+    flare: Vec<f64>,
     /// Root height and bank per frame and bird (frame-major) of a flight that starts on the
     /// ground (empty otherwise): the downstroke is kept off the ground.
     ground: Vec<(f64, f64)>,
@@ -783,6 +786,7 @@ impl Flapper {
                     .collect()
             },
             fold: run.fold,
+            flare: rest::flare_weights(anim),
             nbirds: n,
             nframes: anim.frames.len(),
         }
@@ -820,10 +824,20 @@ impl Flapper {
             (Some(&s), Some(&phi)) => b.pose_at(s, phi),
             _ => return WingPose::EXTENDED,
         };
+        let p = self.flared(p, self.flare.get(k).copied().unwrap_or(0.0));
         let p = self.folded(p, self.fold.get(k).copied().unwrap_or(0.0));
         match self.ground.get(k) {
             Some(&(z, bank)) if z < 1.0 => rest::clear_ground(p, z, bank),
             _ => p,
+        }
+    }
+
+    /// `p` held towards the flare pose by weight `w` (1: [`rest::FLARE`]).
+    fn flared(&self, p: WingPose, w: f64) -> WingPose {
+        if w > 0.0 {
+            p.lerp(&rest::FLARE, w.min(1.0))
+        } else {
+            p
         }
     }
 
@@ -877,7 +891,14 @@ impl Flapper {
             .and_then(|i| self.fold.get(i))
             .copied()
             .unwrap_or(f0);
-        let p = self.folded(b.pose_at(s, s.rem_euclid(TAU)), f0 + w * (f1 - f0));
+        let q0 = self.flare.get(a).copied().unwrap_or(0.0);
+        let q1 = self
+            .index(k + 1, bird)
+            .and_then(|i| self.flare.get(i))
+            .copied()
+            .unwrap_or(q0);
+        let p = self.flared(b.pose_at(s, s.rem_euclid(TAU)), q0 + w * (q1 - q0));
+        let p = self.folded(p, f0 + w * (f1 - f0));
         let g0 = self.ground.get(a).copied();
         let g1 = self
             .index(k + 1, bird)

@@ -62,23 +62,41 @@ pub fn stance(species: Species) -> Stance {
 /// for a bird high up (below 1e-17 wingspans from 10 wingspans up). Run it after the course
 /// (whose pitch comes from the height change, so the body stays level while the bird stands
 /// up) and before the wingbeats. Animations without a take-off are left as they are.
+///
+/// The `landing` stage is treated the same way (the flare ends standing, the running steps slow
+/// to sitting), except on water, where a bird skis on its feet with the root at half its
+/// standing height and floats, root [`crate::animation::landing::FLOAT_HEIGHT`] above the
+/// waterline, once slow.
 pub fn stand_on_ground(anim: &mut Animation, species: Species) {
-    let Some(stage) = anim.stage("initiation").cloned() else {
-        return;
-    };
     let st = stance(species);
     let ws = anim.wingspan_m;
     if !(ws.is_finite() && ws > 0.0) {
         return;
     }
-    let end = stage.end.min(anim.frames.len());
-    for f in &mut anim.frames[stage.start.min(end)..end] {
-        for (z, &v) in f.z.iter_mut().zip(&f.speed) {
-            let u = (v * ws / STAND_UP_SPEED_MS).clamp(0.0, 1.0);
-            let h = st.sit + (st.stand - st.sit) * u * u * (3.0 - 2.0 * u);
-            let lift = h * (-z.max(0.0) / st.stand).exp();
-            if z.is_finite() && lift.is_finite() {
-                *z += lift;
+    let water = anim
+        .landing
+        .as_ref()
+        .is_some_and(|l| l.surface == crate::animation::landing::Surface::Water);
+    for name in ["initiation", "landing"] {
+        let Some(stage) = anim.stage(name).cloned() else {
+            continue;
+        };
+        let float = (name == "landing" && water).then_some(crate::animation::landing::FLOAT_HEIGHT);
+        let end = stage.end.min(anim.frames.len());
+        for f in &mut anim.frames[stage.start.min(end)..end] {
+            for (z, &v) in f.z.iter_mut().zip(&f.speed) {
+                let u = (v * ws / STAND_UP_SPEED_MS).clamp(0.0, 1.0);
+                // On water a bird skis on its feet while fast, body half out of the water,
+                // and floats once slow.
+                let (sit, stand) = match float {
+                    Some(fl) => (fl, 0.5 * st.stand),
+                    None => (st.sit, st.stand),
+                };
+                let h = sit + (stand - sit) * u * u * (3.0 - 2.0 * u);
+                let lift = h * (-z.max(0.0) / st.stand).exp();
+                if z.is_finite() && lift.is_finite() {
+                    *z += lift;
+                }
             }
         }
     }
@@ -146,6 +164,31 @@ pub const FOLDED: WingPose = WingPose {
     spread: 0.75,
     tail_bend: 0.0,
 };
+
+/// The landing flare: wings spread wide and held, raised a little, swept forward, twisted
+/// leading edge up (air brakes at a high angle of attack), tail spread down. Our choice from
+/// photographs of geese and swans landing (docs/landing.md).
+pub const FLARE: WingPose = WingPose {
+    dihedral: 0.2,
+    hand_dihedral: -0.1,
+    sweep: 0.2,
+    arm_twist: 0.35,
+    hand_twist: 0.25,
+    spread: 1.0,
+    tail_bend: -0.35,
+};
+
+/// Flare weight of every bird in every frame (frame-major) from the animation's landing record
+/// ([`crate::animation::landing::LandingRecord::flare_weight`]); empty without a landing.
+pub fn flare_weights(anim: &Animation) -> Vec<f64> {
+    let Some(rec) = anim.landing.as_ref() else {
+        return Vec::new();
+    };
+    anim.frames
+        .iter()
+        .flat_map(|f| (0..anim.birds).map(move |i| rec.flare_weight(i, f.t)))
+        .collect()
+}
 
 impl WingPose {
     /// The pose a fraction `w` of the way from `self` to `other` (every angle linearly).
