@@ -916,14 +916,14 @@ pub fn out_of_memory(bytes: usize) -> ! {
         let output = CURRENT_OUTPUT.try_lock().ok();
         let what = output.as_ref().and_then(|g| g.as_deref());
         let _ = match what {
-            Some(p) => write!(
+            Some(p) => writeln!(
                 w,
-                "error: {}: out of memory: {bytes} more bytes could not be allocated; lower the picture size, the frame rate, the flock or the length, or raise the memory limit; no output written\n",
+                "error: {}: out of memory: {bytes} more bytes could not be allocated; lower the picture size, the frame rate, the flock or the length, or raise the memory limit; no output written",
                 p.display()
             ),
-            None => write!(
+            None => writeln!(
                 w,
-                "error: out of memory: {bytes} more bytes could not be allocated; lower the flock, the length or the picture size, or raise the memory limit; no output written\n"
+                "error: out of memory: {bytes} more bytes could not be allocated; lower the flock, the length or the picture size, or raise the memory limit; no output written"
             ),
         };
         1024 - w.len()

@@ -219,6 +219,9 @@ fn on_the_command_line() {
     assert!(!out.exists());
 }
 
+/// A change to a valid model: what it breaks, the change, and what the refusal must name.
+type Edit = (&'static str, Box<dyn Fn(&mut Value)>, &'static str);
+
 /// Models that break the glTF rules in ways a reader could miss (found by probing): each is
 /// refused with one line naming the accessor, view, joint or extension, before any animation.
 #[test]
@@ -238,7 +241,7 @@ fn models_breaking_the_gltf_rules_are_refused_naming_the_part() {
             .position(|n| n["name"] == name)
             .unwrap()
     };
-    let edits: Vec<(&str, Box<dyn Fn(&mut Value)>, &str)> = vec![
+    let edits: Vec<Edit> = vec![
         (
             "a required extension",
             Box::new(|j| {

@@ -537,21 +537,14 @@ pub fn start_simulation(
             .fov_per_eye;
         *field = field.max(target.required_field(FIELD_MARGIN));
     }
-    if matches!(opts.start, Start::Ground(_)) {
-        let reach = reachable_altitude(params.climb_rate, params.vertical_accel, opts.max_time);
-        if opts.cruise_altitude > reach {
-            return Err(Error::parameter(
-                "initiate.cruise_altitude",
-                format!(
-                    "{} wingspans cannot be reached: climbing at most {:.3} wingspans/s (initiate.climb_rate, times the take-off's drive {:.2}) the birds reach at most about {:.0} wingspans within the time limit of {} s (initiate.max_time)",
-                    opts.cruise_altitude,
-                    params.climb_rate,
-                    plan.drive,
-                    reach.floor(),
-                    opts.max_time
-                ),
-            ));
-        }
+    if opts.hold >= opts.max_time {
+        return Err(Error::parameter(
+            "initiate.hold",
+            format!(
+                "{} s: the flock must hold its formation for longer than the whole time limit of {} s (initiate.max_time); give a shorter hold or a longer limit",
+                opts.hold, opts.max_time
+            ),
+        ));
     }
     let alt = opts.cruise_altitude;
     let (pos, z, heading, speed, depart) = match &opts.start {
@@ -560,10 +553,11 @@ pub fn start_simulation(
             // The flock sits for `ground_seconds` before the first run starts.
             let first = depart.iter().copied().fold(f64::INFINITY, f64::min);
             let first = if first.is_finite() { first } else { 0.0 };
-            let depart = depart
+            let depart: Vec<f64> = depart
                 .iter()
                 .map(|d| d - first + opts.ground_seconds)
                 .collect();
+            check_climb(opts, &params, plan.drive, &depart)?;
             (pos, vec![0.0; n], heading, vec![0.0; n], depart)
         }
         Start::Random(region) => {
@@ -600,6 +594,50 @@ pub fn start_simulation(
         sim.separate_heights(AIR_HEIGHT_BAND, rng);
     }
     Ok((sim, plan))
+}
+
+/// Share of the climb the time limit allows that a take-off may need: the rest is left for the
+/// run-up, the levelling off and settling into the slots (our choice; a cruise altitude just
+/// under the bare climb limit ran the whole take-off and ended without converging).
+const CLIMB_BUDGET_SHARE: f64 = 0.9;
+
+/// Refuses a ground take-off that cannot reach the cruise altitude and then hold the formation
+/// for `initiate.hold` within the time limit: the last bird leaves the ground at the latest of
+/// `depart`, climbs at most `params.climb_rate` and must be level, in its slot, `hold` seconds
+/// before the limit. Decided before the simulation, so an impossible request costs nothing.
+fn check_climb(
+    opts: &InitiateOptions,
+    params: &StepParams,
+    drive: f64,
+    depart: &[f64],
+) -> Result<()> {
+    let last = depart.iter().copied().fold(0.0f64, f64::max);
+    let budget = opts.max_time - opts.hold - last;
+    if budget <= 0.0 {
+        return Err(Error::parameter(
+            "initiate.hold",
+            format!(
+                "{} s: the last bird starts its take-off run {last:.1} s in, so holding the formation that long leaves no time to climb and form up within the time limit of {} s (initiate.max_time); give a shorter hold or a longer limit",
+                opts.hold, opts.max_time
+            ),
+        ));
+    }
+    let reach =
+        CLIMB_BUDGET_SHARE * reachable_altitude(params.climb_rate, params.vertical_accel, budget);
+    if opts.cruise_altitude > reach {
+        return Err(Error::parameter(
+            "initiate.cruise_altitude",
+            format!(
+                "{} wingspans cannot be reached: climbing at most {:.3} wingspans/s (initiate.climb_rate, times the take-off's drive {drive:.2}) from the last take-off run at {last:.1} s, and holding the formation for {} s (initiate.hold), the birds reach at most about {:.0} wingspans within the time limit of {} s (initiate.max_time)",
+                opts.cruise_altitude,
+                params.climb_rate,
+                opts.hold,
+                reach.floor(),
+                opts.max_time
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// Refuses a start file with a bird farther from the flock's middle (the median position) than
