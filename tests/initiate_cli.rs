@@ -139,7 +139,7 @@ fn bad_input_is_exit_2_with_one_line() {
         ),
         (
             vec!["initiate", s, "-o", o, "--cruise-altitude", "10000"],
-            "at most about 746 wingspans",
+            "at most about 665 wingspans",
         ),
         (
             vec![
@@ -152,7 +152,7 @@ fn bad_input_is_exit_2_with_one_line() {
                 "--max-seconds",
                 "100",
             ],
-            "at most about 246 wingspans",
+            "at most about 215 wingspans",
         ),
         (
             vec![
