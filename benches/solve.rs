@@ -46,6 +46,22 @@ fn bench_solve(c: &mut Criterion) {
         group.bench_with_input(BenchmarkId::new("perturbed_start", n), &n, |b, _| {
             b.iter(|| solve(black_box(&x), black_box(&xi), Some(&guess), &opts).unwrap())
         });
+        // The same problem with the 3-D wake (the birds in one plane: the same numbers through
+        // the 3-D model's code).
+        if n >= 1000 {
+            let opts3 = SolveOptions {
+                aero: aero::AeroOptions {
+                    wake: aero::Wake::ThreeD,
+                    ..aero::AeroOptions::default()
+                },
+                ..SolveOptions::default()
+            };
+            let check = solve(&x, &xi, Some(&guess), &opts3).unwrap();
+            assert!(check.converged, "N = {n}, 3-D wake: did not converge");
+            group.bench_with_input(BenchmarkId::new("perturbed_start_wake3d", n), &n, |b, _| {
+                b.iter(|| solve(black_box(&x), black_box(&xi), Some(&guess), &opts3).unwrap())
+            });
+        }
         if n <= 1000 {
             group.bench_with_input(BenchmarkId::new("neutral_start", n), &n, |b, _| {
                 b.iter(|| solve(black_box(&x), black_box(&xi), None, &opts).unwrap())

@@ -103,12 +103,13 @@ fn start_words_are_read_in_any_case_and_misspelt_ones_refused() {
         "--start",
         "AIR",
         "--max-seconds",
-        "1",
+        "2",
         "-q",
         "-o",
         s(&dir.join("i.json")),
     ]);
-    // Read as the air start: the take-off is flown (a second of flight does not converge).
+    // Read as the air start: the take-off is flown (two seconds of flight do not converge; one
+    // second is refused up front, as no longer than the one-second hold).
     assert_eq!(
         o.status.code(),
         Some(1),

@@ -429,13 +429,13 @@ fn the_follow_camera_frames_the_whole_sky_of_formations() {
 
 #[test]
 fn a_take_off_that_never_converges_is_flown_again_then_reported() {
-    // 3 s of flight are too short for any formation to form: every formation tries
+    // 6 s of flight are too short for any formation to form: every formation tries
     // TAKEOFF_TRIES take-offs (fresh steady flights and starts), then the run fails naming one.
     let mut c = config(60, 0, 2.0);
-    c.initiate.max_time = 3.0;
-    // Low enough to climb to in 3 s (a cruise altitude out of the climb's reach within the time
-    // limit is refused up front, exit 2).
-    c.initiate.cruise_altitude = 2.0;
+    c.initiate.max_time = 6.0;
+    // Low enough to climb to in the time the limit leaves after the hold and the last run (a
+    // cruise altitude out of the climb's reach is refused up front, exit 2).
+    c.initiate.cruise_altitude = 1.0;
     let e = Pipeline::from_path(example("barnacle_geese_v.json"))
         .run(&c)
         .unwrap_err();

@@ -603,6 +603,12 @@ fn animation_sections(page: &mut Page, a: &Animation, s: &Subject<'_>) -> Result
         ]);
     }
     page.table(&["quantity", "value"], &rows);
+    if a.birds > crate::report::BAND_MAX_BIRDS {
+        page.p(&format!(
+            "The saving's sensitivity to the model, wake and vortex core is left out for flocks of more than {} birds: each choice sums over every pair of birds.",
+            crate::report::BAND_MAX_BIRDS
+        ));
+    }
     band_section(
         page,
         "saving-band",

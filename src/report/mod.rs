@@ -49,6 +49,10 @@ pub const BAND_FRAMES: usize = 24;
 /// about 20 µs each: a 60-bird band takes a few seconds).
 pub const BAND_LIFTING_LINE_BIRDS: usize = 60;
 
+/// Flocks of more birds get no band at all: each of its options sums over every pair of birds
+/// (a 100 000-bird sky took minutes), and the main saving, computed once, stands alone.
+pub const BAND_MAX_BIRDS: usize = 2000;
+
 /// One entry of the saving's sensitivity band: a model, wake and core, and the flock's mean
 /// saving (fraction of induced power) with them.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -117,7 +121,7 @@ pub fn footage_band(p: &FormationParams) -> Vec<BandEntry> {
 
 /// An animation's flock saving in steady flight (all frames without a steady stage) with every
 /// option of [`band_options`], on at most [`BAND_FRAMES`] evenly spaced frames (fewer, down to 3,
-/// for flocks of more than 200 birds), each evaluated
+/// for flocks of more than 200 birds; none above [`BAND_MAX_BIRDS`]), each evaluated
 /// in the formation frame of the leader's heading as [`crate::aero::fill_frame_savings`] does.
 pub fn animation_band(a: &Animation) -> Vec<BandEntry> {
     let range = a
@@ -125,7 +129,7 @@ pub fn animation_band(a: &Animation) -> Vec<BandEntry> {
         .map(|s| s.start..s.end.min(a.frames.len()))
         .unwrap_or(0..a.frames.len());
     let len = range.end.saturating_sub(range.start);
-    if len == 0 || a.birds < 2 {
+    if len == 0 || a.birds < 2 || a.birds > BAND_MAX_BIRDS {
         return Vec::new();
     }
     // Big flocks: fewer frames (the sums are O(N²) per frame), at least 3.
