@@ -293,21 +293,8 @@ impl AeroOptions {
                 "height is not a finite number",
             ));
         }
-        if self.model == super::AeroModel::Lissaman {
-            self.validate()?;
-            if x.len() < 2 {
-                return Err(Error::parameter(
-                    "birds",
-                    format!("{} bird(s) given, at least 2 needed", x.len()),
-                ));
-            }
-            self.check_shape(x, y)?;
-            let e = self.power_lenient_3d(x, y, z);
-            let total: f64 = e.iter().sum();
-            let xi = e.iter().map(|v| v / total).collect();
-            return Ok(PowerReduction { e, xi, total });
-        }
-        if self.wake == Wake::Planar {
+        let lissaman = self.model == super::AeroModel::Lissaman;
+        if !lissaman && self.wake == Wake::Planar {
             return self.power_reduction(x, y);
         }
         self.validate()?;
@@ -318,7 +305,11 @@ impl AeroOptions {
             ));
         }
         self.check_shape(x, y)?;
-        let e = self.power_unchecked_3d(x, y, z);
+        let e = if lissaman {
+            self.power_lenient_3d(x, y, z)
+        } else {
+            self.power_unchecked_3d(x, y, z)
+        };
         let total: f64 = e.iter().sum();
         let xi = e.iter().map(|v| v / total).collect();
         Ok(PowerReduction { e, xi, total })

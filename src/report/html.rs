@@ -172,20 +172,22 @@ fn intervals_svg(rows: &[Bar]) -> String {
     out
 }
 
+/// The least and the largest flock saving of the band's entries.
+fn band_range(entries: &[crate::report::BandEntry]) -> (f64, f64) {
+    entries
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), e| {
+            (lo.min(e.saving), hi.max(e.saving))
+        })
+}
+
 /// The saving's sensitivity band: one dot per model, wake and core on a common axis (percent of
 /// induced power), the band from the least to the largest as an error bar on top, and the
 /// number the page reports (`main`) marked.
 fn band_svg(entries: &[crate::report::BandEntry], main: Option<f64>) -> String {
     let (w, row_h, left, right) = (760.0, 20.0, 250.0, 730.0);
     let h = 70.0 + row_h * entries.len() as f64;
-    let lo = entries
-        .iter()
-        .map(|e| e.saving)
-        .fold(f64::INFINITY, f64::min);
-    let hi = entries
-        .iter()
-        .map(|e| e.saving)
-        .fold(f64::NEG_INFINITY, f64::max);
+    let (lo, hi) = band_range(entries);
     let a = lo.min(0.0);
     let b = (hi.max(main.unwrap_or(hi)) * 1.1).max(a + 0.01);
     let px = |v: f64| left + (right - left) * (v - a) / (b - a);
@@ -255,14 +257,7 @@ fn band_section(
     if entries.is_empty() {
         return;
     }
-    let lo = entries
-        .iter()
-        .map(|e| e.saving)
-        .fold(f64::INFINITY, f64::min);
-    let hi = entries
-        .iter()
-        .map(|e| e.saving)
-        .fold(f64::NEG_INFINITY, f64::max);
+    let (lo, hi) = band_range(entries);
     page.p(&format!(
         "Sensitivity of the flock saving to modelling choices no measurement fixes ({what}): {} to {} of induced power over Hummel's model at vortex cores of 0.02 to 0.32 wingspans{}{}.",
         pct(lo),
