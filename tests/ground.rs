@@ -1,44 +1,20 @@
 //! Birds on the ground (take-off): at rest they sit, wings folded, not flapping; the run starts
 //! the wingbeat; no part of the built-in bird goes below the ground in any frame.
 
+mod support;
+
 use std::path::Path;
 
 use formation::animation::Animation;
-use formation::export::bird::{self, BirdAsset, JOINTS, PARENT};
+use formation::export::bird::{self, BirdAsset};
 use formation::pipeline::{Config, Pipeline};
 use formation::wingbeat::rest::{stance, REST_SPEED_MS};
 use formation::wingbeat::{self, Flapper, Species, WingPose};
 use glam::{Quat, Vec3};
-
-/// World positions (bird frame of the export: +Y up) of the built-in bird's vertices for a pose,
-/// root at `root` with rotation `rot`, bank `bank`.
-fn posed(asset: &BirdAsset, pose: &WingPose, bank: f32, root: Vec3, rot: Quat) -> Vec<Vec3> {
-    let q = bird::joint_rotations(pose, bank);
-    let skel = &asset.skeleton;
-    let mut g = [Quat::IDENTITY; 7];
-    let mut t = [Vec3::ZERO; 7];
-    let mut global = [(Quat::IDENTITY, Vec3::ZERO); 7];
-    for j in 0..JOINTS.len() {
-        match PARENT[j] {
-            None => {
-                g[j] = rot * q[j];
-                t[j] = root + rot * skel.bind_pos[j];
-            }
-            Some(p) => {
-                g[j] = g[p] * q[j];
-                t[j] = t[p] + g[p] * (skel.bind_pos[j] - skel.bind_pos[p]);
-            }
-        }
-        global[j] = (g[j] * skel.bind_rot[j], t[j]);
-    }
-    asset.mesh.posed(skel, &global)
-}
+use support::rig::lowest_vertex;
 
 fn lowest(asset: &BirdAsset, pose: &WingPose) -> f32 {
-    posed(asset, pose, 0.0, Vec3::ZERO, Quat::IDENTITY)
-        .iter()
-        .map(|p| p.y)
-        .fold(f32::INFINITY, f32::min)
+    lowest_vertex(asset, pose, 0.0, Vec3::ZERO, Quat::IDENTITY)
 }
 
 #[test]
@@ -131,10 +107,7 @@ fn check_on_the_rig(anim: &Animation, species: Species) -> f32 {
             if root.y > 0.7 {
                 continue; // every pose fits in a sphere of 0.6 wingspans
             }
-            let low = posed(&asset, &pose, flight.bank[k], root, flight.yaw[k])
-                .iter()
-                .map(|p| p.y)
-                .fold(f32::INFINITY, f32::min);
+            let low = lowest_vertex(&asset, &pose, flight.bank[k], root, flight.yaw[k]);
             assert!(
                 low >= -1e-4,
                 "bird {b} frame {k}: a vertex {low} wingspans under the ground"

@@ -9,36 +9,13 @@ mod support;
 use std::path::Path;
 
 use formation::animation::Animation;
-use formation::export::bird::{self, BirdAsset, JOINTS, PARENT};
+use formation::export::bird::{self, BirdAsset};
 use formation::initiate::landing::{Surface, FLOAT_HEIGHT};
 use formation::pipeline::{Config, Pipeline};
 use formation::wingbeat::rest::{stance, REST_SPEED_MS};
 use formation::wingbeat::{self, Flapper, Species, WingPose};
-use glam::{Quat, Vec3};
+use support::rig::lowest_vertex;
 use support::{bin, example_arg, scratch};
-
-/// World positions (bird frame of the export: +Y up) of the built-in bird's vertices for a pose.
-fn posed(asset: &BirdAsset, pose: &WingPose, bank: f32, root: Vec3, rot: Quat) -> Vec<Vec3> {
-    let q = bird::joint_rotations(pose, bank);
-    let skel = &asset.skeleton;
-    let mut g = [Quat::IDENTITY; 7];
-    let mut t = [Vec3::ZERO; 7];
-    let mut global = [(Quat::IDENTITY, Vec3::ZERO); 7];
-    for j in 0..JOINTS.len() {
-        match PARENT[j] {
-            None => {
-                g[j] = rot * q[j];
-                t[j] = root + rot * skel.bind_pos[j];
-            }
-            Some(p) => {
-                g[j] = g[p] * q[j];
-                t[j] = t[p] + g[p] * (skel.bind_pos[j] - skel.bind_pos[p]);
-            }
-        }
-        global[j] = (g[j] * skel.bind_rot[j], t[j]);
-    }
-    asset.mesh.posed(skel, &global)
-}
 
 fn landing(birds: usize, seed: u64, fps: f64, surface: Surface, takeoff: bool) -> Animation {
     let mut c = Config {
@@ -115,10 +92,7 @@ fn check_on_the_rig(anim: &Animation, species: Species) -> f64 {
             if root.y > 0.7 {
                 continue; // every pose fits in a sphere of 0.6 wingspans
             }
-            let low = posed(&asset, &pose, flight.bank[k], root, flight.yaw[k])
-                .iter()
-                .map(|p| p.y)
-                .fold(f32::INFINITY, f32::min);
+            let low = lowest_vertex(&asset, &pose, flight.bank[k], root, flight.yaw[k]);
             // On water the body floats: its lower part (the body's depth, about 0.1 wingspans)
             // is under the waterline, and the tail touches it in the flare.
             let floor = if water { -0.1 } else { -1e-4 };
