@@ -9,10 +9,11 @@ use formation::export::gltf::{glb_bytes, glb_bytes_with, SceneOptions};
 use formation::export::synthetic::{synthetic_flock, SyntheticParams};
 use formation::wingbeat::{assign_phases, Species, WingbeatOptions};
 use formation::Animation;
-use serde_json::{json, Value};
+use serde_json::json;
 
 mod support;
 
+use support::glb::{join, json};
 use support::scratch;
 
 fn flock() -> Animation {
@@ -25,30 +26,6 @@ fn flock() -> Animation {
     let mut a = synthetic_flock(&mut formation::rng::seeded(3), &p);
     assign_phases(&mut a, &WingbeatOptions::default()).unwrap();
     a
-}
-
-/// A minimal GLB: `gltf` JSON and binary chunk.
-fn glb(gltf: &Value, bin: &[u8]) -> Vec<u8> {
-    let mut j = serde_json::to_vec(gltf).unwrap();
-    while j.len() % 4 != 0 {
-        j.push(b' ');
-    }
-    let mut b = bin.to_vec();
-    while b.len() % 4 != 0 {
-        b.push(0);
-    }
-    let total = 12 + 8 + j.len() + 8 + b.len();
-    let mut out = Vec::new();
-    out.extend_from_slice(b"glTF");
-    out.extend_from_slice(&2u32.to_le_bytes());
-    out.extend_from_slice(&(total as u32).to_le_bytes());
-    out.extend_from_slice(&(j.len() as u32).to_le_bytes());
-    out.extend_from_slice(b"JSON");
-    out.extend_from_slice(&j);
-    out.extend_from_slice(&(b.len() as u32).to_le_bytes());
-    out.extend_from_slice(b"BIN\0");
-    out.extend_from_slice(&b);
-    out
 }
 
 /// A static "bird" of `n` vertices (a fan of triangles) 4 units across X and 1 along Z, under a
@@ -64,7 +41,7 @@ fn static_bird(n: usize) -> Vec<u8> {
     let ioff = bin.len();
     bin.extend(idx.iter().flat_map(|v| v.to_le_bytes()));
     let (lo, hi) = ([-2.0, -0.1, -0.5], [2.0, 0.1, 0.5]);
-    glb(
+    join(
         &json!({
             "asset": {"version": "2.0"},
             "scene": 0,
@@ -86,11 +63,6 @@ fn static_bird(n: usize) -> Vec<u8> {
     )
 }
 
-fn parse(bytes: &[u8]) -> Value {
-    let jlen = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
-    serde_json::from_slice(&bytes[20..20 + jlen]).unwrap()
-}
-
 #[test]
 fn a_static_model_is_scaled_to_the_wingspan_and_bound_to_the_body() {
     let d = scratch("static");
@@ -109,7 +81,7 @@ fn a_static_model_is_scaled_to_the_wingspan_and_bound_to_the_body() {
         ..SceneOptions::default()
     };
     let bytes = glb_bytes_with(&anim, 1.5, &opts).unwrap();
-    let g = parse(&bytes);
+    let g = json(&bytes);
     let pos = &g["accessors"][g["meshes"][0]["primitives"][0]["attributes"]["POSITION"]
         .as_u64()
         .unwrap() as usize];
@@ -152,8 +124,8 @@ fn a_skinned_model_with_the_convention_flaps_like_the_built_in_bird() {
         assets: vec![asset],
         ..SceneOptions::default()
     };
-    let theirs = parse(&glb_bytes_with(&anim, 1.5, &opts).unwrap());
-    let ours = parse(&glb_bytes(&anim, 1.5).unwrap());
+    let theirs = json(&glb_bytes_with(&anim, 1.5, &opts).unwrap());
+    let ours = json(&glb_bytes(&anim, 1.5).unwrap());
     // Same channels (wing and tail joints included) as the built-in bird.
     for (a, b) in theirs["animations"]
         .as_array()
@@ -190,7 +162,7 @@ fn bad_models_are_refused_with_the_reason() {
     refused(&p, "not a glTF binary");
     std::fs::write(
         &p,
-        glb(
+        join(
             &json!({"asset": {"version": "2.0"}, "nodes": [{"name": "empty"}]}),
             &[],
         ),

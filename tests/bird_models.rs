@@ -14,30 +14,12 @@ use formation::wingbeat::Species;
 use formation::Animation;
 use serde_json::{json, Value};
 use std::path::Path;
+use support::glb::{join, json};
 use support::{bin, code, data, s, scratch, stderr};
 
 fn flock() -> Animation {
     let text = std::fs::read_to_string(data("flock_small.json")).unwrap();
     serde_json::from_str(&text).unwrap()
-}
-
-fn glb(gltf: &Value, bin: &[u8]) -> Vec<u8> {
-    let mut j = serde_json::to_vec(gltf).unwrap();
-    while j.len() % 4 != 0 {
-        j.push(b' ');
-    }
-    let total = 12 + 8 + j.len() + 8 + bin.len();
-    let mut out = Vec::new();
-    out.extend_from_slice(b"glTF");
-    out.extend_from_slice(&2u32.to_le_bytes());
-    out.extend_from_slice(&(total as u32).to_le_bytes());
-    out.extend_from_slice(&(j.len() as u32).to_le_bytes());
-    out.extend_from_slice(b"JSON");
-    out.extend_from_slice(&j);
-    out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
-    out.extend_from_slice(b"BIN\0");
-    out.extend_from_slice(bin);
-    out
 }
 
 /// A static "bird": one flat diamond, 4 units across X.
@@ -46,7 +28,7 @@ fn static_bird() -> Vec<u8> {
     let idx: [u32; 6] = [0, 1, 2, 0, 2, 3];
     let mut b: Vec<u8> = pos.iter().flat_map(|v| v.to_le_bytes()).collect();
     b.extend(idx.iter().flat_map(|v| v.to_le_bytes()));
-    glb(
+    join(
         &json!({
             "asset": {"version": "2.0"},
             "scene": 0,
@@ -68,11 +50,6 @@ fn static_bird() -> Vec<u8> {
     )
 }
 
-fn parse(bytes: &[u8]) -> Value {
-    let jlen = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
-    serde_json::from_slice(&bytes[20..20 + jlen]).unwrap()
-}
-
 fn two_models() -> SceneOptions {
     let still = bird_model::parse(Path::new("still.glb"), &static_bird(), Species::Goose).unwrap();
     assert!(!still.wingbeat);
@@ -89,7 +66,7 @@ fn each_bird_wears_its_assigned_model_in_gltf_and_usd() {
     let opts = two_models();
     let bytes = glb_bytes_with(&a, a.wingspan_m, &opts).unwrap();
     assert_eq!(bytes, glb_bytes_with(&a, a.wingspan_m, &opts).unwrap());
-    let j = parse(&bytes);
+    let j = json(&bytes);
     let want = model_assignment(a.seed, a.birds, 2);
     let ones = want.iter().filter(|&&m| m == 1).count();
     assert!(
@@ -194,7 +171,7 @@ fn one_model_keeps_the_single_model_layout() {
         assets: vec![still],
         ..SceneOptions::default()
     };
-    let j = parse(&glb_bytes_with(&a, a.wingspan_m, &opts).unwrap());
+    let j = json(&glb_bytes_with(&a, a.wingspan_m, &opts).unwrap());
     assert_eq!(j["scenes"][0]["extras"]["bird_model"], "still.glb");
     assert!(j["scenes"][0]["extras"].get("bird_model_of").is_none());
     assert_eq!(j["meshes"][0]["name"], "bird");
@@ -219,7 +196,7 @@ fn the_cli_takes_several_models_and_refuses_mismatched_maps() {
     };
     let o = run(&["--bird-model", s(&still), "--bird-model", s(&other)]);
     assert_eq!(code(&o), 0, "{}", stderr(&o));
-    let j = parse(&std::fs::read(&out).unwrap());
+    let j = json(&std::fs::read(&out).unwrap());
     assert_eq!(j["meshes"].as_array().unwrap().len(), 2);
     std::fs::remove_file(&out).unwrap();
     // Two maps for three models.
@@ -283,7 +260,7 @@ fn floats(bytes: &[u8], j: &Value, i: &Value) -> Vec<f32> {
 fn the_built_in_bird_is_one_primitive_coloured_by_its_vertices() {
     let a = flock();
     let bytes = glb_bytes_with(&a, a.wingspan_m, &SceneOptions::default()).unwrap();
-    let j = parse(&bytes);
+    let j = json(&bytes);
     let goose = BirdAsset::builtin(Species::Goose);
     assert_eq!(j["meshes"].as_array().unwrap().len(), 1);
     let prims = j["meshes"][0]["primitives"].as_array().unwrap();

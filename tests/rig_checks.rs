@@ -10,6 +10,7 @@ use formation::export::synthetic::{synthetic_flock, SyntheticParams};
 use formation::wingbeat::{assign_phases, Species, WingbeatOptions};
 use formation::Animation;
 use serde_json::Value;
+use support::glb::{join, split};
 use support::{bin, code, s, scratch, stderr};
 
 fn flock() -> Animation {
@@ -22,32 +23,6 @@ fn flock() -> Animation {
     let mut a = synthetic_flock(&mut formation::rng::seeded(3), &p);
     assign_phases(&mut a, &WingbeatOptions::default()).unwrap();
     a
-}
-
-/// The JSON and binary chunks of a GLB.
-fn split(bytes: &[u8]) -> (Value, Vec<u8>) {
-    let n = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
-    let json = serde_json::from_slice(&bytes[20..20 + n]).unwrap();
-    (json, bytes[28 + n..].to_vec())
-}
-
-fn join(json: &Value, bin: &[u8]) -> Vec<u8> {
-    let mut j = serde_json::to_vec(json).unwrap();
-    while j.len() % 4 != 0 {
-        j.push(b' ');
-    }
-    let total = 12 + 8 + j.len() + 8 + bin.len();
-    let mut out = Vec::new();
-    out.extend_from_slice(b"glTF");
-    out.extend_from_slice(&2u32.to_le_bytes());
-    out.extend_from_slice(&(total as u32).to_le_bytes());
-    out.extend_from_slice(&(j.len() as u32).to_le_bytes());
-    out.extend_from_slice(b"JSON");
-    out.extend_from_slice(&j);
-    out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
-    out.extend_from_slice(b"BIN\0");
-    out.extend_from_slice(bin);
-    out
 }
 
 /// Our own exported bird with its joints renamed as a rig from another tool would name them.

@@ -6,13 +6,8 @@ mod support;
 use std::path::Path;
 
 use serde_json::Value;
+use support::glb::split;
 use support::{bin, code, data, example_arg, s, scratch, stderr};
-
-fn split_glb(bytes: &[u8]) -> (Value, Vec<u8>) {
-    let jlen = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
-    let j = serde_json::from_slice(&bytes[20..20 + jlen]).unwrap();
-    (j, bytes[20 + jlen + 8..].to_vec())
-}
 
 fn ok(args: &[&str]) {
     let out = bin().args(args).output().unwrap();
@@ -21,7 +16,7 @@ fn ok(args: &[&str]) {
 
 /// Per bird root node: its scale (1 when absent); the scene's recorded list and variation.
 fn scales(glb: &Path) -> (Vec<f64>, Vec<f64>, f64) {
-    let (j, _) = split_glb(&std::fs::read(glb).unwrap());
+    let (j, _) = split(&std::fs::read(glb).unwrap());
     let flock = j["nodes"]
         .as_array()
         .unwrap()
@@ -148,8 +143,8 @@ fn size_variation_scales_each_bird_deterministically_without_moving_it() {
     let sd = (nodes.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / 11.0).sqrt();
     assert!(sd > 0.02 && sd < 0.1, "spread {sd} for F = 0.05");
     // The roots' translation keys are the same bytes as without variation.
-    let (ja, bin_a) = split_glb(&read("a.glb"));
-    let (jz, bin_z) = split_glb(&read("zero.glb"));
+    let (ja, bin_a) = split(&read("a.glb"));
+    let (jz, bin_z) = split(&read("zero.glb"));
     let (ta, tz) = (translations(&ja, &bin_a), translations(&jz, &bin_z));
     assert!(!ta.is_empty() && ta == tz, "root translations changed");
     let (zn, _, zf) = scales(&p("zero.glb"));

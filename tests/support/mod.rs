@@ -5,6 +5,7 @@
 
 #![allow(dead_code)]
 
+pub mod glb;
 pub mod rig;
 
 use std::path::{Path, PathBuf};
