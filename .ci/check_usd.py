@@ -199,7 +199,9 @@ def check_instancer(stage, anim, start, failed, check):
     model_of = [int(m) for m in model_of]
     for k in picks:
         t = Usd.TimeCode(start + round((frames[k]["t"] - frames[0]["t"]) * anim["fps"], 6))
-        pos = pi.GetPositionsAttr().Get(t)
+        # Positions are relative to the crowd's own translation (the flock's centre).
+        xf = UsdGeom.Xformable(pi.GetPrim()).ComputeLocalToWorldTransform(t)
+        pos = [xf.Transform(Gf.Vec3d(p)) for p in pi.GetPositionsAttr().Get(t)]
         rot = pi.GetOrientationsAttr().Get(t)
         idx = pi.GetProtoIndicesAttr().Get(t)
         check(len(pos) == birds and len(rot) == birds and len(idx) == birds, "frame %d: array lengths" % k)

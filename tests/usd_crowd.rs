@@ -67,6 +67,15 @@ fn instances_follow_the_birds_and_flap_through_the_prototypes() {
     let protos = text.matches("def Mesh \"pose_").count();
     assert_eq!(protos, crowd::PROTOTYPES);
     let pos = samples(&text, "positions");
+    // Positions are whole millimetres about the crowd's translation (the flock's centre).
+    assert!(text.contains("double3 xformOp:scale = (0.001, 0.001, 0.001)"));
+    assert_eq!(
+        text.matches("double3 xformOp:scale = (1000, 1000, 1000)")
+            .count(),
+        protos
+    );
+    let centre = samples(&text, "xformOp:translate");
+    assert_eq!(centre.len(), a.frames.len());
     let rot = samples(&text, "orientations");
     let idx = samples(&text, "protoIndices");
     assert_eq!(pos.len(), a.frames.len());
@@ -78,8 +87,16 @@ fn instances_follow_the_birds_and_flap_through_the_prototypes() {
         assert_eq!(*code, k as f64);
         assert_eq!(items.len(), a.birds);
         let f = &a.frames[k];
+        let c: Vec<f64> = centre[k].1[0]
+            .split(',')
+            .map(|x| x.parse().unwrap())
+            .collect();
         for (b, item) in items.iter().enumerate() {
-            let v: Vec<f64> = item.split(',').map(|x| x.parse().unwrap()).collect();
+            let v: Vec<f64> = item
+                .split(',')
+                .zip(&c)
+                .map(|(x, c)| c + x.parse::<i64>().unwrap() as f64 / 1e3)
+                .collect();
             let want = [f.x[b] * ws, f.z[b] * ws, -f.y[b] * ws];
             let d = (0..3).map(|i| (v[i] - want[i]).powi(2)).sum::<f64>().sqrt();
             worst = worst.max(d);

@@ -10,10 +10,11 @@
 //! worst and mean differences are recorded in the stage metadata (`pose_error_rad`).
 //!
 //! **Instances.** `/flock/crowd` holds, per time sample, `positions` (metres, the `.glb`'s Y-up
-//! axes), `orientations` (`quath`: heading, pitch and bank) and `protoIndices`; `ids` are the
-//! bird numbers. Bank turns the bird about its body joint, as on the rig. Positions are written
-//! to 1 mm and orientation components to 1e-3 (about 0.1°; `quath` itself keeps about 5e-4),
-//! without spaces: the arrays are most of the file.
+//! axes, relative to the crowd's own translation: the flock's centre at that time, to 1 mm),
+//! `orientations` (`quath`: heading, pitch and bank) and `protoIndices`; `ids` are the bird
+//! numbers. Bank turns the bird about its body joint, as on the rig. Positions are written to
+//! 1 mm and orientation components to 1e-3 (about 0.1°; `quath` itself keeps about 5e-4),
+//! without spaces or the leading zeros of fractions: the arrays are most of the file.
 //!
 //! The price: the wingbeat steps between prototypes instead of moving continuously (about 13°
 //! at most with 24 prototypes on the README flock), in exchange for a stage that opens in a
@@ -120,12 +121,20 @@ fn posed(asset: &BirdAsset, pose: &WingPose, ws: f32) -> Vec<Vec3> {
 }
 
 /// A number rounded to `scale` (e.g. 1e4 for 4 decimals), as short text.
+/// Without the leading zero of a fraction (`.25`, `-.5`): USD's text format reads both, and these
+/// arrays are most of the file.
 fn rounded(v: f32, scale: f32) -> String {
     let r = (v * scale).round() / scale;
     if r == 0.0 {
-        "0".into()
+        return "0".into();
+    }
+    let s = format!("{r}");
+    if let Some(rest) = s.strip_prefix("0.") {
+        format!(".{rest}")
+    } else if let Some(rest) = s.strip_prefix("-0.") {
+        format!("-.{rest}")
     } else {
-        format!("{r}")
+        s
     }
 }
 
@@ -245,28 +254,58 @@ pub fn write_usda_instancer(
     let mut pos = String::new();
     let mut rot = String::new();
     let mut idx = String::new();
+    // Positions in whole millimetres relative to the flock's centre at each frame (the
+    // instancer's own translation, rounded to 1 mm; its scale 0.001 turns millimetres into
+    // metres, and each prototype's scale 1000 undoes it for the bird): short numbers however far
+    // the flock flies, as glTF's quantised positions do it.
+    let mut centres: Vec<[f64; 3]> = Vec::with_capacity(n);
+    let mut world: Vec<Vec3> = Vec::with_capacity(birds);
+    out.write_all(
+        b"        uniform token[] xformOpOrder = [\"xformOp:translate\", \"xformOp:scale\"]\n",
+    )?;
+    out.write_all(b"        double3 xformOp:scale = (0.001, 0.001, 0.001)\n")?;
     out.write_all(b"        point3f[] positions.timeSamples = {\n")?;
     let mut lo = Vec3::splat(f32::MAX);
     let mut hi = Vec3::splat(f32::MIN);
     for k in 0..n {
-        pos.clear();
+        world.clear();
         for (b, fl) in flights.iter().enumerate() {
             // The skeleton's world point of a prototype point x: t + yaw·s·(b + d + bank·(x − b))
             // (b the body joint, d its size shift); the instance's: p + yaw·bank·s·x.
             let bank = Quat::from_rotation_z(fl.bank[k]);
-            let p = fl.translation[k] + fl.yaw[k] * (shifts[b] - bank * (pivots[b] * scales[b]));
-            lo = lo.min(p);
-            hi = hi.max(p);
+            world
+                .push(fl.translation[k] + fl.yaw[k] * (shifts[b] - bank * (pivots[b] * scales[b])));
+        }
+        let mut c = [0.0f64; 3];
+        for p in &world {
+            for (ci, v) in c.iter_mut().zip(p.to_array()) {
+                *ci += v as f64;
+            }
+        }
+        let c = c.map(|v| (v / birds.max(1) as f64 * 1e3).round() / 1e3);
+        centres.push(c);
+        pos.clear();
+        for (b, p) in world.iter().enumerate() {
+            let mm = |v: f32, c: f64| ((v as f64 - c) * 1e3).round() as i64;
+            let (x, y, z) = (mm(p.x, c[0]), mm(p.y, c[1]), mm(p.z, c[2]));
+            let local = Vec3::new(x as f32, y as f32, z as f32);
+            lo = lo.min(local);
+            hi = hi.max(local);
             let sep = if b == 0 { "" } else { "," };
-            let _ = write!(
-                pos,
-                "{sep}({},{},{})",
-                rounded(p.x, 1e3),
-                rounded(p.y, 1e3),
-                rounded(p.z, 1e3)
-            );
+            let _ = write!(pos, "{sep}({x},{y},{z})");
         }
         writeln!(out, "            {}: [{pos}],", time_code(anim, opts, k))?;
+    }
+    out.write_all(b"        }\n        double3 xformOp:translate.timeSamples = {\n")?;
+    for (k, c) in centres.iter().enumerate() {
+        writeln!(
+            out,
+            "            {}: ({},{},{}),",
+            time_code(anim, opts, k),
+            c[0],
+            c[1],
+            c[2]
+        )?;
     }
     out.write_all(b"        }\n        quath[] orientations.timeSamples = {\n")?;
     for k in 0..n {
@@ -303,9 +342,10 @@ pub fn write_usda_instancer(
         let items: Vec<String> = scales.iter().map(|&s| format!("({s},{s},{s})")).collect();
         writeln!(out, "        float3[] scales = [{}]", items.join(","))?;
     }
-    // The instances' extent over the whole shot, grown by the largest bird's wingspan.
+    // The instances' extent over the whole shot (millimetres about the centre), grown by the
+    // largest bird's wingspan.
     let largest = scales.iter().fold(1.0f32, |a, &s| a.max(s));
-    let pad = Vec3::splat(ws * largest);
+    let pad = Vec3::splat(ws * largest * 1e3);
     if n > 0 && birds > 0 {
         writeln!(
             out,
@@ -354,6 +394,11 @@ fn prototypes(asset: &BirdAsset, poses: &[WingPose], ws: f32, model: Option<usiz
             proto_name(model, i)
         );
         let _ = writeln!(s, "                uniform bool doubleSided = 1");
+        // The crowd's positions are in millimetres: its scale 0.001, undone here.
+        let _ = writeln!(
+            s,
+            "                uniform token[] xformOpOrder = [\"xformOp:scale\"]\n                double3 xformOp:scale = (1000, 1000, 1000)"
+        );
         let _ = writeln!(
             s,
             "                float3[] extent = [{}, {}]",
