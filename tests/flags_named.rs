@@ -164,6 +164,7 @@ fn commands() -> Vec<Command> {
         ("--up", "x", None),
         ("--path-out", "OUT/path.txt", None),
         ("--usd-mode", "pixie", None),
+        ("--gltf-mode", "pixie", None),
         ("--joint-map", "OUT/no-map.json", None),
     ];
     // The savings flags of `report` and `plot savings`.

@@ -200,6 +200,7 @@ pub const FLAGS: &[(&str, &str, &[Cmd])] = &[
     ("render.up", "--up", SCENE),
     ("render.path_out", "--path-out", SCENE),
     ("render.usd_mode", "--usd-mode", SCENE),
+    ("render.gltf_mode", "--gltf-mode", SCENE),
     ("render.animation_fps", "--fps", &[Render]),
     ("render.bird_model", "--bird-model", SCENE),
     ("render.joint_map", "--joint-map", SCENE),

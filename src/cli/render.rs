@@ -145,6 +145,11 @@ pub struct SceneArgs {
     /// from 200 birds, skel below].
     #[arg(long, value_name = "skel|instancer")]
     pub usd_mode: Option<formation::export::UsdMode>,
+    /// How the .glb holds the birds: birds (one skin and mesh each: one armature per bird in
+    /// Blender) or flock (the whole flock as one skinned mesh on one skin: one armature, one draw
+    /// call, quick to import) [default: flock from 200 birds, birds below].
+    #[arg(long, value_name = "birds|flock")]
+    pub gltf_mode: Option<formation::export::GltfMode>,
     /// Indent the written .json for reading (it is one compact line by default).
     #[arg(long)]
     pub pretty: bool,
@@ -187,6 +192,7 @@ impl SceneArgs {
             up: self.up,
             path_out: self.path_out.clone(),
             usd_mode: self.usd_mode,
+            gltf_mode: self.gltf_mode,
             pretty: self.pretty,
             ..RenderOptions::default()
         }

@@ -66,6 +66,10 @@ pub struct SceneOptions {
     /// Spread of the birds' sizes, the F of [`bird::bird_scales`] (0 = every bird the same size,
     /// this struct's default; `render.size_variation` defaults to the species').
     pub size_variation: f64,
+    /// The whole flock as one skinned mesh on one skin (`render.gltf_mode` = flock): every
+    /// bird's joints in one skeleton, so a DCC makes one armature instead of one per bird (and a
+    /// viewer one draw call); `false` = one skin and mesh node per bird.
+    pub one_skin: bool,
 }
 
 impl SceneOptions {
@@ -383,9 +387,11 @@ pub fn glb_bytes_with(anim: &Animation, wingspan_m: f64, opts: &SceneOptions) ->
         },
         ..Default::default()
     };
-    // Each model's mesh and inverse bind matrices, shared by the birds that wear it.
+    // Each model's mesh and inverse bind matrices, shared by the birds that wear it (none with
+    // one skin for the flock: its mesh is made after the birds).
     let shared: Vec<(json::Index<json::Mesh>, json::Index<json::Accessor>)> = assets
         .iter()
+        .filter(|_| !opts.one_skin)
         .enumerate()
         .map(|(m, asset)| {
             let name = if assets.len() == 1 {
@@ -409,6 +415,8 @@ pub fn glb_bytes_with(anim: &Animation, wingspan_m: f64, opts: &SceneOptions) ->
     let species = WingbeatOptions::for_animation(anim).species;
     let mut bird_nodes = Vec::with_capacity(anim.birds);
     let mut mesh_nodes = Vec::with_capacity(anim.birds);
+    // With one skin for the flock: every bird's joints, in bird order.
+    let mut flock_joints = Vec::new();
     // Per clip: channels and samplers.
     let mut anims: Vec<(Vec<json::animation::Channel>, Vec<json::animation::Sampler>)> =
         clips.iter().map(|_| (Vec::new(), Vec::new())).collect();
@@ -421,7 +429,6 @@ pub fn glb_bytes_with(anim: &Animation, wingspan_m: f64, opts: &SceneOptions) ->
     for (bird, &scale) in scales.iter().enumerate() {
         let model = model_of[bird];
         let asset = &assets[model];
-        let (mesh, ibm_acc) = shared[model];
         let track = bird_track(anim, &flapper, asset, bird, wingspan_m);
         // Skeleton nodes, children before parents so indices are known.
         let mut joint_nodes: [Option<json::Index<json::Node>>; 7] = [None; 7];
@@ -434,8 +441,14 @@ pub fn glb_bytes_with(anim: &Animation, wingspan_m: f64, opts: &SceneOptions) ->
             if j == bird::BODY && scale != 1.0 {
                 rest += bird::size_pivot(species, scale);
             }
+            // Joint names repeat from bird to bird; in one skeleton they carry the bird's name.
+            let joint_name = if opts.one_skin {
+                format!("bird_{bird:0digits$}.{}", bird::JOINTS[j])
+            } else {
+                bird::JOINTS[j].to_string()
+            };
             let node = root.push(json::Node {
-                name: Some(bird::JOINTS[j].to_string()),
+                name: Some(joint_name),
                 translation: Some((rest * ws).to_array()),
                 rotation: Some(json::scene::UnitQuaternion(track.joints[0][j].to_array())),
                 children: (!children.is_empty()).then_some(children),
@@ -469,20 +482,28 @@ pub fn glb_bytes_with(anim: &Animation, wingspan_m: f64, opts: &SceneOptions) ->
             ..Default::default()
         });
         bird_nodes.push(bird_node);
-        let skin = root.push(json::Skin {
-            extensions: None,
-            extras: Default::default(),
-            inverse_bind_matrices: Some(ibm_acc),
-            joints: joints.clone(),
-            name: Some(format!("{name}_skin")),
-            skeleton: Some(joints[bird::BODY]),
-        });
-        mesh_nodes.push(root.push(json::Node {
-            name: Some(format!("{name}_mesh")),
-            mesh: Some(mesh),
-            skin: Some(skin),
-            ..Default::default()
-        }));
+        if opts.one_skin {
+            // The bird's root is a joint too (bound to no vertex, its bind at the origin): an
+            // importer then takes each bone's rest from its own bind, not from its children's.
+            flock_joints.push(bird_node);
+            flock_joints.extend(joints.iter().copied());
+        } else {
+            let (mesh, ibm_acc) = shared[model];
+            let skin = root.push(json::Skin {
+                extensions: None,
+                extras: Default::default(),
+                inverse_bind_matrices: Some(ibm_acc),
+                joints: joints.clone(),
+                name: Some(format!("{name}_skin")),
+                skeleton: Some(joints[bird::BODY]),
+            });
+            mesh_nodes.push(root.push(json::Node {
+                name: Some(format!("{name}_mesh")),
+                mesh: Some(mesh),
+                skin: Some(skin),
+                ..Default::default()
+            }));
+        }
 
         for (ci, c) in clips.iter().enumerate() {
             let r = c.first..c.last + 1;
@@ -591,6 +612,46 @@ pub fn glb_bytes_with(anim: &Animation, wingspan_m: f64, opts: &SceneOptions) ->
         children: Some(bird_nodes),
         ..Default::default()
     });
+    if opts.one_skin {
+        // The flock in parts of FLOCK_PART birds: each part one mesh holding its birds (each
+        // bird's copy of its model bound to its own seven joints) on one skin of their joints.
+        // All skins hang from the flock node, so a DCC makes one armature of them; parts keep
+        // each mesh's skin small (Blender's importer binds a mesh's vertices joint by joint).
+        let joints_per_bird = bird::JOINTS.len() + 1;
+        let models = &assets;
+        let parts = anim.birds.div_ceil(FLOCK_PART);
+        let part_digits = bird_digits(parts);
+        for (p, first) in (0..anim.birds).step_by(FLOCK_PART).enumerate() {
+            let last = (first + FLOCK_PART).min(anim.birds);
+            let name = format!("flock_{p:0part_digits$}");
+            let mesh = b.skinned_meshes(&mut root, models, &model_of[first..last], ws, &name, true);
+            let ibm: Vec<f32> = model_of[first..last]
+                .iter()
+                .flat_map(|&m| {
+                    std::iter::once(glam::Mat4::IDENTITY.to_cols_array()).chain(
+                        (0..bird::JOINTS.len())
+                            .map(move |j| models[m].skeleton.inverse_bind(j, ws).to_cols_array()),
+                    )
+                })
+                .flatten()
+                .collect();
+            let ibm = b.accessor(&mut root, &ibm, 16, json::accessor::Type::Mat4, false, None);
+            let skin = root.push(json::Skin {
+                extensions: None,
+                extras: Default::default(),
+                inverse_bind_matrices: Some(ibm),
+                joints: flock_joints[first * joints_per_bird..last * joints_per_bird].to_vec(),
+                name: Some(format!("{name}_skin")),
+                skeleton: Some(flock),
+            });
+            mesh_nodes.push(root.push(json::Node {
+                name: Some(format!("{name}_mesh")),
+                mesh: Some(mesh),
+                skin: Some(skin),
+                ..Default::default()
+            }));
+        }
+    }
     let mut scene_nodes = vec![flock];
     scene_nodes.extend(mesh_nodes);
     // The course as flown (turns widened), for layout: a line strip (no material: a viewer
@@ -861,6 +922,31 @@ fn one_primitive(m: &bird::SkinnedMesh) -> (Vec<usize>, Vec<[f32; 3]>, Vec<u32>)
     (order, colours, idx)
 }
 
+/// Birds per skinned mesh when the flock is one skeleton ([`SceneOptions::one_skin`]): 64 birds
+/// are 448 joints, within what real-time engines skin in one draw call.
+pub const FLOCK_PART: usize = 64;
+
+/// A value in 0..=1 as a normalised byte.
+fn unit_byte(v: f32) -> u8 {
+    (v.clamp(0.0, 1.0) * 255.0).round() as u8
+}
+
+/// Skin weights as normalised bytes summing to exactly 255 (the rounding's remainder goes to
+/// the largest weight), as glTF asks of quantised weights.
+fn weight_bytes(w: [f32; 4]) -> [u8; 4] {
+    let total: f32 = w.iter().sum();
+    let mut q = w.map(|v| {
+        ((v / total.max(f32::MIN_POSITIVE)) * 255.0)
+            .round()
+            .clamp(0.0, 255.0) as i32
+    });
+    let largest = (0..4)
+        .max_by(|&a, &b| q[a].cmp(&q[b]).then(b.cmp(&a)))
+        .unwrap_or(0);
+    q[largest] += 255 - q.iter().sum::<i32>();
+    q.map(|v| v.clamp(0, 255) as u8)
+}
+
 /// Collects binary data, 4-byte aligned, one buffer view per accessor.
 #[derive(Default)]
 struct Builder {
@@ -985,35 +1071,121 @@ impl Builder {
         ws: f32,
         name: &str,
     ) -> json::Index<json::Mesh> {
-        let m = &asset.mesh;
-        let (order, colours, idx) = one_primitive(m);
-        let pos: Vec<f32> = order
-            .iter()
-            .flat_map(|&v| (m.positions[v] * ws).to_array())
-            .collect();
-        let nor: Vec<f32> = order
-            .iter()
-            .flat_map(|&v| m.normals[v].to_array())
-            .collect();
-        let col: Vec<f32> = colours.iter().flatten().copied().collect();
+        self.skinned_meshes(root, std::slice::from_ref(asset), &[0], ws, name, false)
+    }
+
+    /// One skinned primitive holding, for every bird `i`, a copy of the mesh of its model
+    /// `assets[model_of[i]]` bound to its joints of one skin. `flock`: a part of the flock's one
+    /// skeleton, where each bird has 8 joints (its root, then the seven; joints `8·i + 1 ..`)
+    /// and colours and weights are normalised bytes; else one bird's mesh (joints `0 .. 7`).
+    fn skinned_meshes(
+        &mut self,
+        root: &mut json::Root,
+        assets: &[BirdAsset],
+        model_of: &[usize],
+        ws: f32,
+        name: &str,
+        flock: bool,
+    ) -> json::Index<json::Mesh> {
+        let joints_per_bird = bird::JOINTS.len() + usize::from(flock);
+        let (mut pos, mut nor, mut col) = (Vec::new(), Vec::new(), Vec::new());
+        let (mut jw, mut wf, mut idx): (Vec<u16>, Vec<f32>, Vec<u32>) =
+            (Vec::new(), Vec::new(), Vec::new());
+        // Each model's primitive, made once.
+        let made: Vec<_> = assets.iter().map(|a| one_primitive(&a.mesh)).collect();
+        for (i, &model) in model_of.iter().enumerate() {
+            let (order, colours, tri) = &made[model];
+            let m = &assets[model].mesh;
+            let base = (pos.len() / 3) as u32;
+            let first_joint = (i * joints_per_bird + usize::from(flock)) as u16;
+            for &v in order {
+                pos.extend((m.positions[v] * ws).to_array());
+                nor.extend(m.normals[v].to_array());
+                // Unused slots (weight 0) stay at joint 0, as glTF asks.
+                for (&j, &w) in m.joints[v].iter().zip(&m.weights[v]) {
+                    jw.push(if w > 0.0 {
+                        first_joint + u16::from(j)
+                    } else {
+                        0
+                    });
+                }
+                wf.extend(m.weights[v]);
+            }
+            col.extend(colours.iter().flatten().copied());
+            idx.extend(tri.iter().map(|&t| base + t));
+        }
+        let vertices = pos.len() / 3;
         let target = Some(json::buffer::Target::ArrayBuffer);
         let pos = self.accessor(root, &pos, 3, json::accessor::Type::Vec3, true, target);
         let nor = self.accessor(root, &nor, 3, json::accessor::Type::Vec3, false, target);
-        let col = self.accessor(root, &col, 3, json::accessor::Type::Vec3, false, target);
-        let jb: Vec<u8> = order.iter().flat_map(|&v| m.joints[v]).collect();
+        // A flock's mesh repeats the bird a thousand times: colours and weights as normalised
+        // bytes there (4 bytes each instead of 12 and 16); one bird's mesh keeps floats. A weight
+        // that rounds to 0 frees its slot (joint 0, as glTF asks of unused slots).
+        let mut bytes = Vec::new();
+        if flock {
+            for (w, j) in wf.chunks_exact(4).zip(jw.chunks_exact_mut(4)) {
+                let q = weight_bytes([w[0], w[1], w[2], w[3]]);
+                for (jk, &qk) in j.iter_mut().zip(&q) {
+                    if qk == 0 {
+                        *jk = 0;
+                    }
+                }
+                bytes.extend(q);
+            }
+        }
+        let col = if flock {
+            let rgba: Vec<u8> = col
+                .chunks_exact(3)
+                .flat_map(|c| [unit_byte(c[0]), unit_byte(c[1]), unit_byte(c[2]), 255])
+                .collect();
+            self.raw_accessor(
+                root,
+                &rgba,
+                vertices,
+                json::accessor::ComponentType::U8,
+                json::accessor::Type::Vec4,
+                true,
+                target,
+            )
+        } else {
+            self.accessor(root, &col, 3, json::accessor::Type::Vec3, false, target)
+        };
+        // Joint indices as bytes while they fit (one bird: 7 joints), else as shorts.
+        let (jb, jct): (Vec<u8>, _) = if model_of.len() * joints_per_bird <= 256 {
+            (
+                jw.iter().map(|&j| j as u8).collect(),
+                json::accessor::ComponentType::U8,
+            )
+        } else {
+            (
+                jw.iter().flat_map(|j| j.to_le_bytes()).collect(),
+                json::accessor::ComponentType::U16,
+            )
+        };
         let joints = self.raw_accessor(
             root,
             &jb,
-            order.len(),
-            json::accessor::ComponentType::U8,
+            vertices,
+            jct,
             json::accessor::Type::Vec4,
             false,
             target,
         );
-        let wf: Vec<f32> = order.iter().flat_map(|&v| m.weights[v]).collect();
-        let weights = self.accessor(root, &wf, 4, json::accessor::Type::Vec4, false, target);
+        let weights = if flock {
+            self.raw_accessor(
+                root,
+                &bytes,
+                vertices,
+                json::accessor::ComponentType::U8,
+                json::accessor::Type::Vec4,
+                true,
+                target,
+            )
+        } else {
+            self.accessor(root, &wf, 4, json::accessor::Type::Vec4, false, target)
+        };
         let mat = root.push(material(name, [1.0, 1.0, 1.0]));
-        let (bytes, ct): (Vec<u8>, _) = if order.len() > u16::MAX as usize {
+        let (bytes, ct): (Vec<u8>, _) = if vertices > u16::MAX as usize {
             (
                 idx.iter().flat_map(|v| v.to_le_bytes()).collect(),
                 json::accessor::ComponentType::U32,

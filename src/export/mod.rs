@@ -134,6 +134,10 @@ pub struct RenderOptions {
     /// crowd of posed prototypes (`instancer`, see [`crowd`]); `None` = instancer from
     /// [`crowd::INSTANCER_FROM`] birds, skel below.
     pub usd_mode: Option<UsdMode>,
+    /// How the `.glb` holds the birds: one skin and mesh per bird (`birds`) or the whole flock as
+    /// one skinned mesh on one skin (`flock`, which Blender imports as one armature); `None` =
+    /// flock from [`crowd::INSTANCER_FROM`] birds, birds below.
+    pub gltf_mode: Option<GltfMode>,
     /// Indent the written animation JSON (and the flown path) for reading; compact by default.
     pub pretty: bool,
 }
@@ -171,6 +175,39 @@ impl std::fmt::Display for UsdMode {
     }
 }
 
+/// How the `.glb` holds the birds ([`RenderOptions::gltf_mode`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum GltfMode {
+    /// One skin and one skinned mesh node per bird (one armature per bird in a DCC).
+    Birds,
+    /// One skinned mesh and one skin for the whole flock (one armature, one draw call).
+    Flock,
+}
+
+impl std::str::FromStr for GltfMode {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<GltfMode> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "birds" => Ok(GltfMode::Birds),
+            "flock" => Ok(GltfMode::Flock),
+            _ => Err(Error::parameter(
+                "render.gltf_mode",
+                format!("unknown glTF mode \"{s}\": expected birds or flock"),
+            )),
+        }
+    }
+}
+
+impl std::fmt::Display for GltfMode {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            GltfMode::Birds => "birds",
+            GltfMode::Flock => "flock",
+        })
+    }
+}
+
 pub use crate::limits::MAX_START_FRAME;
 /// Largest accepted [`RenderOptions::subframes`].
 pub const MAX_SUBFRAMES: u32 = 16;
@@ -200,6 +237,7 @@ impl Default for RenderOptions {
             up: crate::animation::axes::Up::Z,
             path_out: None,
             usd_mode: None,
+            gltf_mode: None,
             pretty: false,
         }
     }
@@ -564,6 +602,10 @@ pub fn write_outputs(
         assets,
         start_frame: anim.start_frame,
         frame_rate: None,
+        one_skin: match opts.gltf_mode {
+            Some(m) => m == GltfMode::Flock,
+            None => anim.birds >= crowd::INSTANCER_FROM,
+        },
         size_variation: opts.size_variation.unwrap_or_else(|| {
             bird::default_size_variation(
                 crate::wingbeat::WingbeatOptions::for_animation(anim).species,

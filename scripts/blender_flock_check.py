@@ -1,0 +1,97 @@
+# Imports a large flock's .glb written with one skeleton for the flock (`--gltf-mode flock`, the
+# default from 200 birds) into Blender (headless) and checks what arrived: one armature holding
+# every bird's bones, one skinned mesh per part of the flock, the import's CPU time under a
+# budget, the birds where the CSV of the same animation puts them (10 frames, within 1 mm) and the
+# wings flapping. Prints a summary; exits 1 when a check fails.
+# Usage: blender -b --python scripts/blender_flock_check.py -- flock.glb flock.csv [BUDGET_S]
+# (Debian's Blender 3.4 glTF add-on still uses numpy.bool, which numpy 1.24 removed: the first
+# lines put Debian's numpy first and restore the alias.)
+import sys; sys.path.insert(0, "/usr/lib/python3/dist-packages"); [sys.modules.pop(m) for m in list(sys.modules) if m.startswith("numpy")]
+import numpy; numpy.bool = bool
+import csv, json, math, struct, time
+import bpy
+
+args = sys.argv[sys.argv.index("--") + 1:]
+path, csv_path = args[0], args[1]
+budget = float(args[2]) if len(args) > 2 else 60.0
+with open(path, "rb") as fh:
+    head = fh.read(20)
+    doc = json.loads(fh.read(struct.unpack("<I", head[12:16])[0]))
+extras = doc["scenes"][0].get("extras", {})
+wingspan = float(extras["wingspan_m"])
+fps = int(round(extras.get("fps", 30)))
+birds = int(extras["birds"])
+bpy.ops.wm.read_factory_settings(use_empty=True)
+sc = bpy.context.scene
+sc.render.fps = fps
+t = time.process_time()
+bpy.ops.import_scene.gltf(filepath=path)
+cpu = time.process_time() - t
+failed = []
+arms = [o for o in bpy.data.objects if o.type == "ARMATURE"]
+meshes = [o for o in bpy.data.objects if o.type == "MESH"]
+parts = math.ceil(birds / 64)
+print("IMPORT %d birds: %.1f s CPU, %d armature(s), %d meshes" % (birds, cpu, len(arms), len(meshes)))
+if cpu > budget:
+    failed.append("import took %.1f s of CPU (budget %.0f s)" % (cpu, budget))
+if len(arms) != 1:
+    failed.append("%d armatures, expected 1" % len(arms))
+if len(meshes) != parts:
+    failed.append("%d meshes, expected %d" % (len(meshes), parts))
+arm = arms[0]
+bones = arm.pose.bones
+if len(bones) != 8 * birds:
+    failed.append("%d bones, expected %d" % (len(bones), 8 * birds))
+for m in meshes:
+    if not any(md.type == "ARMATURE" and md.object == arm for md in m.modifiers):
+        failed.append("%s is not bound to the armature" % m.name)
+        break
+digits = len(str(birds - 1))
+name = lambda b: "bird_%0*d" % (digits, b)
+# The CSV at 10 frames across the flight.
+frames = set()
+with open(csv_path) as fh:
+    for r in csv.DictReader(fh):
+        frames.add(int(r["frame"]))
+frames = sorted(frames)
+picks = {frames[round(i * (len(frames) - 1) / 9)] for i in range(10)}
+rows = {}
+with open(csv_path) as fh:
+    for r in csv.DictReader(fh):
+        f = int(r["frame"])
+        if f in picks:
+            rows[(f, int(r["bird"]))] = (float(r["x"]), float(r["y"]), float(r["z"]))
+worst, at = 0.0, None
+for f in sorted(picks):
+    sc.frame_set(f)
+    for b in range(birds):
+        got = (arm.matrix_world @ bones[name(b)].matrix).translation
+        want = [v * wingspan for v in rows[(f, b)]]
+        err = max(abs(got[i] - want[i]) for i in range(3))
+        if err > worst:
+            worst, at = err, (f, b, tuple(round(v, 4) for v in got), tuple(round(v, 4) for v in want))
+print("POSITIONS 10 frames %d..%d, %d birds: worst %.6f m (frame, bird, Blender, CSV: %s)"
+      % (min(picks), max(picks), birds, worst, at))
+if worst > 0.001:
+    failed.append("positions off the CSV by %.4f m" % worst)
+# The first bird's wing over a second: it flaps, and the mesh follows (evaluated vertices move).
+mid = frames[len(frames) // 2]
+wing = set()
+deps = bpy.context.evaluated_depsgraph_get()
+first = sorted(meshes, key=lambda m: m.name)[0]
+spans = set()
+for f in range(mid, mid + fps + 1):
+    sc.frame_set(f)
+    wing.add(round(bones[name(0) + ".upper_arm.L"].matrix.to_euler()[2], 4))
+    ev = first.evaluated_get(bpy.context.evaluated_depsgraph_get())
+    zs = [v.co.z for v in ev.data.vertices[:400]]
+    spans.add(round(max(zs) - min(zs), 4))
+print("WING upper_arm.L angles over a second: %d; first bird's mesh heights: %d" % (len(wing), len(spans)))
+if len(wing) < 10:
+    failed.append("upper_arm.L does not flap")
+if len(spans) < 10:
+    failed.append("the skinned mesh does not follow the wings")
+if failed:
+    print("FAILED", "; ".join(failed))
+    sys.exit(1)
+print("OK")
