@@ -27,7 +27,7 @@ pub fn annotations(data: &[u8], expect: Format) {
         ReadOptions {
             wingspan_px: Some(20.0),
             heading: Some(Heading::Degrees(-30.0)),
-            y_origin: None,
+            ..ReadOptions::default()
         },
     ];
     for o in &options {
@@ -41,6 +41,21 @@ pub fn annotations(data: &[u8], expect: Format) {
             config.extract.max_samples = 64;
             let _ = extract_stage(&ann, &config, &Silent);
         }
+    }
+}
+
+/// TRex's `.npz` reader (one individual's archive: zip, deflate, `.npy` headers), then
+/// extraction of whatever it accepts, with a scale and heading given.
+pub fn trex_npz(data: &[u8]) {
+    let o = ReadOptions {
+        wingspan_px: Some(20.0),
+        heading: Some(Heading::Degrees(90.0)),
+        ..ReadOptions::default()
+    };
+    if let Ok(ann) = formation::annotations::parse_trex_bytes(Path::new(PATH), data, &o) {
+        let mut config = Config::default();
+        config.extract.max_samples = 64;
+        let _ = extract_stage(&ann, &config, &Silent);
     }
 }
 

@@ -17,6 +17,7 @@
 mod csv_formats;
 mod labelme;
 mod native;
+mod npz;
 pub mod synth;
 mod trackers;
 
@@ -136,6 +137,8 @@ pub enum Format {
     /// idtracker.ai `trajectories.csv` (`time,x1,y1,x2,y2,...`).
     #[serde(rename = "idtracker")]
     IdTracker,
+    /// TRex's `.npz` archives, one per individual (`VIDEO_fish0.npz`, ...).
+    Trex,
 }
 
 impl Format {
@@ -151,6 +154,7 @@ impl Format {
             Format::Dlc => "DeepLabCut CSV",
             Format::Mot => "MOT text",
             Format::IdTracker => "idtracker.ai CSV",
+            Format::Trex => "TRex .npz",
         }
     }
 }
@@ -317,6 +321,9 @@ pub(crate) struct RawAnnotations {
 
 /// What a path holds, judged by content.
 pub fn detect(path: &Path) -> Result<Format> {
+    if (path.is_dir() && npz::dir_has_npz(path)) || (path.is_file() && npz::is_zip(path)) {
+        return Ok(Format::Trex);
+    }
     if path.is_dir() {
         return Ok(Format::LabelmeDir);
     }
@@ -403,6 +410,19 @@ fn detect_text(path: &Path, text: &str) -> Result<Format> {
 /// Reads annotations from `path` (a file in any docs/formats.md §4.1 format, or a Labelme directory),
 /// resolving heading, scale and bird ids.
 pub fn read(path: &Path, opts: &ReadOptions) -> Result<Annotations> {
+    if (path.is_dir() && npz::dir_has_npz(path)) || (path.is_file() && npz::is_zip(path)) {
+        if opts.bodypart.is_some() {
+            return Err(Error::parameter(
+                "read.bodypart",
+                format!(
+                    "{}: is TRex's tracks, which have one point per individual; a body part is chosen only in SLEAP and DeepLabCut files",
+                    path.display()
+                ),
+            ));
+        }
+        let raw = npz::read(path)?;
+        return finish(path, raw, opts);
+    }
     if path.is_dir() {
         if opts.bodypart.is_some() {
             return Err(Error::parameter(
@@ -418,6 +438,13 @@ pub fn read(path: &Path, opts: &ReadOptions) -> Result<Annotations> {
     }
     let text = crate::io::read_text(path)?;
     parse_str(path, &text, opts)
+}
+
+/// Parses one TRex `.npz` archive (one individual, bird 0) from bytes as if read from `path`
+/// (which only names it in messages), checked as [`read`] checks a file.
+pub fn parse_trex_bytes(path: &Path, bytes: &[u8], opts: &ReadOptions) -> Result<Annotations> {
+    let raw = npz::read_one(path, bytes)?;
+    finish(path, raw, opts)
 }
 
 /// Parses annotation text as if read from `path` (which only names the file in messages).
@@ -440,7 +467,12 @@ pub fn parse_str(path: &Path, text: &str, opts: &ReadOptions) -> Result<Annotati
         Format::LongCsv | Format::Dltdv => csv_formats::parse(path, t, format)?,
         Format::Sleap | Format::Dlc => trackers::parse(path, t, format, opts.bodypart.as_deref())?,
         Format::Mot | Format::IdTracker => trackers::parse(path, t, format, None)?,
-        Format::LabelmeDir => return Err(Error::Internal("directory detected for text".into())),
+        Format::LabelmeDir | Format::Trex => {
+            return Err(Error::Internal(format!(
+                "{} detected for text",
+                format.name()
+            )))
+        }
     };
     finish(path, raw, opts)
 }
