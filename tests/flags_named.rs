@@ -230,6 +230,25 @@ fn commands() -> Vec<Command> {
             ],
         },
         Command {
+            name: &["annotate"],
+            base: strings(&[
+                "annotate",
+                &geese,
+                "--images",
+                &data("track_frames").to_string_lossy(),
+                "-o",
+                "OUT/r.html",
+            ]),
+            cases: cat(vec![
+                read.clone(),
+                vec![
+                    ("--images", "OUT/no-frames", Some("no-frames".into())),
+                    o("OUT/r.txt"),
+                    seed.clone(),
+                ],
+            ]),
+        },
+        Command {
             name: &["power"],
             base: strings(&["power", &shape]),
             cases: vec![
@@ -433,9 +452,9 @@ fn every_flag_of_every_command_is_named_when_its_value_is_bad() {
                 .iter()
                 .map(|a| a.replace("OUT", &out_dir))
                 .collect();
-            if *flag == "-o" {
-                // Replace the valid output instead of adding a second one.
-                let k = args.iter().position(|a| a == "-o").unwrap();
+            if let Some(k) = args.iter().position(|a| a == flag) {
+                // Replace a flag the base command has (the output, `annotate --images`)
+                // instead of adding a second one.
                 args[k + 1] = value.replace("OUT", &out_dir);
             } else {
                 args.push(flag.to_string());

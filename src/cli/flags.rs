@@ -40,11 +40,13 @@ pub enum Cmd {
     Report,
     /// `formation track`.
     Track,
+    /// `formation annotate`.
+    Annotate,
 }
 
 use Cmd::*;
 
-const READ: &[Cmd] = &[Extract, PlotShape, Animate, Report];
+const READ: &[Cmd] = &[Extract, PlotShape, Animate, Report, Annotate];
 const FIT: &[Cmd] = &[Extract, PlotShape, Report];
 const STEADY: &[Cmd] = &[Steady, Animate];
 const INITIATE: &[Cmd] = &[Initiate, Animate];
@@ -68,6 +70,7 @@ pub const FLAGS: &[(&str, &str, &[Cmd])] = &[
     ("track.frames", "--frames", &[Track]),
     ("track.roi", "--roi", &[Track]),
     ("track.fps", "--fps", &[Track]),
+    ("annotate.images", "--images", &[Annotate]),
     ("read.heading", "--heading", READ),
     ("read.wingspan_px", "--wingspan-px", READ),
     ("read.y_origin", "--y-origin", READ),

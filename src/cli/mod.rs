@@ -6,6 +6,7 @@ use clap::{Parser, Subcommand};
 use formation::Result;
 
 mod animate;
+mod annotate;
 mod chart;
 mod course;
 mod extract;
@@ -79,6 +80,9 @@ enum Command {
     /// Find and track the birds of footage (a video, a directory of images or a glob) and write
     /// native annotations for `extract`.
     Track(track::TrackArgs),
+    /// A review page for annotations made elsewhere (any format extract reads) over the
+    /// footage's frames, to check and correct them in a browser.
+    Annotate(annotate::AnnotateArgs),
 }
 
 /// Runs the parsed command line.
@@ -102,6 +106,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Plot(a) => (a.cmd(), plot::run(a, g)),
         Command::Report(a) => (Cmd::Report, report::run(a, g)),
         Command::Track(a) => (Cmd::Track, track::run(a, g)),
+        Command::Annotate(a) => (Cmd::Annotate, annotate::run(a, g)),
     };
     // Library errors name option paths; the user typed this command's flags.
     result.map_err(|e| flags::name_flags(cmd, e))?;

@@ -84,6 +84,95 @@ fn html_escape(s: &str) -> String {
         .replace('"', "&quot;")
 }
 
+/// The review page of annotations made elsewhere (any input format) over their footage's frames
+/// `images` (in order): each annotated frame shows the image its `image` field names, else the
+/// image at its frame index. Positions become pixels from the top-left (y down) as the page
+/// edits them; every bird starts with confidence 1. `save_as` is the file name "Save" suggests.
+pub fn annotations_page(
+    ann: &crate::annotations::Annotations,
+    images: &[std::path::PathBuf],
+    save_as: &str,
+) -> Result<String> {
+    if ann.frames.len() > MAX_FRAMES {
+        return Err(Error::format(
+            &ann.path,
+            format!(
+                "{} annotated frames; a review page holds at most {MAX_FRAMES}",
+                ann.frames.len()
+            ),
+        ));
+    }
+    let mut jpegs = BTreeMap::new();
+    let mut frames = Vec::with_capacity(ann.frames.len());
+    let mut size: Option<(usize, usize)> = None;
+    for f in &ann.frames {
+        let by_name = f.image.as_deref().and_then(|name| {
+            let file = std::path::Path::new(name).file_name()?;
+            images.iter().find(|p| p.file_name() == Some(file))
+        });
+        let by_index = usize::try_from(f.index).ok().and_then(|i| images.get(i));
+        let path = by_name.or(by_index).ok_or_else(|| {
+            Error::format(
+                &ann.path,
+                format!(
+                    "frame {}: no image for it ({} images given; frames are matched by their image name, else by frame index from 0)",
+                    f.index,
+                    images.len()
+                ),
+            )
+        })?;
+        let gray = super::source::read_image(path)?;
+        let (w, h) = (gray.width, gray.height);
+        size.get_or_insert((w, h));
+        let index = usize::try_from(f.index).map_err(|_| {
+            Error::format(
+                &ann.path,
+                format!("frame {}: a negative frame index", f.index),
+            )
+        })?;
+        let birds = f
+            .birds
+            .iter()
+            .map(|b| {
+                let y = if ann.y_up { h as f64 - b.py } else { b.py };
+                super::TrackedBird {
+                    id: b.id,
+                    x: b.px,
+                    y,
+                    confidence: 1.0,
+                    blob: super::detect::Blob {
+                        x: b.px,
+                        y,
+                        area: 0,
+                        span: f.wingspan_px,
+                        axis: 0.0,
+                        snr: 0.0,
+                        split: false,
+                    },
+                }
+            })
+            .collect();
+        jpegs.insert(index, frame_jpeg(&gray)?);
+        frames.push(super::TrackedFrame {
+            index,
+            image: path.file_name().map(|n| n.to_string_lossy().into_owned()),
+            wingspan_px: f.wingspan_px,
+            heading_deg: f.heading_deg,
+            birds,
+        });
+    }
+    let (width, height) = size.unwrap_or((0, 0));
+    let tracked = Tracked {
+        source: ann.source.clone(),
+        width,
+        height,
+        fps: ann.fps,
+        polarity: super::Polarity::Dark,
+        frames,
+    };
+    Ok(page(&tracked, &jpegs, save_as))
+}
+
 /// The page for `tracked`, with `jpegs` (frame index → JPEG of [`frame_jpeg`]); `save_as` is
 /// the file name the page's "Save" suggests.
 pub fn page(tracked: &Tracked, jpegs: &BTreeMap<usize, Vec<u8>>, save_as: &str) -> String {
