@@ -35,6 +35,7 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::mpsc;
 
 use super::camera::{self, CameraParams, View};
+use super::lzw::Lzw;
 use super::palette::{Lookup, Palette, TRANSPARENT};
 use super::raster::{Canvas, Mask};
 use super::sample::{self, BirdState};
@@ -468,6 +469,39 @@ fn loop_tolerance(base: i32, looped: bool, k: usize, total: usize, ramp: usize) 
     (base as f64 * left as f64 / ramp as f64).floor() as i32
 }
 
+/// A value borrowed from a pool for one worker of [`run_frames`], handed back when dropped.
+struct Pooled<'a, T: Default> {
+    item: Option<T>,
+    pool: &'a std::sync::Mutex<Vec<T>>,
+}
+
+impl<'a, T: Default> Pooled<'a, T> {
+    /// A value from `pool`, or a new one.
+    fn take(pool: &'a std::sync::Mutex<Vec<T>>) -> Self {
+        let item = pool
+            .lock()
+            .ok()
+            .and_then(|mut p| p.pop())
+            .unwrap_or_default();
+        Pooled {
+            item: Some(item),
+            pool,
+        }
+    }
+
+    fn get(&mut self) -> &mut T {
+        self.item.get_or_insert_with(T::default)
+    }
+}
+
+impl<T: Default> Drop for Pooled<'_, T> {
+    fn drop(&mut self) {
+        if let (Some(item), Ok(mut p)) = (self.item.take(), self.pool.lock()) {
+            p.push(item);
+        }
+    }
+}
+
 /// Writes an animated, looping GIF of `film` to `path` (atomically).
 pub fn write_gif(film: &Film, path: &Path, threads: usize, progress: &dyn Progress) -> Result<()> {
     let (w, h) = (film.width, film.height);
@@ -500,6 +534,7 @@ pub fn write_gif(film: &Film, path: &Path, threads: usize, progress: &dyn Progre
         let batch = gif_batch(w, h, threads);
         let mut deltas: Vec<Vec<u8>> = vec![vec![TRANSPARENT; w * h]; batch];
         let pool: std::sync::Mutex<Vec<Vec<u8>>> = std::sync::Mutex::new(Vec::new());
+        let encoders: std::sync::Mutex<Vec<Lzw>> = std::sync::Mutex::new(Vec::new());
         for start in (0..film.len()).step_by(batch) {
             let count = batch.min(film.len() - start);
             // 1. Draw the batch in parallel (into buffers reused from earlier batches).
@@ -582,14 +617,15 @@ pub fn write_gif(film: &Film, path: &Path, threads: usize, progress: &dyn Progre
             if let Ok(mut p) = pool.lock() {
                 p.extend(drawn);
             }
-            // 3. Crop to the changed box and LZW-compress in parallel.
+            // 3. Crop to the changed box and LZW-compress in parallel (one encoder per worker,
+            // its dictionary table kept from batch to batch).
             let mut frames = Vec::with_capacity(count);
             let deltas = &deltas;
             run_frames(
                 count,
                 threads,
-                || (),
-                |k, _| {
+                || Pooled::take(&encoders),
+                |k, lzw: &mut Pooled<Lzw>| {
                     let (left, top, fw, fh, buf, transparent) = if start + k == 0 {
                         (0, 0, w, h, deltas[0].clone(), None)
                     } else {
@@ -604,10 +640,11 @@ pub fn write_gif(film: &Film, path: &Path, threads: usize, progress: &dyn Progre
                         delay,
                         dispose: gif::DisposalMethod::Keep,
                         transparent,
-                        buffer: Cow::Owned(buf),
                         ..gif::Frame::default()
                     };
-                    frame.make_lzw_pre_encoded();
+                    let mut code = Vec::with_capacity(buf.len() / 4 + 16);
+                    lzw.get().encode_frame(&buf, &mut code);
+                    frame.buffer = Cow::Owned(code);
                     Ok(frame)
                 },
                 |_, frame| {
