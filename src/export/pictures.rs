@@ -39,7 +39,7 @@ use super::lzw::Lzw;
 use super::palette::{Lookup, Palette, TRANSPARENT};
 use super::raster::{Canvas, Mask};
 use super::sample::{self, BirdState};
-use super::scene::{self, Backdrop, Background, Style};
+use super::scene::{self, Backdrop, Background, SkyCache, Style};
 use super::RenderOptions;
 use crate::animation::Animation;
 use crate::error::{Error, Result};
@@ -67,6 +67,8 @@ pub struct Film {
     /// The birds' species (silhouette and plumage).
     pub species: Species,
     backdrop: Backdrop,
+    /// The GIF's scrolled sky, shared by the workers.
+    sky: SkyCache,
     gif_tolerance: i32,
     /// One cycle of a loop: the GIF's last frame is written exactly (no tolerance), so that the
     /// step back to the first frame (always drawn whole) is a true step.
@@ -121,6 +123,7 @@ impl Film {
             views,
             species,
             backdrop: Backdrop::new(width, height, &style, opts.background, anim.seed),
+            sky: SkyCache::default(),
             gif_tolerance: opts.gif_tolerance.round().clamp(0.0, 255.0) as i32,
             looped: anim.looped,
         }
@@ -146,10 +149,17 @@ impl Film {
         &self.backdrop
     }
 
-    /// Draws frame `k` into `canvas` (which must be `width × height`). `_for_gif` is kept for
-    /// callers of the earlier dithered renderer; pictures are the same for every output now.
-    pub fn draw(&self, k: usize, canvas: &mut Canvas, mask: &mut Mask, _for_gif: bool) {
-        self.backdrop.paint(&self.views[k], canvas);
+    /// Draws frame `k` into `canvas` (which must be `width × height`). With `for_gif` the
+    /// top-down sky's cloud layers are rendered once and scrolled by whole pixels
+    /// ([`Backdrop::paint_scrolled`]: the GIF's frames then repeat the sky exactly between
+    /// steps); without, every frame's sky is painted exactly (PNG frames, video).
+    pub fn draw(&self, k: usize, canvas: &mut Canvas, mask: &mut Mask, for_gif: bool) {
+        if for_gif {
+            self.backdrop
+                .paint_scrolled(&self.views[k], canvas, &self.sky);
+        } else {
+            self.backdrop.paint(&self.views[k], canvas);
+        }
         scene::draw_birds(canvas, &self.states[k], &self.views[k], self.species, mask);
     }
 
@@ -349,8 +359,61 @@ fn crop_changed(delta: &[u8], width: usize) -> (usize, usize, usize, usize, Vec<
 /// must change are looked up in the palette. A pixel's "own" index is its colour with the
 /// screen-fixed ordered dither ([`Lookup::index_dithered`]), except the colours in `plain` (the
 /// plumage, which the palette holds exactly) which are mapped undithered.
+///
+/// Runs of [`DELTA_BLOCK`] pixels whose colour is the same as in the previous frame and that
+/// hold nothing back are skipped whole: nothing to send there (the scrolled sky repeats
+/// exactly between its whole-pixel steps, so most of a frame is such runs).
 #[allow(clippy::too_many_arguments)]
 fn delta_step(
+    shown: &mut [u8],
+    dirty: &mut [u8],
+    first: bool,
+    rgba: &[u8],
+    prev: &[u8],
+    out: &mut [u8],
+    lookup: &mut Lookup,
+    palette: &Palette,
+    tolerance: i32,
+    catch_up: bool,
+    refresh: bool,
+    (start, width): (usize, usize),
+    plain: &[[u8; 3]],
+) {
+    let n = shown.len().min(dirty.len()).min(out.len());
+    let skip = !first && !catch_up;
+    let mut i = 0;
+    while i < n {
+        let e = (i + DELTA_BLOCK).min(n);
+        if skip && rgba[i * 4..e * 4] == prev[i * 4..e * 4] && dirty[i..e].iter().all(|&d| d == 0) {
+            out[i..e].fill(TRANSPARENT);
+        } else {
+            delta_pixels(
+                &mut shown[i..e],
+                &mut dirty[i..e],
+                first,
+                &rgba[i * 4..e * 4],
+                &prev[i * 4..e * 4],
+                &mut out[i..e],
+                lookup,
+                palette,
+                tolerance,
+                catch_up,
+                refresh,
+                (start + i, width),
+                plain,
+            );
+        }
+        i = e;
+    }
+}
+
+/// Pixels [`delta_step`] skips in one comparison when nothing changed there.
+const DELTA_BLOCK: usize = 32;
+
+/// [`delta_step`] pixel by pixel.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn delta_pixels(
     shown: &mut [u8],
     dirty: &mut [u8],
     first: bool,
