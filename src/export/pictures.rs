@@ -18,8 +18,11 @@
 //! one by more than the tolerance (plus half the dither and the palette's own error), and a
 //! pixel held back that way is set to its own colour once its true colour stops changing. The
 //! differencing is
-//! sequential in time but independent per pixel, so it runs in parallel over bands of rows;
-//! LZW compression runs in parallel over frames. GIF frame delays are whole hundredths of a
+//! sequential in time but independent per pixel, so it runs in parallel over bands of rows,
+//! and skips runs of pixels that repeat the previous frame (the top-down sky is scrolled by whole
+//! pixels, [`Backdrop::paint_scrolled`], so most of the sky repeats from frame to frame); LZW
+//! compression ([`super::lzw`], which matches a run of the transparent index in one step per
+//! code) runs in parallel over frames. GIF frame delays are whole hundredths of a
 //! second, so the GIF frame rate is `100 / round(100 / fps)`: 25 fps by default.
 //!
 //! **Video.** Raw RGBA frames are piped into `ffmpeg` (found on `PATH`, or at the path in the

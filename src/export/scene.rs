@@ -23,6 +23,16 @@
 //! camera a layer is a plane at a fixed height above the observer, intersected by each pixel's
 //! ray. The background is evaluated on a grid of one sample per [`GRID`] pixels and bilinearly
 //! interpolated, which makes it a few milliseconds per 960×540 frame.
+//!
+//! **Scrolled sky (GIF).** For the top-down cameras each cloud layer moves rigidly by its
+//! parallax times the camera's motion as long as the layer scale does not change, so the GIF
+//! renders each layer once into a tile larger than the picture ([`SkyCache`], at the layer scale
+//! rounded to steps of 1/1024 in log) and shifts it by whole pixels, the offset rounded once per
+//! frame ([`Backdrop::paint_scrolled`]). Both layers and the row's gradient are composed through
+//! a per-row table indexed by what the two layers let through, `(1 − a₀)(1 − a₁)`. Between two
+//! one-pixel steps the sky repeats exactly, which the GIF's frame differencing skips cheaply;
+//! the screen-fixed dither maps a repeated colour to the same entry, so nothing flickers. The
+//! ground camera and the sun glow keep the exact per-frame paint.
 
 use super::camera::View;
 use super::raster::{Canvas, Mask};
