@@ -575,7 +575,13 @@ impl Backdrop {
     /// step `key` (widened to whole grid cells): samples every [`GRID`] lattice points (aligned
     /// to multiples of `GRID`, so every tile interpolates the same samples) and bilinear between
     /// them.
-    fn make_tile(&self, l: usize, key: i64, sq: f64, x0: i64, y0: i64, w: usize, h: usize) -> Tile {
+    fn make_tile(
+        &self,
+        l: usize,
+        (key, sq): (i64, f64),
+        (x0, y0): (i64, i64),
+        (w, h): (usize, usize),
+    ) -> Tile {
         let g = GRID as i64;
         // Aligned to the grid: from a grid point, whole cells.
         let (gx0, gy0) = (x0.div_euclid(g), y0.div_euclid(g));
@@ -651,12 +657,9 @@ impl Backdrop {
         };
         let t = std::sync::Arc::new(self.make_tile(
             l,
-            key,
-            sq,
-            x - m as i64,
-            y - m as i64,
-            w + 2 * m,
-            h + 2 * m,
+            (key, sq),
+            (x - m as i64, y - m as i64),
+            (w + 2 * m, h + 2 * m),
         ));
         let mut tiles = cache.tiles[l].lock().unwrap_or_else(|e| e.into_inner());
         tiles.push(t.clone());
