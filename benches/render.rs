@@ -66,7 +66,7 @@ fn render(c: &mut Criterion) {
         let mut canvas = formation::export::raster::Canvas::new(960, 540);
         let mut mask = formation::export::raster::Mask::new();
         g.bench_function(format!("frame_960x540_{birds}_birds"), |b| {
-            b.iter(|| film.draw(k, &mut canvas, &mut mask, true))
+            b.iter(|| film.draw(k, &mut canvas, &mut mask, false))
         });
     }
     g.finish();

@@ -20,6 +20,7 @@ pub mod camera;
 pub mod crowd;
 pub mod gltf;
 pub mod keys;
+pub mod lzw;
 pub mod palette;
 pub mod pictures;
 pub mod raster;

@@ -18,8 +18,11 @@
 //! one by more than the tolerance (plus half the dither and the palette's own error), and a
 //! pixel held back that way is set to its own colour once its true colour stops changing. The
 //! differencing is
-//! sequential in time but independent per pixel, so it runs in parallel over bands of rows;
-//! LZW compression runs in parallel over frames. GIF frame delays are whole hundredths of a
+//! sequential in time but independent per pixel, so it runs in parallel over bands of rows,
+//! and skips runs of pixels that repeat the previous frame (the top-down sky is scrolled by whole
+//! pixels, [`Backdrop::paint_scrolled`], so most of the sky repeats from frame to frame); LZW
+//! compression ([`super::lzw`], which matches a run of the transparent index in one step per
+//! code) runs in parallel over frames. GIF frame delays are whole hundredths of a
 //! second, so the GIF frame rate is `100 / round(100 / fps)`: 25 fps by default.
 //!
 //! **Video.** Raw RGBA frames are piped into `ffmpeg` (found on `PATH`, or at the path in the
@@ -35,10 +38,11 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::mpsc;
 
 use super::camera::{self, CameraParams, View};
+use super::lzw::Lzw;
 use super::palette::{Lookup, Palette, TRANSPARENT};
 use super::raster::{Canvas, Mask};
 use super::sample::{self, BirdState};
-use super::scene::{self, Backdrop, Background, Style};
+use super::scene::{self, Backdrop, Background, SkyCache, Style};
 use super::RenderOptions;
 use crate::animation::Animation;
 use crate::error::{Error, Result};
@@ -66,6 +70,8 @@ pub struct Film {
     /// The birds' species (silhouette and plumage).
     pub species: Species,
     backdrop: Backdrop,
+    /// The GIF's scrolled sky, shared by the workers.
+    sky: SkyCache,
     gif_tolerance: i32,
     /// One cycle of a loop: the GIF's last frame is written exactly (no tolerance), so that the
     /// step back to the first frame (always drawn whole) is a true step.
@@ -120,6 +126,7 @@ impl Film {
             views,
             species,
             backdrop: Backdrop::new(width, height, &style, opts.background, anim.seed),
+            sky: SkyCache::default(),
             gif_tolerance: opts.gif_tolerance.round().clamp(0.0, 255.0) as i32,
             looped: anim.looped,
         }
@@ -145,10 +152,17 @@ impl Film {
         &self.backdrop
     }
 
-    /// Draws frame `k` into `canvas` (which must be `width × height`). `_for_gif` is kept for
-    /// callers of the earlier dithered renderer; pictures are the same for every output now.
-    pub fn draw(&self, k: usize, canvas: &mut Canvas, mask: &mut Mask, _for_gif: bool) {
-        self.backdrop.paint(&self.views[k], canvas);
+    /// Draws frame `k` into `canvas` (which must be `width × height`). With `for_gif` the
+    /// top-down sky's cloud layers are rendered once and scrolled by whole pixels
+    /// ([`Backdrop::paint_scrolled`]: the GIF's frames then repeat the sky exactly between
+    /// steps); without, every frame's sky is painted exactly (PNG frames, video).
+    pub fn draw(&self, k: usize, canvas: &mut Canvas, mask: &mut Mask, for_gif: bool) {
+        if for_gif {
+            self.backdrop
+                .paint_scrolled(&self.views[k], canvas, &self.sky);
+        } else {
+            self.backdrop.paint(&self.views[k], canvas);
+        }
         scene::draw_birds(canvas, &self.states[k], &self.views[k], self.species, mask);
     }
 
@@ -348,8 +362,61 @@ fn crop_changed(delta: &[u8], width: usize) -> (usize, usize, usize, usize, Vec<
 /// must change are looked up in the palette. A pixel's "own" index is its colour with the
 /// screen-fixed ordered dither ([`Lookup::index_dithered`]), except the colours in `plain` (the
 /// plumage, which the palette holds exactly) which are mapped undithered.
+///
+/// Runs of [`DELTA_BLOCK`] pixels whose colour is the same as in the previous frame and that
+/// hold nothing back are skipped whole: nothing to send there (the scrolled sky repeats
+/// exactly between its whole-pixel steps, so most of a frame is such runs).
 #[allow(clippy::too_many_arguments)]
 fn delta_step(
+    shown: &mut [u8],
+    dirty: &mut [u8],
+    first: bool,
+    rgba: &[u8],
+    prev: &[u8],
+    out: &mut [u8],
+    lookup: &mut Lookup,
+    palette: &Palette,
+    tolerance: i32,
+    catch_up: bool,
+    refresh: bool,
+    (start, width): (usize, usize),
+    plain: &[[u8; 3]],
+) {
+    let n = shown.len().min(dirty.len()).min(out.len());
+    let skip = !first && !catch_up;
+    let mut i = 0;
+    while i < n {
+        let e = (i + DELTA_BLOCK).min(n);
+        if skip && rgba[i * 4..e * 4] == prev[i * 4..e * 4] && dirty[i..e].iter().all(|&d| d == 0) {
+            out[i..e].fill(TRANSPARENT);
+        } else {
+            delta_pixels(
+                &mut shown[i..e],
+                &mut dirty[i..e],
+                first,
+                &rgba[i * 4..e * 4],
+                &prev[i * 4..e * 4],
+                &mut out[i..e],
+                lookup,
+                palette,
+                tolerance,
+                catch_up,
+                refresh,
+                (start + i, width),
+                plain,
+            );
+        }
+        i = e;
+    }
+}
+
+/// Pixels [`delta_step`] skips in one comparison when nothing changed there.
+const DELTA_BLOCK: usize = 32;
+
+/// [`delta_step`] pixel by pixel.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn delta_pixels(
     shown: &mut [u8],
     dirty: &mut [u8],
     first: bool,
@@ -468,6 +535,39 @@ fn loop_tolerance(base: i32, looped: bool, k: usize, total: usize, ramp: usize) 
     (base as f64 * left as f64 / ramp as f64).floor() as i32
 }
 
+/// A value borrowed from a pool for one worker of [`run_frames`], handed back when dropped.
+struct Pooled<'a, T: Default> {
+    item: Option<T>,
+    pool: &'a std::sync::Mutex<Vec<T>>,
+}
+
+impl<'a, T: Default> Pooled<'a, T> {
+    /// A value from `pool`, or a new one.
+    fn take(pool: &'a std::sync::Mutex<Vec<T>>) -> Self {
+        let item = pool
+            .lock()
+            .ok()
+            .and_then(|mut p| p.pop())
+            .unwrap_or_default();
+        Pooled {
+            item: Some(item),
+            pool,
+        }
+    }
+
+    fn get(&mut self) -> &mut T {
+        self.item.get_or_insert_with(T::default)
+    }
+}
+
+impl<T: Default> Drop for Pooled<'_, T> {
+    fn drop(&mut self) {
+        if let (Some(item), Ok(mut p)) = (self.item.take(), self.pool.lock()) {
+            p.push(item);
+        }
+    }
+}
+
 /// Writes an animated, looping GIF of `film` to `path` (atomically).
 pub fn write_gif(film: &Film, path: &Path, threads: usize, progress: &dyn Progress) -> Result<()> {
     let (w, h) = (film.width, film.height);
@@ -500,6 +600,7 @@ pub fn write_gif(film: &Film, path: &Path, threads: usize, progress: &dyn Progre
         let batch = gif_batch(w, h, threads);
         let mut deltas: Vec<Vec<u8>> = vec![vec![TRANSPARENT; w * h]; batch];
         let pool: std::sync::Mutex<Vec<Vec<u8>>> = std::sync::Mutex::new(Vec::new());
+        let encoders: std::sync::Mutex<Vec<Lzw>> = std::sync::Mutex::new(Vec::new());
         for start in (0..film.len()).step_by(batch) {
             let count = batch.min(film.len() - start);
             // 1. Draw the batch in parallel (into buffers reused from earlier batches).
@@ -582,14 +683,15 @@ pub fn write_gif(film: &Film, path: &Path, threads: usize, progress: &dyn Progre
             if let Ok(mut p) = pool.lock() {
                 p.extend(drawn);
             }
-            // 3. Crop to the changed box and LZW-compress in parallel.
+            // 3. Crop to the changed box and LZW-compress in parallel (one encoder per worker,
+            // its dictionary table kept from batch to batch).
             let mut frames = Vec::with_capacity(count);
             let deltas = &deltas;
             run_frames(
                 count,
                 threads,
-                || (),
-                |k, _| {
+                || Pooled::take(&encoders),
+                |k, lzw: &mut Pooled<Lzw>| {
                     let (left, top, fw, fh, buf, transparent) = if start + k == 0 {
                         (0, 0, w, h, deltas[0].clone(), None)
                     } else {
@@ -604,10 +706,11 @@ pub fn write_gif(film: &Film, path: &Path, threads: usize, progress: &dyn Progre
                         delay,
                         dispose: gif::DisposalMethod::Keep,
                         transparent,
-                        buffer: Cow::Owned(buf),
                         ..gif::Frame::default()
                     };
-                    frame.make_lzw_pre_encoded();
+                    let mut code = Vec::with_capacity(buf.len() / 4 + 16);
+                    lzw.get().encode_frame(&buf, &mut code);
+                    frame.buffer = Cow::Owned(code);
                     Ok(frame)
                 },
                 |_, frame| {

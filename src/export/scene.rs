@@ -23,6 +23,16 @@
 //! camera a layer is a plane at a fixed height above the observer, intersected by each pixel's
 //! ray. The background is evaluated on a grid of one sample per [`GRID`] pixels and bilinearly
 //! interpolated, which makes it a few milliseconds per 960×540 frame.
+//!
+//! **Scrolled sky (GIF).** For the top-down cameras each cloud layer moves rigidly by its
+//! parallax times the camera's motion as long as the layer scale does not change, so the GIF
+//! renders each layer once into a tile larger than the picture ([`SkyCache`], at the layer scale
+//! rounded to steps of 1/1024 in log) and shifts it by whole pixels, the offset rounded once per
+//! frame ([`Backdrop::paint_scrolled`]). Both layers and the row's gradient are composed through
+//! a per-row table indexed by what the two layers let through, `(1 − a₀)(1 − a₁)`. Between two
+//! one-pixel steps the sky repeats exactly, which the GIF's frame differencing skips cheaply;
+//! the screen-fixed dither maps a repeated colour to the same entry, so nothing flickers. The
+//! ground camera and the sun glow keep the exact per-frame paint.
 
 use super::camera::View;
 use super::raster::{Canvas, Mask};
@@ -472,6 +482,246 @@ impl Backdrop {
     }
 }
 
+/// Steps of the top-down layer scale at which the scrolled sky is rendered, in natural log:
+/// the layer scale is rounded to `e^(k/1024)`, so a zoom shows the far edge of a 960-pixel
+/// picture at most a quarter of a pixel off (our choice: under the half pixel the scroll rounds).
+const SCALE_STEP: f64 = 1.0 / 1024.0;
+/// Cloud opacity in the scrolled tiles: fixed point with this many fraction bits.
+const ALPHA_BITS: u32 = 12;
+/// Pixels of layer rendered beyond each edge of the picture when a tile is first made for a
+/// scale, and when the picture has scrolled out of the one before at the same scale (a zoom
+/// changes the scale every few frames, steady flight never). Our choice.
+const TILE_MARGIN: (usize, usize) = (8, 384);
+/// Tiles kept per layer (workers a few frames apart may need two). Our choice.
+const TILES_KEPT: usize = 3;
+
+/// One cloud layer's opacity over a rectangle of the layer's own pixel lattice at one quantised
+/// scale: a pure function of the lattice point and the scale, whichever frame made it.
+#[derive(Debug)]
+struct Tile {
+    /// Quantised layer scale, steps of [`SCALE_STEP`].
+    key: i64,
+    /// Lattice point of the tile's first sample.
+    x0: i64,
+    y0: i64,
+    w: usize,
+    h: usize,
+    /// Opacity (layer opacity × [`Style::cloud_opacity`] included), 0..=255.
+    alpha: Vec<u8>,
+}
+
+impl Tile {
+    fn covers(&self, key: i64, x: i64, y: i64, w: usize, h: usize) -> bool {
+        self.key == key
+            && x >= self.x0
+            && y >= self.y0
+            && x + w as i64 <= self.x0 + self.w as i64
+            && y + h as i64 <= self.y0 + self.h as i64
+    }
+}
+
+/// The top-down sky, each cloud layer rendered once per scale and scrolled by whole pixels
+/// ([`Backdrop::paint_scrolled`]); shared by the workers drawing one film. Everything it holds
+/// is a pure function of the backdrop and the scale, so what is painted does not depend on
+/// which worker made a tile or in which order frames were drawn.
+#[derive(Debug, Default)]
+pub struct SkyCache {
+    /// Each row's colours under the clouds, made on first use: entry `i` of row `r` is the row's
+    /// sky colour seen through clouds that let `(256 i + 128)/255²` of it through (both layers
+    /// together: a far layer of opacity `a₀` under a near one of `a₁` lets `(1 − a₀)(1 − a₁)`
+    /// through, and the cloud colour makes up the rest), as RGBA bytes.
+    rows: std::sync::OnceLock<Vec<[u8; 4]>>,
+    /// Recent tiles of each layer, newest last.
+    tiles: [std::sync::Mutex<Vec<std::sync::Arc<Tile>>>; 2],
+}
+
+impl Backdrop {
+    /// The quantised layer scale's step number and value for the bird scale `scale`.
+    fn quantised_scale(&self, scale: f64) -> (i64, f64) {
+        let s = self.style.layer_scale(scale);
+        let key = (s.ln() / SCALE_STEP).round() as i64;
+        (key, (key as f64 * SCALE_STEP).exp())
+    }
+
+    /// Screen offset of layer `l`'s lattice for the top-down view centred on `(cx, cy)` at the
+    /// quantised layer scale `sq`: pixel `(col, row)` shows lattice point
+    /// `(col + ox, row − oy)`. Rounded once per frame, so the layer moves rigidly by whole pixels.
+    fn lattice_offset(&self, l: usize, cx: f64, cy: f64, sq: f64) -> (i64, i64) {
+        let p = self.style.layers[l].parallax;
+        (floor_i(p * cx * sq + 0.5), floor_i(p * cy * sq + 0.5))
+    }
+
+    /// Opacity (times [`Style::cloud_opacity`]) of layer `l` at lattice sample `(x, y)` of the
+    /// quantised layer scale `sq`.
+    fn lattice_alpha(&self, l: usize, sq: f64, x: i64, y: i64) -> f32 {
+        let layer = &self.style.layers[l];
+        let seed = self.seed.wrapping_mul(31).wrapping_add(l as u64 + 1);
+        let k = 1.0 / (sq * layer.size);
+        let u = (x as f64 + 0.5 - 0.5 * self.width as f64) * k;
+        let v = (0.5 * self.height as f64 - (y as f64 + 0.5)) * k;
+        let n = cloud_noise_within(
+            u / layer.stretch,
+            v,
+            GRID as f64 * k,
+            seed,
+            (layer.threshold, layer.threshold + layer.softness),
+        );
+        smoothstep((n - layer.threshold) / layer.softness)
+            * layer.opacity
+            * self.style.cloud_opacity
+    }
+
+    /// Renders layer `l` over at least the lattice points `x0.. x0 + w`, `y0 .. y0 + h` at scale
+    /// step `key` (widened to whole grid cells): samples every [`GRID`] lattice points (aligned
+    /// to multiples of `GRID`, so every tile interpolates the same samples) and bilinear between
+    /// them.
+    fn make_tile(
+        &self,
+        l: usize,
+        (key, sq): (i64, f64),
+        (x0, y0): (i64, i64),
+        (w, h): (usize, usize),
+    ) -> Tile {
+        let g = GRID as i64;
+        // Aligned to the grid: from a grid point, whole cells.
+        let (gx0, gy0) = (x0.div_euclid(g), y0.div_euclid(g));
+        let (x0, y0) = (gx0 * g, gy0 * g);
+        let (w, h) = (
+            w.div_ceil(GRID) * GRID + GRID,
+            h.div_ceil(GRID) * GRID + GRID,
+        );
+        let (gw, gh) = (w / GRID + 1, h / GRID + 1);
+        let one = (1u32 << ALPHA_BITS) as f32;
+        let mut grid = vec![0i32; gw * gh];
+        for j in 0..gh {
+            for i in 0..gw {
+                let a = self.lattice_alpha(l, sq, (gx0 + i as i64) * g, (gy0 + j as i64) * g);
+                grid[j * gw + i] = (a * one).round() as i32;
+            }
+        }
+        const SH: u32 = GRID.trailing_zeros();
+        const ROUND: i32 = 1 << (ALPHA_BITS + 2 * SH - 1);
+        let mut alpha = vec![0u8; w * h];
+        let mut line = vec![0i32; gw];
+        for (r, out) in alpha.chunks_exact_mut(w).enumerate() {
+            let (j, fy) = (r / GRID, (r % GRID) as i32);
+            let (a, b) = (
+                &grid[j * gw..(j + 1) * gw],
+                &grid[(j + 1) * gw..(j + 2) * gw],
+            );
+            for ((l, &p), &q) in line.iter_mut().zip(a).zip(b) {
+                *l = (p << SH) + (q - p) * fy;
+            }
+            // Whole cells of GRID pixels (the tile is aligned to the grid).
+            for (cell, pair) in out.chunks_exact_mut(GRID).zip(line.windows(2)) {
+                let (p, d) = (pair[0] << SH, pair[1] - pair[0]);
+                for (fx, o) in cell.iter_mut().enumerate() {
+                    let v = (p + d * fx as i32).max(0);
+                    // Fixed point ALPHA_BITS + 2·SH bits to 0..=255, rounded.
+                    *o = ((v * 255 + ROUND) >> (ALPHA_BITS + 2 * SH)).min(255) as u8;
+                }
+            }
+        }
+        Tile {
+            key,
+            x0,
+            y0,
+            w,
+            h,
+            alpha,
+        }
+    }
+
+    /// The tile of layer `l` at scale step `key` holding the picture's lattice window from
+    /// `(x, y)`, from `cache` or newly made (and kept).
+    fn tile(
+        &self,
+        cache: &SkyCache,
+        l: usize,
+        (key, sq): (i64, f64),
+        x: i64,
+        y: i64,
+    ) -> std::sync::Arc<Tile> {
+        let (w, h) = (self.width, self.height);
+        let same_scale = {
+            let tiles = cache.tiles[l].lock().unwrap_or_else(|e| e.into_inner());
+            if let Some(t) = tiles.iter().rev().find(|t| t.covers(key, x, y, w, h)) {
+                return t.clone();
+            }
+            tiles.iter().any(|t| t.key == key)
+        };
+        let m = if same_scale {
+            TILE_MARGIN.1
+        } else {
+            TILE_MARGIN.0
+        };
+        let t = std::sync::Arc::new(self.make_tile(
+            l,
+            (key, sq),
+            (x - m as i64, y - m as i64),
+            (w + 2 * m, h + 2 * m),
+        ));
+        let mut tiles = cache.tiles[l].lock().unwrap_or_else(|e| e.into_inner());
+        tiles.push(t.clone());
+        if tiles.len() > TILES_KEPT {
+            tiles.remove(0);
+        }
+        t
+    }
+
+    /// [`Backdrop::paint`], with the top-down sky's cloud layers rendered once per scale into
+    /// `cache` and scrolled by whole pixels (parallax kept: each layer by its own offset), for
+    /// the GIF: the clouds move in whole-pixel steps, so the frames between steps repeat the sky
+    /// exactly and the frame differencing finds nothing to write there. Within a quarter of a
+    /// pixel of zoom and half a pixel of position of [`Backdrop::paint`], and a few levels of
+    /// colour (measured in the tests). The ground camera and plain backgrounds paint as
+    /// [`Backdrop::paint`].
+    pub fn paint_scrolled(&self, view: &View, canvas: &mut Canvas, cache: &SkyCache) {
+        let View::Top { cx, cy, scale } = *view else {
+            return self.paint(view, canvas);
+        };
+        if self.background != Background::Sky || self.style.sun {
+            // The sun glow is not the same along a row: painted per frame.
+            return self.paint(view, canvas);
+        }
+        let (w, h) = (self.width, self.height);
+        let cloud = self.style.cloud.map(|c| c as f64);
+        let rows = cache.rows.get_or_init(|| {
+            let mut v = Vec::with_capacity(h * 256);
+            for r in 0..h {
+                let b = self.sky_at(view, 0.5, r as f64 + 0.5);
+                for i in 0..256 {
+                    let t = (256.0 * i as f64 + 128.0) / 65025.0;
+                    let c = [0, 1, 2]
+                        .map(|k| (cloud[k] - (cloud[k] - b[k] as f64) * t.min(1.0)).round());
+                    v.push([c[0] as u8, c[1] as u8, c[2] as u8, 255]);
+                }
+            }
+            v
+        });
+        let q = self.quantised_scale(scale);
+        let (o0, o1) = (
+            self.lattice_offset(0, cx, cy, q.1),
+            self.lattice_offset(1, cx, cy, q.1),
+        );
+        let t0 = self.tile(cache, 0, q, o0.0, -o0.1);
+        let t1 = self.tile(cache, 1, q, o1.0, -o1.1);
+        for r in 0..h {
+            let i0 = (-o0.1 + r as i64 - t0.y0) as usize * t0.w + (o0.0 - t0.x0) as usize;
+            let i1 = (-o1.1 + r as i64 - t1.y0) as usize * t1.w + (o1.0 - t1.x0) as usize;
+            let a0 = &t0.alpha[i0..i0 + w];
+            let a1 = &t1.alpha[i1..i1 + w];
+            let lut = &rows[r * 256..(r + 1) * 256];
+            let out = &mut canvas.rgba[r * w * 4..(r + 1) * w * 4];
+            for ((px, &p), &q) in out.chunks_exact_mut(4).zip(a0).zip(a1) {
+                // What both layers let through, 0..=65025, to 0..=254.
+                let t = (255 - p as u32) * (255 - q as u32);
+                px.copy_from_slice(&lut[(t >> 8) as usize]);
+            }
+        }
+    }
+}
+
 /// Draws every bird of `birds` (of `species`) for `view` on `canvas`, far ones first.
 pub fn draw_birds(
     canvas: &mut Canvas,
@@ -632,5 +882,80 @@ mod tests {
                 / 200.0;
             assert!(diff > 0.03, "period {period}: {diff}");
         }
+    }
+}
+
+#[cfg(test)]
+mod scrolled_tests {
+    use super::*;
+
+    /// Largest and mean channel difference between the scrolled and the exact sky, and the
+    /// share of pixels more than 4 levels apart.
+    fn compare(bd: &Backdrop, cache: &SkyCache, view: &View) -> (i32, f64, f64) {
+        let (w, h) = (bd.width, bd.height);
+        let (mut a, mut b) = (Canvas::new(w, h), Canvas::new(w, h));
+        bd.paint(view, &mut a);
+        bd.paint_scrolled(view, &mut b, cache);
+        let (mut worst, mut sum, mut over) = (0, 0.0, 0usize);
+        for (p, q) in a.rgba.chunks_exact(4).zip(b.rgba.chunks_exact(4)) {
+            let d = (0..3)
+                .map(|k| (p[k] as i32 - q[k] as i32).abs())
+                .max()
+                .unwrap();
+            worst = worst.max(d);
+            sum += d as f64;
+            over += (d > 4) as usize;
+        }
+        (worst, sum / (w * h) as f64, over as f64 / (w * h) as f64)
+    }
+
+    #[test]
+    fn scrolled_sky_stays_near_the_exact_one_and_does_not_depend_on_what_came_before() {
+        let st = Style::default();
+        let bd = Backdrop::new(480, 270, &st, Background::Sky, 11);
+        let cache = SkyCache::default();
+        let views: Vec<View> = (0..40)
+            .map(|i| View::Top {
+                cx: 3.7 * i as f64 - 50.0,
+                cy: 1.3 * i as f64 + 20.0,
+                scale: 12.0 + 0.37 * (i / 8) as f64,
+            })
+            .collect();
+        let mut worst = (0, 0.0f64, 0.0f64);
+        for v in &views {
+            let (m, mean, over) = compare(&bd, &cache, v);
+            worst = (worst.0.max(m), worst.1.max(mean), worst.2.max(over));
+        }
+        eprintln!(
+            "scrolled vs exact: largest {} levels, mean up to {:.3}, over 4 levels {:.4} %",
+            worst.0,
+            worst.1,
+            100.0 * worst.2
+        );
+        assert!(
+            worst.0 <= 10 && worst.1 < 1.0 && worst.2 < 0.001,
+            "{worst:?}"
+        );
+        // The same view painted from a fresh cache and from one that has seen other views.
+        for v in [&views[5], &views[39], &views[17]] {
+            let (mut a, mut b) = (Canvas::new(480, 270), Canvas::new(480, 270));
+            bd.paint_scrolled(v, &mut a, &SkyCache::default());
+            bd.paint_scrolled(v, &mut b, &cache);
+            assert!(a.rgba == b.rgba);
+        }
+        // A still camera repeats the sky exactly; a step of a tenth of a pixel moves no cloud.
+        let (mut a, mut b) = (Canvas::new(480, 270), Canvas::new(480, 270));
+        let at = |cx: f64| View::Top {
+            cx,
+            cy: 0.0,
+            scale: 16.0,
+        };
+        bd.paint_scrolled(&at(100.0), &mut a, &cache);
+        bd.paint_scrolled(
+            &at(100.0 + 0.1 / (0.12 * st.layer_scale(16.0))),
+            &mut b,
+            &cache,
+        );
+        assert!(a.rgba == b.rgba);
     }
 }
