@@ -985,7 +985,7 @@ fn strays() {
 /// pelican 0.23 wingspans/s at their typical wingspans): above the burst climb after lift-off
 /// (the lowest 2 wingspans) no frame climbs faster, the climb
 /// reaches that rate, and the take-off lasts what the plan expects of it (the climb to 10
-/// wingspans dominating: about 24, 36 and 47 s), within 10 %.
+/// wingspans dominating: about 21, 32 and 41 s from the first run), within 10 %.
 #[test]
 fn the_default_climb_is_the_species_power_limited_climb() {
     use formation::aero::flight::Morphology;
