@@ -800,8 +800,18 @@ pub fn initiate_stage(
     config: &Config,
     progress: &dyn Progress,
 ) -> Result<(Animation, InitiateStats)> {
+    // The climb after lift-off: the option, or the power-limited climb of the species the
+    // wingbeats will be of (the steady flight does not name it yet).
+    let cruise = initiate::Cruise::of_birds(
+        0.0,
+        1.0,
+        config.wingbeat.species,
+        steady.wingspan_m,
+        steady.flight.and_then(|f| f.mass_kg),
+    );
     let opts = InitiateOptions {
         seed: config.seed,
+        climb_rate: Some(config.initiate.climb_rate_for(&cruise)),
         ..config.initiate.clone()
     };
     opts.validate()?;

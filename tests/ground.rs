@@ -110,7 +110,8 @@ fn check_on_the_rig(anim: &Animation, species: Species) -> f32 {
             let low = lowest_vertex(&asset, &pose, flight.bank[k], root, flight.yaw[k]);
             assert!(
                 low >= -1e-4,
-                "bird {b} frame {k}: a vertex {low} wingspans under the ground"
+                "bird {b} frame {k}: a vertex {low} wingspans under the ground; z {} v {} bank {} root {root:?} pose {pose:?} {}",
+                f.z[b], f.speed[b], flight.bank[k], anim.species.clone().unwrap_or_default()
             );
             lowest_all = lowest_all.min(low);
         }

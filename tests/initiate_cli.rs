@@ -130,7 +130,7 @@ fn bad_input_is_exit_2_with_one_line() {
             vec!["initiate", s, "-o", o, "--climb-rate", "0"],
             "--climb-rate",
         ),
-        // Higher than the birds can climb within the time limit (2.5 wingspans/s, 300 s): the
+        // Higher than the birds can climb within the time limit (0.51 wingspans/s, 300 s): the
         // highest reachable altitude is given, up front (before: 300 s of simulation, then
         // "did not converge").
         (
@@ -139,7 +139,7 @@ fn bad_input_is_exit_2_with_one_line() {
         ),
         (
             vec!["initiate", s, "-o", o, "--cruise-altitude", "10000"],
-            "at most about 665 wingspans",
+            "at most about 136 wingspans",
         ),
         (
             vec![
@@ -152,7 +152,7 @@ fn bad_input_is_exit_2_with_one_line() {
                 "--max-seconds",
                 "100",
             ],
-            "at most about 215 wingspans",
+            "at most about 44 wingspans",
         ),
         (
             vec![

@@ -316,15 +316,15 @@ fn on_a_path_the_flock_comes_to_rest_at_its_end() {
 fn a_shot_length_cuts_the_steady_flight_so_that_the_landing_ends_it() {
     let mut c = Config {
         seed: 4,
-        shot_seconds: Some(30.0),
+        shot_seconds: Some(45.0),
         land: true,
         ..Config::default()
     };
     c.steady.birds = 9;
     let geese = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples_data/barnacle_geese_v.json");
     let (anim, _) = Pipeline::from_path(geese).run(&c).expect("lands");
-    assert_eq!(anim.frames.len(), 900);
-    assert_eq!(anim.stage("landing").map(|s| s.end), Some(900));
+    assert_eq!(anim.frames.len(), 1350);
+    assert_eq!(anim.stage("landing").map(|s| s.end), Some(1350));
     assert!(anim.frames.last().unwrap().speed.iter().all(|&v| v == 0.0));
     // Too short for the take-off and the landing: refused, naming the shot's length.
     c.shot_seconds = Some(12.0);

@@ -322,6 +322,8 @@ fn shot_seconds_is_the_whole_shot_to_the_frame() {
             shot_seconds: Some(shot),
             ..Config::default()
         };
+        // The fast climb, a take-off of about 10 s (the shot's length is what is tested).
+        c.initiate.climb_rate = Some(2.5);
         c.steady.birds = 9;
         c.steady.fps = fps;
         let a = Pipeline::from_path(example("barnacle_geese_v.json"))
@@ -369,6 +371,8 @@ fn shot_flags_on_the_command_line() {
             s(&geese),
             "--birds",
             "9",
+            "--climb-rate",
+            "2.5",
             "--quiet",
             "-o",
             s(&out),

@@ -160,6 +160,8 @@ def animate(
     path: str | _os.PathLike | None = None,
     initiation: bool = True,
     progress: _Any = False,
+    land: bool = False,
+    land_on: str | None = None,
     **options: _Any,
 ) -> Animation:
     """The whole pipeline: extraction, steady flight, take-off, wingbeats, savings.
@@ -169,7 +171,10 @@ def animate(
     ``seconds``: length of the steady flight (None: the library's default, 20 s). ``seed``:
     equal seeds and inputs give identical motion, the same as ``formation animate --seed``.
     ``path``: a JSON or CSV file of the leader's path (the ``course.path`` option).
-    ``initiation``: fly the take-off first (False: the steady flight alone). ``progress``:
+    ``initiation``: fly the take-off first (False: the steady flight alone). ``land``: end
+    with a landing stage (glide, flare, touch-down, rest; at the path's end with ``path``), the
+    same as ``formation animate --land``; ``land_on``: ``"ground"`` (the default) or
+    ``"water"`` (implies ``land``; the ``landing.surface`` option). ``progress``:
     False (the default) shows nothing; True shows a progress bar: the command line's on a
     terminal, elsewhere (a notebook) a tqdm bar per stage when tqdm is installed, else one
     line on ``sys.stderr`` rewritten in place; a callable is called as
@@ -200,6 +205,12 @@ def animate(
         pairs.append(("seconds", _json.dumps(float(seconds))))
     if path is not None:
         pairs.append(("course.path", _json.dumps(_os.fspath(path))))
+    if land or land_on is not None:
+        pairs.append(("land", _json.dumps(True)))
+    if land_on is not None:
+        if not isinstance(land_on, str):
+            raise ValueError(f"landing.surface: expected 'ground' or 'water', got {land_on!r}")
+        pairs.append(("landing.surface", _json.dumps(land_on)))
     if isinstance(input, _os.PathLike):
         input = _os.fspath(input)
     if callable(progress):

@@ -95,6 +95,8 @@ def animate(
     path: _Path | None = None,
     initiation: bool = True,
     progress: bool | Callable[[str, int, int], object] = False,
+    land: bool = False,
+    land_on: str | None = None,
     **options: Any,
 ) -> Animation: ...
 def read_animation(path: _Path) -> Animation: ...

@@ -78,6 +78,31 @@ def test_same_seed_same_motion_and_another_seed_differs():
     assert a.positions.shape != c.positions.shape or not np.array_equal(a.positions, c.positions)
 
 
+def test_land_and_land_on_end_in_a_landing_at_rest(tmp_path):
+    # land=True: a final 'landing' stage, the flock at rest on the ground at the end; the same
+    # motion as the command line's --land.
+    a = formation.animate(EXAMPLE, birds=5, seconds=2, seed=4, land=True)
+    name, start, end = a.stages[-1]
+    assert name == "landing" and end == len(a) and start < end
+    assert (a.speeds[-1] == 0).all()
+    assert (a.positions[-1, :, 2] >= 0).all() and (a.positions[-1, :, 2] < 0.5).all()
+    out = tmp_path / "land.json"
+    cli("animate", EXAMPLE, "--birds", 5, "--seconds", 2, "--seed", 4, "--land", "--quiet", "-o", out)
+    doc = json.loads(out.read_text())
+    want = np.array([[f["x"], f["y"], f["z"]] for f in doc["frames"]]).transpose(0, 2, 1)
+    np.testing.assert_array_equal(a.positions, want)
+    # land_on="water" lands on water (implies land): bodies float, lower than on the ground.
+    w = formation.animate(EXAMPLE, birds=5, seconds=2, seed=4, land_on="water")
+    assert w.stages[-1][0] == "landing"
+    assert (w.speeds[-1] == 0).all()
+    assert w.positions[-1, :, 2].mean() < a.positions[-1, :, 2].mean()
+    # Without land: no landing stage.
+    assert formation.animate(EXAMPLE, birds=5, seconds=2, seed=4).stages[-1][0] == "steady"
+    # A surface the library does not know is a ValueError naming the option.
+    with pytest.raises(ValueError, match="landing.surface"):
+        formation.animate(EXAMPLE, birds=5, seconds=2, seed=4, land_on="lava")
+
+
 def test_options_by_path_and_by_section():
     a = formation.animate(EXAMPLE, birds=5, seconds=2, initiation=False, **{"steady.fps": 10})
     b = formation.animate(EXAMPLE, birds=5, seconds=2, initiation=False, steady={"fps": 10})

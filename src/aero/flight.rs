@@ -229,6 +229,14 @@ impl PowerCurve {
         ((avail - self.at(v).total()) / self.weight()).max(0.0)
     }
 
+    /// The best power-limited climb rate, m/s: [`PowerCurve::climb_rate`] at the minimum-power
+    /// speed with the margin [`CLIMB_POWER_MARGIN`] (goose 0.76, crane 0.67, pelican 0.67 m/s for
+    /// the presets' typical birds). The take-off's default climb after lift-off
+    /// (docs/initiation.md).
+    pub fn best_climb_rate(&self) -> f64 {
+        self.climb_rate(self.minimum_power_speed(), CLIMB_POWER_MARGIN)
+    }
+
     /// The minimum-power speed of the total curve (with profile power constant, the same as
     /// [`PowerCurve::minimum_power_speed`]).
     pub fn cruise_default(&self) -> f64 {

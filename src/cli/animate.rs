@@ -105,7 +105,10 @@ pub fn run(args: AnimateArgs, g: Global) -> Result<()> {
     // The take-off's length (and the --takeoff warning) is its largest formation's; the whole
     // flock's memory bound is checked by `config.validate()` below.
     let takeoff_birds = config.takeoff_birds();
-    config.initiate = args.initiate.options(g.seed, takeoff_birds)?;
+    let species = args.wingbeat.options()?.species;
+    let cruise =
+        formation::initiate::Cruise::of_birds(0.0, 1.0, species, config.steady.wingspan_m, None);
+    config.initiate = args.initiate.options(g.seed, takeoff_birds, &cruise)?;
     config.course = args.path.options();
     args.land.apply(&mut config);
     if args.no_initiation {

@@ -4,9 +4,10 @@
 use std::path::PathBuf;
 
 use clap::{Args, ValueEnum};
+use formation::animation::wing::Species;
 use formation::animation::Animation;
 use formation::initiate::{
-    self, GroundStart, InitiateOptions, PerceptionMode, Start, StartChoice, StartRegion,
+    self, Cruise, GroundStart, InitiateOptions, PerceptionMode, Start, StartChoice, StartRegion,
     TakeoffPlan, HPR_GAMMA_DEFAULT,
 };
 use formation::io::OutputKind;
@@ -74,11 +75,28 @@ fn start_depth_help() -> String {
     )
 }
 
-/// The help of `--takeoff`, with the library's natural and shortest take-offs for two flock sizes.
-fn takeoff_help() -> String {
-    let (nat, short) = (TakeoffPlan::natural_seconds, TakeoffPlan::shortest_seconds);
+/// The help of `--climb-rate`, with the species' power-limited climbs at their typical wingspans.
+fn climb_rate_help() -> String {
+    let w = |sp: Species| {
+        let b = formation::aero::flight::Morphology::of(sp).span_m;
+        Cruise::power_climb(sp, b, None)
+    };
     format!(
-        "Take-off duration, seconds: the birds start closer or farther apart and drive harder or softer to form in about this time; outside what the flock can fly a warning gives the duration it will have [default: the natural one, {:.1} s for 14 birds and {:.1} s for 100; the shortest about {:.1} and {:.1} s; `--json` reports it as planned_seconds]",
+        "Largest climb rate after lift-off, wingspans per second, scaled by the take-off's drive [default: the species' power-limited climb: goose {:.2}, crane {:.2}, pelican {:.2} at their typical wingspans]",
+        w(Species::Goose),
+        w(Species::Crane),
+        w(Species::Pelican)
+    )
+}
+
+/// The help of `--takeoff`, with the library's natural and shortest take-offs for two flock sizes
+/// of geese.
+fn takeoff_help() -> String {
+    let (o, c) = (InitiateOptions::default(), Cruise::new(0.0, 10.0));
+    let nat = |n| TakeoffPlan::natural_seconds(n, &o, &c);
+    let short = |n| TakeoffPlan::shortest_seconds(n, &o, &c);
+    format!(
+        "Take-off duration, seconds: the birds start closer or farther apart and drive harder or softer to form in about this time; outside what the flock can fly a warning gives the duration it will have [default: the natural one, for geese {:.1} s for 14 birds and {:.1} s for 100; the shortest about {:.1} and {:.1} s; `--json` reports it as planned_seconds]",
         nat(14),
         nat(100),
         short(14),
@@ -134,8 +152,8 @@ pub struct InitiateFlags {
     #[arg(long, allow_negative_numbers = true, default_value_t = d().cruise_altitude)]
     pub cruise_altitude: f64,
     /// Largest climb rate after lift-off, wingspans per second (scaled by the take-off's drive).
-    #[arg(long, allow_negative_numbers = true, default_value_t = d().climb_rate)]
-    pub climb_rate: f64,
+    #[arg(long, allow_negative_numbers = true, help = climb_rate_help())]
+    pub climb_rate: Option<f64>,
     /// Occlusion model.
     #[arg(long, value_enum, default_value_t = PerceptionArg::of(&d().perception.mode))]
     pub perception: PerceptionArg,
@@ -212,8 +230,9 @@ impl PerceptionArg {
 impl InitiateFlags {
     /// The library options these flags describe, checked by the library
     /// ([`InitiateOptions::validate`]; its errors name option paths, which the command line
-    /// turns into these flags). A take-off duration the rules cannot reach is warned about.
-    pub fn options(&self, seed: u64, birds: usize) -> Result<InitiateOptions> {
+    /// turns into these flags). A take-off duration the rules cannot reach for birds of `cruise`
+    /// (their climb) is warned about.
+    pub fn options(&self, seed: u64, birds: usize, cruise: &Cruise) -> Result<InitiateOptions> {
         let def = InitiateOptions::default();
         let mut o = InitiateOptions {
             seed,
@@ -254,7 +273,7 @@ impl InitiateFlags {
         )?;
         o.validate()?;
         initiate::check_size(birds, 0, o.max_steps)?;
-        if let Some(w) = TakeoffPlan::warning(birds, &o) {
+        if let Some(w) = TakeoffPlan::warning(birds, &o, cruise) {
             super::stdout::warning(&super::flags::rewrite(Cmd::Initiate, &w));
         }
         Ok(o)
@@ -269,7 +288,12 @@ pub fn run(args: InitiateArgs, g: Global) -> Result<()> {
     if steady.formations.is_none() {
         initiate::check_steady(&steady, &args.steady)?;
     }
-    let mut opts = args.initiate.options(g.seed, steady.birds)?;
+    // The climb after lift-off is the power-limited climb of the species the output is made
+    // of (its wingbeats), unless --climb-rate gives one.
+    let mass = steady.flight.and_then(|f| f.mass_kg);
+    let cruise = Cruise::of_birds(0.0, 1.0, wing.species, steady.wingspan_m, mass);
+    let mut opts = args.initiate.options(g.seed, steady.birds, &cruise)?;
+    opts.climb_rate = Some(opts.climb_rate_for(&cruise));
     // The take-off climbs to the path's first point, then the course step maps the
     // whole flight onto the path.
     let mut course = super::course::course_config(&args.path, &steady, &args.steady, &mut opts)?;

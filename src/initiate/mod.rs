@@ -46,6 +46,7 @@ use glam::{DVec2, DVec3};
 use rand::Rng;
 use serde::{Deserialize, Serialize};
 
+use crate::animation::wing::Species;
 use crate::animation::{Animation, Frame, Stage};
 use crate::error::{Error, Result};
 use crate::progress::Progress;
@@ -325,7 +326,8 @@ pub fn simulate(
 }
 
 /// The target shape and cruise of a steady flight (the leader's heading and speed in the first
-/// frame, the file's wingspan).
+/// frame, the file's wingspan, and the climb of its species, a goose when it names none, and
+/// mass).
 pub fn steady_target(steady: &Animation) -> Result<(TargetShape, Cruise)> {
     let ks = steady.key_shapes.first().ok_or_else(|| {
         Error::parameter(
@@ -341,13 +343,15 @@ pub fn steady_target(steady: &Animation) -> Result<(TargetShape, Cruise)> {
         .ok_or_else(|| Error::parameter("frames", "the steady flight has no frames"))?;
     let heading = f0.heading.get(target.leader).copied().unwrap_or(0.0);
     let speed = f0.speed.get(target.leader).copied().unwrap_or(0.0);
+    let species = steady
+        .species
+        .as_deref()
+        .and_then(|s| s.parse::<Species>().ok())
+        .unwrap_or_default();
+    let mass = steady.flight.and_then(|f| f.mass_kg);
     Ok((
         target,
-        Cruise {
-            heading,
-            speed,
-            wingspan_m: steady.wingspan_m,
-        },
+        Cruise::of_birds(heading, speed, species, steady.wingspan_m, mass),
     ))
 }
 

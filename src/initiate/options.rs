@@ -51,8 +51,10 @@ pub struct InitiateOptions {
     /// Cruise altitude: `z` of the steady flight above the ground, wingspans (the steady flight's
     /// own `z` is added to it).
     pub cruise_altitude: f64,
-    /// Largest climb rate, wingspans per second.
-    pub climb_rate: f64,
+    /// Largest climb rate, wingspans per second (`None`: the birds' power-limited climb, the
+    /// cruise's [`Cruise::climb_rate`]: goose 0.51, crane 0.31, pelican 0.23 wingspans/s; see
+    /// [`InitiateOptions::climb_rate_for`]).
+    pub climb_rate: Option<f64>,
     /// Largest vertical acceleration, wingspans per second squared.
     pub vertical_accel: f64,
     /// Acceleration of the take-off run on the ground, wingspans per second squared.
@@ -158,7 +160,7 @@ impl Default for InitiateOptions {
             roll_lag: 0.2,
             max_roll_accel: 400f64.to_radians(),
             cruise_altitude: 10.0,
-            climb_rate: 2.5,
+            climb_rate: None,
             vertical_accel: 2.0,
             run_accel: 3.0,
             takeoff: None,
@@ -194,7 +196,8 @@ impl Default for InitiateOptions {
 }
 
 /// The steady flight the flock converges into: the leader's cruise heading (radians) and speed
-/// (wingspans per second), and the wingspan in metres (for gravity in wingspans/s²).
+/// (wingspans per second), the wingspan in metres (for gravity in wingspans/s²) and the birds'
+/// power-limited climb rate (the take-off's climb when [`InitiateOptions::climb_rate`] is `None`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Cruise {
     /// Cruise heading, radians clockwise from +y.
@@ -203,17 +206,51 @@ pub struct Cruise {
     pub speed: f64,
     /// Wingspan, metres.
     pub wingspan_m: f64,
+    /// The birds' best power-limited climb rate, wingspans per second
+    /// ([`crate::aero::flight::PowerCurve::best_climb_rate`] over the wingspan; see
+    /// [`Cruise::power_climb`]).
+    pub climb_rate: f64,
 }
 
 impl Cruise {
-    /// A cruise along `heading` (radians) at `speed` (wingspans per second) of birds with a
-    /// wingspan of 1.5 m.
+    /// A cruise along `heading` (radians) at `speed` (wingspans per second) of geese with a
+    /// wingspan of 1.5 m (climbing at most 0.51 wingspans/s).
     pub fn new(heading: f64, speed: f64) -> Cruise {
+        Cruise::of_birds(heading, speed, Species::Goose, 1.5, None)
+    }
+
+    /// A cruise of birds of `species` with a wingspan of `wingspan_m` metres (the species'
+    /// typical bird scaled to it) and, when given, a body mass of `mass_kg`: their climb rate is
+    /// [`Cruise::power_climb`]'s.
+    pub fn of_birds(
+        heading: f64,
+        speed: f64,
+        species: Species,
+        wingspan_m: f64,
+        mass_kg: Option<f64>,
+    ) -> Cruise {
         Cruise {
             heading,
             speed,
-            wingspan_m: 1.5,
+            wingspan_m,
+            climb_rate: Cruise::power_climb(species, wingspan_m, mass_kg),
         }
+    }
+
+    /// The best power-limited climb rate of birds of `species` with a wingspan of `wingspan_m`
+    /// metres (and a mass of `mass_kg`, default the species' typical mass scaled to the
+    /// wingspan), wingspans per second: goose 0.51 (1.5 m), crane 0.31 (2.2 m), pelican 0.23
+    /// (2.9 m). The power left over from flight at the minimum-power speed over the weight
+    /// ([`crate::aero::flight::PowerCurve::best_climb_rate`]); docs/initiation.md.
+    pub fn power_climb(species: Species, wingspan_m: f64, mass_kg: Option<f64>) -> f64 {
+        let curve =
+            crate::aero::flight::animation_curve_with(Some(species.name()), wingspan_m, mass_kg);
+        let span = if wingspan_m.is_finite() && wingspan_m > 0.0 {
+            wingspan_m
+        } else {
+            curve.bird.span_m
+        };
+        curve.best_climb_rate() / span
     }
 
     /// Gravity in wingspans per second squared.
@@ -221,6 +258,11 @@ impl Cruise {
         GRAVITY_M_S2 / self.wingspan_m
     }
 }
+
+/// Largest climb rate of birds starting in the air (`Start::Random`, `Start::Given`), wingspans per
+/// second: they start within a few wingspans of the cruise altitude and only change layers, so
+/// they keep the take-off's fast climb from before the power-limited default (our choice).
+pub const AIR_CLIMB_RATE: f64 = 2.5;
 
 impl InitiateOptions {
     /// Checks every parameter; errors name the option path (`initiate.alpha`).
@@ -311,7 +353,9 @@ impl InitiateOptions {
             self.max_roll_accel,
             "degrees per second squared",
         )?;
-        pos("initiate.climb_rate", self.climb_rate)?;
+        if let Some(w) = self.climb_rate {
+            pos("initiate.climb_rate", w)?;
+        }
         pos("initiate.vertical_accel", self.vertical_accel)?;
         pos("initiate.run_accel", self.run_accel)?;
         pos("initiate.visual_range", self.visual_range)?;
@@ -537,6 +581,38 @@ impl InitiateOptions {
         Ok(())
     }
 
+    /// The largest climb rate at the natural drive for birds of `cruise`, wingspans per second:
+    /// the option, or for a take-off from the ground the birds' power-limited climb
+    /// ([`Cruise::climb_rate`]); birds starting in the air, at the cruise altitude, change
+    /// height by a few wingspans only, at up to [`AIR_CLIMB_RATE`].
+    pub fn climb_rate_for(&self, cruise: &Cruise) -> f64 {
+        self.climb_rate.unwrap_or(match self.start {
+            Start::Ground(_) => cruise.climb_rate,
+            _ => AIR_CLIMB_RATE,
+        })
+    }
+
+    /// How long a bird of `cruise` takes to climb from the ground to the cruise altitude and level
+    /// off at the natural drive, seconds: h/w + w/a (the climb rate w reached and shed at the
+    /// vertical acceleration a), less what the burst climb after lift-off saves
+    /// ([`sim::LIFTOFF_BURST_CLIMB`]).
+    pub fn climb_seconds(&self, cruise: &Cruise) -> f64 {
+        let w = self.climb_rate_for(cruise);
+        let (b, h, alt) = (
+            sim::LIFTOFF_BURST_CLIMB,
+            sim::LIFTOFF_BURST_HEIGHT,
+            self.cruise_altitude,
+        );
+        // The burst after lift-off: dz/dt = w + (b − w)(1 − z/h) over the lowest h wingspans
+        // takes h/(b − w) ln(b/w).
+        let burst = if w < b && alt > h {
+            h / (b - w) * (b / w).ln() - h / w
+        } else {
+            0.0
+        };
+        alt / w + burst + w / self.vertical_accel
+    }
+
     /// The reference memory in seconds (the option, or the default of the perception mode).
     pub fn reference_memory(&self) -> f64 {
         self.reference_memory.unwrap_or(match self.perception.mode {
@@ -571,7 +647,7 @@ impl InitiateOptions {
             max_speed: self.max_speed * vc,
             cruise_heading: cruise.heading,
             cruise_speed: vc,
-            climb_rate: self.climb_rate * drive,
+            climb_rate: self.climb_rate_for(cruise) * drive,
             vertical_accel: self.vertical_accel * drive,
             gravity: cruise.gravity(),
             run_accel: self.run_accel * drive,

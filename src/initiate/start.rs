@@ -529,7 +529,7 @@ pub fn start_simulation(
         ));
     }
     let n = target.len();
-    let plan = TakeoffPlan::new(n, opts);
+    let plan = TakeoffPlan::new(n, opts, cruise);
     let mut params = opts.plan_params(cruise, &plan);
     if opts.widen_field {
         let field = &mut std::sync::Arc::make_mut(&mut params.opts)

@@ -40,42 +40,71 @@ impl TakeoffPlan {
     /// keep 0.36 and 0.34, and the take-off lasts 0.4–1.1 s longer (docs/initiation.md).
     pub const MAX_APPROACH_DRIVE: f64 = 1.0;
 
-    /// The natural take-off of `n` birds from the ground at the default options, seconds:
-    /// measured medians (docs/initiation.md) about 9.5 s for 9–14 birds, 10.7 s for 41, 12.7 s
-    /// for 100, 23 s for 300 (the lift-off and climb to 10 wingspans take about 7 s; the rest
-    /// grows with the width of the V).
-    pub fn natural_seconds(n: usize) -> f64 {
-        9.0 + 0.045 * n.max(1) as f64
+    /// Time a bird's take-off takes beside its climb at the natural drive, seconds: the departure
+    /// stagger (1 s), the run to lift-off (about 1.7 s) and holding the formation (1 s); fitted to
+    /// the README job's take-off at the goose's power-limited climb (24.7 s, 1 s of it sitting,
+    /// for a climb of 20.0 s).
+    pub const CLIMB_OVERHEAD: f64 = 3.7;
+
+    /// [`Self::CLIMB_OVERHEAD`] at the strongest drive, seconds: the stagger and the run shortened
+    /// by it, the hold not.
+    pub const SHORTEST_CLIMB_OVERHEAD: f64 = 2.7;
+
+    /// The natural take-off of `n` birds from the ground under `opts` (at their drive 1), seconds:
+    /// the longer of the time the flock needs to form, measured at a fast climb (medians about
+    /// 9.5 s for 9–14 birds, 10.7 s for 41, 12.7 s for 100, 23 s for 300: 9.0 + 0.045 N, growing
+    /// with the width of the V), and the time the last bird needs to leave, climb to the cruise
+    /// altitude and hold the formation ([`Self::CLIMB_OVERHEAD`] +
+    /// [`InitiateOptions::climb_seconds`]: 23.7 s for geese at their power-limited climb to
+    /// 10 wingspans; docs/initiation.md).
+    pub fn natural_seconds(n: usize, opts: &InitiateOptions, cruise: &Cruise) -> f64 {
+        (9.0 + 0.045 * n.max(1) as f64).max(Self::CLIMB_OVERHEAD + opts.climb_seconds(cruise))
     }
 
     /// The automatic take-off duration of `n` birds, seconds: the natural one.
-    pub fn auto_seconds(n: usize) -> f64 {
-        Self::natural_seconds(n)
+    pub fn auto_seconds(n: usize, opts: &InitiateOptions, cruise: &Cruise) -> f64 {
+        Self::natural_seconds(n, opts, cruise)
     }
 
-    /// The shortest take-off of `n` birds from the ground at the strongest drive, seconds:
-    /// measured medians 7.9 s for 9 birds, 8.3 for 14, 9.2 for 41, 11.7 for 100, 22.4 for 300
-    /// (`initiate.takeoff` 5 s, docs/initiation.md); fitted 8.1, 8.4, 9.7, 12.6 and 22.4. The
-    /// run, lift-off and climb to the cruise altitude take about 7 s at the strongest drive
-    /// (climb rate and accelerations bounded), and the outer birds of a wider V have farther to
-    /// fly to their slots at bounded speeds.
-    pub fn shortest_seconds(n: usize) -> f64 {
-        7.7 + 0.049 * n.max(1) as f64
+    /// The shortest take-off of `n` birds from the ground at the strongest drive, seconds: the
+    /// longer of the forming time, measured medians 7.9 s for 9 birds, 8.3 for 14, 9.2 for 41,
+    /// 11.7 for 100, 22.4 for 300 (`initiate.takeoff` 5 s at a fast climb, docs/initiation.md;
+    /// fitted 8.1, 8.4, 9.7, 12.6 and 22.4, the outer birds of a wider V having farther to fly to
+    /// their slots at bounded speeds), and the run, lift-off and climb to the cruise altitude at
+    /// the strongest drive ([`Self::climb_part_shortest`]).
+    pub fn shortest_seconds(n: usize, opts: &InitiateOptions, cruise: &Cruise) -> f64 {
+        (7.7 + 0.049 * n.max(1) as f64).max(Self::climb_part_shortest(opts, cruise))
     }
 
-    /// A warning when the take-off duration of `opts` cannot be met within 25 % for `n` birds:
-    /// shorter than [`Self::shortest_seconds`] allows, or longer than twice the natural
+    /// The departure, run, climb to the cruise altitude and hold at the strongest drive
+    /// ([`Self::MAX_DRIVE`]), seconds: [`Self::SHORTEST_CLIMB_OVERHEAD`] + h/(d w) + w/a (the climb
+    /// rate and the vertical acceleration both scaled by the drive d).
+    pub fn climb_part_shortest(opts: &InitiateOptions, cruise: &Cruise) -> f64 {
+        let w = opts.climb_rate_for(cruise);
+        Self::SHORTEST_CLIMB_OVERHEAD
+            + opts.cruise_altitude / (Self::MAX_DRIVE * w)
+            + w / opts.vertical_accel
+    }
+
+    /// A warning when the take-off duration of `opts` cannot be met within 25 % for `n` birds of
+    /// `cruise`: shorter than [`Self::shortest_seconds`] allows, or longer than twice the natural
     /// duration; it names `initiate.takeoff`, the duration the take-off will have and why.
-    pub fn warning(n: usize, opts: &InitiateOptions) -> Option<String> {
+    pub fn warning(n: usize, opts: &InitiateOptions, cruise: &Cruise) -> Option<String> {
         let t = opts.takeoff?;
         if !matches!(opts.start, Start::Ground(_)) {
             return None;
         }
-        let shortest = Self::shortest_seconds(n);
-        let longest = 2.0 * Self::natural_seconds(n);
+        let shortest = Self::shortest_seconds(n, opts, cruise);
+        let longest = 2.0 * Self::natural_seconds(n, opts, cruise);
+        let climb = Self::climb_part_shortest(opts, cruise);
         if t * 1.25 < shortest {
+            let why = if climb >= shortest {
+                format!("the run and the climb to the cruise altitude take about {climb:.0} s at the strongest drive")
+            } else {
+                "the run and the climb to the cruise altitude take about 7 s at the strongest drive, and the outer birds of a wide V need longer to reach their slots".to_string()
+            };
             Some(format!(
-                "initiate.takeoff {t} s: {n} birds cannot take off in less than about {shortest:.0} s (the run and the climb to the cruise altitude take about 7 s at the strongest drive, and the outer birds of a wide V need longer to reach their slots); the take-off will last about {shortest:.0} s"
+                "initiate.takeoff {t} s: {n} birds cannot take off in less than about {shortest:.0} s ({why}); the take-off will last about {shortest:.0} s"
             ))
         } else if t > 1.25 * longest {
             Some(format!(
@@ -86,13 +115,13 @@ impl TakeoffPlan {
         }
     }
 
-    /// The plan for `n` birds under `opts` (its `takeoff`, or the automatic duration): the
+    /// The plan for `n` birds of `cruise` under `opts` (its `takeoff`, or the automatic duration): the
     /// drive is the natural duration over the wanted one (bounded), which scales the departure
     /// stagger, the accelerations, the climb rate, the approach and (for a longer take-off) the
     /// take-off area, so that every part of the take-off takes about `seconds / natural` times
     /// as long. The simulation itself is never cut.
-    pub fn new(n: usize, opts: &InitiateOptions) -> TakeoffPlan {
-        let natural = Self::natural_seconds(n);
+    pub fn new(n: usize, opts: &InitiateOptions, cruise: &Cruise) -> TakeoffPlan {
+        let natural = Self::natural_seconds(n, opts, cruise);
         let seconds = opts.takeoff.unwrap_or(natural);
         let drive = (natural / seconds).clamp(Self::MIN_DRIVE, Self::MAX_DRIVE);
         let root = (n.max(1) as f64).sqrt();
