@@ -78,6 +78,9 @@ fn fly(path: &Path, seconds: f64) -> Animation {
     };
     c.steady.birds = 9;
     c.course.path = Some(path.to_path_buf());
+    // The take-off must end before the test path's turn (200 wingspans out): climb at the
+    // former 2.5 wingspans/s (a goose's power-limited climb doubles the take-off's length).
+    c.initiate.climb_rate = Some(2.5);
     Pipeline::from_path(data("steady_v9_params.json"))
         .run(&c)
         .unwrap()
