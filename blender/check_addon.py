@@ -36,7 +36,7 @@ cu = bpy.data.curves.new("flight path", "CURVE")
 cu.dimensions = "3D"
 sp = cu.splines.new("BEZIER")
 sp.bezier_points.add(3)
-for bp, co in zip(sp.bezier_points, [(0, 0, 30), (0, 150, 30), (60, 260, 36), (170, 320, 40)]):
+for bp, co in zip(sp.bezier_points, [(0, 0, 30), (0, 450, 30), (180, 780, 36), (510, 960, 40)]):
     bp.co = co
     bp.handle_left_type = bp.handle_right_type = "AUTO"
 path_obj = bpy.data.objects.new("flight path", cu)
