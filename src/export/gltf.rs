@@ -387,6 +387,15 @@ pub fn glb_bytes_with(anim: &Animation, wingspan_m: f64, opts: &SceneOptions) ->
         },
         ..Default::default()
     };
+    // Each model's inverse bind matrices (its seven joints, column-major).
+    let model_ibm: Vec<Vec<f32>> = assets
+        .iter()
+        .map(|asset| {
+            (0..bird::JOINTS.len())
+                .flat_map(|j| asset.skeleton.inverse_bind(j, ws).to_cols_array())
+                .collect()
+        })
+        .collect();
     // Each model's mesh and inverse bind matrices, shared by the birds that wear it (none with
     // one skin for the flock: its mesh is made after the birds).
     let shared: Vec<(json::Index<json::Mesh>, json::Index<json::Accessor>)> = assets
@@ -400,10 +409,14 @@ pub fn glb_bytes_with(anim: &Animation, wingspan_m: f64, opts: &SceneOptions) ->
                 format!("bird_model_{m}")
             };
             let mesh = b.skinned_mesh(&mut root, asset, ws, &name);
-            let ibm: Vec<f32> = (0..bird::JOINTS.len())
-                .flat_map(|j| asset.skeleton.inverse_bind(j, ws).to_cols_array())
-                .collect();
-            let ibm_acc = b.accessor(&mut root, &ibm, 16, json::accessor::Type::Mat4, false, None);
+            let ibm_acc = b.accessor(
+                &mut root,
+                &model_ibm[m],
+                16,
+                json::accessor::Type::Mat4,
+                false,
+                None,
+            );
             (mesh, ibm_acc)
         })
         .collect();
@@ -625,15 +638,11 @@ pub fn glb_bytes_with(anim: &Animation, wingspan_m: f64, opts: &SceneOptions) ->
             let last = (first + FLOCK_PART).min(anim.birds);
             let name = format!("flock_{p:0part_digits$}");
             let mesh = b.skinned_meshes(&mut root, models, &model_of[first..last], ws, &name, true);
+            // Per bird: its root's bind (the origin), then its model's seven.
+            let identity = glam::Mat4::IDENTITY.to_cols_array();
             let ibm: Vec<f32> = model_of[first..last]
                 .iter()
-                .flat_map(|&m| {
-                    std::iter::once(glam::Mat4::IDENTITY.to_cols_array()).chain(
-                        (0..bird::JOINTS.len())
-                            .map(move |j| models[m].skeleton.inverse_bind(j, ws).to_cols_array()),
-                    )
-                })
-                .flatten()
+                .flat_map(|&m| identity.iter().chain(&model_ibm[m]).copied())
                 .collect();
             let ibm = b.accessor(&mut root, &ibm, 16, json::accessor::Type::Mat4, false, None);
             let skin = root.push(json::Skin {
@@ -1061,6 +1070,24 @@ impl Builder {
         })
     }
 
+    /// A vertex attribute of `count` four-byte elements, normalised bytes (colours, weights).
+    fn unit_bytes4(
+        &mut self,
+        root: &mut json::Root,
+        bytes: &[u8],
+        count: usize,
+    ) -> json::Index<json::Accessor> {
+        self.raw_accessor(
+            root,
+            bytes,
+            count,
+            json::accessor::ComponentType::U8,
+            json::accessor::Type::Vec4,
+            true,
+            Some(json::buffer::Target::ArrayBuffer),
+        )
+    }
+
     /// The asset's skinned mesh in metres, as one primitive with one material (one draw call a
     /// bird): each part's colour is its vertices' `COLOR_0`, which glTF multiplies into the
     /// white base colour (see [`one_primitive`]).
@@ -1138,15 +1165,7 @@ impl Builder {
                 .chunks_exact(3)
                 .flat_map(|c| [unit_byte(c[0]), unit_byte(c[1]), unit_byte(c[2]), 255])
                 .collect();
-            self.raw_accessor(
-                root,
-                &rgba,
-                vertices,
-                json::accessor::ComponentType::U8,
-                json::accessor::Type::Vec4,
-                true,
-                target,
-            )
+            self.unit_bytes4(root, &rgba, vertices)
         } else {
             self.accessor(root, &col, 3, json::accessor::Type::Vec3, false, target)
         };
@@ -1172,15 +1191,7 @@ impl Builder {
             target,
         );
         let weights = if flock {
-            self.raw_accessor(
-                root,
-                &bytes,
-                vertices,
-                json::accessor::ComponentType::U8,
-                json::accessor::Type::Vec4,
-                true,
-                target,
-            )
+            self.unit_bytes4(root, &bytes, vertices)
         } else {
             self.accessor(root, &wf, 4, json::accessor::Type::Vec4, false, target)
         };
