@@ -326,32 +326,152 @@ pub struct Frame {
     /// Time, seconds since the start of the animation.
     pub t: f64,
     /// East, wingspans.
+    #[serde(serialize_with = "precision::positions")]
     pub x: Vec<f64>,
     /// North, wingspans.
+    #[serde(serialize_with = "precision::positions")]
     pub y: Vec<f64>,
     /// Up, wingspans.
+    #[serde(serialize_with = "precision::positions")]
     pub z: Vec<f64>,
     /// Heading, radians clockwise from +y (north).
+    #[serde(serialize_with = "precision::angles")]
     pub heading: Vec<f64>,
     /// Ground speed, wingspans per second.
+    #[serde(serialize_with = "precision::speeds")]
     pub speed: Vec<f64>,
     /// Bank angle, radians, right wing down positive (coordinated turns; 0 in straight flight).
     /// Absent in files that do not carry it (then level).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        serialize_with = "precision::some_angles"
+    )]
     pub bank: Option<Vec<f64>>,
     /// Pitch angle, radians, nose up positive (climbs and descents; 0 in level flight). Absent in
     /// files that do not carry it (then level).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        serialize_with = "precision::some_angles"
+    )]
     pub pitch: Option<Vec<f64>>,
     /// Power reduction e_i of the current shape (absent when undefined, e.g. during initiation).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        serialize_with = "precision::some_savings"
+    )]
     pub e: Option<Vec<f64>>,
     /// Relative power reduction ξ_i of the current shape (absent when undefined).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        serialize_with = "precision::some_savings"
+    )]
     pub xi: Option<Vec<f64>>,
     /// Wingbeat phase, radians in [0, 2π), 0 = start of the downstroke.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        serialize_with = "precision::some_angles"
+    )]
     pub wing_phase: Option<Vec<f64>>,
+}
+
+impl Frame {
+    /// Rounds every bird's values to the precision the animation file stores
+    /// ([`precision`]), so that what is written and read back is exactly what every other output
+    /// of the same run was made from.
+    pub fn quantize(&mut self) {
+        use precision::*;
+        let round = |v: &mut Vec<f64>, steps: f64| v.iter_mut().for_each(|x| *x = to(*x, steps));
+        for v in [&mut self.x, &mut self.y, &mut self.z] {
+            round(v, POSITION);
+        }
+        round(&mut self.heading, ANGLE);
+        round(&mut self.speed, SPEED);
+        for v in [&mut self.bank, &mut self.pitch, &mut self.wing_phase]
+            .into_iter()
+            .flatten()
+        {
+            round(v, ANGLE);
+        }
+        for v in [&mut self.e, &mut self.xi].into_iter().flatten() {
+            round(v, SAVING);
+        }
+    }
+}
+
+/// The precision of the animation file's per-bird values, in steps per unit: positions to 10⁻⁵
+/// of their unit (wingspans, or metres in files written in metres: 0.015 mm for a goose's 1.5 m
+/// wingspan) whatever their distance from the origin, speeds to 10⁻⁵ units per second, angles
+/// (heading, bank, pitch, wingbeat phase) to 10⁻⁶ radians, savings (`e`, `xi`) to 10⁻⁶. A value
+/// is rounded to its step and written with the fewest digits that read back to the same number,
+/// so a file is about half the size of one at full precision and reads back exactly to the
+/// rounded values, which are what every output of the run is made from.
+pub mod precision {
+    use serde::ser::{SerializeSeq, Serializer};
+
+    /// Steps per unit of a position (wingspans or metres).
+    pub const POSITION: f64 = 1e5;
+    /// Steps per unit of a speed (wingspans or metres per second).
+    pub const SPEED: f64 = 1e5;
+    /// Steps per radian of an angle.
+    pub const ANGLE: f64 = 1e6;
+    /// Steps per unit of a saving (a fraction of power).
+    pub const SAVING: f64 = 1e6;
+
+    /// `x` rounded to the nearest of `steps` per unit (values too large to round, and
+    /// non-finite ones, which are refused elsewhere, kept as they are). Rounding twice gives
+    /// the same value.
+    pub fn to(x: f64, steps: f64) -> f64 {
+        let q = (x * steps).round() / steps;
+        if q.is_finite() && (x * steps).abs() < 9e15 {
+            q
+        } else {
+            x
+        }
+    }
+
+    fn rounded<S: Serializer>(v: &[f64], steps: f64, s: S) -> Result<S::Ok, S::Error> {
+        let mut seq = s.serialize_seq(Some(v.len()))?;
+        for &x in v {
+            seq.serialize_element(&to(x, steps))?;
+        }
+        seq.end()
+    }
+
+    /// Writes positions at the file's precision.
+    pub fn positions<S: Serializer>(v: &[f64], s: S) -> Result<S::Ok, S::Error> {
+        rounded(v, POSITION, s)
+    }
+
+    /// Writes speeds at the file's precision.
+    pub fn speeds<S: Serializer>(v: &[f64], s: S) -> Result<S::Ok, S::Error> {
+        rounded(v, SPEED, s)
+    }
+
+    /// Writes angles at the file's precision.
+    pub fn angles<S: Serializer>(v: &[f64], s: S) -> Result<S::Ok, S::Error> {
+        rounded(v, ANGLE, s)
+    }
+
+    /// Writes optional angles (only called when present).
+    pub fn some_angles<S: Serializer>(v: &Option<Vec<f64>>, s: S) -> Result<S::Ok, S::Error> {
+        match v {
+            Some(v) => rounded(v, ANGLE, s),
+            None => s.serialize_none(),
+        }
+    }
+
+    /// Writes optional savings (only called when present).
+    pub fn some_savings<S: Serializer>(v: &Option<Vec<f64>>, s: S) -> Result<S::Ok, S::Error> {
+        match v {
+            Some(v) => rounded(v, SAVING, s),
+            None => s.serialize_none(),
+        }
+    }
 }
 
 impl Animation {
@@ -455,6 +575,63 @@ impl Animation {
         Cow::Owned(out)
     }
 
+    /// Rounds every frame's values to the precision the file stores ([`precision`]): the last
+    /// step of every run, so that all its outputs and the animation file read back agree.
+    pub fn quantize(&mut self) {
+        self.frames.iter_mut().for_each(Frame::quantize);
+    }
+
+    /// A copy of everything but the frames, with `frames` instead (a few frames of a large
+    /// animation without copying the rest first).
+    pub fn with_frames(&self, frames: Vec<Frame>) -> Animation {
+        let Animation {
+            format,
+            seed,
+            fps,
+            wingspan_m,
+            birds,
+            species,
+            wingbeat,
+            stages,
+            key_shapes,
+            xi_ranges,
+            formations,
+            looped,
+            start_frame,
+            units,
+            up,
+            path,
+            flight,
+            savings_model,
+            events,
+            landing,
+            frames: _,
+        } = self;
+        Animation {
+            format: format.clone(),
+            seed: *seed,
+            fps: *fps,
+            wingspan_m: *wingspan_m,
+            birds: *birds,
+            species: species.clone(),
+            wingbeat: wingbeat.clone(),
+            stages: stages.clone(),
+            key_shapes: key_shapes.clone(),
+            xi_ranges: xi_ranges.clone(),
+            formations: formations.clone(),
+            looped: *looped,
+            start_frame: *start_frame,
+            units: *units,
+            up: *up,
+            path: path.clone(),
+            flight: *flight,
+            savings_model: savings_model.clone(),
+            events: events.clone(),
+            landing: landing.clone(),
+            frames,
+        }
+    }
+
     /// An empty animation with the format tag set.
     pub fn new(seed: u64, fps: f64, wingspan_m: f64, birds: usize) -> Animation {
         Animation {
@@ -483,12 +660,15 @@ impl Animation {
     }
 
     /// Reads and validates an animation file.
+    ///
+    /// The file is parsed as it is read, never held whole: reading takes the memory of the
+    /// animation itself (about 90 bytes per bird and frame), not that and the text's.
     pub fn read(path: &Path) -> Result<Animation> {
-        let text = crate::io::read_text(path)?;
-        let mut a: Animation = crate::io::parse_json(path, &text).map_err(|e| {
-            // A structure error on another kind of file: say what the file is instead.
-            match crate::sniff::text_kind(&text) {
-                Some(kind) if kind != crate::sniff::Kind::Animation => Error::format(
+        let mut a: Animation = crate::io::read_json_streaming(path).map_err(|e| {
+            // A structure error on another kind of file: say what the file is instead (the file
+            // is read again only on this path).
+            match crate::sniff::stream_kind(path) {
+                Ok(Some(kind)) if kind != crate::sniff::Kind::Animation => Error::format(
                     path,
                     format!("not an animation file ({}, expected \"format\": \"{ANIMATION_FORMAT}\"); write one with `formation steady` or `formation animate`", kind.describe()),
                 ),

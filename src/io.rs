@@ -11,12 +11,12 @@ use serde::Serialize;
 
 use crate::error::{Error, Result};
 
-/// Upper bound on the size of any input file we read fully into memory, bytes: 4 GiB, enough for
-/// the largest animation file `formation` writes (10⁷ bird-frames of pretty JSON: 1.97 GB for
-/// 100 birds × 100 000 frames, 2.9 GB for 100 000 birds × 100 frames of a wide sky of
-/// formations, whose coordinates have more digits; see [`crate::limits::MAX_BIRD_FRAMES`]). It
-/// was 2 GiB, which refused the latter.
-pub const MAX_INPUT_BYTES: u64 = 4 * 1024 * 1024 * 1024;
+/// Upper bound on the size of any input file, bytes: 6 GiB, enough for the largest animation
+/// file `formation` writes ([`crate::limits::MAX_BIRD_FRAMES`] bird-frames: about 2.4 GB compact
+/// for a wide sky of formations, whose coordinates have more digits, and 4.3 GB with `pretty`).
+/// Animation files are parsed as they are read (their text is never held whole); other inputs
+/// are small in practice and read whole.
+pub const MAX_INPUT_BYTES: u64 = 6 * 1024 * 1024 * 1024;
 
 /// Opens an input for reading, refusing directories and regular files over the size limit up
 /// front. Devices, FIFOs and process substitutions (`<(…)`) are read too, through a bounded
@@ -179,6 +179,173 @@ pub fn parse_json<T: DeserializeOwned>(path: &Path, text: &str) -> Result<T> {
 pub fn read_json<T: DeserializeOwned>(path: &Path) -> Result<T> {
     let text = read_text(path)?;
     parse_json(path, &text)
+}
+
+/// An input read as UTF-8 text in chunks, with the checks of [`read_text`] made as the bytes go
+/// by (the size limit, UTF-16, NUL bytes, UTF-8 across chunk boundaries, a leading byte-order
+/// mark skipped), for parsers that stream: memory stays at one chunk whatever the file's size.
+/// A failed check ends the reading with an I/O error; [`TextInput::error`] then holds the
+/// message naming the file.
+pub struct TextInput {
+    reader: std::io::Take<fs::File>,
+    path: PathBuf,
+    limit: u64,
+    /// Bytes read from the file so far.
+    read: u64,
+    /// Bytes checked and ready to be served: `buf[pos..end]`; `buf[end..]` is the start of a
+    /// character cut by the chunk boundary, kept for the next chunk.
+    buf: Vec<u8>,
+    pos: usize,
+    end: usize,
+    started: bool,
+    done: bool,
+    /// Some byte other than JSON whitespace was seen.
+    content: bool,
+    error: Option<Error>,
+}
+
+impl TextInput {
+    /// Opens `path` for streaming (directories and files over the size limit refused at once).
+    pub fn open(path: &Path) -> Result<TextInput> {
+        let (reader, limit, _) = open_input(path)?;
+        Ok(TextInput {
+            reader,
+            path: path.to_path_buf(),
+            limit,
+            read: 0,
+            buf: Vec::new(),
+            pos: 0,
+            end: 0,
+            started: false,
+            done: false,
+            content: false,
+            error: None,
+        })
+    }
+
+    /// The check that stopped the reading, if one did.
+    pub fn error(&mut self) -> Option<Error> {
+        self.error.take()
+    }
+
+    /// Whether everything read so far was whitespace (an empty file, for its message).
+    pub fn blank(&self) -> bool {
+        !self.content
+    }
+
+    fn fail(&mut self, e: Error) -> std::io::Error {
+        let text = e.to_string();
+        self.error = Some(e);
+        self.done = true;
+        std::io::Error::new(std::io::ErrorKind::InvalidData, text)
+    }
+
+    /// Reads and checks the next chunk; false at the end of the input.
+    fn refill(&mut self) -> std::io::Result<bool> {
+        // The cut character's bytes move to the front.
+        let carry = self.buf.len() - self.end;
+        self.buf.copy_within(self.end.., 0);
+        self.buf.resize(carry + READ_CHUNK, 0);
+        let n = loop {
+            match std::io::Read::read(&mut self.reader, &mut self.buf[carry..]) {
+                Ok(n) => break n,
+                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+                Err(e) => {
+                    let path = self.path.clone();
+                    return Err(self.fail(Error::io(&path, e)));
+                }
+            }
+        };
+        self.buf.truncate(carry + n);
+        let offset = self.read - carry as u64;
+        self.read += n as u64;
+        if self.read > self.limit {
+            let e = too_big(&self.path, None, self.limit);
+            return Err(self.fail(e));
+        }
+        self.pos = 0;
+        if n == 0 {
+            self.end = 0;
+            if carry > 0 {
+                let e = not_utf8(&self.path, offset as usize);
+                return Err(self.fail(e));
+            }
+            self.buf.clear();
+            return Ok(false);
+        }
+        if !self.started {
+            self.started = true;
+            if let Some(e) = utf16_text(&self.path, &self.buf) {
+                return Err(self.fail(e));
+            }
+            if self.buf.starts_with("\u{feff}".as_bytes()) {
+                self.pos = 3;
+            }
+        }
+        if let Some(k) = self.buf.iter().position(|&b| b == 0) {
+            let e = Error::format(
+                &self.path,
+                format!(
+                    "binary data (a NUL byte at offset {}), expected a text file",
+                    offset + k as u64
+                ),
+            );
+            return Err(self.fail(e));
+        }
+        self.end = match std::str::from_utf8(&self.buf) {
+            Ok(_) => self.buf.len(),
+            Err(e) if e.error_len().is_none() => e.valid_up_to(),
+            Err(e) => {
+                let e = not_utf8(&self.path, offset as usize + e.valid_up_to());
+                return Err(self.fail(e));
+            }
+        };
+        if !self.content {
+            self.content = self.buf[self.pos..self.end]
+                .iter()
+                .any(|b| !matches!(b, b' ' | b'\t' | b'\n' | b'\r'));
+        }
+        Ok(true)
+    }
+}
+
+impl std::io::Read for TextInput {
+    fn read(&mut self, out: &mut [u8]) -> std::io::Result<usize> {
+        while self.pos == self.end {
+            if self.done || !self.refill()? {
+                self.done = true;
+                return Ok(0);
+            }
+        }
+        let n = out.len().min(self.end - self.pos);
+        if n == 1 {
+            out[0] = self.buf[self.pos];
+        } else {
+            out[..n].copy_from_slice(&self.buf[self.pos..self.pos + n]);
+        }
+        self.pos += n;
+        Ok(n)
+    }
+}
+
+/// Parses the JSON file at `path` into `T` while reading it ([`TextInput`]): the text is never
+/// held whole, so a large file takes the memory of what it parses into, not twice that. Errors
+/// as [`read_json`]'s.
+pub fn read_json_streaming<T: DeserializeOwned>(path: &Path) -> Result<T> {
+    let mut input = TextInput::open(path)?;
+    // Through a `BufReader`: the standard library reads its bytes one by one without a call each
+    // (serde_json's reader asks byte by byte; three times faster than asking the input).
+    let parsed = serde_json::from_reader(std::io::BufReader::with_capacity(1 << 16, &mut input));
+    match parsed {
+        Ok(v) => Ok(v),
+        Err(e) => Err(match input.error() {
+            Some(read) => read,
+            None if e.is_eof() && input.blank() => {
+                Error::format(path, "file is empty, expected JSON")
+            }
+            None => json_error(path, &e),
+        }),
+    }
 }
 
 /// One-line description of a serde_json error with its position.

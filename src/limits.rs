@@ -22,11 +22,54 @@ pub const MAX_FORMATION_BIRDS: usize = 5_000;
 /// 30 fps.
 pub const MAX_FRAMES: usize = 1_000_000;
 
-/// Most bird-frames (birds × frames) in an animation. Measured at the limit (100 birds ×
-/// 100 000 frames, release build): `steady` takes 51 s and 1.3 GB resident and writes 1.97 GB of
-/// JSON, which `render` reads back (under [`crate::io::MAX_INPUT_BYTES`] = 2 GiB) in 70 s and
-/// 2.8 GB resident. E.g. 100 birds for 55 minutes at 30 fps, or 1000 birds for 5½ minutes.
-pub const MAX_BIRD_FRAMES: usize = 10_000_000;
+/// Most bird-frames (birds × frames) in an animation: 2·10⁷, e.g. 10 000 birds for a minute of
+/// take-off and flight at 30 fps, or 1000 birds for 11 minutes. An animation takes 88 bytes per
+/// bird-frame in memory, so 1.8 GB at the limit, and its file about 90 (up to 120 for a wide
+/// sky of formations, whose coordinates have more digits): within
+/// [`crate::io::MAX_INPUT_BYTES`], so every file written can be read back.
+pub const MAX_BIRD_FRAMES: usize = 20_000_000;
+
+/// Most memory a run takes per bird-frame while it makes an animation (the take-off's history,
+/// the frames, the wingbeats' work arrays), bytes: measured 110 at the peak of a 300-bird
+/// take-off and 30 s flight; 160 leaves room.
+pub const RUN_BYTES_PER_BIRD_FRAME: u64 = 160;
+
+/// The memory this process may still use, bytes: the smaller of the machine's available memory
+/// (`MemAvailable` in `/proc/meminfo`) and the address-space limit (`ulimit -v`, less what the
+/// process has mapped already); `None` where neither is known. Checks of a request's size up
+/// front compare with it, so that what cannot fit is refused before the work, not by running out.
+pub fn memory_budget() -> Option<u64> {
+    let kib = |text: &str, key: &str| -> Option<u64> {
+        let line = text.lines().find(|l| l.starts_with(key))?;
+        line[key.len()..]
+            .split_whitespace()
+            .next()?
+            .parse::<u64>()
+            .ok()
+    };
+    let available = std::fs::read_to_string("/proc/meminfo")
+        .ok()
+        .and_then(|t| kib(&t, "MemAvailable:"))
+        .map(|k| k.saturating_mul(1024));
+    let limit = std::fs::read_to_string("/proc/self/limits")
+        .ok()
+        .and_then(|t| {
+            let line = t.lines().find(|l| l.starts_with("Max address space"))?;
+            let soft = line["Max address space".len()..]
+                .split_whitespace()
+                .next()?;
+            let soft: u64 = soft.parse().ok()?;
+            let used = std::fs::read_to_string("/proc/self/status")
+                .ok()
+                .and_then(|s| kib(&s, "VmSize:"))
+                .map_or(0, |k| k.saturating_mul(1024));
+            Some(soft.saturating_sub(used))
+        });
+    match (available, limit) {
+        (Some(a), Some(l)) => Some(a.min(l)),
+        (a, l) => a.or(l),
+    }
+}
 
 /// Most pixels in one picture (width × height): 8K UHD, 7680 × 4320.
 pub const MAX_FRAME_PIXELS: u64 = 7680 * 4320;

@@ -542,11 +542,14 @@ pub fn fit_shot(anim: &mut Animation, config: &Config) -> Result<()> {
 }
 
 /// The last steps of every run, after the course and the shot's length: birds on the ground
-/// stand or sit, birds in their flare pitch up, and the wingbeats.
+/// stand or sit, birds in their flare pitch up, the wingbeats, and the values rounded to the
+/// animation file's precision ([`Animation::quantize`]).
 pub fn finish(anim: &mut Animation, config: &Config) -> Result<()> {
     wingbeat::rest::stand_on_ground(anim, config.wingbeat.species);
     landing::flare_pitch(anim, landing::FLARE_PITCH);
-    wingbeat::assign_phases(anim, &config.wingbeat)
+    wingbeat::assign_phases(anim, &config.wingbeat)?;
+    anim.quantize();
+    Ok(())
 }
 
 /// The config whose steady flight is long enough for a landing at the end of an open path: its
@@ -719,7 +722,7 @@ fn flock_run(
         .initiation
         .then(|| takeoff_config(config, path)?.initiate_options())
         .transpose()?;
-    let (mut anim, report) = skein::fly(
+    let (mut anim, mut report) = skein::fly(
         params,
         sizes,
         &FlockOptions {
@@ -734,6 +737,9 @@ fn flock_run(
     let course = course_stage(&mut anim, path, config)?;
     fit_shot(&mut anim, config)?;
     finish(&mut anim, config)?;
+    // The closest approach of the animation as written (its positions rounded to the file's
+    // precision, moved along a path).
+    report.min_separation = skein::min_separation(&anim);
     let first = report
         .formations
         .first()

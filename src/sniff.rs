@@ -83,8 +83,162 @@ pub fn path_kind(path: &std::path::Path) -> crate::error::Result<Kind> {
     if path.is_dir() {
         return Ok(Kind::Labelme);
     }
-    let text = crate::io::read_text(path)?;
-    Ok(text_kind(&text).unwrap_or(Kind::Unknown))
+    Ok(stream_kind(path)?.unwrap_or(Kind::Unknown))
+}
+
+/// [`text_kind`] of the file at `path`, judged while it is read ([`crate::io::TextInput`]): only
+/// the top-level fields that tell the kinds apart are kept, so sniffing a large animation takes
+/// no more memory than a chunk of it. Errors of reading (not text, too big) are errors; text
+/// that is not JSON is `None`.
+pub fn stream_kind(path: &std::path::Path) -> crate::error::Result<Option<Kind>> {
+    let mut input = crate::io::TextInput::open(path)?;
+    let head =
+        serde_json::from_reader::<_, Head>(std::io::BufReader::with_capacity(1 << 16, &mut input));
+    if let Some(e) = input.error() {
+        return Err(e);
+    }
+    Ok(head.ok().and_then(|h| h.kind))
+}
+
+/// The top-level facts [`json_kind`] looks at, gathered without keeping the values.
+struct Head {
+    /// `None` for a document that is neither an object nor an array.
+    kind: Option<Kind>,
+}
+
+impl<'de> serde::Deserialize<'de> for Head {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Head, D::Error> {
+        d.deserialize_any(HeadVisitor)
+    }
+}
+
+struct HeadVisitor;
+
+/// Skips any value, telling whether it was an array.
+struct IsArray(bool);
+
+impl<'de> serde::Deserialize<'de> for IsArray {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<IsArray, D::Error> {
+        struct V;
+        impl<'de> serde::de::Visitor<'de> for V {
+            type Value = IsArray;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("any value")
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(
+                self,
+                mut a: A,
+            ) -> Result<IsArray, A::Error> {
+                while a.next_element::<serde::de::IgnoredAny>()?.is_some() {}
+                Ok(IsArray(true))
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(
+                self,
+                mut a: A,
+            ) -> Result<IsArray, A::Error> {
+                while a
+                    .next_entry::<serde::de::IgnoredAny, serde::de::IgnoredAny>()?
+                    .is_some()
+                {}
+                Ok(IsArray(false))
+            }
+            fn visit_bool<E>(self, _: bool) -> Result<IsArray, E> {
+                Ok(IsArray(false))
+            }
+            fn visit_i64<E>(self, _: i64) -> Result<IsArray, E> {
+                Ok(IsArray(false))
+            }
+            fn visit_u64<E>(self, _: u64) -> Result<IsArray, E> {
+                Ok(IsArray(false))
+            }
+            fn visit_f64<E>(self, _: f64) -> Result<IsArray, E> {
+                Ok(IsArray(false))
+            }
+            fn visit_str<E>(self, _: &str) -> Result<IsArray, E> {
+                Ok(IsArray(false))
+            }
+            fn visit_unit<E>(self) -> Result<IsArray, E> {
+                Ok(IsArray(false))
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+/// A string value, or `None` for any other value (skipped).
+struct MaybeStr(Option<String>);
+
+impl<'de> serde::Deserialize<'de> for MaybeStr {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<MaybeStr, D::Error> {
+        match serde_json::Value::deserialize(d)? {
+            // Small in any real file; a huge non-string value is rare and only costs its parse.
+            Value::String(s) => Ok(MaybeStr(Some(s))),
+            _ => Ok(MaybeStr(None)),
+        }
+    }
+}
+
+impl<'de> serde::de::Visitor<'de> for HeadVisitor {
+    type Value = Head;
+    fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str("a JSON document")
+    }
+    fn visit_map<A: serde::de::MapAccess<'de>>(self, mut a: A) -> Result<Head, A::Error> {
+        let mut format: Option<Option<String>> = None;
+        let (mut shapes, mut frames, mut birds, mut x, mut xi) =
+            (false, false, false, false, false);
+        while let Some(key) = a.next_key::<String>()? {
+            match key.as_str() {
+                "format" => format = Some(a.next_value::<MaybeStr>()?.0),
+                "birds" => birds = a.next_value::<IsArray>()?.0,
+                other => {
+                    match other {
+                        "shapes" => shapes = true,
+                        "frames" => frames = true,
+                        "x" => x = true,
+                        "xi" => xi = true,
+                        _ => {}
+                    }
+                    a.next_value::<serde::de::IgnoredAny>()?;
+                }
+            }
+        }
+        let kind = match format.flatten().as_deref() {
+            Some(PARAMS_FORMAT) => Kind::Params,
+            Some(ANIMATION_FORMAT) => Kind::Animation,
+            Some(t) => Kind::OtherFormat(t.to_string()),
+            None if shapes => Kind::Labelme,
+            None if frames => Kind::NativeAnnotations,
+            None if birds => Kind::Shape,
+            None if x && xi => Kind::Target,
+            None => Kind::Unknown,
+        };
+        Ok(Head { kind: Some(kind) })
+    }
+    fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut a: A) -> Result<Head, A::Error> {
+        while a.next_element::<serde::de::IgnoredAny>()?.is_some() {}
+        Ok(Head {
+            kind: Some(Kind::Unknown),
+        })
+    }
+    fn visit_bool<E>(self, _: bool) -> Result<Head, E> {
+        Ok(Head { kind: None })
+    }
+    fn visit_i64<E>(self, _: i64) -> Result<Head, E> {
+        Ok(Head { kind: None })
+    }
+    fn visit_u64<E>(self, _: u64) -> Result<Head, E> {
+        Ok(Head { kind: None })
+    }
+    fn visit_f64<E>(self, _: f64) -> Result<Head, E> {
+        Ok(Head { kind: None })
+    }
+    fn visit_str<E>(self, _: &str) -> Result<Head, E> {
+        Ok(Head { kind: None })
+    }
+    fn visit_unit<E>(self) -> Result<Head, E> {
+        Ok(Head { kind: None })
+    }
 }
 
 /// Whether `text` is a params file (`"format": "formation-params/1"`); cheap for annotations,

@@ -753,7 +753,8 @@ fn running_out_of_memory_is_one_line_and_leaves_the_old_outputs() {
         .display()
         .to_string();
     let example = support::example_arg("barnacle_geese_v.json");
-    // A 10 MB animation for the report (it needs about 45 MB; the flock_small page fits in 20).
+    // A 120-bird animation for the report (8.7 MB; its report needs about 26 MB; the flock_small
+    // page fits in 18).
     let o = run_in(
         &dir,
         &[
@@ -770,7 +771,13 @@ fn running_out_of_memory_is_one_line_and_leaves_the_old_outputs() {
     assert!(o.status.success(), "{}", stderr(&o));
     std::fs::rename(dir.join("mid.json"), dir.with_extension("mid.json")).unwrap();
     let mid = dir.with_extension("mid.json").display().to_string();
-    let runs: [(&str, u64, Vec<&str>, &[&str]); 3] = [
+    // A request that cannot fit is refused before the work (the take-off's history at its
+    // longest); one that could, but does not, runs out and ends the same clean way.
+    const OOM: &[&str] = &["out of memory", "bytes could not be allocated"];
+    const UP_FRONT: &[&str] = &["--max-steps: ", "of memory available"];
+    // What, memory cap (KiB), arguments, outputs, what the message says.
+    type Run<'a> = (&'a str, u64, Vec<&'a str>, &'a [&'a str], &'a [&'a str]);
+    let runs: [Run; 4] = [
         (
             "render to a 1920x1080 GIF and a .glb",
             100_000,
@@ -785,21 +792,41 @@ fn running_out_of_memory_is_one_line_and_leaves_the_old_outputs() {
                 "a.glb",
             ],
             &["a.gif", "a.glb"],
+            OOM,
         ),
         (
             "animate 200 birds",
             30_000,
             vec!["animate", &example, "--birds", "200", "-o", "a.json"],
             &["a.json"],
+            UP_FRONT,
         ),
         (
-            "report on a 10 MB animation",
-            25_000,
+            "animate 200 birds for a minute without a take-off",
+            30_000,
+            vec![
+                "animate",
+                &example,
+                "--birds",
+                "200",
+                "--seconds",
+                "60",
+                "--no-initiation",
+                "-o",
+                "a.json",
+            ],
+            &["a.json"],
+            OOM,
+        ),
+        (
+            "report on a 9 MB animation",
+            18_000,
             vec!["report", &mid, "-o", "a.html"],
             &["a.html"],
+            OOM,
         ),
     ];
-    for (what, cap, args, outputs) in runs {
+    for (what, cap, args, outputs, needles) in runs {
         for o in outputs {
             std::fs::write(dir.join(o), VICTIM).unwrap();
         }
@@ -808,9 +835,7 @@ fn running_out_of_memory_is_one_line_and_leaves_the_old_outputs() {
         assert_eq!(support::code(&o), 2, "{what}: {err}");
         assert_eq!(err.trim_end().lines().count(), 1, "{what}: {err}");
         assert!(
-            err.starts_with("error: ")
-                && err.contains("out of memory")
-                && err.contains("bytes could not be allocated"),
+            err.starts_with("error: ") && needles.iter().all(|n| err.contains(n)),
             "{what}: {err}"
         );
         for o in outputs {

@@ -207,7 +207,8 @@ fn the_flag_changes_the_savings_not_the_motion() {
         let e = b["e"].as_array().unwrap();
         let sum: f64 = e.iter().map(|v| v.as_f64().unwrap()).sum();
         let xi0 = b["xi"][0].as_f64().unwrap();
-        assert!((xi0 - e[0].as_f64().unwrap() / sum).abs() < 1e-12);
+        // e and xi are stored to 10⁻⁶.
+        assert!((xi0 - e[0].as_f64().unwrap() / sum).abs() < 5e-6);
         differ += usize::from(a["e"] != b["e"]);
     }
     assert_eq!(differ, hf.len());

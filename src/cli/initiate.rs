@@ -336,6 +336,7 @@ pub fn run(args: InitiateArgs, g: Global) -> Result<()> {
     formation::wingbeat::rest::stand_on_ground(&mut anim, wing.species);
     formation::initiate::landing::flare_pitch(&mut anim, formation::initiate::landing::FLARE_PITCH);
     formation::wingbeat::assign_phases(&mut anim, &wing)?;
+    anim.quantize();
     super::check_bird_model(
         super::flags::Cmd::Initiate,
         g,

@@ -372,7 +372,72 @@ pub fn bird_track(
 
 /// Builds the `.glb` bytes with `opts`.
 pub fn glb_bytes_with(anim: &Animation, wingspan_m: f64, opts: &SceneOptions) -> Result<Vec<u8>> {
-    let mut b = Builder::default();
+    let mut out = Vec::new();
+    write_glb_with(anim, wingspan_m, opts, &mut out)
+        .map_err(|e| Error::Internal(format!("writing glTF to memory: {e}")))??;
+    Ok(out)
+}
+
+/// [`glb_bytes_with`] written to `out` as it is made: the binary chunk goes out from the buffer
+/// it was built in, not through a copy of the whole file. The outer error is `out`'s; the inner
+/// one the scene's.
+pub fn write_glb_with(
+    anim: &Animation,
+    wingspan_m: f64,
+    opts: &SceneOptions,
+    out: &mut impl std::io::Write,
+) -> std::io::Result<Result<()>> {
+    let (json_bytes, bin, _) = match glb_parts(anim, wingspan_m, opts, None) {
+        Ok(parts) => parts?,
+        Err(e) => return Ok(Err(e)),
+    };
+    write_glb(json_bytes, &mut &bin[..], bin.len(), out)?;
+    Ok(Ok(()))
+}
+
+/// [`write_glb_with`] with the binary chunk written to `spill` (a scratch file) as it is made
+/// and copied from `spill_path` into `out` after the JSON: memory holds the JSON, never the
+/// binary data (the larger part: 1000 birds for 53 s is 220 MB of it).
+pub fn write_glb_spilled(
+    anim: &Animation,
+    wingspan_m: f64,
+    opts: &SceneOptions,
+    spill: &mut std::io::BufWriter<std::fs::File>,
+    spill_path: &std::path::Path,
+    out: &mut impl std::io::Write,
+) -> std::io::Result<Result<()>> {
+    let (json_bytes, _, len) = match glb_parts(anim, wingspan_m, opts, Some(spill)) {
+        Ok(parts) => parts?,
+        Err(e) => return Ok(Err(e)),
+    };
+    std::io::Write::flush(spill)?;
+    let mut back = std::io::BufReader::new(std::fs::File::open(spill_path)?);
+    write_glb(json_bytes, &mut back, len, out)?;
+    Ok(Ok(()))
+}
+
+/// A scene's JSON chunk, binary chunk (empty when spilled) and the binary chunk's length.
+type GlbParts = (Vec<u8>, Vec<u8>, usize);
+
+/// The JSON and binary chunks of the scene, and the binary chunk's length; with `spill`, the
+/// binary chunk is written there as it is made (and the one returned is empty).
+fn glb_parts(
+    anim: &Animation,
+    wingspan_m: f64,
+    opts: &SceneOptions,
+    spill: Option<&mut dyn std::io::Write>,
+) -> Result<std::io::Result<GlbParts>> {
+    let mut b = Builder {
+        bin: match spill {
+            Some(out) => Sink::Spill {
+                out,
+                len: 0,
+                error: None,
+            },
+            None => Sink::default(),
+        },
+        non_finite: None,
+    };
     let ws = wingspan_m as f32;
     let assets = opts.models(anim);
     let model_of = opts.model_of(anim);
@@ -730,16 +795,19 @@ pub fn glb_bytes_with(anim: &Animation, wingspan_m: f64, opts: &SceneOptions) ->
             "glTF: refusing to write a non-finite number in {at}"
         )));
     }
-    let bin = b.finish(&mut root);
+    let (bin, len) = match b.finish(&mut root) {
+        Ok(b) => b,
+        Err(e) => return Ok(Err(e)),
+    };
     let json_bytes = root
         .to_vec()
         .map_err(|e| Error::Internal(format!("serialising glTF JSON: {e}")))?;
-    Ok(glb(json_bytes, bin))
+    Ok(Ok((json_bytes, bin, len)))
 }
 
 /// Writes the channels of one bird in one clip.
-struct ClipWriter<'a> {
-    b: &'a mut Builder,
+struct ClipWriter<'a, 's> {
+    b: &'a mut Builder<'s>,
     root: &'a mut json::Root,
     /// Times of every frame of the clip, seconds from its start.
     times: &'a [f32],
@@ -748,7 +816,7 @@ struct ClipWriter<'a> {
     out: &'a mut (Vec<json::animation::Channel>, Vec<json::animation::Sampler>),
 }
 
-impl ClipWriter<'_> {
+impl ClipWriter<'_, '_> {
     /// The time accessor of the frames `kept` (the shared one when that is every frame).
     fn input(&mut self, kept: &[usize]) -> json::Index<json::Accessor> {
         if kept.len() == self.times.len() {
@@ -957,25 +1025,69 @@ fn weight_bytes(w: [f32; 4]) -> [u8; 4] {
 }
 
 /// Collects binary data, 4-byte aligned, one buffer view per accessor.
+/// Where the binary chunk is built: in memory, or written out as it grows (a scratch file, so
+/// that a large scene's binary data is never held whole).
+enum Sink<'a> {
+    Memory(Vec<u8>),
+    Spill {
+        out: &'a mut dyn std::io::Write,
+        len: usize,
+        error: Option<std::io::Error>,
+    },
+}
+
+impl Default for Sink<'_> {
+    fn default() -> Self {
+        Sink::Memory(Vec::new())
+    }
+}
+
+impl Sink<'_> {
+    fn len(&self) -> usize {
+        match self {
+            Sink::Memory(v) => v.len(),
+            Sink::Spill { len, .. } => *len,
+        }
+    }
+
+    fn extend(&mut self, bytes: &[u8]) {
+        match self {
+            Sink::Memory(v) => v.extend_from_slice(bytes),
+            Sink::Spill { out, len, error } => {
+                *len += bytes.len();
+                if error.is_none() {
+                    if let Err(e) = out.write_all(bytes) {
+                        *error = Some(e);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Zero bytes up to the next multiple of 4.
+    fn pad(&mut self) {
+        let n = (4 - self.len() % 4) % 4;
+        self.extend(&[0u8; 3][..n]);
+    }
+}
+
 #[derive(Default)]
-struct Builder {
-    bin: Vec<u8>,
+struct Builder<'a> {
+    bin: Sink<'a>,
     /// The first accessor holding a non-finite number (never written), by index.
     non_finite: Option<String>,
 }
 
-impl Builder {
+impl Builder<'_> {
     fn view(
         &mut self,
         root: &mut json::Root,
         bytes: &[u8],
         target: Option<json::buffer::Target>,
     ) -> json::Index<json::buffer::View> {
-        while self.bin.len() % 4 != 0 {
-            self.bin.push(0);
-        }
+        self.bin.pad();
         let offset = self.bin.len();
-        self.bin.extend_from_slice(bytes);
+        self.bin.extend(bytes);
         root.push(json::buffer::View {
             buffer: json::Index::new(0),
             byte_length: USize64::from(bytes.len()),
@@ -1239,38 +1351,60 @@ impl Builder {
         })
     }
 
-    fn finish(mut self, root: &mut json::Root) -> Vec<u8> {
-        while self.bin.len() % 4 != 0 {
-            self.bin.push(0);
-        }
+    /// The buffer's entry in `root`, and the binary chunk when it was built in memory (empty
+    /// when it was spilled; the spill's write error, if any, is the `Err`).
+    fn finish(mut self, root: &mut json::Root) -> std::io::Result<(Vec<u8>, usize)> {
+        self.bin.pad();
+        let len = self.bin.len();
         root.push(json::Buffer {
-            byte_length: USize64::from(self.bin.len()),
+            byte_length: USize64::from(len),
             name: None,
             uri: None,
             extensions: None,
             extras: Default::default(),
         });
-        self.bin
+        match self.bin {
+            Sink::Memory(v) => Ok((v, len)),
+            Sink::Spill { error: Some(e), .. } => Err(e),
+            Sink::Spill { .. } => Ok((Vec::new(), len)),
+        }
     }
 }
 
-/// Packs JSON and binary chunks into a GLB container (JSON padded with spaces, BIN with zeros).
-fn glb(mut json_bytes: Vec<u8>, bin: Vec<u8>) -> Vec<u8> {
+/// Writes JSON and binary chunks as a GLB container (JSON padded with spaces, BIN with zeros).
+fn write_glb(
+    mut json_bytes: Vec<u8>,
+    bin: &mut impl std::io::Read,
+    bin_len: usize,
+    out: &mut impl std::io::Write,
+) -> std::io::Result<()> {
     while json_bytes.len() % 4 != 0 {
         json_bytes.push(b' ');
     }
-    let total = 12 + 8 + json_bytes.len() + 8 + bin.len();
-    let mut out = Vec::with_capacity(total);
-    out.extend_from_slice(b"glTF");
-    out.extend_from_slice(&2u32.to_le_bytes());
-    out.extend_from_slice(&(total as u32).to_le_bytes());
-    out.extend_from_slice(&(json_bytes.len() as u32).to_le_bytes());
-    out.extend_from_slice(b"JSON");
-    out.extend_from_slice(&json_bytes);
-    out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
-    out.extend_from_slice(b"BIN\0");
-    out.extend_from_slice(&bin);
-    out
+    let total = 12 + 8 + json_bytes.len() + 8 + bin_len;
+    let too_big = |what: &str| {
+        std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            format!("{what} is more than the 4 GiB a GLB file can hold"),
+        )
+    };
+    let total = u32::try_from(total).map_err(|_| too_big("the scene"))?;
+    out.write_all(b"glTF")?;
+    out.write_all(&2u32.to_le_bytes())?;
+    out.write_all(&total.to_le_bytes())?;
+    out.write_all(&(json_bytes.len() as u32).to_le_bytes())?;
+    out.write_all(b"JSON")?;
+    out.write_all(&json_bytes)?;
+    out.write_all(&(bin_len as u32).to_le_bytes())?;
+    out.write_all(b"BIN\0")?;
+    let copied = std::io::copy(&mut std::io::Read::take(bin, bin_len as u64), out)?;
+    if copied != bin_len as u64 {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::UnexpectedEof,
+            "the binary chunk's scratch file is shorter than written",
+        ));
+    }
+    Ok(())
 }
 
 #[cfg(test)]

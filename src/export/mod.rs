@@ -37,7 +37,7 @@ use std::path::{Path, PathBuf};
 
 use crate::animation::Animation;
 use crate::error::{Error, Result};
-use crate::io::{write_bytes_atomic, AtomicFile, OutputKind};
+use crate::io::{AtomicFile, OutputKind};
 use crate::progress::Progress;
 
 pub use camera::CameraKind;
@@ -637,12 +637,19 @@ pub fn write_outputs(
         crate::io::set_current_output(&o.path);
         match o.kind {
             OutputKind::Json => {
-                let mut a = anim.clone();
-                a.wingspan_m = wingspan_m;
-                if !(opts.units.is_default() && opts.up.is_default()) {
-                    a = a.in_axes(opts.units, opts.up);
-                }
-                crate::io::write_json_atomic_as(&o.path, &a, opts.pretty)?;
+                // A copy only when the file differs from the animation in memory.
+                let same_axes = opts.units.is_default() && opts.up.is_default();
+                let a = if wingspan_m == anim.wingspan_m && same_axes {
+                    std::borrow::Cow::Borrowed(anim)
+                } else {
+                    let mut a = anim.clone();
+                    a.wingspan_m = wingspan_m;
+                    if !same_axes {
+                        a = a.in_axes(opts.units, opts.up);
+                    }
+                    std::borrow::Cow::Owned(a)
+                };
+                crate::io::write_json_atomic_as(&o.path, a.as_ref(), opts.pretty)?;
             }
             OutputKind::Csv => {
                 // Streamed into the temporary file (not built in memory: up to 1.4 GB).
@@ -654,8 +661,23 @@ pub fn write_outputs(
             OutputKind::Glb => {
                 progress.start("glb", 1);
                 let (a, sc) = scene_anim()?;
-                let bytes = gltf::glb_bytes_with(&a, wingspan_m, &sc)?;
-                write_bytes_atomic(&o.path, &bytes)?;
+                // The binary chunk is written to a scratch file beside the output as it is made,
+                // then copied after the JSON chunk (never held whole in memory); the scratch file
+                // is removed in any case.
+                let mut f = AtomicFile::create(&o.path)?;
+                let mut spill = AtomicFile::create(&o.path)?;
+                let spill_path = spill.temp_path().to_path_buf();
+                gltf::write_glb_spilled(
+                    &a,
+                    wingspan_m,
+                    &sc,
+                    spill.writer(),
+                    &spill_path,
+                    f.writer(),
+                )
+                .map_err(|e| Error::io(&o.path, e))??;
+                drop(spill);
+                f.commit()?;
                 progress.advance(1);
                 progress.finish();
             }

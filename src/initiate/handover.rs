@@ -13,12 +13,24 @@ pub fn hand_over(
     run: &InitiationRun,
     opts: &InitiateOptions,
 ) -> Result<(Animation, InitiateStats)> {
+    hand_over_owned(steady.clone(), run, opts)
+}
+
+/// [`hand_over`] of a steady flight given up to it: its frames become the animation's steady
+/// frames in place instead of being copied (the flock's memory once, not twice, for large flocks).
+pub fn hand_over_owned(
+    mut steady: Animation,
+    run: &InitiationRun,
+    opts: &InitiateOptions,
+) -> Result<(Animation, InitiateStats)> {
     let n = steady.birds;
     let fps = steady.fps;
     let f0 = steady
         .frames
         .first()
+        .cloned()
         .ok_or_else(|| Error::Internal("steady flight without frames".into()))?;
+    let f0 = &f0;
     // Bird b of the simulation becomes animation bird perm[b] (its slot = the key shape's bird).
     let mut perm = vec![usize::MAX; n];
     let mut used = vec![false; n];
@@ -38,7 +50,7 @@ pub fn hand_over(
     let last = run.pos.len() - 1;
     let alt = opts.cruise_altitude;
     let g = GRAVITY_M_S2 / steady.wingspan_m;
-    let steady_bank = steady_banks(steady, g, opts.max_roll_rate, opts.roll_lag);
+    let steady_bank = steady_banks(&steady, g, opts.max_roll_rate, opts.roll_lag);
     let step_of = |s: usize| perception::direction(f0.heading[s]) * (f0.speed[s] / fps);
     let s0 = |s: usize| DVec2::new(f0.x[s], f0.y[s]);
     // Translation of the steady flight: least squares over birds of the one-step continuation.
@@ -48,10 +60,11 @@ pub fn hand_over(
     }
     shift /= n as f64;
     let window = ((opts.hold * fps).round() as usize).clamp(1, last.max(1));
-    let mut frames: Vec<Frame> = Vec::with_capacity(run.pos.len() + steady.frames.len());
+    let steady_frames = std::mem::take(&mut steady.frames);
+    let mut frames: Vec<Frame> = Vec::with_capacity(run.pos.len() + steady_frames.len());
     let wing_rate: Option<Vec<f64>> = match (
-        steady.frames.first().and_then(|f| f.wing_phase.as_ref()),
-        steady.frames.get(1).and_then(|f| f.wing_phase.as_ref()),
+        steady_frames.first().and_then(|f| f.wing_phase.as_ref()),
+        steady_frames.get(1).and_then(|f| f.wing_phase.as_ref()),
     ) {
         (Some(a), Some(b)) => Some(
             a.iter()
@@ -108,9 +121,9 @@ pub fn hand_over(
     let offset = frames.len();
     let t_start = offset as f64 / fps;
     let t0 = f0.t;
-    for (f, bank) in steady.frames.iter().zip(steady_bank) {
-        let mut g = f.clone();
-        g.t = t_start + (f.t - t0);
+    let steady_len = steady_frames.len();
+    for (mut g, bank) in steady_frames.into_iter().zip(steady_bank) {
+        g.t = t_start + (g.t - t0);
         for s in 0..n {
             if let (Some(x), Some(y)) = (g.x.get_mut(s), g.y.get_mut(s)) {
                 *x += shift.x;
@@ -136,7 +149,7 @@ pub fn hand_over(
         out.stages.push(Stage {
             name: "steady".into(),
             start: offset,
-            end: offset + steady.frames.len(),
+            end: offset + steady_len,
         });
     }
     for st in &steady.stages {

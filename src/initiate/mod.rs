@@ -384,27 +384,33 @@ pub fn initiate(
     hand_over(steady, &run, opts)
 }
 
-/// Refuses an initiation that could hold more than [`crate::limits::MAX_BIRD_FRAMES`]
-/// bird-frames in memory: `birds` × (`steady_frames` + `max_steps`), every step being kept for the
-/// output (refused up front instead of exhausting memory).
+/// Refuses, up front, an initiation that could not fit in the memory this process may use
+/// ([`crate::limits::memory_budget`]): at its longest, `birds` × (`steady_frames` + `max_steps`)
+/// bird-frames, each taking at most [`crate::limits::RUN_BYTES_PER_BIRD_FRAME`] while the run is
+/// made. A take-off that converges sooner takes only what it used: the animation's own limit
+/// ([`crate::limits::MAX_BIRD_FRAMES`]) is checked on the frames it really has.
 pub fn check_size(birds: usize, steady_frames: usize, max_steps: usize) -> Result<()> {
-    let frames = steady_frames.saturating_add(max_steps);
-    match birds.checked_mul(frames) {
-        Some(p) if p <= crate::limits::MAX_BIRD_FRAMES => Ok(()),
-        _ => {
-            let plus = if steady_frames > 0 {
-                format!(" + {steady_frames} steady frames")
-            } else {
-                String::new()
-            };
-            Err(Error::parameter(
-                "initiate.max_steps",
-                format!(
-                    "{birds} birds × ({max_steps} steps{plus}) could be more than {} bird-frames in memory; lower initiate.max_steps to at most {}",
-                    crate::limits::MAX_BIRD_FRAMES,
-                    (crate::limits::MAX_BIRD_FRAMES / birds.max(1)).saturating_sub(steady_frames)
-                ),
-            ))
-        }
+    let frames = steady_frames.saturating_add(max_steps) as u64;
+    let Some(budget) = crate::limits::memory_budget() else {
+        return Ok(());
+    };
+    let per_frame = (birds as u64).saturating_mul(crate::limits::RUN_BYTES_PER_BIRD_FRAME);
+    let need = per_frame.saturating_mul(frames);
+    if need <= budget {
+        return Ok(());
     }
+    let plus = if steady_frames > 0 {
+        format!(" + {steady_frames} steady frames")
+    } else {
+        String::new()
+    };
+    let fits = (budget / per_frame.max(1)).saturating_sub(steady_frames as u64);
+    Err(Error::parameter(
+        "initiate.max_steps",
+        format!(
+            "{birds} birds × ({max_steps} steps{plus}) could take {:.1} GB, more than the {:.1} GB of memory available; lower initiate.max_steps to at most {fits} or fly fewer birds",
+            need as f64 / 1e9,
+            budget as f64 / 1e9
+        ),
+    ))
 }

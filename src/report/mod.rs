@@ -145,8 +145,7 @@ pub fn animation_band(a: &Animation) -> Vec<BandEntry> {
             .map(|k| range.start + k * (len - 1) / (budget - 1))
             .collect()
     };
-    let mut b = a.clone();
-    b.frames = picks.iter().map(|&k| a.frames[k].clone()).collect();
+    let mut b = a.with_frames(picks.iter().map(|&k| a.frames[k].clone()).collect());
     b.stages.clear();
     let heights = b.frames.iter().any(|f| {
         let m = f.z.iter().sum::<f64>() / f.z.len().max(1) as f64;

@@ -318,8 +318,11 @@ fn finish(
             let wait = frames - run.pos.len();
             reports[f].takeoff_delay_s = wait as f64 / anims[f].fps;
             let run = delayed(run, wait);
-            let (mut a, stats) = initiate::hand_over(&anims[f], &run, init)
+            // The formation's steady frames move into its take-off's animation (no copy).
+            let steady = std::mem::replace(&mut anims[f], Animation::new(0, 1.0, 1.0, 0));
+            let (mut a, stats) = initiate::hand_over_owned(steady, &run, init)
                 .map_err(|e| in_formation(e, f, sizes[f]))?;
+            drop(run);
             crate::aero::fill_frame_savings(&mut a, &o.steady.aero);
             anims[f] = a;
             reports[f].initiate = Some(stats);
@@ -342,7 +345,7 @@ fn finish(
             ..p.clone()
         };
     }
-    let anim = join(&anims, &reports)?;
+    let anim = join(anims, &reports)?;
     let min_separation = min_separation(&anim);
     if min_separation < o.skein.clearance - 1e-9 {
         return Err(Error::Internal(format!(
@@ -535,8 +538,9 @@ fn centre_of(env: &[Envelope], p: &[Placement], takeoff: bool) -> [f64; 2] {
 }
 
 /// One animation of the formations `anims` (equal frame counts), each moved by its placement;
-/// birds numbered formation by formation.
-fn join(anims: &[Animation], reports: &[FormationReport]) -> Result<Animation> {
+/// birds numbered formation by formation. The formations' frames are consumed as the flock's are made, so the flock is in memory about
+/// once, not twice.
+fn join(mut anims: Vec<Animation>, reports: &[FormationReport]) -> Result<Animation> {
     let first = anims
         .first()
         .ok_or_else(|| Error::Internal("a flock without formations".into()))?;
@@ -554,7 +558,7 @@ fn join(anims: &[Animation], reports: &[FormationReport]) -> Result<Animation> {
     let steady_start = first.stage("steady").map(|s: &Stage| s.start);
     let mut records = Vec::with_capacity(anims.len());
     let mut base = 0;
-    for a in anims {
+    for a in &anims {
         let leader = a.leaders().first().copied().unwrap_or(0);
         records.push(FormationRecord {
             birds: (base..base + a.birds).collect(),
@@ -576,23 +580,31 @@ fn join(anims: &[Animation], reports: &[FormationReport]) -> Result<Animation> {
         .map(|a| a.xi_ranges.clone())
         .collect::<Option<Vec<_>>>()
         .map(|v| v.concat());
+    let mut sources: Vec<std::vec::IntoIter<Frame>> = anims
+        .iter_mut()
+        .map(|a| std::mem::take(&mut a.frames).into_iter())
+        .collect();
     out.frames = (0..frames)
-        .map(|j| {
+        .map(|_| {
+            // This frame of every formation, dropped once copied.
+            let parts: Vec<Frame> = sources
+                .iter_mut()
+                .map(|s| s.next().unwrap_or_default())
+                .collect();
             let cat = |get: &dyn Fn(&Frame) -> &Vec<f64>, add: Option<usize>| -> Vec<f64> {
                 let mut v = Vec::with_capacity(n);
-                for (a, r) in anims.iter().zip(reports) {
+                for (f, r) in parts.iter().zip(reports) {
                     let d = add.map_or(0.0, |c| r.placement.offset[c]);
-                    v.extend(get(&a.frames[j]).iter().map(|x| x + d));
+                    v.extend(get(f).iter().map(|x| x + d));
                 }
                 v
             };
             let opt = |get: &dyn Fn(&Frame) -> Option<&Vec<f64>>| -> Option<Vec<f64>> {
-                let parts: Option<Vec<&Vec<f64>>> =
-                    anims.iter().map(|a| get(&a.frames[j])).collect();
-                parts.map(|p| p.into_iter().flatten().copied().collect())
+                let got: Option<Vec<&Vec<f64>>> = parts.iter().map(get).collect();
+                got.map(|p| p.into_iter().flatten().copied().collect())
             };
             Frame {
-                t: first.frames[j].t,
+                t: parts[0].t,
                 x: cat(&|f| &f.x, Some(0)),
                 y: cat(&|f| &f.y, Some(1)),
                 z: cat(&|f| &f.z, None),
