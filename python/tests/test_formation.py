@@ -64,10 +64,11 @@ def test_shapes_and_dtypes(anim):
     assert anim.positions.dtype == np.float64 and anim.times.dtype == np.float64
     assert np.all(np.diff(anim.times) > 0)
     assert ((anim.wing_phase >= 0) & (anim.wing_phase < 2 * np.pi)).all()
-    # Munk: in the steady flight, xi sums to 1 in every frame.
+    # Munk: in the steady flight, xi sums to 1 in every frame (each xi rounded to 1e-6, as
+    # the animation file stores it).
     name, start, end = anim.stages[-1]
     assert name == "steady"
-    np.testing.assert_allclose(anim.xi[start:end].sum(axis=1), 1.0, atol=1e-9)
+    np.testing.assert_allclose(anim.xi[start:end].sum(axis=1), 1.0, rtol=0, atol=0.5e-6 * b + 1e-12)
 
 
 def test_same_seed_same_motion_and_another_seed_differs():
