@@ -12,8 +12,8 @@ use serde::Serialize;
 use crate::error::{Error, Result};
 
 /// Upper bound on the size of any input file, bytes: 6 GiB, enough for the largest animation
-/// file `formation` writes ([`crate::limits::MAX_BIRD_FRAMES`] bird-frames: about 2.4 GB compact
-/// for a wide sky of formations, whose coordinates have more digits, and 4.3 GB with `pretty`).
+/// file `formation` writes ([`crate::limits::MAX_BIRD_FRAMES`] bird-frames: up to 2.5 GB compact
+/// for a wide sky of formations, whose coordinates have more digits, and 5.0 GB with `pretty`).
 /// Animation files are parsed as they are read (their text is never held whole); other inputs
 /// are small in practice and read whole.
 pub const MAX_INPUT_BYTES: u64 = 6 * 1024 * 1024 * 1024;
@@ -186,8 +186,8 @@ pub fn read_json<T: DeserializeOwned>(path: &Path) -> Result<T> {
 /// mark skipped), for parsers that stream: memory stays at one chunk whatever the file's size.
 /// A failed check ends the reading with an I/O error; [`TextInput::error`] then holds the
 /// message naming the file.
-pub struct TextInput {
-    reader: std::io::Take<fs::File>,
+pub struct TextInput<R = std::io::Take<fs::File>> {
+    reader: R,
     path: PathBuf,
     limit: u64,
     /// Bytes read from the file so far.
@@ -208,7 +208,14 @@ impl TextInput {
     /// Opens `path` for streaming (directories and files over the size limit refused at once).
     pub fn open(path: &Path) -> Result<TextInput> {
         let (reader, limit, _) = open_input(path)?;
-        Ok(TextInput {
+        Ok(TextInput::new(path, reader, limit))
+    }
+}
+
+impl<R: std::io::Read> TextInput<R> {
+    /// Streams `reader`, named `path` in messages, refusing more than `limit` bytes.
+    pub fn new(path: &Path, reader: R, limit: u64) -> TextInput<R> {
+        TextInput {
             reader,
             path: path.to_path_buf(),
             limit,
@@ -220,7 +227,7 @@ impl TextInput {
             done: false,
             content: false,
             error: None,
-        })
+        }
     }
 
     /// The check that stopped the reading, if one did.
@@ -309,7 +316,7 @@ impl TextInput {
     }
 }
 
-impl std::io::Read for TextInput {
+impl<R: std::io::Read> std::io::Read for TextInput<R> {
     fn read(&mut self, out: &mut [u8]) -> std::io::Result<usize> {
         while self.pos == self.end {
             if self.done || !self.refill()? {
@@ -332,7 +339,15 @@ impl std::io::Read for TextInput {
 /// held whole, so a large file takes the memory of what it parses into, not twice that. Errors
 /// as [`read_json`]'s.
 pub fn read_json_streaming<T: DeserializeOwned>(path: &Path) -> Result<T> {
-    let mut input = TextInput::open(path)?;
+    parse_json_streaming(TextInput::open(path)?)
+}
+
+/// [`read_json_streaming`] of any input (the fuzz targets stream bytes held in memory).
+pub fn parse_json_streaming<T: DeserializeOwned, R: std::io::Read>(
+    mut input: TextInput<R>,
+) -> Result<T> {
+    let path = input.path.clone();
+    let path = path.as_path();
     // Through a `BufReader`: the standard library reads its bytes one by one without a call each
     // (serde_json's reader asks byte by byte; three times faster than asking the input).
     let parsed = serde_json::from_reader(std::io::BufReader::with_capacity(1 << 16, &mut input));

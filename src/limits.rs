@@ -24,8 +24,8 @@ pub const MAX_FRAMES: usize = 1_000_000;
 
 /// Most bird-frames (birds × frames) in an animation: 2·10⁷, e.g. 10 000 birds for a minute of
 /// take-off and flight at 30 fps, or 1000 birds for 11 minutes. An animation takes 88 bytes per
-/// bird-frame in memory, so 1.8 GB at the limit, and its file about 90 (up to 120 for a wide
-/// sky of formations, whose coordinates have more digits): within
+/// bird-frame in memory, so 1.8 GB at the limit, and its file about 90 (126 for a wide sky of
+/// formations, whose coordinates have more digits; 248 with `pretty`): within
 /// [`crate::io::MAX_INPUT_BYTES`], so every file written can be read back.
 pub const MAX_BIRD_FRAMES: usize = 20_000_000;
 

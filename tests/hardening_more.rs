@@ -365,7 +365,7 @@ fn report_of_a_sky_of_many_formations_is_not_quadratic() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
-/// The largest animation file `steady` writes (2·10⁷ bird-frames: about 2.4 GB compact, 4.3 GB
+/// The largest animation file `steady` writes (2·10⁷ bird-frames: up to 2.5 GB compact, 5.0 GB
 /// with `--pretty`) must be readable: it once was refused by a 2 GiB input limit. Sparse files
 /// show the limit (6 GiB) without writing gigabytes: 3 GB is read (and refused as binary: it is
 /// all NUL bytes), 7 GB is refused by its size before reading.

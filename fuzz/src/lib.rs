@@ -82,14 +82,15 @@ pub fn params(data: &[u8]) {
 }
 
 /// Animation file (`render`, `initiate`, `plot xi|power|paths`): `Animation::read` is
-/// `io::parse_json` + `validate`; `render` adds `check_times`, `initiate` adds `check_steady`.
+/// `io::read_json_streaming` (the same reader, here over the bytes) + `validate`; `render` adds
+/// `check_times`, `initiate` adds `check_steady`.
 /// Whatever is accepted is exported in memory (CSV, glTF) and one picture frame is drawn small.
 pub fn animation(data: &[u8]) {
     use formation::export::{gltf, pictures::Film, raster, sample, table};
     use formation::Animation;
-    let Some(t) = text(data) else { return };
     let path = Path::new(PATH);
-    let Ok(a) = formation::io::parse_json::<Animation>(path, t) else {
+    let input = formation::io::TextInput::new(path, data, formation::io::MAX_INPUT_BYTES);
+    let Ok(a) = formation::io::parse_json_streaming::<Animation, _>(input) else {
         return;
     };
     if a.validate(path).is_err() {
