@@ -33,6 +33,18 @@ use crate::animation::Animation;
 pub const CSV_HEADER: &str =
     "frame,t,bird,x,y,z,heading,speed,e,xi,stage,formation,rank,leader,lateral,behind,wing_phase,bank,saving_total,qx,qy,qz,qw,pitch";
 
+/// An optional number as a CSV cell: the number, or nothing (written without a `String`).
+struct Cell(Option<f64>);
+
+impl std::fmt::Display for Cell {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.0 {
+            Some(x) => write!(f, "{x}"),
+            None => Ok(()),
+        }
+    }
+}
+
 /// The stage word of every frame (`none` outside every stage).
 fn stage_words(anim: &Animation) -> Vec<&str> {
     let mut w = vec!["none"; anim.frames.len()];
@@ -71,23 +83,17 @@ pub fn write_csv_in<W: Write>(
         let rel = anim.relative_with(k, &of, &leaders);
         for (b, r) in rel.iter().enumerate() {
             let v = |a: &Vec<f64>| a.get(b).copied().unwrap_or(f64::NAN);
-            let o = |a: &Option<Vec<f64>>| match a.as_ref().and_then(|a| a.get(b)) {
-                Some(x) => format!("{x}"),
-                None => String::new(),
-            };
+            let o = |a: &Option<Vec<f64>>| Cell(a.as_ref().and_then(|a| a.get(b)).copied());
             let or0 =
                 |a: &Option<Vec<f64>>| a.as_ref().and_then(|a| a.get(b)).copied().unwrap_or(0.0);
             let bank = or0(&f.bank);
             let pitch = or0(&f.pitch);
-            let total = match f.e.as_ref().and_then(|a| a.get(b)) {
-                Some(e) => {
-                    let v = anim.flight.and_then(|f| f.speed_ms).unwrap_or_else(|| {
-                        crate::aero::flight::airspeed_ms(&curve, v(&f.speed), anim.wingspan_m)
-                    });
-                    format!("{}", e * curve.induced_share(v))
-                }
-                None => String::new(),
-            };
+            let total = Cell(f.e.as_ref().and_then(|a| a.get(b)).map(|e| {
+                let v = anim.flight.and_then(|f| f.speed_ms).unwrap_or_else(|| {
+                    crate::aero::flight::airspeed_ms(&curve, v(&f.speed), anim.wingspan_m)
+                });
+                e * curve.induced_share(v)
+            }));
             let p = up
                 .from_world([v(&f.x), v(&f.y), v(&f.z)])
                 .map(|c| c * scale);
