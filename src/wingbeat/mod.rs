@@ -19,6 +19,7 @@
 
 pub mod kinematics;
 pub mod rest;
+pub mod sparse;
 pub mod species;
 
 use std::f64::consts::{PI, TAU};
