@@ -30,8 +30,8 @@ impl<T: Copy + PartialEq> FrameTable<T> {
     ) -> FrameTable<T> {
         let mut rows = Vec::new();
         let mut data = Vec::new();
-        if birds > 0 {
-            rows.reserve(values.len() / birds);
+        if let Some(frames) = values.len().checked_div(birds) {
+            rows.reserve(frames);
             for (f, row) in values.chunks(birds).enumerate() {
                 if !keep(f, row) {
                     rows.push(NONE);
