@@ -331,12 +331,16 @@ const WING_JOINTS: [usize; 5] = [
     bird::hand_joint(Side::Right),
 ];
 
+/// The leg joints: animated only for a bird whose legs move in the animation (a take-off or a
+/// landing), so that a flight in the air keeps the channels it had without them.
+const LEG_JOINTS: [usize; 2] = [bird::leg_joint(Side::Left), bird::leg_joint(Side::Right)];
+
 /// Per bird: flight and local joint rotations at every frame, on the asset's skeleton.
 pub struct BirdTrack {
     /// Root translation (metres) and yaw, and the bank.
     pub flight: Flight,
     /// Local rotation of every joint at every frame (bind rotations applied), sign-continuous.
-    pub joints: Vec<[Quat; 7]>,
+    pub joints: Vec<[Quat; bird::N_JOINTS]>,
 }
 
 /// The track of `bird` for `asset`.
@@ -350,9 +354,9 @@ pub fn bird_track(
     let flight = bird::flight(anim, bird, wingspan_m);
     let ours = bird::joint_track(flapper, &flight, bird);
     let skel = &asset.skeleton;
-    let mut joints: Vec<[Quat; 7]> = Vec::with_capacity(ours.len());
+    let mut joints: Vec<[Quat; bird::N_JOINTS]> = Vec::with_capacity(ours.len());
     for q in ours {
-        let mut l: [Quat; 7] = std::array::from_fn(|j| {
+        let mut l: [Quat; bird::N_JOINTS] = std::array::from_fn(|j| {
             // The neck never moves; a static model moves only its body.
             if j == bird::NECK || (!asset.wingbeat && j != bird::BODY) {
                 skel.rest_rotation(j)
@@ -361,7 +365,7 @@ pub fn bird_track(
             }
         });
         if let Some(p) = joints.last() {
-            for j in 0..7 {
+            for j in 0..bird::N_JOINTS {
                 l[j] = bird::continuous(p[j], l[j]);
             }
         }
@@ -387,7 +391,7 @@ pub fn glb_bytes_with(anim: &Animation, wingspan_m: f64, opts: &SceneOptions) ->
         },
         ..Default::default()
     };
-    // Each model's inverse bind matrices (its seven joints, column-major).
+    // Each model's inverse bind matrices (its joints, column-major).
     let model_ibm: Vec<Vec<f32>> = assets
         .iter()
         .map(|asset| {
@@ -444,7 +448,7 @@ pub fn glb_bytes_with(anim: &Animation, wingspan_m: f64, opts: &SceneOptions) ->
         let asset = &assets[model];
         let track = bird_track(anim, &flapper, asset, bird, wingspan_m);
         // Skeleton nodes, children before parents so indices are known.
-        let mut joint_nodes: [Option<json::Index<json::Node>>; 7] = [None; 7];
+        let mut joint_nodes: [Option<json::Index<json::Node>>; bird::N_JOINTS] = [None; bird::N_JOINTS];
         for j in (0..bird::JOINTS.len()).rev() {
             let children: Vec<_> = (0..bird::JOINTS.len())
                 .filter(|&c| bird::PARENT[c] == Some(j))
@@ -518,6 +522,19 @@ pub fn glb_bytes_with(anim: &Animation, wingspan_m: f64, opts: &SceneOptions) ->
             }));
         }
 
+        // The wing joints, and the legs when they move in any frame of the bird's track.
+        let rest_leg = |j: usize| asset.skeleton.rest_rotation(j);
+        let legs_move = LEG_JOINTS.iter().any(|&j| {
+            track
+                .joints
+                .iter()
+                .any(|q| q[j].dot(rest_leg(j)).abs() < 1.0 - 1e-7)
+        });
+        let moving: Vec<usize> = WING_JOINTS
+            .iter()
+            .chain(LEG_JOINTS.iter().filter(|_| legs_move))
+            .copied()
+            .collect();
         for (ci, c) in clips.iter().enumerate() {
             let r = c.first..c.last + 1;
             let times = &clip_t[ci];
@@ -575,17 +592,17 @@ pub fn glb_bytes_with(anim: &Animation, wingspan_m: f64, opts: &SceneOptions) ->
                 if !reduced {
                     let all: Vec<usize> = (0..times.len()).collect();
                     let input = ch.input(&all);
-                    for &j in &WING_JOINTS {
+                    for &j in &moving {
                         ch.quats(input, joints[j], &per_joint[j], &all);
                     }
                 } else {
                     // Reduced: the wing rotations are stored as normalised bytes (4 bytes a key
                     // instead of 16), and the kept keys are chosen against the decoded values.
-                    let q8: Vec<(Vec<[i8; 4]>, Vec<Quat>)> = WING_JOINTS
+                    let q8: Vec<(Vec<[i8; 4]>, Vec<Quat>)> = moving
                         .iter()
                         .map(|&j| per_joint[j].iter().map(|&q| keys::quantise_i8(q)).unzip())
                         .collect();
-                    let curves: Vec<Curve> = WING_JOINTS
+                    let curves: Vec<Curve> = moving
                         .iter()
                         .zip(&q8)
                         .map(|(&j, (_, stored))| Curve::Stored {
@@ -598,11 +615,11 @@ pub fn glb_bytes_with(anim: &Animation, wingspan_m: f64, opts: &SceneOptions) ->
                     // A time accessor of its own costs 4 bytes a key; keeping every frame on the
                     // clip's shared one costs 4 bytes a joint for each extra key: take the smaller.
                     let n = times.len();
-                    if kept.len() * (4 + 4 * WING_JOINTS.len()) >= n * 4 * WING_JOINTS.len() {
+                    if kept.len() * (4 + 4 * moving.len()) >= n * 4 * moving.len() {
                         kept = (0..n).collect();
                     }
                     let input = ch.input(&kept);
-                    for (&j, (bytes, _)) in WING_JOINTS.iter().zip(&q8) {
+                    for (&j, (bytes, _)) in moving.iter().zip(&q8) {
                         let data: Vec<u8> = kept
                             .iter()
                             .flat_map(|&k| bytes[k].map(|v| v as u8))
@@ -627,7 +644,7 @@ pub fn glb_bytes_with(anim: &Animation, wingspan_m: f64, opts: &SceneOptions) ->
     });
     if opts.one_skin {
         // The flock in parts of FLOCK_PART birds: each part one mesh holding its birds (each
-        // bird's copy of its model bound to its own seven joints) on one skin of their joints.
+        // bird's copy of its model bound to its own joints) on one skin of their joints.
         // All skins hang from the flock node, so a DCC makes one armature of them; parts keep
         // each mesh's skin small (Blender's importer binds a mesh's vertices joint by joint).
         let joints_per_bird = bird::JOINTS.len() + 1;
@@ -638,7 +655,7 @@ pub fn glb_bytes_with(anim: &Animation, wingspan_m: f64, opts: &SceneOptions) ->
             let last = (first + FLOCK_PART).min(anim.birds);
             let name = format!("flock_{p:0part_digits$}");
             let mesh = b.skinned_meshes(&mut root, models, &model_of[first..last], ws, &name, true);
-            // Per bird: its root's bind (the origin), then its model's seven.
+            // Per bird: its root's bind (the origin), then its model's joints.
             let identity = glam::Mat4::IDENTITY.to_cols_array();
             let ibm: Vec<f32> = model_of[first..last]
                 .iter()
@@ -1103,8 +1120,8 @@ impl Builder {
 
     /// One skinned primitive holding, for every bird `i`, a copy of the mesh of its model
     /// `assets[model_of[i]]` bound to its joints of one skin. `flock`: a part of the flock's one
-    /// skeleton, where each bird has 8 joints (its root, then the seven; joints `8·i + 1 ..`)
-    /// and colours and weights are normalised bytes; else one bird's mesh (joints `0 .. 7`).
+    /// skeleton, where each bird has 10 joints (its root, then the nine of [`bird::JOINTS`]; joints `10·i + 1 ..`)
+    /// and colours and weights are normalised bytes; else one bird's mesh (joints `0 .. 9`).
     fn skinned_meshes(
         &mut self,
         root: &mut json::Root,
@@ -1169,7 +1186,7 @@ impl Builder {
         } else {
             self.accessor(root, &col, 3, json::accessor::Type::Vec3, false, target)
         };
-        // Joint indices as bytes while they fit (one bird: 7 joints), else as shorts.
+        // Joint indices as bytes while they fit (one bird: 9 joints), else as shorts.
         let (jb, jct): (Vec<u8>, _) = if model_of.len() * joints_per_bird <= 256 {
             (
                 jw.iter().map(|&j| j as u8).collect(),
