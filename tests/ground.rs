@@ -191,10 +191,7 @@ fn a_crane_sits_on_folded_legs_runs_on_them_and_trails_them_after_lift_off() {
                     ran += 1;
                 }
                 if lift_off.is_some_and(|t| f.t > t + LEG_SWING_S) {
-                    assert!(
-                        l.z < -0.99 * reach,
-                        "bird {b} frame {k}: climbing, leg {l}"
-                    );
+                    assert!(l.z < -0.99 * reach, "bird {b} frame {k}: climbing, leg {l}");
                     trailed += 1;
                 }
             }

@@ -448,7 +448,8 @@ pub fn glb_bytes_with(anim: &Animation, wingspan_m: f64, opts: &SceneOptions) ->
         let asset = &assets[model];
         let track = bird_track(anim, &flapper, asset, bird, wingspan_m);
         // Skeleton nodes, children before parents so indices are known.
-        let mut joint_nodes: [Option<json::Index<json::Node>>; bird::N_JOINTS] = [None; bird::N_JOINTS];
+        let mut joint_nodes: [Option<json::Index<json::Node>>; bird::N_JOINTS] =
+            [None; bird::N_JOINTS];
         for j in (0..bird::JOINTS.len()).rev() {
             let children: Vec<_> = (0..bird::JOINTS.len())
                 .filter(|&c| bird::PARENT[c] == Some(j))

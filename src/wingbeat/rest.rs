@@ -212,7 +212,12 @@ pub fn leg_angles(anim: &Animation, species: Species) -> Vec<f64> {
                 });
             let w = ground.max(landing);
             let z = f.z.get(i).copied().unwrap_or(f64::INFINITY);
-            let pitch = f.pitch.as_ref().and_then(|p| p.get(i)).copied().unwrap_or(0.0);
+            let pitch = f
+                .pitch
+                .as_ref()
+                .and_then(|p| p.get(i))
+                .copied()
+                .unwrap_or(0.0);
             let a = if w > 0.0 && z.is_finite() && pitch.is_finite() {
                 w * legs_down(&leg, z, pitch)
             } else {

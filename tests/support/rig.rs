@@ -53,7 +53,13 @@ pub fn lowest_vertex(asset: &BirdAsset, pose: &WingPose, bank: f32, root: Vec3, 
 
 /// Each leg's hip and the tip of its toes in the world for a pose: the leg mesh's farthest
 /// vertex from the hip (the built-in crane), posed on the rig.
-pub fn legs(asset: &BirdAsset, pose: &WingPose, bank: f32, root: Vec3, rot: Quat) -> [(Vec3, Vec3); 2] {
+pub fn legs(
+    asset: &BirdAsset,
+    pose: &WingPose,
+    bank: f32,
+    root: Vec3,
+    rot: Quat,
+) -> [(Vec3, Vec3); 2] {
     let global = globals(asset, pose, bank, root, rot);
     let posed = asset.mesh.posed(&asset.skeleton, &global);
     Side::BOTH.map(|side| {
