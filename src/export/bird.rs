@@ -836,6 +836,19 @@ pub struct BirdAsset {
 }
 
 impl BirdAsset {
+    /// Whether the legs' joints move anything: a skinned model with vertices on `leg.L` or
+    /// `leg.R` (the built-in crane). Without, the leg joints stay at rest (no animation for them).
+    pub fn has_legs(&self) -> bool {
+        let legs = Side::BOTH.map(leg_joint);
+        self.wingbeat
+            && self
+                .mesh
+                .joints
+                .iter()
+                .zip(&self.mesh.weights)
+                .any(|(j, w)| (0..4).any(|k| w[k] > 0.0 && legs.contains(&(j[k] as usize))))
+    }
+
     /// The built-in bird of `species`.
     pub fn builtin(species: Species) -> BirdAsset {
         BirdAsset {

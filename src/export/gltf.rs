@@ -355,10 +355,15 @@ pub fn bird_track(
     let ours = bird::joint_track(flapper, &flight, bird);
     let skel = &asset.skeleton;
     let mut joints: Vec<[Quat; bird::N_JOINTS]> = Vec::with_capacity(ours.len());
+    let still_legs = !asset.has_legs();
     for q in ours {
         let mut l: [Quat; bird::N_JOINTS] = std::array::from_fn(|j| {
-            // The neck never moves; a static model moves only its body.
-            if j == bird::NECK || (!asset.wingbeat && j != bird::BODY) {
+            // The neck never moves; a static model moves only its body; legs that nothing is
+            // skinned to stay at rest.
+            if j == bird::NECK
+                || (!asset.wingbeat && j != bird::BODY)
+                || (still_legs && LEG_JOINTS.contains(&j))
+            {
                 skel.rest_rotation(j)
             } else {
                 skel.local_rotation(j, q[j])
