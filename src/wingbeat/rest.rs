@@ -104,7 +104,7 @@ pub fn stand_on_ground(anim: &mut Animation, species: Species) {
 
 /// A leg of the built-in rig: the left hip in the bird frame (`x` left, `y` up, `z` forward) and
 /// the leg's reach from the hip to the tip of the toes, wingspans. The reach is what a straight
-/// leg needs to stand the bird at its [`Stance::stand`] height, less [`LEG_GAP`]: the built-in
+/// leg needs to stand the bird at its [`Stance::stand`] height, less [`leg_gap`]: the built-in
 /// rig has one joint per leg, so a standing bird's legs are straight and under the body.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Leg {
@@ -112,10 +112,23 @@ pub struct Leg {
     pub hip: [f64; 3],
     /// Hip to the toes' tip, wingspans.
     pub reach: f64,
+    /// Gap kept between the toes and the ground ([`leg_gap`]), wingspans.
+    pub gap: f64,
 }
 
-/// Gap kept between the toes and the ground, wingspans.
-pub const LEG_GAP: f64 = 0.006;
+/// Gap kept between the toes and the ground, wingspans: 0.006 for the toes' rounding, plus what
+/// a bird larger by [`LEG_SCALE_MARGIN`] sinks its toes by when it stands (exports scale a bird
+/// about the ground point under it sitting, so a larger one's standing toes are lower by
+/// (s − 1)(h_stand − h_sit)).
+pub fn leg_gap(species: Species) -> f64 {
+    let st = stance(species);
+    0.006 + LEG_SCALE_MARGIN * (st.stand - st.sit)
+}
+
+/// Size margin of [`leg_gap`]: 0.12, three standard deviations of the exports' default size
+/// spread (4 %, clipped at three), so that no bird of the default spread puts a toe below the
+/// ground.
+pub const LEG_SCALE_MARGIN: f64 = 0.12;
 
 /// The legs of `species`: hips just behind the body's centre, low in the body; reach from the
 /// standing height (our choice, docs/landing.md).
@@ -125,9 +138,11 @@ pub fn leg(species: Species) -> Leg {
         Species::Crane => [0.018, -0.035, -0.06],
         Species::Pelican => [0.02, -0.04, -0.05],
     };
+    let gap = leg_gap(species);
     Leg {
         hip,
-        reach: stance(species).stand + hip[1] - LEG_GAP,
+        reach: stance(species).stand + hip[1] - gap,
+        gap,
     }
 }
 
@@ -142,13 +157,13 @@ pub const LIFT_OFF_BAND: f64 = 0.05;
 
 /// Leg swing of a bird with its legs lowered whose root is `z` wingspans above the ground with
 /// the body pitched `pitch` radians nose up: [`LEGS_DOWN`] when the feet clear the ground, and
-/// otherwise swung further forward, just as far as the toes keep [`LEG_GAP`] off the ground
+/// otherwise swung further forward, just as far as the toes keep [`leg_gap`] off the ground
 /// (a bird sitting down folds its legs forward under its belly).
 pub fn legs_down(leg: &Leg, z: f64, pitch: f64) -> f64 {
     let (s, c) = pitch.sin_cos();
     let hip = z + leg.hip[1] * c + leg.hip[2] * s;
     // Toe height of a swing a: hip − reach·sin(a + pitch).
-    let r = ((hip - LEG_GAP) / leg.reach).clamp(0.0, 1.0);
+    let r = ((hip - leg.gap) / leg.reach).clamp(0.0, 1.0);
     LEGS_DOWN.max(std::f64::consts::PI - r.asin() - pitch)
 }
 
