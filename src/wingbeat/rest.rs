@@ -450,6 +450,28 @@ mod tests {
     }
 
     #[test]
+    fn legs_stand_straight_down_and_fold_forward_as_the_body_sinks() {
+        for sp in Species::ALL {
+            let (st, l) = (stance(sp), leg(sp));
+            assert_eq!(legs_down(&l, st.stand, 0.0), LEGS_DOWN);
+            let sitting = legs_down(&l, st.sit, 0.0);
+            assert!(sitting > 2.8, "{sp}: {sitting}");
+            let mut prev = LEGS_DOWN;
+            for k in 0..=20 {
+                let z = st.stand - (st.stand - st.sit) * k as f64 / 20.0;
+                let a = legs_down(&l, z, 0.0);
+                assert!(a >= prev - 1e-12, "{sp}: {z} {a}");
+                // The toes keep the gap (hip height − reach·sin(a)), or lie level with the hip
+                // when it is lower than the gap (a sitting crane).
+                let hip = z + l.hip[1];
+                let toe = hip - l.reach * a.sin();
+                assert!(toe >= l.gap.min(hip) - 1e-9, "{sp}: {z} {toe}");
+                prev = a;
+            }
+        }
+    }
+
+    #[test]
     fn a_flight_without_rest_needs_no_weights() {
         assert!(fold_weights(&anim(&[5.0; 10], 30.0)).is_empty());
     }
