@@ -6,7 +6,7 @@ file it came from. Usage: python .ci/check_usd.py flock.usda flock.json [--toler
 - metersPerUnit 1, upAxis Y, timeCodesPerSecond and framesPerSecond = the animation's fps,
   startTimeCode = the file's start_frame (0 when absent) and endTimeCode = the last frame; with
   --subframes K, K time samples a frame (time codes start + k/K);
-- one SkelRoot, Skeleton (with the 7 joints of the convention) and SkelAnimation per bird, the
+- one SkelRoot, Skeleton (with the 9 joints of the convention) and SkelAnimation per bird, the
   animation bound to the skeleton, the skinned mesh bound to it with 4 influences a vertex;
 - every bird's root transform at every frame matches the JSON positions (x, z, -y) * wingspan_m
   to the tolerance (default 1e-4 m; give the --keys reduced tolerance for reduced files), and the
@@ -21,7 +21,7 @@ import sys
 from pxr import Gf, Sdf, Usd, UsdGeom, UsdSkel, UsdValidation
 
 JOINTS = ["body", "body/neck", "body/tail", "body/upper_arm_L", "body/upper_arm_L/hand_L",
-          "body/upper_arm_R", "body/upper_arm_R/hand_R"]
+          "body/upper_arm_R", "body/upper_arm_R/hand_R", "body/leg_L", "body/leg_R"]
 
 
 def main():

@@ -34,7 +34,7 @@ print("BONES", bones)
 clips = sorted({t.name for a in arms if a.animation_data for t in a.animation_data.nla_tracks})
 print("CLIPS", clips, "ACTIONS", len(bpy.data.actions))
 failed = []
-want = ["body", "neck", "tail", "upper_arm.L", "hand.L", "upper_arm.R", "hand.R"]
+want = ["body", "neck", "tail", "upper_arm.L", "hand.L", "upper_arm.R", "hand.R", "leg.L", "leg.R"]
 if bones != want:
     failed.append("bones %s" % bones)
 names = [a.name for a in arms]

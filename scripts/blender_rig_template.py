@@ -1,6 +1,6 @@
 # Exports the rig of one bird of a .glb written by `formation` as a template for your own bird
 # (Blender headless): the armature `bird_000` (bones body, neck, tail, upper_arm.L, hand.L,
-# upper_arm.R, hand.R, bound with Blender's own bone orientations) and its skinned mesh, at the
+# upper_arm.R, hand.R, leg.L, leg.R, bound with Blender's own bone orientations) and its skinned mesh, at the
 # origin, unanimated. Model your bird on it, keep the bone names, export as .glb and give it to
 # `--bird-model`. Also a check that a Blender-made rig works: `formation render ... --bird-model`
 # on this file gives the same birds as the built-in one.

@@ -95,7 +95,8 @@ fn the_flock_as_one_skeleton_is_the_same_birds_as_one_skin_each() {
             assert_eq!(root_b[key], root_f[key], "bird {b} {key}");
         }
     }
-    // Skins and meshes: one per part, 8 joints a bird (root first).
+    // Skins and meshes: one per part, JOINTS.len() + 1 joints a bird (root first).
+    let per = JOINTS.len() + 1;
     let parts = birds.div_ceil(FLOCK_PART);
     assert_eq!(fj["skins"].as_array().unwrap().len(), parts);
     assert_eq!(fj["meshes"].as_array().unwrap().len(), parts);
@@ -113,24 +114,28 @@ fn the_flock_as_one_skeleton_is_the_same_birds_as_one_skin_each() {
         let n = (birds - first).min(FLOCK_PART);
         let skin = &fj["skins"][p];
         let joints = skin["joints"].as_array().unwrap();
-        assert_eq!(joints.len(), 8 * n);
+        assert_eq!(joints.len(), per * n);
         for i in 0..n {
             assert_eq!(
-                fj["nodes"][joints[8 * i].as_u64().unwrap() as usize]["name"],
+                fj["nodes"][joints[per * i].as_u64().unwrap() as usize]["name"],
                 name(first + i).as_str()
             );
             for (j, joint) in JOINTS.iter().enumerate() {
                 assert_eq!(
-                    fj["nodes"][joints[8 * i + 1 + j].as_u64().unwrap() as usize]["name"],
+                    fj["nodes"][joints[per * i + 1 + j].as_u64().unwrap() as usize]["name"],
                     format!("{}.{joint}", name(first + i)).as_str()
                 );
             }
         }
         let ibm = floats(&fj, &fb, &skin["inverseBindMatrices"]);
-        assert_eq!(ibm.len(), 16 * 8 * n);
+        assert_eq!(ibm.len(), 16 * per * n);
         for i in 0..n {
-            assert_eq!(&ibm[128 * i..128 * i + 16], &identity[..], "root bind");
-            assert_eq!(&ibm[128 * i + 16..128 * (i + 1)], &bird_ibm[..]);
+            assert_eq!(
+                &ibm[16 * per * i..16 * per * i + 16],
+                &identity[..],
+                "root bind"
+            );
+            assert_eq!(&ibm[16 * per * i + 16..16 * per * (i + 1)], &bird_ibm[..]);
         }
         let prim = &fj["meshes"][mesh_of_skin(&fj, p)]["primitives"][0];
         let pos = floats(&fj, &fb, &prim["attributes"]["POSITION"]);
@@ -154,7 +159,7 @@ fn the_flock_as_one_skeleton_is_the_same_birds_as_one_skin_each() {
                     assert!((fw - bw).abs() <= 1.0 / 255.0 + 1e-6, "weight {fw} vs {bw}");
                     let j = jw[4 * (verts * i + v) + k] as usize;
                     if w[k] > 0 {
-                        assert_eq!(j, 8 * i + 1 + bird_joints[4 * v + k] as usize);
+                        assert_eq!(j, per * i + 1 + bird_joints[4 * v + k] as usize);
                     } else {
                         assert_eq!(j, 0, "an unused slot names joint 0");
                     }

@@ -11,7 +11,7 @@ use formation::pipeline::{Config, Pipeline};
 use formation::wingbeat::rest::{stance, REST_SPEED_MS};
 use formation::wingbeat::{self, Flapper, Species, WingPose};
 use glam::{Quat, Vec3};
-use support::rig::lowest_vertex;
+use support::rig::{legs, lowest_vertex, wings};
 
 fn lowest(asset: &BirdAsset, pose: &WingPose) -> f32 {
     lowest_vertex(asset, pose, 0.0, Vec3::ZERO, Quat::IDENTITY)
@@ -82,7 +82,7 @@ fn check_on_the_rig(anim: &Animation, species: Species) -> f32 {
             let pose = flapper.pose(k, b);
             if v_ms < REST_SPEED_MS && f.z[b] < 1.0 {
                 assert_eq!(
-                    pose,
+                    wings(pose),
                     wingbeat::FOLDED,
                     "bird {b} frame {k}: at rest, wings folded"
                 );
@@ -100,7 +100,7 @@ fn check_on_the_rig(anim: &Animation, species: Species) -> f32 {
             if run_start.is_none() && f.speed[b] > 0.0 && f.z[b] < 1.0 {
                 run_start = Some(f.t);
             }
-            if flapping_from.is_none() && pose != wingbeat::FOLDED {
+            if flapping_from.is_none() && wings(pose) != wingbeat::FOLDED {
                 flapping_from = Some(f.t);
             }
             let root = flight.translation[k] / ws as f32;
@@ -136,6 +136,10 @@ fn take_offs_sit_fold_run_and_flap_above_the_ground() {
         (14, Species::Pelican, 3),
         (41, Species::Goose, 4),
         (100, Species::Goose, 5),
+        // The crane's legs swing (down while it runs, back after lift-off).
+        (9, Species::Crane, 1),
+        (41, Species::Crane, 4),
+        (100, Species::Crane, 5),
     ] {
         let anim = take_off(birds, species, seed);
         let low = check_on_the_rig(&anim, species);
@@ -150,4 +154,52 @@ fn take_offs_sit_fold_run_and_flap_above_the_ground() {
             "{birds}: the first run starts at {first_run} s"
         );
     }
+}
+
+/// The crane's legs on the rig over a take-off: folded forward under the belly while it sits,
+/// straight down under the body while it stands and runs, trailing behind once it has climbed
+/// away (the swing back takes `LEG_SWING_S` after lift-off).
+#[test]
+fn a_crane_sits_on_folded_legs_runs_on_them_and_trails_them_after_lift_off() {
+    use formation::wingbeat::rest::{leg, LEG_SWING_S, LIFT_OFF_BAND};
+    let sp = Species::Crane;
+    let anim = take_off(14, sp, 2);
+    let asset = BirdAsset::builtin(sp);
+    let flapper = Flapper::from_animation(&anim);
+    let (st, reach) = (stance(sp), leg(sp).reach as f32);
+    let ws = anim.wingspan_m;
+    let (mut sat, mut ran, mut trailed) = (0, 0, 0);
+    for b in 0..anim.birds {
+        let flight = bird::flight(&anim, b, ws);
+        let mut lift_off: Option<f64> = None;
+        for (k, f) in anim.frames.iter().enumerate() {
+            let pose = flapper.pose(k, b);
+            let root = flight.translation[k] / ws as f32;
+            let rot = flight.yaw[k];
+            for (hip, toe) in legs(&asset, &pose, flight.bank[k], root, rot) {
+                // The leg in the body's frame: +Z forward, +Y up.
+                let l = rot.inverse() * (toe - hip);
+                let z = f.z[b];
+                if z <= st.sit + 1e-9 && f.speed[b] == 0.0 {
+                    assert!(l.z > 0.8 * reach, "bird {b} frame {k}: sitting, leg {l}");
+                    sat += 1;
+                } else if (z - st.stand).abs() < 1e-6 && f.speed[b] * ws > REST_SPEED_MS {
+                    assert!(
+                        (toe - hip).y < -0.95 * reach && l.z.abs() < 0.2 * reach,
+                        "bird {b} frame {k}: running, leg {l}"
+                    );
+                    ran += 1;
+                }
+                if lift_off.is_some_and(|t| f.t > t + LEG_SWING_S) {
+                    assert!(l.z < -0.99 * reach, "bird {b} frame {k}: climbing, leg {l}");
+                    trailed += 1;
+                }
+            }
+            if lift_off.is_none() && f.z[b] > st.stand + LIFT_OFF_BAND {
+                lift_off = Some(f.t);
+            }
+        }
+        assert!(lift_off.is_some(), "bird {b} never lifted off");
+    }
+    assert!(sat > 0 && ran > 0 && trailed > 0, "{sat} {ran} {trailed}");
 }

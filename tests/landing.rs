@@ -14,10 +14,21 @@ use formation::initiate::landing::{Surface, FLOAT_HEIGHT};
 use formation::pipeline::{Config, Pipeline};
 use formation::wingbeat::rest::{stance, REST_SPEED_MS};
 use formation::wingbeat::{self, Flapper, Species, WingPose};
-use support::rig::lowest_vertex;
+use support::rig::{legs, lowest_vertex, wings};
 use support::{bin, example_arg, scratch};
 
 fn landing(birds: usize, seed: u64, fps: f64, surface: Surface, takeoff: bool) -> Animation {
+    landing_of(Species::Goose, birds, seed, fps, surface, takeoff)
+}
+
+fn landing_of(
+    species: Species,
+    birds: usize,
+    seed: u64,
+    fps: f64,
+    surface: Surface,
+    takeoff: bool,
+) -> Animation {
     let mut c = Config {
         seed,
         seconds: Some(1.0),
@@ -28,6 +39,7 @@ fn landing(birds: usize, seed: u64, fps: f64, surface: Surface, takeoff: bool) -
     c.steady.birds = birds;
     c.steady.fps = fps;
     c.landing.surface = surface;
+    c.wingbeat.species = species;
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples_data/barnacle_geese_v.json");
     Pipeline::from_path(path)
         .run(&c)
@@ -72,12 +84,16 @@ fn check_on_the_rig(anim: &Animation, species: Species) -> f64 {
                         (pose.dihedral - folded.dihedral).abs() < 0.01
                             && WingPose {
                                 dihedral: folded.dihedral,
-                                ..pose
+                                ..wings(pose)
                             } == folded,
                         "bird {b} frame {k}: folded at rest, {pose:?}"
                     );
                 } else if settled {
-                    assert_eq!(pose, wingbeat::FOLDED, "bird {b} frame {k}: folded at rest");
+                    assert_eq!(
+                        wings(pose),
+                        wingbeat::FOLDED,
+                        "bird {b} frame {k}: folded at rest"
+                    );
                 }
                 let before = &anim.frames[k - 1];
                 if before.speed[b] * ws < REST_SPEED_MS {
@@ -335,4 +351,63 @@ fn a_shot_length_cuts_the_steady_flight_so_that_the_landing_ends_it() {
     .unwrap_err()
     .to_string();
     assert!(e.starts_with("shot_seconds: "), "{e}");
+}
+
+/// The crane's legs on the rig over a landing of 9, 14, 41 and 100 birds: trailing in the glide,
+/// swung down (toes below the hips) through the last third of the flare, straight down under the
+/// body while the bird stands and runs out, folded forward under the belly once it sits; and no
+/// vertex under the ground in any frame (with the checks of every landing).
+#[test]
+fn a_crane_lowers_its_legs_in_the_flare_and_lands_on_them() {
+    use formation::wingbeat::rest::leg;
+    let sp = Species::Crane;
+    let (st, reach) = (stance(sp), leg(sp).reach as f32);
+    let asset = BirdAsset::builtin(sp);
+    for (birds, seed) in [(9, 1), (14, 0), (41, 4), (100, 5)] {
+        let anim = landing_of(sp, birds, seed, 30.0, Surface::Ground, true);
+        check_on_the_rig(&anim, sp);
+        let flapper = Flapper::from_animation(&anim);
+        let rec = anim.landing.clone().expect("a landing record");
+        let fs = rec.flare_seconds;
+        let stage = anim.stage("landing").unwrap().clone();
+        let ws = anim.wingspan_m;
+        let (mut glide, mut flare, mut stood, mut sat) = (0, 0, 0, 0);
+        for b in 0..birds {
+            let flight = bird::flight(&anim, b, ws);
+            let td = rec.touchdown[b];
+            for k in stage.start..stage.end {
+                let f = &anim.frames[k];
+                let pose = flapper.pose(k, b);
+                let rot = flight.yaw[k];
+                let root = flight.translation[k] / ws as f32;
+                for (hip, toe) in legs(&asset, &pose, flight.bank[k], root, rot) {
+                    let l = rot.inverse() * (toe - hip);
+                    let at = format!("{birds} birds, bird {b} at {:.3} s: leg {l}", f.t);
+                    if f.t < td - fs {
+                        assert!(l.z < -0.99 * reach, "{at}: trailing in the glide");
+                        glide += 1;
+                    } else if f.t >= td - fs / 3.0 && f.t <= td {
+                        assert!((toe - hip).y < -0.5 * reach, "{at}: down in the flare");
+                        flare += 1;
+                    }
+                    if f.t >= td && (f.z[b] - st.stand).abs() < 1e-6 {
+                        assert!(
+                            (toe - hip).y < -0.8 * reach && l.z.abs() < 0.2 * reach,
+                            "{at}: standing on them (body pitched {:.1}°)",
+                            f.pitch.as_ref().map_or(0.0, |p| p[b].to_degrees())
+                        );
+                        stood += 1;
+                    }
+                    if f.t > td && f.speed[b] == 0.0 && (f.z[b] - st.sit).abs() < 1e-9 {
+                        assert!(l.z > 0.8 * reach, "{at}: folded under the sitting bird");
+                        sat += 1;
+                    }
+                }
+            }
+        }
+        assert!(
+            glide > 0 && flare > 0 && stood > 0 && sat > 0,
+            "{birds}: {glide} {flare} {stood} {sat}"
+        );
+    }
 }

@@ -266,3 +266,85 @@ fn models_breaking_the_gltf_rules_are_refused_naming_the_part() {
     }
     std::fs::remove_dir_all(&d).unwrap();
 }
+
+/// A model without leg joints (the built-in crane's `leg.L`/`leg.R` renamed to names outside
+/// the convention, so its legs are skinned to the nearest convention joint above them, `body`)
+/// loads, flaps, and exports with no error; its legs move with the body, with no animation of
+/// the convention's leg joints. The built-in crane's do move in the same take-off.
+#[test]
+fn a_model_without_leg_joints_flies_with_its_legs_as_modelled() {
+    use formation::export::bird::{leg_joint, BirdAsset, JOINTS};
+    use formation::export::rig::Side;
+    let d = scratch("rig-legless");
+    let anim = flock();
+    let crane = |asset: BirdAsset| SceneOptions {
+        assets: vec![asset],
+        ..SceneOptions::default()
+    };
+    let builtin = BirdAsset::builtin(Species::Crane);
+    assert!(builtin.has_legs());
+    let ours = glb_bytes_with(&anim, 1.5, &crane(builtin)).unwrap();
+    let (mut json, chunk) = split(&ours);
+    for n in json["nodes"].as_array_mut().unwrap() {
+        match n["name"].as_str() {
+            Some("leg.L") => n["name"] = Value::from("Shin.L"),
+            Some("leg.R") => n["name"] = Value::from("Shin.R"),
+            _ => {}
+        }
+    }
+    let model = d.join("legless.glb");
+    std::fs::write(&model, join(&json, &chunk)).unwrap();
+    let asset = bird_model::load(&model, Species::Crane).expect("a model without legs loads");
+    assert!(asset.wingbeat && !asset.has_legs());
+    let legs = Side::BOTH.map(leg_joint);
+    assert!(asset
+        .mesh
+        .joints
+        .iter()
+        .zip(&asset.mesh.weights)
+        .all(|(j, w)| (0..4).all(|k| w[k] == 0.0 || !legs.contains(&(j[k] as usize)))));
+    // Channels on the leg joints: the built-in crane's legs swing in the take-off, the legless
+    // model's joints stay at rest.
+    let leg_channels = |bytes: &[u8]| {
+        let (j, _) = split(bytes);
+        let leg_nodes: Vec<u64> = j["nodes"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .enumerate()
+            .filter(|(_, n)| {
+                n["name"]
+                    .as_str()
+                    .is_some_and(|s| legs.iter().any(|&l| s.ends_with(JOINTS[l])))
+            })
+            .map(|(i, _)| i as u64)
+            .collect();
+        j["animations"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .flat_map(|a| a["channels"].as_array().unwrap().clone())
+            .filter(|c| leg_nodes.contains(&c["target"]["node"].as_u64().unwrap()))
+            .count()
+    };
+    assert!(leg_channels(&ours) > 0);
+    let out = glb_bytes_with(&anim, 1.5, &crane(asset)).unwrap();
+    assert_eq!(leg_channels(&out), 0);
+    // And on the command line, to a .glb and a .usda.
+    let anim_path = d.join("flock.json");
+    std::fs::write(&anim_path, serde_json::to_vec(&anim).unwrap()).unwrap();
+    let (glb, usda) = (d.join("r.glb"), d.join("r.usda"));
+    let o = bin()
+        .args([
+            "render",
+            s(&anim_path),
+            "--bird-model",
+            s(&model),
+            "--quiet",
+        ])
+        .args(["-o", s(&glb), "-o", s(&usda)])
+        .output()
+        .unwrap();
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    assert!(glb.exists() && usda.exists());
+}

@@ -13,6 +13,7 @@
 //! | 2 | `tail` | `body` | tail bend β: `R_X(β)` (up positive) |
 //! | 3, 4 | `upper_arm.L`, `hand.L` | `body`, `upper_arm.L` | shoulder and wrist of [`rig::wing_joints`] |
 //! | 5, 6 | `upper_arm.R`, `hand.R` | `body`, `upper_arm.R` | the same, mirrored |
+//! | 7, 8 | `leg.L`, `leg.R` | `body` | leg swing a: `R_X(−a)` (0 trailing, π/2 straight down) |
 //!
 //! The bind (rest) pose is the wing spread flat and straight out (every joint rotation the
 //! identity), so the inverse bind matrix of joint j is the translation by minus its bind position
@@ -37,7 +38,7 @@ use crate::wingbeat::{Flapper, Species, WingPose};
 
 /// Joint names, in skin order (the convention a user's skinned model must follow to get the
 /// wingbeat, see `docs/export.md`).
-pub const JOINTS: [&str; 7] = [
+pub const JOINTS: [&str; N_JOINTS] = [
     "body",
     "neck",
     "tail",
@@ -45,9 +46,23 @@ pub const JOINTS: [&str; 7] = [
     "hand.L",
     "upper_arm.R",
     "hand.R",
+    "leg.L",
+    "leg.R",
 ];
+/// Number of joints of the convention.
+pub const N_JOINTS: usize = 9;
 /// Parent of each joint in [`JOINTS`] (`None`: the bird's root node).
-pub const PARENT: [Option<usize>; 7] = [None, Some(0), Some(0), Some(0), Some(3), Some(0), Some(5)];
+pub const PARENT: [Option<usize>; N_JOINTS] = [
+    None,
+    Some(0),
+    Some(0),
+    Some(0),
+    Some(3),
+    Some(0),
+    Some(5),
+    Some(0),
+    Some(0),
+];
 /// Index of `body`.
 pub const BODY: usize = 0;
 /// Index of `neck`.
@@ -66,6 +81,14 @@ pub const fn arm_joint(side: Side) -> usize {
 /// Index of a wing's hand joint.
 pub const fn hand_joint(side: Side) -> usize {
     arm_joint(side) + 1
+}
+
+/// Index of a leg's joint (at the hip; optional in a user's model).
+pub const fn leg_joint(side: Side) -> usize {
+    match side {
+        Side::Left => 7,
+        Side::Right => 8,
+    }
 }
 
 /// Joint paths as UsdSkel wants them (`body/upper_arm_L/hand_L`; USD path elements cannot hold
@@ -192,8 +215,9 @@ struct Proportions {
     wing: &'static [Station],
     /// Left half of the tail fan outline `(x, z)`, from the base outwards and back to the centre.
     tail_fan: &'static [(f32, f32)],
-    /// Legs trailing behind (cranes): hip `(x, y, z)`, toe `(x, y, z)`, radius.
-    legs: Option<([f32; 3], [f32; 3], f32)>,
+    /// Radius of the legs that the mesh shows (cranes; hips and reach from
+    /// [`crate::wingbeat::rest::leg`]), or none.
+    legs: Option<f32>,
     /// Linear RGB of each [`Part`].
     colours: [[f32; 3]; 8],
 }
@@ -299,7 +323,7 @@ const CRANE: Proportions = Proportions {
         (0.03, -0.225),
         (0.0, -0.232),
     ],
-    legs: Some(([0.018, -0.035, -0.06], [0.012, -0.025, -0.40], 0.006)),
+    legs: Some(0.006),
     colours: [
         [0.40, 0.42, 0.43],
         [0.05, 0.05, 0.05],
@@ -380,9 +404,9 @@ fn proportions(species: Species) -> &'static Proportions {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Skeleton {
     /// Bind position of each joint of [`JOINTS`], bird frame.
-    pub bind_pos: [Vec3; 7],
+    pub bind_pos: [Vec3; N_JOINTS],
     /// Bind rotation of each joint, bird frame.
-    pub bind_rot: [Quat; 7],
+    pub bind_rot: [Quat; N_JOINTS],
 }
 
 impl Skeleton {
@@ -390,6 +414,7 @@ impl Skeleton {
     pub fn of(species: Species) -> Skeleton {
         let p = proportions(species);
         let [sx, sy, sz] = p.shoulder;
+        let [hx, hy, hz] = crate::wingbeat::rest::leg(species).hip.map(|v| v as f32);
         Skeleton {
             bind_pos: [
                 Vec3::ZERO,
@@ -399,8 +424,10 @@ impl Skeleton {
                 Vec3::new(sx + p.arm, sy, sz),
                 Vec3::new(-sx, sy, sz),
                 Vec3::new(-sx - p.arm, sy, sz),
+                Vec3::new(hx, hy, hz),
+                Vec3::new(-hx, hy, hz),
             ],
-            bind_rot: [Quat::IDENTITY; 7],
+            bind_rot: [Quat::IDENTITY; N_JOINTS],
         }
     }
 
@@ -438,14 +465,15 @@ impl Skeleton {
 }
 
 /// Local rotations of every joint of [`JOINTS`] for a wing pose and a bank angle (radians).
-pub fn joint_rotations(pose: &WingPose, bank: f32) -> [Quat; 7] {
-    let mut q = [Quat::IDENTITY; 7];
+pub fn joint_rotations(pose: &WingPose, bank: f32) -> [Quat; N_JOINTS] {
+    let mut q = [Quat::IDENTITY; N_JOINTS];
     q[BODY] = Quat::from_rotation_z(bank);
     q[TAIL] = Quat::from_rotation_x(pose.tail_bend as f32);
     for side in Side::BOTH {
         let w = rig::wing_joints(pose, side);
         q[arm_joint(side)] = w.shoulder_q;
         q[hand_joint(side)] = w.wrist_q;
+        q[leg_joint(side)] = Quat::from_rotation_x(-(pose.legs as f32));
     }
     q
 }
@@ -552,7 +580,7 @@ impl SkinnedMesh {
 
     /// Positions of the mesh posed by `global` joint transforms (rotation, translation) of every
     /// joint, by linear blend skinning against the bind positions of `skel` (tests and checks).
-    pub fn posed(&self, skel: &Skeleton, global: &[(Quat, Vec3); 7]) -> Vec<Vec3> {
+    pub fn posed(&self, skel: &Skeleton, global: &[(Quat, Vec3); N_JOINTS]) -> Vec<Vec3> {
         self.positions
             .iter()
             .zip(self.joints.iter().zip(&self.weights))
@@ -588,11 +616,13 @@ pub fn mesh(species: Species) -> SkinnedMesh {
         wing(&mut m, p, &skel, side);
     }
     tail(&mut m, p);
-    if let Some((hip, toe, r)) = p.legs {
-        for s in [1.0f32, -1.0] {
-            let a = Vec3::new(s * hip[0], hip[1], hip[2]);
-            let b = Vec3::new(s * toe[0], toe[1], toe[2]);
-            tube(&mut m, a, b, r, Part::Legs, &[(BODY, 1.0)]);
+    if let Some(r) = p.legs {
+        // Trailing straight back from the hip in the bind pose; the cap reaches `reach`.
+        let reach = crate::wingbeat::rest::leg(species).reach as f32;
+        for side in Side::BOTH {
+            let a = skel.bind_pos[leg_joint(side)];
+            let b = a - Vec3::Z * (reach - 0.5 * r);
+            tube(&mut m, a, b, r, Part::Legs, &[(leg_joint(side), 1.0)]);
         }
     }
     m.smooth_normals();
@@ -806,6 +836,19 @@ pub struct BirdAsset {
 }
 
 impl BirdAsset {
+    /// Whether the legs' joints move anything: a skinned model with vertices on `leg.L` or
+    /// `leg.R` (the built-in crane). Without, the leg joints stay at rest (no animation for them).
+    pub fn has_legs(&self) -> bool {
+        let legs = Side::BOTH.map(leg_joint);
+        self.wingbeat
+            && self
+                .mesh
+                .joints
+                .iter()
+                .zip(&self.mesh.weights)
+                .any(|(j, w)| (0..4).any(|k| w[k] > 0.0 && legs.contains(&(j[k] as usize))))
+    }
+
     /// The built-in bird of `species`.
     pub fn builtin(species: Species) -> BirdAsset {
         BirdAsset {
@@ -946,13 +989,13 @@ pub fn flight(anim: &Animation, bird: usize, wingspan_m: f64) -> Flight {
 
 /// Joint rotations of `bird` at every frame, sign-continuous per joint (so LINEAR/slerp keys
 /// never take the long way round).
-pub fn joint_track(flapper: &Flapper, flight: &Flight, bird: usize) -> Vec<[Quat; 7]> {
+pub fn joint_track(flapper: &Flapper, flight: &Flight, bird: usize) -> Vec<[Quat; N_JOINTS]> {
     let n = flight.bank.len();
-    let mut out: Vec<[Quat; 7]> = Vec::with_capacity(n);
+    let mut out: Vec<[Quat; N_JOINTS]> = Vec::with_capacity(n);
     for k in 0..n {
         let mut q = joint_rotations(&flapper.pose(k, bird), flight.bank[k]);
         if let Some(p) = out.last() {
-            for j in 0..7 {
+            for j in 0..N_JOINTS {
                 q[j] = continuous(p[j], q[j]);
             }
         }
@@ -1002,7 +1045,8 @@ mod tests {
     fn bind_pose_skinning_is_the_identity_and_a_raised_wing_lifts_its_tip() {
         let skel = Skeleton::of(Species::Goose);
         let m = mesh(Species::Goose);
-        let rest: [(Quat, Vec3); 7] = std::array::from_fn(|j| (Quat::IDENTITY, skel.bind_pos[j]));
+        let rest: [(Quat, Vec3); N_JOINTS] =
+            std::array::from_fn(|j| (Quat::IDENTITY, skel.bind_pos[j]));
         let posed = m.posed(&skel, &rest);
         for (a, b) in posed.iter().zip(&m.positions) {
             assert!((*a - *b).length() < 1e-6);
@@ -1014,7 +1058,7 @@ mod tests {
         };
         let q = joint_rotations(&pose, 0.0);
         let mut global = rest;
-        for j in 0..7 {
+        for j in 0..N_JOINTS {
             let (mut gq, mut gt) = (q[j], skel.rest_translation(j));
             if let Some(p) = PARENT[j] {
                 let (pq, pt) = global[p];

@@ -215,14 +215,15 @@ pub fn read_joint_map(path: &Path) -> Result<JointMap> {
 pub fn static_warning(asset: &BirdAsset) -> Option<String> {
     (!asset.wingbeat).then(|| {
         format!(
-            "render.bird_model: {} has no animatable joints (no skinned mesh): the birds will fly and bank but not flap; give a skinned model with the joints {} (neck and tail optional), or map yours with render.joint_map",
+            "render.bird_model: {} has no animatable joints (no skinned mesh): the birds will fly and bank but not flap; give a skinned model with the joints {} (neck, tail and legs optional), or map yours with render.joint_map",
             asset.source,
             REQUIRED.map(|j| JOINTS[j]).join(", ")
         )
     })
 }
 
-/// The joints a skinned model must have (neck and tail are optional).
+/// The joints a skinned model must have (neck, tail and the legs are optional: a model without
+/// leg joints flies with its legs as they are modelled).
 const REQUIRED: [usize; 5] = [bird::BODY, 3, 4, 5, 6];
 
 /// Splits a GLB container into its JSON root and binary chunk.
@@ -279,7 +280,7 @@ struct Reader<'a> {
 
 /// A skin mapped to the convention: our joint for every skin slot, and the bind (model-space)
 /// matrix of each of our joints the skin has.
-type Convention = (Vec<usize>, [Option<Mat4>; 7]);
+type Convention = (Vec<usize>, [Option<Mat4>; bird::N_JOINTS]);
 
 /// One triangle primitive gathered from the file, in model space.
 struct Prim {
@@ -700,7 +701,7 @@ impl Reader<'_> {
             names.iter().position(|n| *n == nm)
         };
         // Two joints standing for the same joint of the convention: one would silently win.
-        let mut seen: [Option<usize>; 7] = [None; 7];
+        let mut seen: [Option<usize>; bird::N_JOINTS] = [None; bird::N_JOINTS];
         for (slot, n) in skin.joints.iter().enumerate() {
             if let Some(j) = ours(n.value()) {
                 if let Some(first) = seen[j].replace(slot) {
@@ -711,7 +712,7 @@ impl Reader<'_> {
                 }
             }
         }
-        let mut bind: [Option<Mat4>; 7] = [None; 7];
+        let mut bind: [Option<Mat4>; bird::N_JOINTS] = [None; bird::N_JOINTS];
         for (slot, n) in skin.joints.iter().enumerate() {
             if let Some(j) = ours(n.value()) {
                 let m = ibm[slot].inverse();
@@ -834,7 +835,7 @@ impl Reader<'_> {
     fn build(
         &self,
         prims: Vec<Prim>,
-        bind: Option<[Option<Mat4>; 7]>,
+        bind: Option<[Option<Mat4>; bird::N_JOINTS]>,
         species: Species,
     ) -> Result<BirdAsset> {
         let nv: usize = prims.iter().map(|p| p.positions.len()).sum();

@@ -38,8 +38,9 @@ const SAMPLE: usize = 40_000;
 /// Flocks of at least this many birds get an instancer when no USD mode is asked for.
 pub const INSTANCER_FROM: usize = 200;
 
-/// The wing pose as a vector of its joint angles (spread scaled to radians).
-fn angles(p: &WingPose) -> [f64; 7] {
+/// The wing pose as a vector of its joint angles (spread scaled to radians), the legs' swing
+/// last.
+fn angles(p: &WingPose) -> [f64; 8] {
     [
         p.dihedral,
         p.hand_dihedral,
@@ -48,11 +49,12 @@ fn angles(p: &WingPose) -> [f64; 7] {
         p.hand_twist,
         p.spread * std::f64::consts::FRAC_PI_2,
         p.tail_bend,
+        p.legs,
     ]
 }
 
 /// Largest angle difference between two poses, radians.
-fn distance(a: &[f64; 7], b: &[f64; 7]) -> f64 {
+fn distance(a: &[f64; 8], b: &[f64; 8]) -> f64 {
     a.iter()
         .zip(b)
         .map(|(x, y)| (x - y).abs())
@@ -63,7 +65,7 @@ fn distance(a: &[f64; 7], b: &[f64; 7]) -> f64 {
 fn choose(anim: &Animation, flapper: &Flapper, count: usize) -> Vec<WingPose> {
     let total = anim.frames.len() * anim.birds;
     let step = total.div_ceil(SAMPLE).max(1);
-    let pool: Vec<(WingPose, [f64; 7])> = (0..total)
+    let pool: Vec<(WingPose, [f64; 8])> = (0..total)
         .step_by(step)
         .map(|i| {
             let p = flapper.pose(i / anim.birds, i % anim.birds);
@@ -97,7 +99,7 @@ fn choose(anim: &Animation, flapper: &Flapper, count: usize) -> Vec<WingPose> {
 fn posed(asset: &BirdAsset, pose: &WingPose, ws: f32) -> Vec<Vec3> {
     let skel = &asset.skeleton;
     let q = bird::joint_rotations(pose, 0.0);
-    let mut global = [(Quat::IDENTITY, Vec3::ZERO); 7];
+    let mut global = [(Quat::IDENTITY, Vec3::ZERO); bird::N_JOINTS];
     for j in 0..bird::JOINTS.len() {
         let local = if j == bird::NECK || (!asset.wingbeat && j != bird::BODY) {
             skel.rest_rotation(j)
@@ -175,7 +177,7 @@ pub fn write_usda_instancer(
         })
         .collect();
     let total: usize = model_poses.iter().map(Vec::len).sum();
-    let pose_angles: Vec<[f64; 7]> = poses.iter().map(angles).collect();
+    let pose_angles: Vec<[f64; 8]> = poses.iter().map(angles).collect();
     let n = anim.frames.len();
     let birds = anim.birds;
     // Each bird-frame's prototype and the error it makes.

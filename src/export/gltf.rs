@@ -331,12 +331,16 @@ const WING_JOINTS: [usize; 5] = [
     bird::hand_joint(Side::Right),
 ];
 
+/// The leg joints: animated only for a bird whose legs move in the animation (a take-off or a
+/// landing), so that a flight in the air keeps the channels it had without them.
+const LEG_JOINTS: [usize; 2] = [bird::leg_joint(Side::Left), bird::leg_joint(Side::Right)];
+
 /// Per bird: flight and local joint rotations at every frame, on the asset's skeleton.
 pub struct BirdTrack {
     /// Root translation (metres) and yaw, and the bank.
     pub flight: Flight,
     /// Local rotation of every joint at every frame (bind rotations applied), sign-continuous.
-    pub joints: Vec<[Quat; 7]>,
+    pub joints: Vec<[Quat; bird::N_JOINTS]>,
 }
 
 /// The track of `bird` for `asset`.
@@ -350,18 +354,23 @@ pub fn bird_track(
     let flight = bird::flight(anim, bird, wingspan_m);
     let ours = bird::joint_track(flapper, &flight, bird);
     let skel = &asset.skeleton;
-    let mut joints: Vec<[Quat; 7]> = Vec::with_capacity(ours.len());
+    let mut joints: Vec<[Quat; bird::N_JOINTS]> = Vec::with_capacity(ours.len());
+    let still_legs = !asset.has_legs();
     for q in ours {
-        let mut l: [Quat; 7] = std::array::from_fn(|j| {
-            // The neck never moves; a static model moves only its body.
-            if j == bird::NECK || (!asset.wingbeat && j != bird::BODY) {
+        let mut l: [Quat; bird::N_JOINTS] = std::array::from_fn(|j| {
+            // The neck never moves; a static model moves only its body; legs that nothing is
+            // skinned to stay at rest.
+            if j == bird::NECK
+                || (!asset.wingbeat && j != bird::BODY)
+                || (still_legs && LEG_JOINTS.contains(&j))
+            {
                 skel.rest_rotation(j)
             } else {
                 skel.local_rotation(j, q[j])
             }
         });
         if let Some(p) = joints.last() {
-            for j in 0..7 {
+            for j in 0..bird::N_JOINTS {
                 l[j] = bird::continuous(p[j], l[j]);
             }
         }
@@ -452,7 +461,7 @@ fn glb_parts(
         },
         ..Default::default()
     };
-    // Each model's inverse bind matrices (its seven joints, column-major).
+    // Each model's inverse bind matrices (its joints, column-major).
     let model_ibm: Vec<Vec<f32>> = assets
         .iter()
         .map(|asset| {
@@ -509,7 +518,8 @@ fn glb_parts(
         let asset = &assets[model];
         let track = bird_track(anim, &flapper, asset, bird, wingspan_m);
         // Skeleton nodes, children before parents so indices are known.
-        let mut joint_nodes: [Option<json::Index<json::Node>>; 7] = [None; 7];
+        let mut joint_nodes: [Option<json::Index<json::Node>>; bird::N_JOINTS] =
+            [None; bird::N_JOINTS];
         for j in (0..bird::JOINTS.len()).rev() {
             let children: Vec<_> = (0..bird::JOINTS.len())
                 .filter(|&c| bird::PARENT[c] == Some(j))
@@ -583,6 +593,19 @@ fn glb_parts(
             }));
         }
 
+        // The wing joints, and the legs when they move in any frame of the bird's track.
+        let rest_leg = |j: usize| asset.skeleton.rest_rotation(j);
+        let legs_move = LEG_JOINTS.iter().any(|&j| {
+            track
+                .joints
+                .iter()
+                .any(|q| q[j].dot(rest_leg(j)).abs() < 1.0 - 1e-7)
+        });
+        let moving: Vec<usize> = WING_JOINTS
+            .iter()
+            .chain(LEG_JOINTS.iter().filter(|_| legs_move))
+            .copied()
+            .collect();
         for (ci, c) in clips.iter().enumerate() {
             let r = c.first..c.last + 1;
             let times = &clip_t[ci];
@@ -640,17 +663,17 @@ fn glb_parts(
                 if !reduced {
                     let all: Vec<usize> = (0..times.len()).collect();
                     let input = ch.input(&all);
-                    for &j in &WING_JOINTS {
+                    for &j in &moving {
                         ch.quats(input, joints[j], &per_joint[j], &all);
                     }
                 } else {
                     // Reduced: the wing rotations are stored as normalised bytes (4 bytes a key
                     // instead of 16), and the kept keys are chosen against the decoded values.
-                    let q8: Vec<(Vec<[i8; 4]>, Vec<Quat>)> = WING_JOINTS
+                    let q8: Vec<(Vec<[i8; 4]>, Vec<Quat>)> = moving
                         .iter()
                         .map(|&j| per_joint[j].iter().map(|&q| keys::quantise_i8(q)).unzip())
                         .collect();
-                    let curves: Vec<Curve> = WING_JOINTS
+                    let curves: Vec<Curve> = moving
                         .iter()
                         .zip(&q8)
                         .map(|(&j, (_, stored))| Curve::Stored {
@@ -663,11 +686,11 @@ fn glb_parts(
                     // A time accessor of its own costs 4 bytes a key; keeping every frame on the
                     // clip's shared one costs 4 bytes a joint for each extra key: take the smaller.
                     let n = times.len();
-                    if kept.len() * (4 + 4 * WING_JOINTS.len()) >= n * 4 * WING_JOINTS.len() {
+                    if kept.len() * (4 + 4 * moving.len()) >= n * 4 * moving.len() {
                         kept = (0..n).collect();
                     }
                     let input = ch.input(&kept);
-                    for (&j, (bytes, _)) in WING_JOINTS.iter().zip(&q8) {
+                    for (&j, (bytes, _)) in moving.iter().zip(&q8) {
                         let data: Vec<u8> = kept
                             .iter()
                             .flat_map(|&k| bytes[k].map(|v| v as u8))
@@ -692,7 +715,7 @@ fn glb_parts(
     });
     if opts.one_skin {
         // The flock in parts of FLOCK_PART birds: each part one mesh holding its birds (each
-        // bird's copy of its model bound to its own seven joints) on one skin of their joints.
+        // bird's copy of its model bound to its own joints) on one skin of their joints.
         // All skins hang from the flock node, so a DCC makes one armature of them; parts keep
         // each mesh's skin small (Blender's importer binds a mesh's vertices joint by joint).
         let joints_per_bird = bird::JOINTS.len() + 1;
@@ -703,7 +726,7 @@ fn glb_parts(
             let last = (first + FLOCK_PART).min(anim.birds);
             let name = format!("flock_{p:0part_digits$}");
             let mesh = b.skinned_meshes(&mut root, models, &model_of[first..last], ws, &name, true);
-            // Per bird: its root's bind (the origin), then its model's seven.
+            // Per bird: its root's bind (the origin), then its model's joints.
             let identity = glam::Mat4::IDENTITY.to_cols_array();
             let ibm: Vec<f32> = model_of[first..last]
                 .iter()
@@ -1000,7 +1023,7 @@ fn one_primitive(m: &bird::SkinnedMesh) -> (Vec<usize>, Vec<[f32; 3]>, Vec<u32>)
 }
 
 /// Birds per skinned mesh when the flock is one skeleton ([`SceneOptions::one_skin`]): 64 birds
-/// are 448 joints, within what real-time engines skin in one draw call.
+/// are 640 joints (ten a bird with its root), within what real-time engines skin in one draw call.
 pub const FLOCK_PART: usize = 64;
 
 /// A value in 0..=1 as a normalised byte.
@@ -1215,8 +1238,8 @@ impl Builder<'_> {
 
     /// One skinned primitive holding, for every bird `i`, a copy of the mesh of its model
     /// `assets[model_of[i]]` bound to its joints of one skin. `flock`: a part of the flock's one
-    /// skeleton, where each bird has 8 joints (its root, then the seven; joints `8·i + 1 ..`)
-    /// and colours and weights are normalised bytes; else one bird's mesh (joints `0 .. 7`).
+    /// skeleton, where each bird has 10 joints (its root, then the nine of [`bird::JOINTS`]; joints `10·i + 1 ..`)
+    /// and colours and weights are normalised bytes; else one bird's mesh (joints `0 .. 9`).
     fn skinned_meshes(
         &mut self,
         root: &mut json::Root,
@@ -1281,7 +1304,7 @@ impl Builder<'_> {
         } else {
             self.accessor(root, &col, 3, json::accessor::Type::Vec3, false, target)
         };
-        // Joint indices as bytes while they fit (one bird: 7 joints), else as shorts.
+        // Joint indices as bytes while they fit (one bird: 9 joints), else as shorts.
         let (jb, jct): (Vec<u8>, _) = if model_of.len() * joints_per_bird <= 256 {
             (
                 jw.iter().map(|&j| j as u8).collect(),

@@ -85,6 +85,7 @@ fn lerp_pose(a: &WingPose, b: &WingPose, w: f64) -> WingPose {
         hand_twist: l(a.hand_twist, b.hand_twist),
         spread: l(a.spread, b.spread),
         tail_bend: l(a.tail_bend, b.tail_bend),
+        legs: l(a.legs, b.legs),
     }
 }
 

@@ -94,7 +94,8 @@ struct Build {
     tail: f32,
     tail_w0: f32,
     tail_w1: f32,
-    /// Legs trailing behind the tail root (0 = none), half-gap between them.
+    /// How far the legs trail behind the tail root (0 = none; their hips and reach are the
+    /// rig's, `wingbeat::rest::leg`).
     legs: f32,
     /// Arm chord at the body and at the wrist; hand chord at the wrist.
     arm_chord: f32,
@@ -139,7 +140,7 @@ fn build(species: Species) -> Build {
             tail: 0.05,
             tail_w0: 0.03,
             tail_w1: 0.02,
-            legs: 0.3,
+            legs: 0.13,
             arm_chord: 0.2,
             wrist_chord: 0.18,
             arm_frac: 0.5,
@@ -250,21 +251,26 @@ pub fn pieces(species: Species, pose: &WingPose, bank: f64) -> Vec<Piece> {
             (b.bill_w * 0.3, head_end + b.bill),
         ],
     ));
-    // Legs trailing behind the tail (cranes): two thin strips with feet.
+    // Legs (cranes): two thin strips from the hips as long as the rig's, swung by the pose's
+    // leg swing from trailing behind the tail (0) to down under the body (π/2) and folded
+    // forward (towards π).
     if b.legs > 0.0 {
+        let leg = crate::wingbeat::rest::leg(species);
+        let (y0, reach) = (leg.hip[2] as f32, leg.reach as f32);
+        let z0 = leg.hip[1] as f32;
+        let (sa, ca) = (pose.legs as f32).sin_cos();
         for side in [-1.0f32, 1.0] {
-            let x = side * 0.012;
-            let y0 = b.body_back + 0.03;
-            let y1 = b.body_back - b.legs;
-            out.push(flat(
-                Part::Body,
-                &[
-                    (x - 0.004, y0),
-                    (x + 0.004, y0),
-                    (x + 0.003, y1),
-                    (x - 0.003, y1),
+            let x = side * leg.hip[0] as f32;
+            let at = |dx: f32, d: f32| [x + dx, y0 - d * ca, z0 - d * sa];
+            out.push(Piece {
+                part: Part::Body,
+                points: vec![
+                    at(-0.004, 0.0),
+                    at(0.004, 0.0),
+                    at(0.003, reach),
+                    at(-0.003, reach),
                 ],
-            ));
+            });
         }
     }
     // Wings.
@@ -409,8 +415,20 @@ mod tests {
         };
         let front = |p: &[f32; 3]| p[1];
         let back = |p: &[f32; 3]| -p[1];
-        // Cranes' legs trail farthest; geese and cranes stretch the neck; pelicans' bill is long.
-        assert!(reach(Species::Crane, back) > reach(Species::Goose, back) + 0.15);
+        // Cranes' legs trail well past their tail; geese and cranes stretch the neck; pelicans'
+        // bill is long.
+        let crane = build(Species::Crane);
+        assert!(reach(Species::Crane, back) > -(crane.body_back - crane.tail) + 0.05);
+        // Lowered, they hang under the body.
+        let down = WingPose {
+            legs: std::f64::consts::FRAC_PI_2,
+            ..WingPose::EXTENDED
+        };
+        let low = pieces(Species::Crane, &down, 0.0)
+            .iter()
+            .flat_map(|p| p.points.iter().map(|q| q[2]))
+            .fold(f32::MAX, f32::min);
+        assert!(low < -0.2, "{low}");
         assert!(reach(Species::Crane, front) > reach(Species::Goose, front));
         let b = build(Species::Pelican);
         assert!(b.bill > 3.0 * build(Species::Goose).bill && b.neck < 0.05);

@@ -258,6 +258,7 @@ pub fn pose(strokes: &Strokes, timing: &Timing, phi: f64) -> WingPose {
         hand_twist: lin(strokes.hand_twist, c2),
         spread,
         tail_bend: lin(strokes.tail_bend, c1),
+        legs: 0.0,
     }
 }
 

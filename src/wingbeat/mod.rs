@@ -59,6 +59,10 @@ pub struct WingPose {
     pub spread: f64,
     /// Tail bend, up positive.
     pub tail_bend: f64,
+    /// Leg swing at the hip from trailing (0, legs along the body behind it, as in cruise)
+    /// through straight down (π/2) to folded forward under the body (towards π), radians
+    /// (see [`rest::leg_angles`]).
+    pub legs: f64,
 }
 
 impl WingPose {
@@ -71,6 +75,7 @@ impl WingPose {
         hand_twist: 0.0,
         spread: 1.0,
         tail_bend: 0.0,
+        legs: 0.0,
     };
 }
 
@@ -741,6 +746,8 @@ pub struct Flapper {
     /// Root height and bank per frame and bird (frame-major) of a flight that starts on the
     /// ground (empty otherwise): the downstroke is kept off the ground.
     ground: Vec<(f64, f64)>,
+    /// Leg swing per frame and bird (frame-major; empty: the legs trail throughout).
+    legs: Vec<f64>,
     nbirds: usize,
     nframes: usize,
 }
@@ -788,6 +795,7 @@ impl Flapper {
             },
             fold: run.fold,
             flare: rest::flare_weights(anim),
+            legs: rest::leg_angles(anim, opts.species),
             nbirds: n,
             nframes: anim.frames.len(),
         }
@@ -826,7 +834,8 @@ impl Flapper {
             _ => return WingPose::EXTENDED,
         };
         let p = self.flared(p, self.flare.get(k).copied().unwrap_or(0.0));
-        let p = self.folded(p, self.fold.get(k).copied().unwrap_or(0.0));
+        let mut p = self.folded(p, self.fold.get(k).copied().unwrap_or(0.0));
+        p.legs = self.legs.get(k).copied().unwrap_or(0.0);
         match self.ground.get(k) {
             Some(&(z, bank)) if z < 1.0 => rest::clear_ground(p, z, bank),
             _ => p,
@@ -898,8 +907,15 @@ impl Flapper {
             .and_then(|i| self.flare.get(i))
             .copied()
             .unwrap_or(q0);
+        let l0 = self.legs.get(a).copied().unwrap_or(0.0);
+        let l1 = self
+            .index(k + 1, bird)
+            .and_then(|i| self.legs.get(i))
+            .copied()
+            .unwrap_or(l0);
         let p = self.flared(b.pose_at(s, s.rem_euclid(TAU)), q0 + w * (q1 - q0));
-        let p = self.folded(p, f0 + w * (f1 - f0));
+        let mut p = self.folded(p, f0 + w * (f1 - f0));
+        p.legs = l0 + w * (l1 - l0);
         let g0 = self.ground.get(a).copied();
         let g1 = self
             .index(k + 1, bird)

@@ -102,6 +102,148 @@ pub fn stand_on_ground(anim: &mut Animation, species: Species) {
     }
 }
 
+/// A leg of the built-in rig: the left hip in the bird frame (`x` left, `y` up, `z` forward) and
+/// the leg's reach from the hip to the tip of the toes, wingspans. The reach is what a straight
+/// leg needs to stand the bird at its [`Stance::stand`] height, less [`leg_gap`]: the built-in
+/// rig has one joint per leg, so a standing bird's legs are straight and under the body.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Leg {
+    /// Left hip, bird frame, wingspans (the right one mirrored).
+    pub hip: [f64; 3],
+    /// Hip to the toes' tip, wingspans.
+    pub reach: f64,
+    /// Gap kept between the toes and the ground ([`leg_gap`]), wingspans.
+    pub gap: f64,
+}
+
+/// Gap kept between the toes and the ground, wingspans: 0.006 for the toes' rounding, plus what
+/// a bird larger by [`LEG_SCALE_MARGIN`] sinks its toes by when it stands (exports scale a bird
+/// about the ground point under it sitting, so a larger one's standing toes are lower by
+/// (s − 1)(h_stand − h_sit)).
+pub fn leg_gap(species: Species) -> f64 {
+    let st = stance(species);
+    0.006 + LEG_SCALE_MARGIN * (st.stand - st.sit)
+}
+
+/// Size margin of [`leg_gap`]: 0.12, three standard deviations of the exports' default size
+/// spread (4 %, clipped at three), so that no bird of the default spread puts a toe below the
+/// ground.
+pub const LEG_SCALE_MARGIN: f64 = 0.12;
+
+/// The legs of `species`: hips just behind the body's centre, low in the body; reach from the
+/// standing height (our choice, docs/landing.md).
+pub fn leg(species: Species) -> Leg {
+    let hip = match species {
+        Species::Goose => [0.02, -0.04, -0.04],
+        Species::Crane => [0.018, -0.035, -0.06],
+        Species::Pelican => [0.02, -0.04, -0.05],
+    };
+    let gap = leg_gap(species);
+    Leg {
+        hip,
+        reach: stance(species).stand + hip[1] - gap,
+        gap,
+    }
+}
+
+/// Leg swing of a bird standing or in the flare (from trailing, radians): 100°, straight down
+/// and a little forward, so the feet are under the body's centre. Our choice.
+pub const LEGS_DOWN: f64 = 100.0 * std::f64::consts::PI / 180.0;
+/// Time the legs take to swing back after lift-off, seconds (our choice, docs/landing.md).
+pub const LEG_SWING_S: f64 = 0.5;
+/// A bird of the take-off whose root is more than this above its standing height (wingspans)
+/// has lifted off; lower, it is on its legs.
+pub const LIFT_OFF_BAND: f64 = 0.05;
+
+/// Leg swing of a bird with its legs lowered whose root is `z` wingspans above the ground with
+/// the body pitched `pitch` radians nose up: [`LEGS_DOWN`] when the feet clear the ground, and
+/// otherwise swung further forward, just as far as the toes keep [`leg_gap`] off the ground
+/// (a bird sitting down folds its legs forward under its belly).
+pub fn legs_down(leg: &Leg, z: f64, pitch: f64) -> f64 {
+    let (s, c) = pitch.sin_cos();
+    let hip = z + leg.hip[1] * c + leg.hip[2] * s;
+    // Toe height of a swing a: hip − reach·sin(a + pitch).
+    let r = ((hip - leg.gap) / leg.reach).clamp(0.0, 1.0);
+    LEGS_DOWN.max(std::f64::consts::PI - r.asin() - pitch)
+}
+
+/// Leg swing of every bird in every frame (frame-major, radians, see [`WingPose::legs`]); empty
+/// for a flight that neither starts on the ground nor lands (the legs trail throughout).
+///
+/// The legs are lowered (weight w = 1) while a bird of the take-off is on the ground (root less
+/// than [`LIFT_OFF_BAND`] above its standing height) and swing back over [`LEG_SWING_S`] seconds
+/// after lift-off; in the landing they swing down over the first two thirds of each bird's
+/// flare (its touch-down time and the flare's length from the landing record) and stay down.
+/// The swing is `w ·` [`legs_down`]. Times, heights and pitch only: the same at any frame rate.
+pub fn leg_angles(anim: &Animation, species: Species) -> Vec<f64> {
+    let init = anim.stage("initiation").cloned();
+    let rec = anim.landing.as_ref();
+    if init.is_none() && rec.is_none() {
+        return Vec::new();
+    }
+    let n = anim.birds;
+    let nf = anim.frames.len();
+    let st = stance(species);
+    let leg = leg(species);
+    let smooth = |x: f64| {
+        let x = x.clamp(0.0, 1.0);
+        x * x * (3.0 - 2.0 * x)
+    };
+    let on_ground = |k: usize, i: usize| {
+        init.as_ref().is_some_and(|s| (s.start..s.end).contains(&k))
+            && anim.frames[k]
+                .z
+                .get(i)
+                .is_some_and(|&z| z < st.stand + LIFT_OFF_BAND)
+    };
+    let mut out = vec![0.0; n * nf];
+    for i in 0..n {
+        // Lowered on the ground: a ramp of LEG_SWING_S from the weight reached at each change.
+        let mut since = f64::NEG_INFINITY;
+        let mut was = nf > 0 && on_ground(0, i);
+        let mut from = if was { 1.0 } else { 0.0 };
+        let mut prev = from;
+        for k in 0..nf {
+            let f = &anim.frames[k];
+            let g = on_ground(k, i);
+            if g != was {
+                from = prev;
+                since = anim.frames[k.saturating_sub(1)].t;
+                was = g;
+            }
+            let target = if g { 1.0 } else { 0.0 };
+            let u = if since.is_finite() {
+                smooth((f.t - since) / LEG_SWING_S)
+            } else {
+                1.0
+            };
+            let ground = from + (target - from) * u;
+            prev = ground;
+            let landing = rec
+                .and_then(|r| r.touchdown.get(i).map(|&td| (td, r.flare_seconds)))
+                .map_or(0.0, |(td, fs)| {
+                    let fs = fs.max(1e-6);
+                    smooth((f.t - (td - fs)) / (2.0 * fs / 3.0))
+                });
+            let w = ground.max(landing);
+            let z = f.z.get(i).copied().unwrap_or(f64::INFINITY);
+            let pitch = f
+                .pitch
+                .as_ref()
+                .and_then(|p| p.get(i))
+                .copied()
+                .unwrap_or(0.0);
+            let a = if w > 0.0 && z.is_finite() && pitch.is_finite() {
+                w * legs_down(&leg, z, pitch)
+            } else {
+                0.0
+            };
+            out[k * n + i] = a;
+        }
+    }
+    out
+}
+
 /// Height of the shoulder above the bird's root, wingspans (the built-in birds: 0.02 or less).
 const SHOULDER_UP: f64 = 0.02;
 /// Reach of a wing from the shoulder to the tip, and half its widest chord, wingspans: at least
@@ -163,6 +305,7 @@ pub const FOLDED: WingPose = WingPose {
     hand_twist: 0.0,
     spread: 0.75,
     tail_bend: 0.0,
+    legs: 0.0,
 };
 
 /// The landing flare: wings spread wide and held, raised a little, swept forward, twisted
@@ -176,6 +319,7 @@ pub const FLARE: WingPose = WingPose {
     hand_twist: 0.25,
     spread: 1.0,
     tail_bend: -0.35,
+    legs: 0.0,
 };
 
 /// Flare weight of every bird in every frame (frame-major) from the animation's landing record
@@ -202,6 +346,7 @@ impl WingPose {
             hand_twist: l(self.hand_twist, other.hand_twist),
             spread: l(self.spread, other.spread),
             tail_bend: l(self.tail_bend, other.tail_bend),
+            legs: l(self.legs, other.legs),
         }
     }
 }
@@ -301,6 +446,28 @@ mod tests {
         assert!(w[done..].iter().all(|&x| x == 0.0));
         for p in w.windows(2) {
             assert!(p[1] <= p[0]);
+        }
+    }
+
+    #[test]
+    fn legs_stand_straight_down_and_fold_forward_as_the_body_sinks() {
+        for sp in Species::ALL {
+            let (st, l) = (stance(sp), leg(sp));
+            assert_eq!(legs_down(&l, st.stand, 0.0), LEGS_DOWN);
+            let sitting = legs_down(&l, st.sit, 0.0);
+            assert!(sitting > 2.8, "{sp}: {sitting}");
+            let mut prev = LEGS_DOWN;
+            for k in 0..=20 {
+                let z = st.stand - (st.stand - st.sit) * k as f64 / 20.0;
+                let a = legs_down(&l, z, 0.0);
+                assert!(a >= prev - 1e-12, "{sp}: {z} {a}");
+                // The toes keep the gap (hip height − reach·sin(a)), or lie level with the hip
+                // when it is lower than the gap (a sitting crane).
+                let hip = z + l.hip[1];
+                let toe = hip - l.reach * a.sin();
+                assert!(toe >= l.gap.min(hip) - 1e-9, "{sp}: {z} {toe}");
+                prev = a;
+            }
         }
     }
 
