@@ -739,15 +739,19 @@ pub struct Flapper {
     phase: Vec<f64>,
     /// Unwrapped phase per frame and bird (frame-major).
     unwrapped: Vec<f64>,
-    /// Fold weight per frame and bird (frame-major; empty: never at rest).
-    fold: Vec<f64>,
+    /// Fold weight per frame and bird (frame-major; empty: never at rest). Like the tables
+    /// below, kept only for the frames where some bird is not at its usual value (0 here), so a
+    /// long flight costs a few bytes a frame.
+    fold: sparse::FrameTable<f64>,
     /// Flare weight per frame and bird (frame-major; empty: no landing).
-    flare: Vec<f64>,
+    flare: sparse::FrameTable<f64>,
     /// Root height and bank per frame and bird (frame-major) of a flight that starts on the
-    /// ground (empty otherwise): the downstroke is kept off the ground.
-    ground: Vec<(f64, f64)>,
+    /// ground (empty otherwise): the downstroke is kept off the ground. Kept for the frames
+    /// within one of a frame where some bird is less than a wingspan up (others read as
+    /// infinitely high and level, which no use tells apart).
+    ground: sparse::FrameTable<(f64, f64)>,
     /// Leg swing per frame and bird (frame-major; empty: the legs trail throughout).
-    legs: Vec<f64>,
+    legs: sparse::FrameTable<f64>,
     nbirds: usize,
     nframes: usize,
 }
@@ -775,27 +779,35 @@ impl Flapper {
         } else {
             simulate(anim, opts)
         };
+        let frames = &anim.frames;
+        let ground = if run.fold.is_empty() {
+            sparse::FrameTable::default()
+        } else {
+            let low: Vec<bool> = frames
+                .iter()
+                .map(|f| (0..n).any(|i| f.z.get(i).copied().unwrap_or(f64::INFINITY) < 1.0))
+                .collect();
+            let near = |k: usize| {
+                low[k.saturating_sub(1)..(k + 2).min(low.len())]
+                    .iter()
+                    .any(|&l| l)
+            };
+            sparse::FrameTable::from_fn(frames.len(), n, (f64::INFINITY, 0.0), near, |k, i| {
+                let f = &frames[k];
+                let z = f.z.get(i).copied().unwrap_or(f64::INFINITY);
+                let bank = f.bank.as_ref().and_then(|b| b.get(i)).copied();
+                (z, bank.unwrap_or(0.0))
+            })
+        };
+        let table = |v: Vec<f64>| sparse::FrameTable::from_dense(&v, n, 0.0);
         Flapper {
             birds: run.birds,
             phase: run.phase,
             unwrapped: run.unwrapped,
-            ground: if run.fold.is_empty() {
-                Vec::new()
-            } else {
-                anim.frames
-                    .iter()
-                    .flat_map(|f| {
-                        (0..n).map(move |i| {
-                            let z = f.z.get(i).copied().unwrap_or(f64::INFINITY);
-                            let bank = f.bank.as_ref().and_then(|b| b.get(i)).copied();
-                            (z, bank.unwrap_or(0.0))
-                        })
-                    })
-                    .collect()
-            },
-            fold: run.fold,
-            flare: rest::flare_weights(anim),
-            legs: rest::leg_angles(anim, opts.species),
+            ground,
+            fold: table(run.fold),
+            flare: table(rest::flare_weights(anim)),
+            legs: table(rest::leg_angles(anim, opts.species)),
             nbirds: n,
             nframes: anim.frames.len(),
         }
@@ -833,11 +845,11 @@ impl Flapper {
             (Some(&s), Some(&phi)) => b.pose_at(s, phi),
             _ => return WingPose::EXTENDED,
         };
-        let p = self.flared(p, self.flare.get(k).copied().unwrap_or(0.0));
-        let mut p = self.folded(p, self.fold.get(k).copied().unwrap_or(0.0));
-        p.legs = self.legs.get(k).copied().unwrap_or(0.0);
+        let p = self.flared(p, self.flare.get(k).unwrap_or(0.0));
+        let mut p = self.folded(p, self.fold.get(k).unwrap_or(0.0));
+        p.legs = self.legs.get(k).unwrap_or(0.0);
         match self.ground.get(k) {
-            Some(&(z, bank)) if z < 1.0 => rest::clear_ground(p, z, bank),
+            Some((z, bank)) if z < 1.0 => rest::clear_ground(p, z, bank),
             _ => p,
         }
     }
@@ -867,7 +879,6 @@ impl Flapper {
     pub fn fold(&self, frame: usize, bird: usize) -> f64 {
         self.index(frame, bird)
             .and_then(|k| self.fold.get(k))
-            .copied()
             .unwrap_or(0.0)
     }
 
@@ -895,32 +906,26 @@ impl Flapper {
             .copied()
             .unwrap_or(s0);
         let s = s0 + w * (s1 - s0);
-        let f0 = self.fold.get(a).copied().unwrap_or(0.0);
+        let f0 = self.fold.get(a).unwrap_or(0.0);
         let f1 = self
             .index(k + 1, bird)
             .and_then(|i| self.fold.get(i))
-            .copied()
             .unwrap_or(f0);
-        let q0 = self.flare.get(a).copied().unwrap_or(0.0);
+        let q0 = self.flare.get(a).unwrap_or(0.0);
         let q1 = self
             .index(k + 1, bird)
             .and_then(|i| self.flare.get(i))
-            .copied()
             .unwrap_or(q0);
-        let l0 = self.legs.get(a).copied().unwrap_or(0.0);
+        let l0 = self.legs.get(a).unwrap_or(0.0);
         let l1 = self
             .index(k + 1, bird)
             .and_then(|i| self.legs.get(i))
-            .copied()
             .unwrap_or(l0);
         let p = self.flared(b.pose_at(s, s.rem_euclid(TAU)), q0 + w * (q1 - q0));
         let mut p = self.folded(p, f0 + w * (f1 - f0));
         p.legs = l0 + w * (l1 - l0);
-        let g0 = self.ground.get(a).copied();
-        let g1 = self
-            .index(k + 1, bird)
-            .and_then(|i| self.ground.get(i))
-            .copied();
+        let g0 = self.ground.get(a);
+        let g1 = self.index(k + 1, bird).and_then(|i| self.ground.get(i));
         match (g0, g1.or(g0)) {
             (Some((z0, b0)), Some((z1, b1))) if z0.min(z1) < 1.0 => {
                 rest::clear_ground(p, z0.min(z1), b0.abs().max(b1.abs()))

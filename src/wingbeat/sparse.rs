@@ -51,6 +51,33 @@ impl<T: Copy + PartialEq> FrameTable<T> {
         }
     }
 
+    /// The table of `frames` frames whose kept frames (`keep`) hold `value(frame, bird)`; every
+    /// other frame reads as `fill` (no dense table is made).
+    pub fn from_fn(
+        frames: usize,
+        birds: usize,
+        fill: T,
+        keep: impl Fn(usize) -> bool,
+        value: impl Fn(usize, usize) -> T,
+    ) -> FrameTable<T> {
+        let mut rows = Vec::with_capacity(frames);
+        let mut data = Vec::new();
+        for f in 0..frames {
+            if birds > 0 && keep(f) {
+                rows.push((data.len() / birds) as u32);
+                data.extend((0..birds).map(|b| value(f, b)));
+            } else {
+                rows.push(NONE);
+            }
+        }
+        FrameTable {
+            rows,
+            data,
+            birds,
+            fill,
+        }
+    }
+
     /// Whether the table has no frames (the dense table was empty).
     pub fn is_empty(&self) -> bool {
         self.rows.is_empty()
