@@ -173,6 +173,10 @@ pub struct MarkedBird {
     pub lateral: f64,
     /// Offset along the flight direction from the image origin, wingspans.
     pub forward: f64,
+    /// Height (upward), wingspans, for 3-D files (DLTdv `xyzpts`, a long CSV with `z`, native
+    /// JSON with `"z"`); `None` for image annotations.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub height: Option<f64>,
 }
 
 /// One annotated frame.
@@ -257,6 +261,7 @@ impl Annotations {
                         .iter()
                         .enumerate()
                         .map(|(i, p)| RawBird {
+                            z: None,
                             id: None,
                             x: p[0],
                             y: p[1],
@@ -288,6 +293,8 @@ pub(crate) struct RawBird {
     pub id: Option<usize>,
     pub x: f64,
     pub y: f64,
+    /// Height in the file's units (3-D files: DLTdv xyzpts, long CSV with `z`, native `"z"`).
+    pub z: Option<f64>,
     /// Where it came from, for messages (`row 12`, `frames[3].birds[2]`, `shapes[4]`).
     pub at: String,
 }
@@ -533,13 +540,37 @@ fn finish(path: &Path, raw: RawAnnotations, opts: &ReadOptions) -> Result<Annota
             return Err(Error::parameter("read.heading", "must be a finite angle"));
         }
     }
-    let heading = opts.heading.or(raw.heading).unwrap_or(Heading::Up);
-    let theta = heading.degrees().to_radians();
-    let (d, r) = ((theta.sin(), -theta.cos()), (theta.cos(), theta.sin()));
     let y_up = match (raw.is_csv, opts.y_origin) {
         (true, Some(o)) => o == YOrigin::Bottom,
         _ => raw.y_up,
     };
+    let three_d = raw
+        .frames
+        .first()
+        .and_then(|f| f.birds.first())
+        .is_some_and(|b| b.z.is_some());
+    for f in &raw.frames {
+        if let Some(b) = f.birds.iter().find(|b| b.z.is_some() != three_d) {
+            return Err(Error::format(
+                path,
+                format!(
+                    "frame {}, {}: {} a height (z) while the file's first bird {}; give every bird a z or none",
+                    f.index,
+                    b.at,
+                    if three_d { "has no" } else { "has" },
+                    if three_d { "has one" } else { "has none" }
+                ),
+            ));
+        }
+    }
+    let heading = match opts.heading.or(raw.heading) {
+        Some(h) => h,
+        // 3-D points lie in the given horizontal plane; the flight direction is their motion.
+        None if three_d => heading_from_motion(&raw, y_up).unwrap_or(Heading::Up),
+        None => Heading::Up,
+    };
+    let theta = heading.degrees().to_radians();
+    let (d, r) = ((theta.sin(), -theta.cos()), (theta.cos(), theta.sin()));
     let file_scale = match raw.wingspan_px {
         Some(w) => Some(check_scale(path, "wingspan_px", w)?),
         None => None,
@@ -595,6 +626,7 @@ fn finish(path: &Path, raw: RawAnnotations, opts: &ReadOptions) -> Result<Annota
                 py: b.y,
                 lateral: (b.x * r.0 + py * r.1) / scale,
                 forward: (b.x * d.0 + py * d.1) / scale,
+                height: b.z.map(|z| z / scale),
             });
         }
         if let Some((b, _)) = f
@@ -663,6 +695,29 @@ fn finish(path: &Path, raw: RawAnnotations, opts: &ReadOptions) -> Result<Annota
         fps: raw.fps,
         frames,
     })
+}
+
+/// Flight direction of 3-D points from their motion: the mean displacement, first frame to
+/// last, of the ids in both (x right, y upward when `y_up`); `None` without ids, with
+/// one frame or without motion.
+fn heading_from_motion(raw: &RawAnnotations, y_up: bool) -> Option<Heading> {
+    let (first, last) = (raw.frames.first()?, raw.frames.last()?);
+    let (mut dx, mut dy, mut n) = (0.0, 0.0, 0usize);
+    for b in &first.birds {
+        let Some(id) = b.id else { continue };
+        if let Some(c) = last.birds.iter().find(|c| c.id == Some(id)) {
+            dx += c.x - b.x;
+            dy += c.y - b.y;
+            n += 1;
+        }
+    }
+    if n == 0 || (dx == 0.0 && dy == 0.0) {
+        return None;
+    }
+    // Pixel y downward: a y-up file's y negated.
+    let down = if y_up { -dy } else { dy };
+    let deg = dx.atan2(-down).to_degrees();
+    Some(Heading::Degrees(if deg < 0.0 { deg + 360.0 } else { deg }))
 }
 
 /// Index of the front-most bird (largest `forward`; ties to the first).

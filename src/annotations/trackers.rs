@@ -247,7 +247,16 @@ fn sleap(path: &Path, text: &str, bodypart: Option<&str>) -> Result<RawAnnotatio
             _ => None,
         };
         match (x, y) {
-            (Some(x), Some(y)) => out.push(index, RawBird { id, x, y, at }),
+            (Some(x), Some(y)) => out.push(
+                index,
+                RawBird {
+                    id,
+                    x,
+                    y,
+                    z: None,
+                    at,
+                },
+            ),
             (None, None) => {}
             _ => {
                 return Err(Error::format(
@@ -367,6 +376,7 @@ fn dlc(path: &Path, text: &str, bodypart: Option<&str>) -> Result<RawAnnotations
                 (Some(x), Some(y)) => out.push(
                     index,
                     RawBird {
+                        z: None,
                         id: Some(k),
                         x,
                         y,
@@ -428,6 +438,7 @@ fn mot(path: &Path, text: &str) -> Result<RawAnnotations> {
         out.push(
             frame,
             RawBird {
+                z: None,
                 id: (id >= 0).then_some(id as usize),
                 x: v[0] + 0.5 * v[2],
                 y: v[1] + 0.5 * v[3],
@@ -485,6 +496,7 @@ fn idtracker(path: &Path, text: &str) -> Result<RawAnnotations> {
                 (Some(x), Some(y)) => out.push(
                     index,
                     RawBird {
+                        z: None,
                         id: Some(id),
                         x,
                         y,
