@@ -18,6 +18,7 @@ mod csv_formats;
 mod labelme;
 mod native;
 mod npz;
+mod sleap_h5;
 pub mod synth;
 mod trackers;
 
@@ -139,6 +140,9 @@ pub enum Format {
     IdTracker,
     /// TRex's `.npz` archives, one per individual (`VIDEO_fish0.npz`, ...).
     Trex,
+    /// SLEAP analysis HDF5 (`tracks`, `track_names`, `node_names`), told by its signature.
+    #[serde(rename = "sleap_h5")]
+    SleapH5,
 }
 
 impl Format {
@@ -155,6 +159,7 @@ impl Format {
             Format::Mot => "MOT text",
             Format::IdTracker => "idtracker.ai CSV",
             Format::Trex => "TRex .npz",
+            Format::SleapH5 => "SLEAP analysis HDF5",
         }
     }
 }
@@ -334,6 +339,9 @@ pub fn detect(path: &Path) -> Result<Format> {
     if path.is_dir() {
         return Ok(Format::LabelmeDir);
     }
+    if sleap_h5::file_is_hdf5(path) {
+        return Ok(Format::SleapH5);
+    }
     let text = crate::io::read_text(path)?;
     detect_text(path, &text)
 }
@@ -443,6 +451,9 @@ pub fn read(path: &Path, opts: &ReadOptions) -> Result<Annotations> {
         let raw = labelme::read_dir(path)?;
         return finish(path, raw, opts);
     }
+    if sleap_h5::file_is_hdf5(path) {
+        return parse_sleap_h5_bytes(path, crate::io::read_bytes(path)?, opts);
+    }
     let text = crate::io::read_text(path)?;
     parse_str(path, &text, opts)
 }
@@ -451,6 +462,20 @@ pub fn read(path: &Path, opts: &ReadOptions) -> Result<Annotations> {
 /// (which only names it in messages), checked as [`read`] checks a file.
 pub fn parse_trex_bytes(path: &Path, bytes: &[u8], opts: &ReadOptions) -> Result<Annotations> {
     let raw = npz::read_one(path, bytes)?;
+    finish(path, raw, opts)
+}
+
+/// Parses SLEAP's analysis HDF5 from bytes as if read from `path` (which only names the file in
+/// messages); bytes without the HDF5 signature are refused.
+pub fn parse_sleap_h5_bytes(
+    path: &Path,
+    bytes: Vec<u8>,
+    opts: &ReadOptions,
+) -> Result<Annotations> {
+    if !sleap_h5::is_hdf5(&bytes) {
+        return Err(Error::format(path, "not an HDF5 file (no HDF5 signature)"));
+    }
+    let raw = sleap_h5::parse(path, bytes, opts.bodypart.as_deref())?;
     finish(path, raw, opts)
 }
 
@@ -474,7 +499,7 @@ pub fn parse_str(path: &Path, text: &str, opts: &ReadOptions) -> Result<Annotati
         Format::LongCsv | Format::Dltdv => csv_formats::parse(path, t, format)?,
         Format::Sleap | Format::Dlc => trackers::parse(path, t, format, opts.bodypart.as_deref())?,
         Format::Mot | Format::IdTracker => trackers::parse(path, t, format, None)?,
-        Format::LabelmeDir | Format::Trex => {
+        Format::LabelmeDir | Format::Trex | Format::SleapH5 => {
             return Err(Error::Internal(format!(
                 "{} detected for text",
                 format.name()

@@ -106,13 +106,13 @@ fn get<'a>(path: &Path, at: &str, row: &[&'a str], c: usize, name: &str) -> Resu
 
 /// Frames in order of first appearance, keyed by index.
 #[derive(Default)]
-struct Frames {
+pub(crate) struct Frames {
     frames: Vec<RawFrame>,
     pos: HashMap<i64, usize>,
 }
 
 impl Frames {
-    fn push(&mut self, index: i64, bird: RawBird) {
+    pub(crate) fn push(&mut self, index: i64, bird: RawBird) {
         let p = *self.pos.entry(index).or_insert_with(|| {
             self.frames.push(RawFrame {
                 index,
@@ -126,7 +126,7 @@ impl Frames {
         self.frames[p].birds.push(bird);
     }
 
-    fn done(self, path: &Path, format: Format) -> Result<RawAnnotations> {
+    pub(crate) fn done(self, path: &Path, format: Format) -> Result<RawAnnotations> {
         if self.frames.is_empty() {
             return Err(Error::format(path, "no bird in any row"));
         }
@@ -168,7 +168,7 @@ pub(crate) fn parse(
 
 /// An id from a track name: its trailing number (`track_3` → 3), else its order of first
 /// appearance among names without one.
-fn track_id(name: &str, named: &mut HashMap<String, usize>) -> usize {
+pub(crate) fn track_id(name: &str, named: &mut HashMap<String, usize>) -> usize {
     let digits: String = name
         .chars()
         .rev()
