@@ -107,3 +107,14 @@ fn damaged_hdf5_files_exit_2_naming_the_file() {
     assert_eq!(code, 0, "{err}");
     assert!(out.exists());
 }
+
+/// A fuzz finding (`fuzz/` target `sleap_h5`, 29 s in): a damaged names dataset declared a
+/// dataset far larger than the file, and the decoder's allocation aborted the process. The
+/// shapes, element sizes and chunk shapes are now checked before any data is read.
+#[test]
+fn a_huge_declared_dataset_is_refused_not_allocated() {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/fuzz/sleap_h5-oom-8c51924d.h5");
+    let bytes = std::fs::read(&p).unwrap();
+    let r = formation::annotations::parse_sleap_h5_bytes(&p, bytes, &opts(None));
+    assert!(r.is_err());
+}

@@ -32,6 +32,36 @@ pub(crate) fn file_is_hdf5(path: &Path) -> bool {
 /// Most values of `tracks` read (4 tracks' x and y of 2 nodes over a million frames is 16 M).
 const MAX_VALUES: u64 = 64_000_000;
 
+/// Most bytes one dataset (or one of its chunks) may take in memory: `tracks` at
+/// [`MAX_VALUES`] doubles; a damaged file can declare any size.
+const MAX_BYTES: u64 = MAX_VALUES * 8;
+
+/// The shape of dataset `name`, refused (before any data is read) when it, its element or its
+/// chunks would take more than [`MAX_BYTES`].
+fn guarded_shape(path: &Path, name: &str, ds: &hdf5_pure::Dataset) -> Result<Vec<u64>> {
+    let what = format!("dataset {name}");
+    let shape = ds.shape().map_err(|e| h5err(path, &what, e))?;
+    let elem = ds.element_size().map_err(|e| h5err(path, &what, e))?;
+    let bytes = |dims: &[u64]| {
+        dims.iter()
+            .try_fold(elem.max(1), |acc, &d| acc.checked_mul(d.max(1)))
+            .filter(|&b| b <= MAX_BYTES)
+    };
+    let too_big = || {
+        Error::format(
+            path,
+            format!(
+                "{what}: shape {shape:?} of {elem}-byte elements is larger than {MAX_BYTES} bytes"
+            ),
+        )
+    };
+    bytes(&shape).ok_or_else(too_big)?;
+    if let Ok(hdf5_pure::Layout::Chunked { chunk_shape, .. }) = ds.layout() {
+        bytes(&chunk_shape).ok_or_else(too_big)?;
+    }
+    Ok(shape)
+}
+
 fn h5err(path: &Path, what: &str, e: impl std::fmt::Display) -> Error {
     Error::format(
         path,
@@ -45,7 +75,7 @@ pub(crate) fn parse(path: &Path, bytes: Vec<u8>, bodypart: Option<&str>) -> Resu
     let ds = file
         .dataset("tracks")
         .map_err(|e| h5err(path, "dataset tracks", e))?;
-    let shape = ds.shape().map_err(|e| h5err(path, "dataset tracks", e))?;
+    let shape = guarded_shape(path, "tracks", &ds)?;
     let [nt, two, nn, nf] = shape[..] else {
         return Err(Error::format(
             path,
@@ -77,6 +107,13 @@ pub(crate) fn parse(path: &Path, bytes: Vec<u8>, bodypart: Option<&str>) -> Resu
         let Ok(d) = file.dataset(name) else {
             return Ok(None);
         };
+        let shape = guarded_shape(path, name, &d)?;
+        if shape != [n] {
+            return Err(Error::format(
+                path,
+                format!("dataset {name}: shape {shape:?}, expected [{n}] (one name per entry of tracks)"),
+            ));
+        }
         let v = d
             .read_string()
             .map_err(|e| h5err(path, &format!("dataset {name}"), e))?;
