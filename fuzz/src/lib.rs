@@ -59,6 +59,23 @@ pub fn trex_npz(data: &[u8]) {
     }
 }
 
+/// SLEAP's analysis HDF5 reader (the pure-Rust HDF5 decoder: superblock, object headers,
+/// B-trees, gzip chunks, strings), then extraction of whatever it accepts.
+pub fn sleap_h5(data: &[u8]) {
+    let o = ReadOptions {
+        wingspan_px: Some(20.0),
+        heading: Some(Heading::Degrees(90.0)),
+        ..ReadOptions::default()
+    };
+    if let Ok(ann) =
+        formation::annotations::parse_sleap_h5_bytes(Path::new(PATH), data.to_vec(), &o)
+    {
+        let mut config = Config::default();
+        config.extract.max_samples = 64;
+        let _ = extract_stage(&ann, &config, &Silent);
+    }
+}
+
 /// Params file (`formation steady PARAMS`, `plot shape PARAMS`): `FormationParams::read` is
 /// `io::parse_json` + `validate`; whatever validates drives a tiny steady flight (6 birds, 4 frames).
 pub fn params(data: &[u8]) {
@@ -223,6 +240,9 @@ pub fn bird_model(data: &[u8]) {
         let poisoned = text
             .split(|c: char| !c.is_ascii_alphanumeric())
             .any(|w| w == "NaN" || w == "inf");
-        assert!(!poisoned, "a non-finite number in the USD text of an accepted bird model");
+        assert!(
+            !poisoned,
+            "a non-finite number in the USD text of an accepted bird model"
+        );
     }
 }

@@ -84,10 +84,26 @@ fn dlt_column(name: &str) -> Option<(usize, usize, bool)> {
     Some((n.parse().ok()?, m.parse().ok()?, is_x))
 }
 
+/// `ptN_X` / `ptN_Y` / `ptN_Z` (DLTdv `xyzpts`, 3-D world coordinates) → (N, axis 0..3).
+fn xyz_column(name: &str) -> Option<(usize, usize)> {
+    let lower = name.to_ascii_lowercase();
+    let (n, axis) = lower.strip_prefix("pt")?.split_once('_')?;
+    let axis = match axis {
+        "x" => 0,
+        "y" => 1,
+        "z" => 2,
+        _ => return None,
+    };
+    Some((n.parse().ok()?, axis))
+}
+
 pub(crate) fn detect_csv(path: &Path, text: &str) -> Result<Format> {
     let h = header(text)
         .ok_or_else(|| Error::format(path, "no header line; expected CSV annotations"))?;
     if !h.is_empty() && h.iter().all(|c| dlt_column(c).is_some()) {
+        return Ok(Format::Dltdv);
+    }
+    if !h.is_empty() && h.iter().all(|c| xyz_column(c).is_some()) {
         return Ok(Format::Dltdv);
     }
     let has = |n: &str| h.iter().any(|c| c.eq_ignore_ascii_case(n));
@@ -130,7 +146,9 @@ pub(crate) fn parse(path: &Path, text: &str, format: Format) -> Result<RawAnnota
         .iter()
         .map(str::to_string)
         .collect();
-    let frames = if format == Format::Dltdv {
+    let frames = if format == Format::Dltdv && hdr.iter().all(|c| xyz_column(c).is_some()) {
+        parse_xyzpts(path, &mut rdr, &hdr)?
+    } else if format == Format::Dltdv {
         parse_dltdv(path, &mut rdr, &hdr)?
     } else {
         parse_long(path, &mut rdr, &hdr)?
@@ -141,7 +159,10 @@ pub(crate) fn parse(path: &Path, text: &str, format: Format) -> Result<RawAnnota
         source: m.source,
         heading: m.heading,
         wingspan_px: m.wingspan_px,
-        y_up: format == Format::Dltdv,
+        // 3-D points (DLTdv xyzpts, a long CSV with `z`) are world coordinates with z up:
+        // seen from above, y grows upward.
+        y_up: format == Format::Dltdv
+            || frames.iter().any(|f| f.birds.iter().any(|b| b.z.is_some())),
         is_csv: true,
         frames,
     })
@@ -152,7 +173,7 @@ fn parse_long(path: &Path, rdr: &mut csv::Reader<&[u8]>, hdr: &[String]) -> Resu
     let (Some(cf), Some(cx), Some(cy)) = (col("frame"), col("x"), col("y")) else {
         return Err(Error::format(path, "header: needs columns frame, x, y"));
     };
-    let (cb, cw) = (col("bird"), col("wingspan_px"));
+    let (cb, cw, cz) = (col("bird"), col("wingspan_px"), col("z"));
     let mut frames: Vec<RawFrame> = Vec::new();
     // Frame index → position in `frames` (a linear search made reading quadratic in frames).
     let mut frame_pos: std::collections::HashMap<i64, usize> = std::collections::HashMap::new();
@@ -218,6 +239,10 @@ fn parse_long(path: &Path, rdr: &mut csv::Reader<&[u8]>, hdr: &[String]) -> Resu
         };
         let x = fnum(cx, "x")?;
         let y = fnum(cy, "y")?;
+        let z = match cz {
+            Some(c) => Some(fnum(c, "z")?),
+            None => None,
+        };
         let w = match cw {
             Some(c) if !field(c, "wingspan_px")?.is_empty() => Some(fnum(c, "wingspan_px")?),
             _ => None,
@@ -251,7 +276,7 @@ fn parse_long(path: &Path, rdr: &mut csv::Reader<&[u8]>, hdr: &[String]) -> Resu
                 }
             }
         }
-        f.birds.push(RawBird { id, x, y, at });
+        f.birds.push(RawBird { id, x, y, z, at });
     }
     if frames.is_empty() {
         return Err(Error::format(path, "no data rows after the header"));
@@ -344,6 +369,7 @@ fn parse_dltdv(path: &Path, rdr: &mut csv::Reader<&[u8]>, hdr: &[String]) -> Res
             let hy = hdr.get(cy).map(String::as_str).unwrap_or("Y");
             match (num(sx, hx)?, num(sy, hy)?) {
                 (Some(x), Some(y)) => birds.push(RawBird {
+                    z: None,
                     id: Some(n - 1),
                     x,
                     y,
@@ -354,6 +380,130 @@ fn parse_dltdv(path: &Path, rdr: &mut csv::Reader<&[u8]>, hdr: &[String]) -> Res
                     return Err(Error::format(
                         path,
                         format!("row {row} (line {line}), pt{n}: only one of X and Y is marked"),
+                    ))
+                }
+            }
+        }
+        if birds.is_empty() {
+            continue;
+        }
+        frames.push(RawFrame {
+            index: row as i64 - 1,
+            image: None,
+            wingspan_px: None,
+            at: format!("row {row}"),
+            birds,
+        });
+    }
+    if frames.is_empty() {
+        return Err(Error::format(path, "no row with a marked bird"));
+    }
+    Ok(frames)
+}
+
+/// DLTdv `xyzpts`: `ptN_X,ptN_Y,ptN_Z` per point, one row per frame, 3-D world coordinates
+/// of the calibration frame with Z up (X, Y the horizontal plane, Y grows upward as seen from
+/// above, as DLTdv's y does).
+fn parse_xyzpts(
+    path: &Path,
+    rdr: &mut csv::Reader<&[u8]>,
+    hdr: &[String],
+) -> Result<Vec<RawFrame>> {
+    // (point number, [X, Y, Z] columns).
+    let mut points: Vec<(usize, [Option<usize>; 3])> = Vec::new();
+    let mut point_pos: std::collections::HashMap<usize, usize> = std::collections::HashMap::new();
+    for (ci, c) in hdr.iter().enumerate() {
+        let Some((n, axis)) = xyz_column(c) else {
+            continue;
+        };
+        let p = match point_pos.get(&n) {
+            Some(&p) => p,
+            None => {
+                if points.len() == crate::limits::MAX_ANNOTATED_BIRDS {
+                    return Err(Error::format(
+                        path,
+                        format!(
+                            "header: more than {} points, at most {} birds per frame",
+                            crate::limits::MAX_ANNOTATED_BIRDS,
+                            crate::limits::MAX_ANNOTATED_BIRDS
+                        ),
+                    ));
+                }
+                point_pos.insert(n, points.len());
+                points.push((n, [None; 3]));
+                points.len() - 1
+            }
+        };
+        points[p].1[axis] = Some(ci);
+    }
+    for p in &points {
+        if p.1.iter().any(Option::is_none) || p.0 == 0 {
+            return Err(Error::format(
+                path,
+                format!(
+                    "header: point pt{} needs _X, _Y and _Z columns (points count from 1)",
+                    p.0
+                ),
+            ));
+        }
+    }
+    points.sort_by_key(|p| p.0);
+    let mut frames = Vec::new();
+    let mut rec = csv::StringRecord::new();
+    let mut row = 0usize;
+    loop {
+        match rdr.read_record(&mut rec) {
+            Ok(false) => break,
+            Ok(true) => {}
+            Err(e) => return Err(csv_error(path, &e)),
+        }
+        row += 1;
+        let line = rec.position().map(|p| p.line()).unwrap_or(0);
+        if rec.len() != hdr.len() {
+            return Err(Error::format(
+                path,
+                format!(
+                    "row {row} (line {line}): {} fields, the header has {} (truncated row?)",
+                    rec.len(),
+                    hdr.len()
+                ),
+            ));
+        }
+        let mut birds = Vec::new();
+        for &(n, cols) in &points {
+            let mut v = [None; 3];
+            for (k, c) in cols.iter().enumerate() {
+                let c = c.unwrap_or(0);
+                let s = rec.get(c).unwrap_or("");
+                if is_nan_text(s) {
+                    continue;
+                }
+                match s.parse::<f64>() {
+                    Ok(x) if x.is_finite() => v[k] = Some(x),
+                    _ => {
+                        let name = hdr.get(c).map(String::as_str).unwrap_or("?");
+                        return Err(Error::format(
+                            path,
+                            format!("row {row} (line {line}), field {name}: `{s}` is not a number (use NaN for an unmarked bird)"),
+                        ));
+                    }
+                }
+            }
+            match v {
+                [Some(x), Some(y), Some(z)] => birds.push(RawBird {
+                    id: Some(n - 1),
+                    x,
+                    y,
+                    z: Some(z),
+                    at: format!("row {row} (line {line}), pt{n}"),
+                }),
+                [None, None, None] => {}
+                _ => {
+                    return Err(Error::format(
+                        path,
+                        format!(
+                            "row {row} (line {line}), pt{n}: only some of X, Y and Z are given"
+                        ),
                     ))
                 }
             }

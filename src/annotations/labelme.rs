@@ -79,6 +79,7 @@ fn parse_frame(path: &Path, text: &str) -> Result<LabelmeFrame> {
                     Some(g) => Some(id(path, &format!("{at}.group_id"), g)?),
                 };
                 birds.push(RawBird {
+                    z: None,
                     id: bird_id,
                     x,
                     y,

@@ -18,6 +18,7 @@ mod csv_formats;
 mod labelme;
 mod native;
 mod npz;
+mod sleap_h5;
 pub mod synth;
 mod trackers;
 
@@ -139,6 +140,9 @@ pub enum Format {
     IdTracker,
     /// TRex's `.npz` archives, one per individual (`VIDEO_fish0.npz`, ...).
     Trex,
+    /// SLEAP analysis HDF5 (`tracks`, `track_names`, `node_names`), told by its signature.
+    #[serde(rename = "sleap_h5")]
+    SleapH5,
 }
 
 impl Format {
@@ -155,6 +159,7 @@ impl Format {
             Format::Mot => "MOT text",
             Format::IdTracker => "idtracker.ai CSV",
             Format::Trex => "TRex .npz",
+            Format::SleapH5 => "SLEAP analysis HDF5",
         }
     }
 }
@@ -173,6 +178,10 @@ pub struct MarkedBird {
     pub lateral: f64,
     /// Offset along the flight direction from the image origin, wingspans.
     pub forward: f64,
+    /// Height (upward), wingspans, for 3-D files (DLTdv `xyzpts`, a long CSV with `z`, native
+    /// JSON with `"z"`); `None` for image annotations.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub height: Option<f64>,
 }
 
 /// One annotated frame.
@@ -257,6 +266,7 @@ impl Annotations {
                         .iter()
                         .enumerate()
                         .map(|(i, p)| RawBird {
+                            z: None,
                             id: None,
                             x: p[0],
                             y: p[1],
@@ -288,6 +298,8 @@ pub(crate) struct RawBird {
     pub id: Option<usize>,
     pub x: f64,
     pub y: f64,
+    /// Height in the file's units (3-D files: DLTdv xyzpts, long CSV with `z`, native `"z"`).
+    pub z: Option<f64>,
     /// Where it came from, for messages (`row 12`, `frames[3].birds[2]`, `shapes[4]`).
     pub at: String,
 }
@@ -326,6 +338,9 @@ pub fn detect(path: &Path) -> Result<Format> {
     }
     if path.is_dir() {
         return Ok(Format::LabelmeDir);
+    }
+    if sleap_h5::file_is_hdf5(path) {
+        return Ok(Format::SleapH5);
     }
     let text = crate::io::read_text(path)?;
     detect_text(path, &text)
@@ -436,6 +451,9 @@ pub fn read(path: &Path, opts: &ReadOptions) -> Result<Annotations> {
         let raw = labelme::read_dir(path)?;
         return finish(path, raw, opts);
     }
+    if sleap_h5::file_is_hdf5(path) {
+        return parse_sleap_h5_bytes(path, crate::io::read_bytes(path)?, opts);
+    }
     let text = crate::io::read_text(path)?;
     parse_str(path, &text, opts)
 }
@@ -444,6 +462,20 @@ pub fn read(path: &Path, opts: &ReadOptions) -> Result<Annotations> {
 /// (which only names it in messages), checked as [`read`] checks a file.
 pub fn parse_trex_bytes(path: &Path, bytes: &[u8], opts: &ReadOptions) -> Result<Annotations> {
     let raw = npz::read_one(path, bytes)?;
+    finish(path, raw, opts)
+}
+
+/// Parses SLEAP's analysis HDF5 from bytes as if read from `path` (which only names the file in
+/// messages); bytes without the HDF5 signature are refused.
+pub fn parse_sleap_h5_bytes(
+    path: &Path,
+    bytes: Vec<u8>,
+    opts: &ReadOptions,
+) -> Result<Annotations> {
+    if !sleap_h5::is_hdf5(&bytes) {
+        return Err(Error::format(path, "not an HDF5 file (no HDF5 signature)"));
+    }
+    let raw = sleap_h5::parse(path, bytes, opts.bodypart.as_deref())?;
     finish(path, raw, opts)
 }
 
@@ -467,7 +499,7 @@ pub fn parse_str(path: &Path, text: &str, opts: &ReadOptions) -> Result<Annotati
         Format::LongCsv | Format::Dltdv => csv_formats::parse(path, t, format)?,
         Format::Sleap | Format::Dlc => trackers::parse(path, t, format, opts.bodypart.as_deref())?,
         Format::Mot | Format::IdTracker => trackers::parse(path, t, format, None)?,
-        Format::LabelmeDir | Format::Trex => {
+        Format::LabelmeDir | Format::Trex | Format::SleapH5 => {
             return Err(Error::Internal(format!(
                 "{} detected for text",
                 format.name()
@@ -533,13 +565,37 @@ fn finish(path: &Path, raw: RawAnnotations, opts: &ReadOptions) -> Result<Annota
             return Err(Error::parameter("read.heading", "must be a finite angle"));
         }
     }
-    let heading = opts.heading.or(raw.heading).unwrap_or(Heading::Up);
-    let theta = heading.degrees().to_radians();
-    let (d, r) = ((theta.sin(), -theta.cos()), (theta.cos(), theta.sin()));
     let y_up = match (raw.is_csv, opts.y_origin) {
         (true, Some(o)) => o == YOrigin::Bottom,
         _ => raw.y_up,
     };
+    let three_d = raw
+        .frames
+        .first()
+        .and_then(|f| f.birds.first())
+        .is_some_and(|b| b.z.is_some());
+    for f in &raw.frames {
+        if let Some(b) = f.birds.iter().find(|b| b.z.is_some() != three_d) {
+            return Err(Error::format(
+                path,
+                format!(
+                    "frame {}, {}: {} a height (z) while the file's first bird {}; give every bird a z or none",
+                    f.index,
+                    b.at,
+                    if three_d { "has no" } else { "has" },
+                    if three_d { "has one" } else { "has none" }
+                ),
+            ));
+        }
+    }
+    let heading = match opts.heading.or(raw.heading) {
+        Some(h) => h,
+        // 3-D points lie in the given horizontal plane; the flight direction is their motion.
+        None if three_d => heading_from_motion(&raw, y_up).unwrap_or(Heading::Up),
+        None => Heading::Up,
+    };
+    let theta = heading.degrees().to_radians();
+    let (d, r) = ((theta.sin(), -theta.cos()), (theta.cos(), theta.sin()));
     let file_scale = match raw.wingspan_px {
         Some(w) => Some(check_scale(path, "wingspan_px", w)?),
         None => None,
@@ -595,6 +651,7 @@ fn finish(path: &Path, raw: RawAnnotations, opts: &ReadOptions) -> Result<Annota
                 py: b.y,
                 lateral: (b.x * r.0 + py * r.1) / scale,
                 forward: (b.x * d.0 + py * d.1) / scale,
+                height: b.z.map(|z| z / scale),
             });
         }
         if let Some((b, _)) = f
@@ -663,6 +720,29 @@ fn finish(path: &Path, raw: RawAnnotations, opts: &ReadOptions) -> Result<Annota
         fps: raw.fps,
         frames,
     })
+}
+
+/// Flight direction of 3-D points from their motion: the mean displacement, first frame to
+/// last, of the ids in both (x right, y upward when `y_up`); `None` without ids, with
+/// one frame or without motion.
+fn heading_from_motion(raw: &RawAnnotations, y_up: bool) -> Option<Heading> {
+    let (first, last) = (raw.frames.first()?, raw.frames.last()?);
+    let (mut dx, mut dy, mut n) = (0.0, 0.0, 0usize);
+    for b in &first.birds {
+        let Some(id) = b.id else { continue };
+        if let Some(c) = last.birds.iter().find(|c| c.id == Some(id)) {
+            dx += c.x - b.x;
+            dy += c.y - b.y;
+            n += 1;
+        }
+    }
+    if n == 0 || (dx == 0.0 && dy == 0.0) {
+        return None;
+    }
+    // Pixel y downward: a y-up file's y negated.
+    let down = if y_up { -dy } else { dy };
+    let deg = dx.atan2(-down).to_degrees();
+    Some(Heading::Degrees(if deg < 0.0 { deg + 360.0 } else { deg }))
 }
 
 /// Index of the front-most bird (largest `forward`; ties to the first).

@@ -244,6 +244,7 @@ pub(crate) fn parse(path: &Path, text: &str) -> Result<RawAnnotations> {
             let bat = format!("{at}.birds[{j}]");
             let bird = match bv {
                 Value::Array(a) if a.len() == 2 => RawBird {
+                    z: None,
                     id: None,
                     x: number(path, &format!("{bat}[0] (x)"), &a[0])?,
                     y: number(path, &format!("{bat}[1] (y)"), &a[1])?,
@@ -262,6 +263,10 @@ pub(crate) fn parse(path: &Path, text: &str) -> Result<RawAnnotations> {
                         },
                         x: number(path, &format!("{bat}.x"), get("x")?)?,
                         y: number(path, &format!("{bat}.y"), get("y")?)?,
+                        z: match o.get("z") {
+                            None | Some(Value::Null) => None,
+                            Some(z) => Some(number(path, &format!("{bat}.z"), z)?),
+                        },
                         at: bat,
                     }
                 }

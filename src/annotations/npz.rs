@@ -156,6 +156,7 @@ fn assemble(path: &Path, tracks: Vec<Track>, mut rates: Vec<f64>) -> Result<RawA
                 frames.len() - 1
             });
             frames[p].birds.push(RawBird {
+                z: None,
                 id: Some(id),
                 x,
                 y,

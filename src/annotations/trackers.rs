@@ -106,13 +106,13 @@ fn get<'a>(path: &Path, at: &str, row: &[&'a str], c: usize, name: &str) -> Resu
 
 /// Frames in order of first appearance, keyed by index.
 #[derive(Default)]
-struct Frames {
+pub(crate) struct Frames {
     frames: Vec<RawFrame>,
     pos: HashMap<i64, usize>,
 }
 
 impl Frames {
-    fn push(&mut self, index: i64, bird: RawBird) {
+    pub(crate) fn push(&mut self, index: i64, bird: RawBird) {
         let p = *self.pos.entry(index).or_insert_with(|| {
             self.frames.push(RawFrame {
                 index,
@@ -126,7 +126,7 @@ impl Frames {
         self.frames[p].birds.push(bird);
     }
 
-    fn done(self, path: &Path, format: Format) -> Result<RawAnnotations> {
+    pub(crate) fn done(self, path: &Path, format: Format) -> Result<RawAnnotations> {
         if self.frames.is_empty() {
             return Err(Error::format(path, "no bird in any row"));
         }
@@ -168,7 +168,7 @@ pub(crate) fn parse(
 
 /// An id from a track name: its trailing number (`track_3` → 3), else its order of first
 /// appearance among names without one.
-fn track_id(name: &str, named: &mut HashMap<String, usize>) -> usize {
+pub(crate) fn track_id(name: &str, named: &mut HashMap<String, usize>) -> usize {
     let digits: String = name
         .chars()
         .rev()
@@ -247,7 +247,16 @@ fn sleap(path: &Path, text: &str, bodypart: Option<&str>) -> Result<RawAnnotatio
             _ => None,
         };
         match (x, y) {
-            (Some(x), Some(y)) => out.push(index, RawBird { id, x, y, at }),
+            (Some(x), Some(y)) => out.push(
+                index,
+                RawBird {
+                    id,
+                    x,
+                    y,
+                    z: None,
+                    at,
+                },
+            ),
             (None, None) => {}
             _ => {
                 return Err(Error::format(
@@ -367,6 +376,7 @@ fn dlc(path: &Path, text: &str, bodypart: Option<&str>) -> Result<RawAnnotations
                 (Some(x), Some(y)) => out.push(
                     index,
                     RawBird {
+                        z: None,
                         id: Some(k),
                         x,
                         y,
@@ -428,6 +438,7 @@ fn mot(path: &Path, text: &str) -> Result<RawAnnotations> {
         out.push(
             frame,
             RawBird {
+                z: None,
                 id: (id >= 0).then_some(id as usize),
                 x: v[0] + 0.5 * v[2],
                 y: v[1] + 0.5 * v[3],
@@ -485,6 +496,7 @@ fn idtracker(path: &Path, text: &str) -> Result<RawAnnotations> {
                 (Some(x), Some(y)) => out.push(
                     index,
                     RawBird {
+                        z: None,
                         id: Some(id),
                         x,
                         y,

@@ -41,6 +41,7 @@
 pub mod bootstrap;
 pub mod checks;
 pub mod geometry;
+pub mod heights;
 pub mod motion;
 pub mod params;
 pub mod ransac;
@@ -249,8 +250,10 @@ pub fn extract_with_report(
         summary: None,
         motion: None,
         ci: None,
+        heights: None,
     };
     params.ci = Some(Box::new(bootstrap::intervals(&params.frames)));
+    params.heights = heights::measure(ann, &params.frames);
     params.motion = opts
         .footage_fps
         .or(ann.fps)

@@ -32,6 +32,28 @@ pub struct FormationParams {
     /// wingtip spacing; absent in files written before them.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub ci: Option<Box<Intervals>>,
+    /// The birds' heights measured in 3-D tracks; absent for image annotations (the steady
+    /// flight then draws heights with the field-data defaults).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub heights: Option<MeasuredHeights>,
+}
+
+/// Heights measured in 3-D tracks (the params' `"heights"`), wingspans, upward.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct MeasuredHeights {
+    /// Frames measured.
+    pub frames: usize,
+    /// Standard deviation of the birds' heights within a frame, root mean square over the
+    /// frames (what `steady.heights.spread` draws).
+    pub spread: f64,
+    /// Root-mean-square height difference of lateral neighbours (what
+    /// `steady.heights.neighbour` draws).
+    pub neighbour: f64,
+    /// Mean height of a bird above the bird ahead of it (its lateral neighbour toward the
+    /// leader), over every bird but the leader of every frame.
+    pub ahead_mean: f64,
+    /// Standard deviation of the height above the bird ahead.
+    pub ahead_sd: f64,
 }
 
 /// What `extract` reports about the whole movie besides the per-frame parameters.
@@ -348,6 +370,24 @@ impl FormationParams {
                             "frames[{k}].positions[{i}]: not a finite number of at most {:e} wingspans",
                             crate::limits::MAX_PARAM_COORDINATE
                         ),
+                    ));
+                }
+            }
+        }
+        if let Some(h) = &self.heights {
+            let fields = [
+                ("spread", h.spread),
+                ("neighbour", h.neighbour),
+                ("ahead_mean", h.ahead_mean),
+                ("ahead_sd", h.ahead_sd),
+            ];
+            for (name, v) in fields {
+                // Heights feed `steady.heights.spread`, which allows at most 10 wingspans.
+                let ok = v.is_finite() && v.abs() <= 10.0 && (name == "ahead_mean" || v >= 0.0);
+                if !ok {
+                    return Err(Error::format(
+                        origin,
+                        format!("heights.{name}: {v} is not a height of at most 10 wingspans (non-negative but for ahead_mean)"),
                     ));
                 }
             }

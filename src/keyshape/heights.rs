@@ -113,3 +113,25 @@ pub fn heights(
     }
     out
 }
+
+/// The height options of a steady flight from `params`: the heights measured in 3-D tracks
+/// (the params' `heights`: spread and neighbour difference, the neighbour capped at
+/// √2 · spread as [`HeightOptions::validate`] requires) when the config leaves
+/// `steady.heights` at its defaults, else `opts`. The key-to-key correlation is not measured
+/// (a few seconds of tracks do not show it) and stays `opts.correlation`.
+pub fn heights_for(
+    params: &crate::extract::params::FormationParams,
+    opts: &HeightOptions,
+) -> HeightOptions {
+    match &params.heights {
+        Some(m) if *opts == HeightOptions::default() => {
+            let spread = m.spread.clamp(0.0, 10.0);
+            HeightOptions {
+                spread,
+                neighbour: m.neighbour.clamp(0.0, spread * std::f64::consts::SQRT_2),
+                correlation: opts.correlation,
+            }
+        }
+        _ => opts.clone(),
+    }
+}

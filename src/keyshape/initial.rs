@@ -588,6 +588,7 @@ mod tests {
             summary: None,
             motion: None,
             ci: None,
+            heights: None,
         };
         let c = correspondence(&p.frames[0], 5).unwrap();
         let s = initial_shapes(&p, &c, &mut seeded(0), &InitialOptions::default());

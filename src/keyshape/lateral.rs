@@ -199,6 +199,7 @@ mod tests {
             summary: None,
             motion: None,
             ci: None,
+            heights: None,
         };
         // The gap of (0, 1) alternates 0.8 and 1.0 (sd 0.1), that of (1, 2) stays 1: median
         // over the two pairs 0.05.

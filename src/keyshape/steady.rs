@@ -26,7 +26,7 @@ use crate::aero::AeroOptions;
 use crate::animation::{Animation, Frame, KeyBird, KeyShapeRecord, Stage};
 use crate::error::{Error, Result};
 use crate::extract::params::FormationParams;
-use crate::keyshape::heights::{heights, HeightOptions};
+use crate::keyshape::heights::{heights, heights_for, HeightOptions};
 use crate::keyshape::initial::{
     correspondence, curve_y, initial_shapes_scaled, lateral_gaps, positions_from_gaps, side_scales,
     Correspondence, InitialOptions,
@@ -618,12 +618,13 @@ pub fn steady_flight_in(
             feasible = feasible.including(&reference);
         }
     }
+    let height_opts = heights_for(params, &opts.heights);
     let heights = heights(
         n,
         &x,
         corr.leader,
         nk,
-        &opts.heights,
+        &height_opts,
         opts.looped,
         &mut scope.stream(opts.seed, Stream::SteadyHeight),
     );

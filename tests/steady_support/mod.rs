@@ -120,6 +120,7 @@ pub fn movie(
         summary: None,
         motion: None,
         ci: None,
+        heights: None,
     }
 }
 
