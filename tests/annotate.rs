@@ -124,7 +124,25 @@ fn annotate_refuses_what_it_cannot_show() {
     let empty = dir.join("empty");
     std::fs::create_dir_all(&empty).unwrap();
     let page = dir.join("r.html");
+    // 3-D tracks (a long CSV with z) have no pixels on the images.
+    let xyz = dir.join("xyz.csv");
+    std::fs::write(
+        &xyz,
+        "frame,bird,x,y,z\n0,0,0,0,10\n0,1,-1.5,-1.5,10.2\n0,2,1.5,-1.5,9.9\n1,0,0,1,10\n1,1,-1.5,-0.5,10.2\n1,2,1.5,-0.5,9.9\n",
+    )
+    .unwrap();
     for (args, needle) in [
+        (
+            vec![
+                "annotate",
+                s(&xyz),
+                "--images",
+                s(&frames),
+                "--wingspan-px",
+                "1.5",
+            ],
+            "frame 0: 3-D positions",
+        ),
         (
             vec![
                 "annotate",

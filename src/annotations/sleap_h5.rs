@@ -1,7 +1,7 @@
-//! SLEAP's analysis HDF5 (`sleap-convert --format analysis`): datasets `tracks` (tracks × 2 ×
-//! nodes × frames, floats, NaN where a node was not found; SLEAP stores its frames × nodes × 2
-//! × tracks array transposed), `track_names` and `node_names` (byte strings), the others
-//! (`track_occupancy`, scores, paths) unused. Read by content: the HDF5 signature.
+//! SLEAP's analysis HDF5 (what `sleap-convert` writes as its analysis format): datasets
+//! `tracks` (tracks × 2 × nodes × frames, floats, NaN where a node was not found; SLEAP stores
+//! its frames × nodes × 2 × tracks array transposed), `track_names` and `node_names` (byte
+//! strings), the others (`track_occupancy`, scores, paths) unused. Read by content: the HDF5 signature.
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -22,6 +22,11 @@ pub(crate) fn is_hdf5(bytes: &[u8]) -> bool {
 /// reader that follows names the problem).
 pub(crate) fn file_is_hdf5(path: &Path) -> bool {
     use std::io::Read;
+    // Only regular files: looking into a pipe or a FIFO would take its first bytes from the
+    // reader that follows.
+    if !path.is_file() {
+        return false;
+    }
     let mut head = [0u8; 8];
     std::fs::File::open(path)
         .and_then(|mut f| f.read_exact(&mut head))
@@ -65,7 +70,7 @@ fn guarded_shape(path: &Path, name: &str, ds: &hdf5_pure::Dataset) -> Result<Vec
 fn h5err(path: &Path, what: &str, e: impl std::fmt::Display) -> Error {
     Error::format(
         path,
-        format!("{what}: {e} (is this SLEAP's analysis HDF5, `sleap-convert --format analysis`?)"),
+        format!("{what}: {e} (is this SLEAP's analysis HDF5, as sleap-convert writes it?)"),
     )
 }
 

@@ -36,6 +36,20 @@ pub fn run(args: AnnotateArgs, g: Global) -> Result<()> {
     OutputKind::for_flag("-o", &args.output, &[OutputKind::Html])?;
     formation::io::check_output_dir("-o", &args.output)?;
     let ann = annotations::read(&args.annotations, &args.read.options())?;
+    // 3-D tracks are world positions, not pixels of the images, and the page saves 2-D birds.
+    if let Some(f) = ann
+        .frames
+        .iter()
+        .find(|f| f.birds.iter().any(|b| b.height.is_some()))
+    {
+        return Err(Error::format(
+            &args.annotations,
+            format!(
+                "frame {}: 3-D positions (with heights), which are not pixels of the images and which the page would drop on saving; review the 2-D tracks they were made from",
+                f.index
+            ),
+        ));
+    }
     let images = match source::open(&args.images) {
         Ok(source::Input::Images(files)) => files,
         Ok(source::Input::Video { .. }) => {
