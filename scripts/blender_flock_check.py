@@ -40,8 +40,10 @@ if len(meshes) != parts:
     failed.append("%d meshes, expected %d" % (len(meshes), parts))
 arm = arms[0]
 bones = arm.pose.bones
-if len(bones) != 8 * birds:
-    failed.append("%d bones, expected %d" % (len(bones), 8 * birds))
+# Each bird: its root and the rig's nine joints (body, neck, tail, four wing joints, two legs).
+BONES_PER_BIRD = 10
+if len(bones) != BONES_PER_BIRD * birds:
+    failed.append("%d bones, expected %d" % (len(bones), BONES_PER_BIRD * birds))
 for m in meshes:
     if not any(md.type == "ARMATURE" and md.object == arm for md in m.modifiers):
         failed.append("%s is not bound to the armature" % m.name)
