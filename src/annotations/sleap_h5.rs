@@ -137,16 +137,7 @@ pub(crate) fn parse(path: &Path, bytes: Vec<u8>, bodypart: Option<&str>) -> Resu
         (Some(b), Some(nodes)) => nodes
             .iter()
             .position(|n| n.eq_ignore_ascii_case(b))
-            .ok_or_else(|| {
-                Error::parameter(
-                    "read.bodypart",
-                    format!(
-                        "{}: no node \"{b}\"; its nodes are {}",
-                        path.display(),
-                        nodes.join(", ")
-                    ),
-                )
-            })?,
+            .ok_or_else(|| super::trackers::no_node(path, b, nodes))?,
         (Some(b), None) => {
             return Err(Error::parameter(
                 "read.bodypart",

@@ -95,6 +95,20 @@ fn num(path: &Path, at: &str, name: &str, s: &str) -> Result<Option<f64>> {
     }
 }
 
+/// `read.bodypart` naming a node the file of SLEAP's (CSV or HDF5) at `path` lacks, listing its
+/// nodes.
+pub(super) fn no_node<S: AsRef<str>>(path: &Path, b: &str, nodes: &[S]) -> Error {
+    let names: Vec<&str> = nodes.iter().map(AsRef::as_ref).collect();
+    Error::parameter(
+        "read.bodypart",
+        format!(
+            "{}: no node \"{b}\"; its nodes are {}",
+            path.display(),
+            names.join(", ")
+        ),
+    )
+}
+
 fn get<'a>(path: &Path, at: &str, row: &[&'a str], c: usize, name: &str) -> Result<&'a str> {
     row.get(c).copied().ok_or_else(|| {
         Error::format(
@@ -203,14 +217,7 @@ fn sleap(path: &Path, text: &str, bodypart: Option<&str>) -> Result<RawAnnotatio
             .ok_or_else(|| Error::format(path, "header: no NODE.x column"))?,
         Some(b) => col(&format!("{}.x", b.to_ascii_lowercase())).ok_or_else(|| {
             let nodes: Vec<&str> = h.iter().filter_map(|c| c.strip_suffix(".x")).collect();
-            Error::parameter(
-                "read.bodypart",
-                format!(
-                    "{}: no node \"{b}\"; its nodes are {}",
-                    path.display(),
-                    nodes.join(", ")
-                ),
-            )
+            no_node(path, b, &nodes)
         })?,
     };
     let node = h[cx].trim_end_matches(".x").to_string();
