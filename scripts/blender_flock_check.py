@@ -1,6 +1,6 @@
 # Imports a large flock's .glb written with one skeleton for the flock (`--gltf-mode flock`, the
-# default from 200 birds) into Blender (headless) and checks what arrived: one armature holding
-# every bird's bones, one skinned mesh per part of the flock, the import's CPU time under a
+# default from 200 birds) into Blender (headless) and checks what arrived: one armature per part
+# of 64 birds holding its birds' bones, with the part's skinned mesh, the import's CPU time under a
 # budget, the birds where the CSV of the same animation puts them (10 frames, within 1 mm) and the
 # wings flapping. Prints a summary; exits 1 when a check fails.
 # Usage: blender -b --python scripts/blender_flock_check.py -- flock.glb flock.csv [BUDGET_S]
@@ -34,19 +34,25 @@ parts = math.ceil(birds / 64)
 print("IMPORT %d birds: %.1f s CPU, %d armature(s), %d meshes" % (birds, cpu, len(arms), len(meshes)))
 if cpu > budget:
     failed.append("import took %.1f s of CPU (budget %.0f s)" % (cpu, budget))
-if len(arms) != 1:
-    failed.append("%d armatures, expected 1" % len(arms))
+if len(arms) != parts:
+    failed.append("%d armatures, expected %d (one a part of 64 birds)" % (len(arms), parts))
 if len(meshes) != parts:
     failed.append("%d meshes, expected %d" % (len(meshes), parts))
-arm = arms[0]
-bones = arm.pose.bones
 # Each bird: its root and the rig's nine joints (body, neck, tail, four wing joints, two legs).
 BONES_PER_BIRD = 10
-if len(bones) != BONES_PER_BIRD * birds:
-    failed.append("%d bones, expected %d" % (len(bones), BONES_PER_BIRD * birds))
+nbones = sum(len(a.pose.bones) for a in arms)
+if nbones != BONES_PER_BIRD * birds:
+    failed.append("%d bones, expected %d" % (nbones, BONES_PER_BIRD * birds))
+# Every bone's armature, by name (bird_000, bird_000.upper_arm.L, ...).
+arm_of = {b.name: a for a in arms for b in a.pose.bones}
 for m in meshes:
-    if not any(md.type == "ARMATURE" and md.object == arm for md in m.modifiers):
-        failed.append("%s is not bound to the armature" % m.name)
+    bound = [md.object for md in m.modifiers if md.type == "ARMATURE" and md.object in arms]
+    if len(bound) != 1:
+        failed.append("%s is not bound to one of the armatures" % m.name)
+        break
+    # Its vertex groups are its part's bones: all of one armature.
+    if any(arm_of.get(g.name) is not bound[0] for g in m.vertex_groups):
+        failed.append("%s has vertex groups outside its armature" % m.name)
         break
 digits = len(str(birds - 1))
 name = lambda b: "bird_%0*d" % (digits, b)
@@ -67,7 +73,8 @@ worst, at = 0.0, None
 for f in sorted(picks):
     sc.frame_set(f)
     for b in range(birds):
-        got = (arm.matrix_world @ bones[name(b)].matrix).translation
+        arm = arm_of[name(b)]
+        got = (arm.matrix_world @ arm.pose.bones[name(b)].matrix).translation
         want = [v * wingspan for v in rows[(f, b)]]
         err = max(abs(got[i] - want[i]) for i in range(3))
         if err > worst:
@@ -84,7 +91,7 @@ first = sorted(meshes, key=lambda m: m.name)[0]
 spans = set()
 for f in range(mid, mid + fps + 1):
     sc.frame_set(f)
-    wing.add(round(bones[name(0) + ".upper_arm.L"].matrix.to_euler()[2], 4))
+    wing.add(round(arm_of[name(0)].pose.bones[name(0) + ".upper_arm.L"].matrix.to_euler()[2], 4))
     ev = first.evaluated_get(bpy.context.evaluated_depsgraph_get())
     zs = [v.co.z for v in ev.data.vertices[:400]]
     spans.add(round(max(zs) - min(zs), 4))

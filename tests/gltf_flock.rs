@@ -127,6 +127,27 @@ fn the_flock_as_one_skeleton_is_the_same_birds_as_one_skin_each() {
                 );
             }
         }
+        // The part's skeleton: a node of its own (one armature a part in Blender) holding
+        // exactly the part's birds, under the flock node.
+        let part = skin["skeleton"].as_u64().unwrap() as usize;
+        let part_node = &fj["nodes"][part];
+        assert_eq!(
+            part_node["name"],
+            format!("flock_{p:0width$}", width = bird_digits(parts)).as_str()
+        );
+        let roots: Vec<&Value> = (0..n).map(|i| &joints[per * i]).collect();
+        assert_eq!(
+            part_node["children"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .collect::<Vec<_>>(),
+            roots
+        );
+        assert!(fj["nodes"][node_index(&fj, "flock")]["children"]
+            .as_array()
+            .unwrap()
+            .contains(&Value::from(part)));
         let ibm = floats(&fj, &fb, &skin["inverseBindMatrices"]);
         assert_eq!(ibm.len(), 16 * per * n);
         for i in 0..n {

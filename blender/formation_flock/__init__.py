@@ -3,8 +3,8 @@
 A panel in the 3D view's sidebar (N, tab "Formation"): pick the footage's annotations or a
 params file, the number of birds, seconds of steady flight, species and seed, optionally a curve
 object as the leader's path, and press Generate. The flock appears as the collection
-"formation flock" (one armature and skinned bird per bird; from 200 birds one armature for the
-whole flock, which imports in a fraction of the time), the scene's frame rate and range are
+"formation flock" (one armature and skinned bird per bird; from 200 birds one armature and
+one mesh for every 64 birds, which imports in a fraction of the time), the scene's frame rate and range are
 set, and the flight plays at once. Generating again replaces the collection. Problems show as
 reports (one line), not tracebacks.
 """

@@ -146,8 +146,9 @@ pub struct SceneArgs {
     #[arg(long, value_name = "skel|instancer")]
     pub usd_mode: Option<formation::export::UsdMode>,
     /// How the .glb holds the birds: birds (one skin and mesh each: one armature per bird in
-    /// Blender) or flock (the whole flock as one skinned mesh on one skin: one armature, one draw
-    /// call, quick to import) [default: flock from 200 birds, birds below].
+    /// Blender) or flock (the birds in parts of 64, each one skinned mesh on one skin: one
+    /// armature and one draw call a part, quick to import) [default: flock from 200 birds, birds
+    /// below].
     #[arg(long, value_name = "birds|flock")]
     pub gltf_mode: Option<formation::export::GltfMode>,
     /// Indent the written .json for reading (it is one compact line by default).

@@ -66,9 +66,10 @@ pub struct SceneOptions {
     /// Spread of the birds' sizes, the F of [`bird::bird_scales`] (0 = every bird the same size,
     /// this struct's default; `render.size_variation` defaults to the species').
     pub size_variation: f64,
-    /// The whole flock as one skinned mesh on one skin (`render.gltf_mode` = flock): every
-    /// bird's joints in one skeleton, so a DCC makes one armature instead of one per bird (and a
-    /// viewer one draw call); `false` = one skin and mesh node per bird.
+    /// The flock in parts of [`FLOCK_PART`] birds (`render.gltf_mode` = flock), each part one
+    /// skinned mesh on one skin whose skeleton is the part's node, so a DCC makes one armature a
+    /// part instead of one per bird (and a viewer one draw call a part); `false` = one skin and
+    /// mesh node per bird.
     pub one_skin: bool,
 }
 
@@ -529,7 +530,7 @@ fn glb_parts(
             if j == bird::BODY && scale != 1.0 {
                 rest += bird::size_pivot(species, scale);
             }
-            // Joint names repeat from bird to bird; in one skeleton they carry the bird's name.
+            // Joint names repeat from bird to bird; in a part's skeleton they carry the bird's name.
             let joint_name = if opts.one_skin {
                 format!("bird_{bird:0digits$}.{}", bird::JOINTS[j])
             } else {
@@ -708,20 +709,39 @@ fn glb_parts(
             }
         }
     }
+    // With one skin a part, the part's birds hang from a node of their own (`flock_000`, …),
+    // the root of the part's skeleton.
+    let part_digits = bird_digits(anim.birds.div_ceil(FLOCK_PART));
+    let flock_children: Vec<_> = if opts.one_skin {
+        bird_nodes
+            .chunks(FLOCK_PART)
+            .enumerate()
+            .map(|(p, birds)| {
+                root.push(json::Node {
+                    name: Some(format!("flock_{p:0part_digits$}")),
+                    children: Some(birds.to_vec()),
+                    ..Default::default()
+                })
+            })
+            .collect()
+    } else {
+        bird_nodes
+    };
     let flock = root.push(json::Node {
         name: Some("flock".into()),
-        children: Some(bird_nodes),
+        children: Some(flock_children.clone()),
         ..Default::default()
     });
     if opts.one_skin {
         // The flock in parts of FLOCK_PART birds: each part one mesh holding its birds (each
-        // bird's copy of its model bound to its own joints) on one skin of their joints.
-        // All skins hang from the flock node, so a DCC makes one armature of them; parts keep
-        // each mesh's skin small (Blender's importer binds a mesh's vertices joint by joint).
+        // bird's copy of its model bound to its own joints) on one skin of their joints, whose
+        // skeleton is the part's node, so a DCC makes one armature a part. Parts keep each
+        // mesh's skin small (Blender's importer binds a mesh's vertices joint by joint) and
+        // each armature's action: Blender's importer looks up every new curve among the
+        // action's curves, and builds its scene graph slower the more bones an armature has
+        // (1000 birds: 67 s of CPU as one armature, 44 s as 16).
         let joints_per_bird = bird::JOINTS.len() + 1;
         let models = &assets;
-        let parts = anim.birds.div_ceil(FLOCK_PART);
-        let part_digits = bird_digits(parts);
         for (p, first) in (0..anim.birds).step_by(FLOCK_PART).enumerate() {
             let last = (first + FLOCK_PART).min(anim.birds);
             let name = format!("flock_{p:0part_digits$}");
@@ -739,7 +759,7 @@ fn glb_parts(
                 inverse_bind_matrices: Some(ibm),
                 joints: flock_joints[first * joints_per_bird..last * joints_per_bird].to_vec(),
                 name: Some(format!("{name}_skin")),
-                skeleton: Some(flock),
+                skeleton: Some(flock_children[p]),
             });
             mesh_nodes.push(root.push(json::Node {
                 name: Some(format!("{name}_mesh")),
@@ -1022,7 +1042,7 @@ fn one_primitive(m: &bird::SkinnedMesh) -> (Vec<usize>, Vec<[f32; 3]>, Vec<u32>)
     (order, colours, idx)
 }
 
-/// Birds per skinned mesh when the flock is one skeleton ([`SceneOptions::one_skin`]): 64 birds
+/// Birds per skinned mesh and skeleton in the flock mode ([`SceneOptions::one_skin`]): 64 birds
 /// are 640 joints (ten a bird with its root), within what real-time engines skin in one draw call.
 pub const FLOCK_PART: usize = 64;
 

@@ -136,7 +136,8 @@ pub struct RenderOptions {
     /// [`crowd::INSTANCER_FROM`] birds, skel below.
     pub usd_mode: Option<UsdMode>,
     /// How the `.glb` holds the birds: one skin and mesh per bird (`birds`) or the whole flock as
-    /// one skinned mesh on one skin (`flock`, which Blender imports as one armature); `None` =
+    /// skinned meshes of 64 birds, each on its own skeleton (`flock`, which Blender imports as
+    /// one armature a part); `None` =
     /// flock from [`crowd::INSTANCER_FROM`] birds, birds below.
     pub gltf_mode: Option<GltfMode>,
     /// Indent the written animation JSON (and the flown path) for reading; compact by default.
@@ -182,7 +183,8 @@ impl std::fmt::Display for UsdMode {
 pub enum GltfMode {
     /// One skin and one skinned mesh node per bird (one armature per bird in a DCC).
     Birds,
-    /// One skinned mesh and one skin for the whole flock (one armature, one draw call).
+    /// The flock in parts of 64 birds, each one skinned mesh on one skin (one armature and one
+    /// draw call a part).
     Flock,
 }
 
