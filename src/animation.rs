@@ -320,6 +320,31 @@ pub struct KeyBird {
     pub slot: Option<usize>,
 }
 
+/// The birds `birds` (indices into `f`'s arrays, in that order) of frame `f`; a missing index
+/// reads as 0.
+fn formation_frame(f: &Frame, birds: &[usize]) -> Frame {
+    let pick = |v: &Vec<f64>| -> Vec<f64> {
+        birds
+            .iter()
+            .map(|&b| v.get(b).copied().unwrap_or(0.0))
+            .collect()
+    };
+    let pick_opt = |v: &Option<Vec<f64>>| v.as_ref().map(pick);
+    Frame {
+        t: f.t,
+        x: pick(&f.x),
+        y: pick(&f.y),
+        z: pick(&f.z),
+        heading: pick(&f.heading),
+        speed: pick(&f.speed),
+        bank: pick_opt(&f.bank),
+        pitch: pick_opt(&f.pitch),
+        e: pick_opt(&f.e),
+        xi: pick_opt(&f.xi),
+        wing_phase: pick_opt(&f.wing_phase),
+    }
+}
+
 /// The state of every bird at one instant (world frame).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
 pub struct Frame {
@@ -1021,13 +1046,42 @@ impl Animation {
             return (k == 0).then(|| self.clone());
         };
         let fm = fs.get(k)?;
-        let pick = |v: &Vec<f64>| -> Vec<f64> {
-            fm.birds
-                .iter()
-                .map(|&b| v.get(b).copied().unwrap_or(0.0))
-                .collect()
+        let mut a = self.formation_shell(fm);
+        a.frames = self
+            .frames
+            .iter()
+            .map(|f| formation_frame(f, &fm.birds))
+            .collect();
+        Some(a)
+    }
+
+    /// Every formation alone, as [`Animation::formation`] gives them, taking the frames apart as
+    /// it goes (each frame of the flock is dropped once its formations have their shares), so a
+    /// flock's frames are never held twice. Empty when the record lists no formation.
+    pub fn into_formations(mut self) -> Vec<Animation> {
+        let Some(fs) = self.formations.take() else {
+            return vec![self];
         };
-        let pick_opt = |v: &Option<Vec<f64>>| v.as_ref().map(pick);
+        let frames = std::mem::take(&mut self.frames);
+        let mut out: Vec<Animation> = fs
+            .iter()
+            .map(|fm| {
+                let mut a = self.formation_shell(fm);
+                a.frames = Vec::with_capacity(frames.len());
+                a
+            })
+            .collect();
+        for f in frames {
+            for (a, fm) in out.iter_mut().zip(&fs) {
+                a.frames.push(formation_frame(&f, &fm.birds));
+            }
+        }
+        out
+    }
+
+    /// Formation `fm` of this flock without frames: its birds, key shapes and ranges, and the
+    /// flock's rate, species, stages and records.
+    fn formation_shell(&self, fm: &FormationRecord) -> Animation {
         let mut a = Animation::new(self.seed, self.fps, self.wingspan_m, fm.birds.len());
         a.species = self.species.clone();
         a.flight = self.flight;
@@ -1036,24 +1090,7 @@ impl Animation {
         a.stages = self.stages.clone();
         a.key_shapes = fm.key_shapes.clone();
         a.xi_ranges = fm.xi_ranges.clone();
-        a.frames = self
-            .frames
-            .iter()
-            .map(|f| Frame {
-                t: f.t,
-                x: pick(&f.x),
-                y: pick(&f.y),
-                z: pick(&f.z),
-                heading: pick(&f.heading),
-                speed: pick(&f.speed),
-                bank: pick_opt(&f.bank),
-                pitch: pick_opt(&f.pitch),
-                e: pick_opt(&f.e),
-                xi: pick_opt(&f.xi),
-                wing_phase: pick_opt(&f.wing_phase),
-            })
-            .collect();
-        Some(a)
+        a
     }
 
     /// Each formation's leader (one entry for a flock of one formation): the recorded leader, or

@@ -74,7 +74,30 @@ mod guarded_alloc {
 }
 
 fn main() -> ExitCode {
+    one_malloc_arena();
     ExitCode::from(run_main(std::env::args_os()))
+}
+
+/// glibc gives each thread that allocates an arena of its own, and memory freed in one arena is
+/// not reused by the others: the flight's threads made a 1000-bird run's resident memory 1.6
+/// times its heap (317 MB for 177 MB; 193 MB with one arena, no slower). One arena, unless the
+/// user chose otherwise with `MALLOC_ARENA_MAX`.
+fn one_malloc_arena() {
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    {
+        use std::ffi::c_int;
+        extern "C" {
+            fn mallopt(param: c_int, value: c_int) -> c_int;
+        }
+        /// glibc's `M_ARENA_MAX` (malloc.h).
+        const M_ARENA_MAX: c_int = -8;
+        if std::env::var_os("MALLOC_ARENA_MAX").is_none() {
+            // SAFETY: mallopt only sets an allocator parameter; called before any thread starts.
+            unsafe {
+                mallopt(M_ARENA_MAX, 1);
+            }
+        }
+    }
 }
 
 /// The whole binary for the arguments `args` (the first is the program's name), giving the exit

@@ -363,7 +363,7 @@ impl Pipeline {
         let (mut anim, initiate_report) = if config.initiation {
             initiate::check_steady(&steady, self.origin())?;
             let config = takeoff_config(config, path.as_ref())?;
-            let (anim, stats) = initiate_stage(&steady, &config, progress)?;
+            let (anim, stats) = initiate_stage(steady, &config, progress)?;
             (anim, Some(stats))
         } else {
             (steady, None)
@@ -802,7 +802,7 @@ pub enum SteadyOutcome {
 /// the seed's `initiate` stream. The flock size is the steady flight's. A steady flight of
 /// several formations takes off formation by formation ([`skein::initiate_flock`]).
 pub fn initiate_stage(
-    steady: &Animation,
+    steady: Animation,
     config: &Config,
     progress: &dyn Progress,
 ) -> Result<(Animation, InitiateStats)> {
@@ -838,7 +838,7 @@ pub fn initiate_stage(
         return Ok((anim, stats));
     }
     initiate::initiate(
-        steady,
+        &steady,
         &opts,
         &mut stream(config.seed, Stream::Initiate),
         progress,

@@ -171,7 +171,7 @@ proptest! {
         assert_animation_finite(&steady);
 
         // initiate → the combined animation, then wingbeats.
-        let mut anim = match initiate_stage(&steady, &config, &Silent) {
+        let mut anim = match initiate_stage(steady.clone(), &config, &Silent) {
             Ok((a, _)) => a,
             Err(Error::NotConverged(e)) => {
                 eprintln!("initiation did not converge: {e}");

@@ -456,3 +456,26 @@ fn a_take_off_that_never_converges_is_flown_again_then_reported() {
         .iter()
         .all(|f| (1..=formation::skein::TAKEOFF_TRIES).contains(&f.takeoff_tries)));
 }
+
+#[test]
+fn a_flock_taken_apart_gives_each_formation_as_it_reads_alone() {
+    // `into_formations` (which consumes the flock frame by frame, so a flock's take-off from a
+    // steady file never holds its frames twice) gives exactly what `formation(k)` copies out.
+    let mut c = config(200, 0, 2.0);
+    c.initiation = false;
+    let (a, _) = Pipeline::from_path(example("barnacle_geese_v.json"))
+        .run(&c)
+        .unwrap();
+    let k = a.formation_count();
+    assert!(k > 1, "{k} formations");
+    let each: Vec<_> = (0..k).map(|f| a.formation(f).unwrap()).collect();
+    let apart = a.clone().into_formations();
+    assert_eq!(apart.len(), k);
+    for (f, (x, y)) in each.iter().zip(&apart).enumerate() {
+        assert_eq!(x, y, "formation {f}");
+        assert!(!x.frames.is_empty());
+    }
+    // A flock of one formation is itself.
+    let one = each[0].clone();
+    assert_eq!(one.clone().into_formations(), vec![one]);
+}

@@ -319,7 +319,7 @@ pub fn run(args: InitiateArgs, g: Global) -> Result<()> {
             initiate: opts,
             ..Default::default()
         };
-        formation::pipeline::initiate_stage(&steady, &config, &progress)?
+        formation::pipeline::initiate_stage(steady, &config, &progress)?
     } else {
         initiate::initiate(&steady, &opts, &mut rng, &progress)?
     };

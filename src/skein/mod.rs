@@ -246,19 +246,19 @@ pub fn fly(
 /// §6 take-off of a flock of several formations whose steady flight is `steady` (a file written
 /// by `steady` or [`fly`] without take-off): every formation takes off into its own first key
 /// shape and the formations are arranged anew around the finished motion.
+/// The steady flight is taken apart into its formations as it is read (never held twice).
 pub fn initiate_flock(
-    steady: &Animation,
+    steady: Animation,
     o: &FlockOptions,
     progress: &dyn Progress,
 ) -> Result<(Animation, SkeinReport)> {
     let k = steady.formation_count();
-    let mut anims = Vec::with_capacity(k);
+    let anims = steady.into_formations();
+    if anims.len() != k {
+        return Err(Error::Internal(format!("no formation {}", anims.len())));
+    }
     let mut reports = Vec::with_capacity(k);
-    for f in 0..k {
-        let a = steady
-            .formation(f)
-            .ok_or_else(|| Error::Internal(format!("no formation {f}")))?;
-        anims.push(a);
+    for _ in 0..k {
         reports.push(FormationReport {
             placement: Placement::default(),
             drift: None,

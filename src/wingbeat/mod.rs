@@ -349,32 +349,32 @@ fn draw_birds(seed: u64, birds: usize, opts: &WingbeatOptions) -> (Vec<BirdBeats
     (out, rngs)
 }
 
-/// Effort of every bird at every frame (frame-major): forward acceleration (m/s², from the speed
-/// change over ±0.25 s) over the species' reference, clamped into [−1, 1].
-fn efforts(anim: &Animation, preset: &SpeciesPreset) -> Vec<f64> {
+/// Effort of every bird at frame `k`, into `out` (one value a bird): forward acceleration
+/// (m/s², from the speed change over ±0.25 s) over the species' reference, clamped into
+/// [−1, 1]; 0 where the frames give no time step. One frame at a time, so no table of the whole
+/// animation is held.
+fn efforts_at(anim: &Animation, preset: &SpeciesPreset, k: usize, out: &mut Vec<f64>) {
     let n = anim.birds;
     let nf = anim.frames.len();
     let half = ((ACCEL_WINDOW_S * anim.fps).round() as usize).max(1);
-    let mut out = vec![0.0; n * nf];
-    for k in 0..nf {
-        let kp = k.saturating_sub(half);
-        let kn = (k + half).min(nf.saturating_sub(1));
-        let (Some(fp), Some(fnx)) = (anim.frames.get(kp), anim.frames.get(kn)) else {
-            continue;
-        };
-        let dt = fnx.t - fp.t;
-        if dt.is_nan() || dt <= 1e-9 {
-            continue;
-        }
-        for i in 0..n {
-            let v0 = fp.speed.get(i).copied().unwrap_or(0.0);
-            let v1 = fnx.speed.get(i).copied().unwrap_or(0.0);
-            let accel = (v1 - v0) / dt * anim.wingspan_m;
-            let e = (accel / preset.accel_ref_mps2).clamp(-1.0, 1.0);
-            out[k * n + i] = if e.is_finite() { e } else { 0.0 };
-        }
+    out.clear();
+    out.resize(n, 0.0);
+    let kp = k.saturating_sub(half);
+    let kn = (k + half).min(nf.saturating_sub(1));
+    let (Some(fp), Some(fnx)) = (anim.frames.get(kp), anim.frames.get(kn)) else {
+        return;
+    };
+    let dt = fnx.t - fp.t;
+    if dt.is_nan() || dt <= 1e-9 {
+        return;
     }
-    out
+    for (i, o) in out.iter_mut().enumerate() {
+        let v0 = fp.speed.get(i).copied().unwrap_or(0.0);
+        let v1 = fnx.speed.get(i).copied().unwrap_or(0.0);
+        let accel = (v1 - v0) / dt * anim.wingspan_m;
+        let e = (accel / preset.accel_ref_mps2).clamp(-1.0, 1.0);
+        *o = if e.is_finite() { e } else { 0.0 };
+    }
 }
 
 /// The bird ahead of bird `i` in `frame` and the streamwise distance to it (wingspans, along
@@ -494,15 +494,17 @@ struct Run {
     /// Unwrapped phase per frame and bird (frame-major), radians.
     unwrapped: Vec<f64>,
     /// Fold weight per frame and bird (frame-major; empty: never at rest), see [`rest`].
-    fold: Vec<f64>,
+    fold: sparse::FrameTable<f64>,
 }
 
-/// Integrates every bird's phase through the animation (what [`assign_phases`] stores).
-fn simulate(anim: &Animation, opts: &WingbeatOptions) -> Run {
+/// Integrates every bird's phase through the animation (what [`assign_phases`] stores). The
+/// unwrapped phases are kept only when `unwrapped` is asked for (the renderers' wingbeats; a
+/// looping animation computes them anyway): [`assign_phases`] stores only the wrapped ones.
+fn simulate(anim: &Animation, opts: &WingbeatOptions, keep_unwrapped: bool) -> Run {
     let n = anim.birds;
     let nf = anim.frames.len();
     let preset = opts.species.preset();
-    let eff = efforts(anim, &preset);
+    let mut eff = Vec::with_capacity(n);
     let fold = rest::fold_weights(anim);
     let (mut birds, mut rngs) = draw_birds(anim.seed, n, opts);
     let mut phi: Vec<f64> = birds.iter().map(|b| b.phase0).collect();
@@ -512,13 +514,21 @@ fn simulate(anim: &Animation, opts: &WingbeatOptions) -> Run {
     let mut last_rate = vec![0.0; n];
     let mut anti = vec![false; n];
     let mut phase = vec![0.0; n * nf];
-    let mut unwrapped = vec![0.0; n * nf];
+    let keep_unwrapped = keep_unwrapped || (anim.looped && nf > 1);
+    let mut unwrapped = if keep_unwrapped {
+        vec![0.0; n * nf]
+    } else {
+        Vec::new()
+    };
     for k in 0..nf {
+        efforts_at(anim, &preset, k, &mut eff);
         for i in 0..n {
             let s = TAU * cycles[i] as f64 + phi[i];
             phase[k * n + i] = phi[i];
-            unwrapped[k * n + i] = s;
-            birds[i].ensure(s, eff[k * n + i], &mut rngs[i], opts.glide, opts.variation);
+            if keep_unwrapped {
+                unwrapped[k * n + i] = s;
+            }
+            birds[i].ensure(s, eff[i], &mut rngs[i], opts.glide, opts.variation);
             own[i] = birds[i].freq_at(s);
         }
         if k == 0 {
@@ -555,7 +565,7 @@ fn simulate(anim: &Animation, opts: &WingbeatOptions) -> Run {
             // A bird at rest holds its phase (no wingbeat below the rest speed; the wings fold
             // from the pose they stopped in).
             for i in 0..n {
-                if fold[k * n + i] >= 1.0 || rest::at_rest(anim, k, i) {
+                if fold.get(k * n + i).unwrap_or(0.0) >= 1.0 || rest::at_rest(anim, k, i) {
                     rate[i] = 0.0;
                 }
             }
@@ -660,7 +670,7 @@ fn replay_phases(
     let n = anim.birds;
     let nf = anim.frames.len();
     let preset = opts.species.preset();
-    let eff = efforts(anim, &preset);
+    let mut eff = Vec::with_capacity(n);
     let (mut birds, mut rngs) = draw_birds(anim.seed, n, opts);
     let wrapped = |k: usize, i: usize| {
         let raw = stored(k, i);
@@ -684,6 +694,7 @@ fn replay_phases(
     let mut phase = vec![0.0; n * nf];
     let mut unwrapped = vec![0.0; n * nf];
     for k in 0..nf {
+        efforts_at(anim, &preset, k, &mut eff);
         for i in 0..n {
             let p = wrapped(k, i);
             if k > 0 && p < prev[i] {
@@ -693,7 +704,7 @@ fn replay_phases(
             let s = TAU * cycles[i] as f64 + p;
             phase[k * n + i] = p;
             unwrapped[k * n + i] = s;
-            birds[i].ensure(s, eff[k * n + i], &mut rngs[i], opts.glide, opts.variation);
+            birds[i].ensure(s, eff[i], &mut rngs[i], opts.glide, opts.variation);
         }
     }
     Run {
@@ -721,10 +732,17 @@ fn replay_phases(
 pub fn assign_phases(anim: &mut Animation, opts: &WingbeatOptions) -> Result<()> {
     opts.validate()?;
     anim.validate(Path::new("<animation>"))?;
-    let run = simulate(anim, opts);
+    let run = simulate(anim, opts, false);
     let n = anim.birds;
-    for (k, frame) in anim.frames.iter_mut().enumerate() {
-        frame.wing_phase = Some(run.phase[k * n..(k + 1) * n].to_vec());
+    drop(run.birds);
+    drop(run.fold);
+    // Frame by frame from the last, each row moved out and the table shrunk behind it, so the
+    // phases are never held twice.
+    let mut phase = run.phase;
+    for (k, frame) in anim.frames.iter_mut().enumerate().rev() {
+        let row = phase.split_off((k * n).min(phase.len()));
+        phase.shrink_to_fit();
+        frame.wing_phase = Some(row);
     }
     anim.species = Some(opts.species.name().to_string());
     anim.wingbeat = Some(opts.clone());
@@ -777,7 +795,7 @@ impl Flapper {
         let run = if stored {
             replay(anim, opts)
         } else {
-            simulate(anim, opts)
+            simulate(anim, opts, true)
         };
         let frames = &anim.frames;
         let ground = if run.fold.is_empty() {
@@ -805,7 +823,7 @@ impl Flapper {
             phase: run.phase,
             unwrapped: run.unwrapped,
             ground,
-            fold: table(run.fold),
+            fold: run.fold,
             flare: table(rest::flare_weights(anim)),
             legs: table(rest::leg_angles(anim, opts.species)),
             nbirds: n,

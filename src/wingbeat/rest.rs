@@ -9,6 +9,7 @@
 
 use crate::animation::Animation;
 
+use super::sparse::FrameTable;
 use super::{Species, WingPose};
 
 /// Below this ground speed, metres per second, a bird on the ground is at rest.
@@ -365,47 +366,54 @@ pub fn at_rest(anim: &Animation, k: usize, i: usize) -> bool {
 
 /// Fold weight of every bird in every frame (frame-major): 1 at rest (folded, phase held), 0 in
 /// the wingbeat, a smoothstep between while the wings unfold or fold. Empty when no bird is ever
-/// at rest (the common case of a flight that starts in the air), so callers can skip the blend.
-pub fn fold_weights(anim: &Animation) -> Vec<f64> {
+/// at rest (the common case of a flight that starts in the air), so callers can skip the blend;
+/// otherwise only the frames where some bird's wings are not spread are stored.
+pub fn fold_weights(anim: &Animation) -> FrameTable<f64> {
     let n = anim.birds;
     let nf = anim.frames.len();
     if !(anim.wingspan_m.is_finite() && anim.wingspan_m > 0.0) {
-        return Vec::new();
+        return FrameTable::default();
     }
     let rest: Vec<bool> = (0..nf)
         .flat_map(|k| (0..n).map(move |i| (k, i)))
         .map(|(k, i)| at_rest(anim, k, i))
         .collect();
     if !rest.iter().any(|&r| r) {
-        return Vec::new();
+        return FrameTable::default();
     }
     let smooth = |x: f64| {
         let x = x.clamp(0.0, 1.0);
         x * x * (3.0 - 2.0 * x)
     };
-    let mut out = vec![0.0; n * nf];
-    for i in 0..n {
-        // Time of the last change between rest and motion, and the weight then.
-        let mut since = f64::NEG_INFINITY;
-        let mut from = if rest[i] { 1.0 } else { 0.0 };
-        let mut was = rest[i];
-        for k in 0..nf {
-            let t = anim.frames[k].t;
+    let mut out = FrameTable::new(n, 0.0);
+    // Per bird: the time of the last change between rest and motion, the weight then, whether
+    // it was at rest, and its weight at the previous frame.
+    let mut since = vec![f64::NEG_INFINITY; n];
+    let mut from: Vec<f64> = rest[..n]
+        .iter()
+        .map(|&r| if r { 1.0 } else { 0.0 })
+        .collect();
+    let mut was = rest[..n].to_vec();
+    let mut row = vec![0.0; n];
+    for k in 0..nf {
+        let t = anim.frames[k].t;
+        for i in 0..n {
             let r = rest[k * n + i];
-            if r != was {
+            if r != was[i] {
                 // Start the new ramp from the weight reached so far (no jump mid-ramp).
-                from = out[k.saturating_sub(1) * n + i];
-                since = anim.frames[k.saturating_sub(1)].t;
-                was = r;
+                from[i] = row[i];
+                since[i] = anim.frames[k.saturating_sub(1)].t;
+                was[i] = r;
             }
             let target = if r { 1.0 } else { 0.0 };
-            let u = if since.is_finite() {
-                smooth((t - since) / UNFOLD_S)
+            let u = if since[i].is_finite() {
+                smooth((t - since[i]) / UNFOLD_S)
             } else {
                 1.0
             };
-            out[k * n + i] = from + (target - from) * u;
+            row[i] = from[i] + (target - from[i]) * u;
         }
+        out.push_row(&row);
     }
     out
 }
@@ -438,7 +446,8 @@ mod tests {
     fn a_resting_bird_is_folded_and_unfolds_smoothly_when_it_runs() {
         let mut v = vec![0.0; 30];
         v.extend((1..60).map(|k| 0.05 * k as f64));
-        let w = fold_weights(&anim(&v, 30.0));
+        let table = fold_weights(&anim(&v, 30.0));
+        let w: Vec<f64> = (0..v.len()).map(|k| table.get(k).unwrap()).collect();
         assert!(w[..30].iter().all(|&x| x == 1.0));
         // 0.5 m/s = 0.333 wingspans/s: frame 36 is the first in motion.
         assert!(w[36] < 1.0 && w[35] == 1.0, "{:?}", &w[30..40]);

@@ -78,6 +78,29 @@ impl<T: Copy + PartialEq> FrameTable<T> {
         }
     }
 
+    /// A table of no frames yet, `birds` a frame; frames are added with [`FrameTable::push_row`].
+    pub fn new(birds: usize, fill: T) -> FrameTable<T> {
+        FrameTable {
+            rows: Vec::new(),
+            data: Vec::new(),
+            birds,
+            fill,
+        }
+    }
+
+    /// Adds the next frame's values (one a bird), kept only if some bird differs from `fill`.
+    pub fn push_row(&mut self, row: &[T]) {
+        if self.birds > 0 && row.iter().any(|v| *v != self.fill) {
+            self.rows.push((self.data.len() / self.birds) as u32);
+            self.data.extend_from_slice(row);
+            // A short row (a malformed input) is padded.
+            self.data
+                .resize(self.data.len().div_ceil(self.birds) * self.birds, self.fill);
+        } else {
+            self.rows.push(NONE);
+        }
+    }
+
     /// Whether the table has no frames (the dense table was empty).
     pub fn is_empty(&self) -> bool {
         self.rows.is_empty()
