@@ -564,9 +564,9 @@ fn simulate(anim: &Animation, opts: &WingbeatOptions, keep_unwrapped: bool) -> R
         if !fold.is_empty() {
             // A bird at rest holds its phase (no wingbeat below the rest speed; the wings fold
             // from the pose they stopped in).
-            for i in 0..n {
+            for (i, r) in rate.iter_mut().enumerate() {
                 if fold.get(k * n + i).unwrap_or(0.0) >= 1.0 || rest::at_rest(anim, k, i) {
-                    rate[i] = 0.0;
+                    *r = 0.0;
                 }
             }
         }
