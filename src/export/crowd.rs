@@ -202,6 +202,8 @@ pub fn write_usda_instancer(
         }
     }
     let mean = sum / (n * birds).max(1) as f64;
+    // The wingbeats' tables are done with: not held beside the birds' flights below.
+    drop(flapper);
     let head = stage_head(
         anim,
         wingspan_m,
