@@ -191,7 +191,8 @@ fn camera_keeps_every_bird_inside_the_picture() {
         };
         let film = Film::with_options(&anim, 25.0, &opts);
         let margin = 0.07 * w.min(h) as f64;
-        for (k, (states, view)) in film.states.iter().zip(&film.views).enumerate() {
+        for (k, view) in film.views.iter().enumerate() {
+            let states = film.states(k);
             for (i, b) in states.iter().enumerate() {
                 let (px, py) = view.to_pixel(b.x, b.y, w, h);
                 let r = formation::export::silhouette::radius(film.species) * view.scale();

@@ -63,7 +63,8 @@ fn follow_camera_never_draws_birds_below_the_minimum_size() {
             let film = Film::with_options(&anim, 25.0, &opts);
             assert!(film.len() > 100);
             let mut in_view_lead = 0;
-            for (k, (v, st)) in film.views.iter().zip(&film.states).enumerate() {
+            for (k, v) in film.views.iter().enumerate() {
+                let st = film.states(k);
                 assert!(
                     v.scale() >= min - 1e-9,
                     "{birds} birds, min {min}: frame {k} draws {:.2} px per wingspan",
@@ -344,14 +345,14 @@ fn ground_camera_keeps_the_flock_in_the_picture_from_take_off_to_the_pass() {
     let film = Film::with_options(&anim, 25.0, &opts);
     let in_view = |k: usize| -> Vec<f64> {
         let v = &film.views[k];
-        film.states[k]
+        film.states(k)
             .iter()
             .filter_map(|b| v.project([b.x, b.y, b.z], 960, 540))
             .filter(|&(c, r, _)| (0.0..960.0).contains(&c) && (0.0..540.0).contains(&r))
             .map(|(_, _, s)| s)
             .collect()
     };
-    let birds = film.states[0].len();
+    let birds = film.states(0).len();
     let mut fewest = (birds, 0);
     let mut sizes = Vec::new();
     for k in 0..film.len() {

@@ -363,8 +363,8 @@ fn the_cameras_frame_the_flock_at_any_heading() {
                 ..RenderOptions::default()
             };
             let film = Film::with_options(&a, 5.0, &opts);
-            film.states
-                .iter()
+            (0..film.len())
+                .map(|k| film.states(k))
                 .zip(&film.views)
                 .map(|(st, view)| {
                     st.iter()

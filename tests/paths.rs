@@ -512,7 +512,8 @@ fn the_pictures_and_the_gltf_of_a_loop_close_the_cycle() {
         .unwrap();
     // Pictures: drawn in the flock's moving frame, the last picture leads into the first.
     let film = formation::export::pictures::Film::new(&a, 25.0, 320, 180);
-    let n = film.states.len();
+    let n = film.len();
+    let states: Vec<_> = (0..n).map(|k| film.states(k)).collect();
     assert_eq!(n, 300, "12 s at 25 fps");
     let step = |p: &[formation::export::sample::BirdState],
                 q: &[formation::export::sample::BirdState]| {
@@ -521,12 +522,11 @@ fn the_pictures_and_the_gltf_of_a_loop_close_the_cycle() {
             .map(|(a, b)| dist([a.x, a.y, a.z], [b.x, b.y, b.z]))
             .fold(0.0, f64::max)
     };
-    let inside = film
-        .states
+    let inside = states
         .windows(2)
         .map(|w| step(&w[0], &w[1]))
         .fold(0.0, f64::max);
-    let wrap_step = step(&film.states[n - 1], &film.states[0]);
+    let wrap_step = step(&states[n - 1], &states[0]);
     assert!(wrap_step <= inside + 1e-9, "wrap {wrap_step} vs {inside}");
     // glTF: the clip ends on a closing key one frame after the last, the first frame moved by
     // the flock's travel.
@@ -556,7 +556,8 @@ fn the_camera_follows_a_flock_turning_at_any_heading() {
     let (w, h) = (480, 270);
     let film = formation::export::pictures::Film::new(&a, 5.0, w, h);
     let lead = a.leaders()[0];
-    for (k, (st, view)) in film.states.iter().zip(&film.views).enumerate() {
+    for (k, view) in film.views.iter().enumerate() {
+        let st = film.states(k);
         let b = &st[lead];
         let (px, py, _) = view.project([b.x, b.y, b.z], w, h).unwrap();
         assert!(

@@ -407,7 +407,8 @@ fn the_follow_camera_frames_the_whole_sky_of_formations() {
     };
     let film = Film::with_options(&a, 25.0, &opts);
     assert!(film.len() > 50);
-    for (k, (v, st)) in film.views.iter().zip(&film.states).enumerate() {
+    for (k, v) in film.views.iter().enumerate() {
+        let st = film.states(k);
         assert!(
             v.scale() >= 3.0 - 1e-9,
             "frame {k}: {} px per wingspan",

@@ -36,7 +36,7 @@
 //! F = \frac{h/2}{\tan(\text{fov}/2)}
 //! ```
 
-use super::sample::BirdState;
+use super::sample::Place;
 use crate::error::{Error, Result};
 
 /// Smallest on-screen wingspan, pixels, down to which the follow camera shows the whole of a
@@ -357,10 +357,10 @@ fn smooth(v: &[f64], kernel: &[f64], cyclic: bool) -> Vec<f64> {
         .collect()
 }
 
-/// The camera path for the sampled frames `states` (one `Vec<BirdState>` per output frame) at
+/// The camera path for the sampled frames `states` (one `Vec<Place>` per output frame) at
 /// `fps`, for a `width × height` image.
 pub fn track(
-    states: &[Vec<BirdState>],
+    states: &[Vec<Place>],
     fps: f64,
     width: usize,
     height: usize,
@@ -404,7 +404,7 @@ const GROUND_FILL: f64 = 0.7;
 /// Where the ground observer stands: `distance` to the right of the flock's course at the pass
 /// time (its centre then, across its mean heading), its eye [`EYE_HEIGHT`] above the lowest
 /// point any bird reaches in `states`.
-pub fn ground_position(states: &[Vec<BirdState>], g: &GroundParams) -> [f64; 3] {
+pub fn ground_position(states: &[Vec<Place>], g: &GroundParams) -> [f64; 3] {
     let k = ((states.len() - 1) as f64 * g.pass_at.clamp(0.0, 1.0)).round() as usize;
     let s = &states[k];
     let m = s.len().max(1) as f64;
@@ -438,7 +438,7 @@ pub fn ground_position(states: &[Vec<BirdState>], g: &GroundParams) -> [f64; 3] 
 /// (a maximum filter, then a Gaussian in log tan(fov/2)), so the flock is never cut off by the
 /// zoom; the elevation is capped at [`GROUND_MAX_ELEVATION_DEG`].
 fn ground(
-    states: &[Vec<BirdState>],
+    states: &[Vec<Place>],
     fps: f64,
     width: usize,
     height: usize,
@@ -540,7 +540,7 @@ fn ground(
 const ZOOM_SMOOTHING_S: f64 = 2.0;
 
 fn follow(
-    states: &[Vec<BirdState>],
+    states: &[Vec<Place>],
     fps: f64,
     width: usize,
     height: usize,
@@ -630,7 +630,7 @@ fn follow(
 /// Centre of a view of half-extents `(ax, ay)` wingspans that holds the leading bird (the one
 /// farthest along the flock's mean heading) and as much of the flock behind it as fits: the box
 /// of the birds within reach of the leader, shifted so that the leader stays inside.
-fn lead_centre(s: &[BirdState], ax: f64, ay: f64) -> (f64, f64) {
+fn lead_centre(s: &[Place], ax: f64, ay: f64) -> (f64, f64) {
     let (hs, hc) = s.iter().fold((0.0, 0.0), |(a, b), q| {
         (a + q.heading.sin(), b + q.heading.cos())
     });
@@ -717,7 +717,7 @@ mod tests {
 
     #[test]
     fn fixed_view_shows_the_given_rectangle() {
-        let states = vec![vec![BirdState::default()]; 3];
+        let states = vec![vec![Place::default()]; 3];
         let p = CameraParams {
             kind: CameraKind::Fixed([-10.0, 0.0, 30.0, 20.0]),
             ..CameraParams::default()
@@ -738,12 +738,12 @@ mod tests {
         // One lap of a circle of radius 60 wingspans in 200 frames, a flock that breathes in
         // width: the smoothed views of a cycle must wrap like any other step.
         let n = 200;
-        let states: Vec<Vec<BirdState>> = (0..n)
+        let states: Vec<Vec<Place>> = (0..n)
             .map(|k| {
                 let a = 2.0 * std::f64::consts::PI * k as f64 / n as f64;
                 let spread = 3.0 + 2.0 * (3.0 * a).sin();
                 (0..5)
-                    .map(|b| BirdState {
+                    .map(|b| Place {
                         x: 60.0 * a.cos() + b as f64 * spread,
                         y: 60.0 * a.sin() - b as f64,
                         ..Default::default()
@@ -795,7 +795,7 @@ mod tests {
             let spread = if (40..60).contains(&k) { 30.0 } else { 3.0 };
             states.push(
                 (0..5)
-                    .map(|b| BirdState {
+                    .map(|b| Place {
                         x: b as f64 * spread,
                         y: k as f64 * 0.5 - b as f64,
                         ..Default::default()
@@ -818,10 +818,10 @@ mod tests {
     #[test]
     fn a_spread_flock_is_never_drawn_below_the_minimum_and_the_leader_stays_in_view() {
         // A line of 60 birds 200 wingspans long flying north: fitting it would need ~2 px.
-        let states: Vec<Vec<BirdState>> = (0..100)
+        let states: Vec<Vec<Place>> = (0..100)
             .map(|k| {
                 (0..60)
-                    .map(|b| BirdState {
+                    .map(|b| Place {
                         x: (b % 2) as f64 * 3.0,
                         y: k as f64 * 0.5 - b as f64 * 3.4,
                         ..Default::default()
@@ -858,7 +858,7 @@ mod tests {
                     p.0 += rng.random_range(-1.0..1.0);
                     p.1 += rng.random_range(-0.5..2.0);
                 }
-                states.push(pos.iter().map(|&(x, y)| BirdState { x, y, ..Default::default() }).collect::<Vec<_>>());
+                states.push(pos.iter().map(|&(x, y)| Place { x, y, ..Default::default() }).collect::<Vec<_>>());
             }
             let views = track(&states, 25.0, w, h, &fit_all());
             let m = 0.07 * w.min(h) as f64;

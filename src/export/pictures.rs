@@ -41,7 +41,7 @@ use super::camera::{self, CameraParams, View};
 use super::lzw::Lzw;
 use super::palette::{Lookup, Palette, TRANSPARENT};
 use super::raster::{Canvas, Mask};
-use super::sample::{self, BirdState};
+use super::sample::{self, BirdState, Place};
 use super::scene::{self, Backdrop, Background, SkyCache, Style};
 use super::RenderOptions;
 use crate::animation::Animation;
@@ -53,8 +53,10 @@ use crate::wingbeat::{Flapper, Species};
 /// Default frame rate of GIF output, frames per second (a whole number of 1/100 s per frame).
 pub const GIF_FPS: f64 = 25.0;
 
-/// Everything needed to draw any frame of one image output.
-pub struct Film {
+/// Everything needed to draw any frame of one image output. The birds of a frame are sampled
+/// from the animation when the frame is drawn ([`Film::states`]), so a film holds its camera
+/// and the wingbeats, not a copy of the flock at every picture frame.
+pub struct Film<'a> {
     /// Image width, pixels.
     pub width: usize,
     /// Image height, pixels.
@@ -63,8 +65,13 @@ pub struct Film {
     pub fps: f64,
     /// Time of each output frame, seconds.
     pub times: Vec<f64>,
-    /// Birds at each output frame.
-    pub states: Vec<Vec<BirdState>>,
+    /// The animation the birds are sampled from.
+    anim: &'a Animation,
+    /// Its wingbeats.
+    flapper: Flapper,
+    /// A loop drawn in the flock's moving frame: the flock's travel taken off (see
+    /// [`loop_travel`]).
+    travel: Option<LoopTravel>,
     /// Camera at each output frame.
     pub views: Vec<View>,
     /// The birds' species (silhouette and plumage).
@@ -78,9 +85,9 @@ pub struct Film {
     looped: bool,
 }
 
-impl Film {
+impl<'a> Film<'a> {
     /// Samples `anim` at `fps` and plans the default camera for a `width × height` picture.
-    pub fn new(anim: &Animation, fps: f64, width: usize, height: usize) -> Film {
+    pub fn new(anim: &'a Animation, fps: f64, width: usize, height: usize) -> Film<'a> {
         let opts = RenderOptions {
             width: width as u32,
             height: height as u32,
@@ -91,15 +98,23 @@ impl Film {
 
     /// Samples `anim` at `fps` and plans the camera, background and look of `opts` (its
     /// `width × height`; its other fields are assumed checked by [`RenderOptions::validate`]).
-    pub fn with_options(anim: &Animation, fps: f64, opts: &RenderOptions) -> Film {
+    pub fn with_options(anim: &'a Animation, fps: f64, opts: &RenderOptions) -> Film<'a> {
         let (width, height) = (opts.width as usize, opts.height as usize);
-        let flapper = Flapper::from_animation(anim);
         let times = sample::output_times(anim, fps);
-        let mut states: Vec<Vec<BirdState>> = times
-            .iter()
-            .map(|&t| sample::state_at(anim, &flapper, t))
-            .collect();
-        loop_frame(anim, &times, &mut states);
+        let travel = loop_travel(anim);
+        // The camera plans from the birds' places at every picture frame (a quarter of their
+        // whole states, and only while it plans).
+        let mut places: Vec<Vec<Place>> =
+            times.iter().map(|&t| sample::places_at(anim, t)).collect();
+        if let Some(lt) = &travel {
+            for (&t, st) in times.iter().zip(places.iter_mut()) {
+                let (dx, dy) = lt.at(t);
+                for b in st.iter_mut() {
+                    b.x -= dx;
+                    b.y -= dy;
+                }
+            }
+        }
         let species = anim
             .species
             .as_deref()
@@ -112,7 +127,9 @@ impl Film {
             cyclic: anim.looped,
             ..CameraParams::default()
         };
-        let views = camera::track(&states, fps, width, height, &params);
+        let views = camera::track(&places, fps, width, height, &params);
+        drop(places);
+        let flapper = Flapper::from_animation(anim);
         let style = Style {
             sun: opts.sun,
             ..Style::default()
@@ -122,7 +139,9 @@ impl Film {
             height,
             fps,
             times,
-            states,
+            anim,
+            flapper,
+            travel,
             views,
             species,
             backdrop: Backdrop::new(width, height, &style, opts.background, anim.seed),
@@ -130,6 +149,22 @@ impl Film {
             gif_tolerance: opts.gif_tolerance.round().clamp(0.0, 255.0) as i32,
             looped: anim.looped,
         }
+    }
+
+    /// The birds at frame `k` (empty past the end).
+    pub fn states(&self, k: usize) -> Vec<BirdState> {
+        let Some(&t) = self.times.get(k) else {
+            return Vec::new();
+        };
+        let mut st = sample::state_at(self.anim, &self.flapper, t);
+        if let Some(lt) = &self.travel {
+            let (dx, dy) = lt.at(t);
+            for b in st.iter_mut() {
+                b.x -= dx;
+                b.y -= dy;
+            }
+        }
+        st
     }
 
     /// Number of frames.
@@ -163,7 +198,7 @@ impl Film {
         } else {
             self.backdrop.paint(&self.views[k], canvas);
         }
-        scene::draw_birds(canvas, &self.states[k], &self.views[k], self.species, mask);
+        scene::draw_birds(canvas, &self.states(k), &self.views[k], self.species, mask);
     }
 
     /// The GIF palette: NeuQuant over pixels of up to 9 frames spread over the film (every
@@ -201,26 +236,41 @@ impl Film {
 /// every bird, so the camera, the sky and the birds of the last picture lead into the first
 /// without a jump (the flock holds its place in a still sky). On a closed path the loop is in
 /// the world and is drawn as it is.
-fn loop_frame(anim: &Animation, times: &[f64], states: &mut [Vec<BirdState>]) {
+struct LoopTravel {
+    /// Time of the loop's first frame, seconds.
+    start: f64,
+    /// The loop's duration, seconds.
+    period: f64,
+    /// The flock's travel over one loop, wingspans east and north.
+    dx: f64,
+    dy: f64,
+}
+
+impl LoopTravel {
+    /// The travel taken off at time `t`, wingspans east and north.
+    fn at(&self, t: f64) -> (f64, f64) {
+        let u = (t - self.start) / self.period;
+        (u * self.dx, u * self.dy)
+    }
+}
+
+/// The travel [`LoopTravel`] of `anim`, `None` when it is not a loop in the flock's frame.
+fn loop_travel(anim: &Animation) -> Option<LoopTravel> {
     if !anim.looped || anim.path.as_ref().is_some_and(|p| p.closed) {
-        return;
+        return None;
     }
     let closed = super::gltf::closed_loop(anim);
-    let (Some(first), Some(close)) = (anim.frames.first(), closed.frames.last()) else {
-        return;
-    };
+    let (first, close) = (anim.frames.first()?, closed.frames.last()?);
     let period = close.t - first.t;
     if !(period > 0.0) || closed.frames.len() == anim.frames.len() {
-        return;
+        return None;
     }
-    let (dx, dy) = (close.x[0] - first.x[0], close.y[0] - first.y[0]);
-    for (t, st) in times.iter().zip(states.iter_mut()) {
-        let u = (t - first.t) / period;
-        for b in st.iter_mut() {
-            b.x -= u * dx;
-            b.y -= u * dy;
-        }
-    }
+    Some(LoopTravel {
+        start: first.t,
+        period,
+        dx: close.x[0] - first.x[0],
+        dy: close.y[0] - first.y[0],
+    })
 }
 
 /// Number of worker threads to use when `requested` is 0 (automatic).

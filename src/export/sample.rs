@@ -5,7 +5,7 @@
 use std::f64::consts::{PI, TAU};
 use std::path::Path;
 
-use crate::animation::Animation;
+use crate::animation::{Animation, Frame};
 use crate::error::{Error, Result};
 use crate::wingbeat::{Flapper, WingPose};
 
@@ -26,6 +26,20 @@ pub struct BirdState {
     pub pitch: f64,
     /// Wing joint angles.
     pub pose: WingPose,
+}
+
+/// Where one bird is and which way it heads at one instant: what the camera plans from (a
+/// quarter of a [`BirdState`], so a whole film's places are cheap to hold).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Place {
+    /// East, wingspans.
+    pub x: f64,
+    /// North, wingspans.
+    pub y: f64,
+    /// Up, wingspans.
+    pub z: f64,
+    /// Heading, radians clockwise from north.
+    pub heading: f64,
 }
 
 /// Checks that frame times strictly increase (every resampling and the glTF time keys need it).
@@ -108,18 +122,13 @@ pub fn state_at(anim: &Animation, flapper: &Flapper, t: f64) -> Vec<BirdState> {
     let (fa, fb) = (&anim.frames[i], &anim.frames[j]);
     (0..anim.birds)
         .map(|b| {
-            let g = |va: &Vec<f64>, vb: &Vec<f64>| {
-                let a = va.get(b).copied().unwrap_or(0.0);
-                let c = vb.get(b).copied().unwrap_or(a);
-                a + (c - a) * w
-            };
-            let ha = fa.heading.get(b).copied().unwrap_or(0.0);
-            let hb = fb.heading.get(b).copied().unwrap_or(ha);
+            let Place { x, y, z, heading } = place_between(fa, fb, w, b);
+            let g = |va: &Vec<f64>, vb: &Vec<f64>| lerp_at(va, vb, w, b);
             BirdState {
-                x: g(&fa.x, &fb.x),
-                y: g(&fa.y, &fb.y),
-                z: g(&fa.z, &fb.z),
-                heading: ha + angle_diff(ha, hb) * w,
+                x,
+                y,
+                z,
+                heading,
                 bank: match (&fa.bank, &fb.bank) {
                     (Some(a), Some(c)) => g(a, c),
                     (Some(a), None) => a.get(b).copied().unwrap_or(0.0),
@@ -134,6 +143,38 @@ pub fn state_at(anim: &Animation, flapper: &Flapper, t: f64) -> Vec<BirdState> {
             }
         })
         .collect()
+}
+
+/// Every bird's place at time `t`: the position and heading of [`state_at`], without the
+/// wingbeats.
+pub fn places_at(anim: &Animation, t: f64) -> Vec<Place> {
+    let (i, w) = locate(anim, t);
+    let j = (i + 1).min(anim.frames.len().saturating_sub(1));
+    let (fa, fb) = (&anim.frames[i], &anim.frames[j]);
+    (0..anim.birds)
+        .map(|b| place_between(fa, fb, w, b))
+        .collect()
+}
+
+/// Bird `b`'s value of `va` (frame a) and `vb` (frame b) at fraction `w` between them; a value
+/// missing in frame b is frame a's, one missing in both 0.
+fn lerp_at(va: &[f64], vb: &[f64], w: f64, b: usize) -> f64 {
+    let a = va.get(b).copied().unwrap_or(0.0);
+    let c = vb.get(b).copied().unwrap_or(a);
+    a + (c - a) * w
+}
+
+/// Bird `b`'s place at fraction `w` from frame `fa` to frame `fb` (the heading the short way
+/// round).
+fn place_between(fa: &Frame, fb: &Frame, w: f64, b: usize) -> Place {
+    let ha = fa.heading.get(b).copied().unwrap_or(0.0);
+    let hb = fb.heading.get(b).copied().unwrap_or(ha);
+    Place {
+        x: lerp_at(&fa.x, &fb.x, w, b),
+        y: lerp_at(&fa.y, &fb.y, w, b),
+        z: lerp_at(&fa.z, &fb.z, w, b),
+        heading: ha + angle_diff(ha, hb) * w,
+    }
 }
 
 #[cfg(test)]

@@ -119,7 +119,7 @@ pub fn shoot(a: &Animation, opts: &RenderOptions, noise: f64) -> Shot {
         frames.push(g);
         let view = &film.views[k];
         truth.push(
-            film.states[k]
+            film.states(k)
                 .iter()
                 .filter_map(|b| view.project([b.x, b.y, b.z], w, h))
                 .map(|(x, y, _)| (x, y))
