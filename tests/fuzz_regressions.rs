@@ -161,3 +161,22 @@ fn a_bird_model_with_a_singular_bind_matrix_is_refused() {
     assert_eq!(e.exit_code(), 2);
     assert!(e.to_string().contains("cannot be inverted"), "{e}");
 }
+
+/// A bird model (bytes changed by the fuzzer) whose NORMAL accessor has fewer vectors than its
+/// POSITION accessor has vertices: building the bird indexed past the normals (a panic). Now the
+/// model is refused naming the mesh, the primitive and the counts.
+#[test]
+fn a_bird_model_with_fewer_normals_than_vertices_is_refused() {
+    let path = data("bird_model-crash-4e3181e8.glb");
+    let bytes = std::fs::read(&path).unwrap();
+    let e =
+        formation::export::bird_model::parse(&path, &bytes, formation::wingbeat::Species::Goose)
+            .unwrap_err();
+    assert_eq!(e.exit_code(), 2);
+    let msg = e.to_string();
+    assert!(
+        msg.contains("NORMAL has") && msg.contains("vertices"),
+        "{msg}"
+    );
+    assert_eq!(msg.lines().count(), 1, "{msg}");
+}

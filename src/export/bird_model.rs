@@ -583,6 +583,12 @@ impl Reader<'_> {
                 None => None,
             };
             let nv = positions.len();
+            if let Some(ns) = normals.as_ref().filter(|ns| ns.len() != nv) {
+                return Err(self.err(format!(
+                    "mesh {mi} primitive {pi}: NORMAL has {} vectors for its {nv} vertices (every attribute of a primitive has one value a vertex)",
+                    ns.len()
+                )));
+            }
             let indices: Vec<u32> = match p.indices {
                 Some(i) => {
                     self.component_types(
