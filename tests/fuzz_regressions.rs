@@ -180,3 +180,18 @@ fn a_bird_model_with_fewer_normals_than_vertices_is_refused() {
     );
     assert_eq!(msg.lines().count(), 1, "{msg}");
 }
+
+/// A bird model (bytes changed by the fuzzer) with an infinite skin weight: the vertex's
+/// normalised weights became NaN and reached the USD text. Now refused naming the vertex.
+#[test]
+fn a_bird_model_with_an_infinite_skin_weight_is_refused() {
+    let path = data("bird_model-nan-e3e38933.glb");
+    let bytes = std::fs::read(&path).unwrap();
+    let e =
+        formation::export::bird_model::parse(&path, &bytes, formation::wingbeat::Species::Goose)
+            .unwrap_err();
+    assert_eq!(e.exit_code(), 2);
+    let msg = e.to_string();
+    assert!(msg.contains("skin weight"), "{msg}");
+    assert_eq!(msg.lines().count(), 1, "{msg}");
+}

@@ -37,6 +37,10 @@ use crate::wingbeat::Species;
 pub const MAX_BYTES: u64 = 64 * 1024 * 1024;
 /// Largest accepted number of vertices over all meshes used.
 pub const MAX_VERTICES: usize = 200_000;
+
+/// Largest skin weight read (glTF's are fractions; a little over 1 is rounding, far more an
+/// error that would make a vertex's normalised weights NaN or zero).
+pub const MAX_SKIN_WEIGHT: f32 = 1.5;
 /// Largest number of elements of one accessor (indices of up to 4 triangles per vertex).
 pub const MAX_ACCESSOR_ELEMENTS: usize = 12 * MAX_VERTICES;
 
@@ -634,6 +638,11 @@ impl Reader<'_> {
                                 jv.get(4 * k + c).copied().unwrap_or(0.0) as usize,
                                 wv.get(4 * k + c).copied().unwrap_or(0.0),
                             );
+                            if !(weight.is_finite() && weight <= MAX_SKIN_WEIGHT) {
+                                return Err(self.err(format!(
+                                    "mesh {mi} primitive {pi}: vertex {k} has a skin weight of {weight} (weights are fractions, at most 1)"
+                                )));
+                            }
                             if weight > 0.0 {
                                 let ours = *map.get(slot).ok_or_else(|| {
                                     self.err(format!("mesh {mi} primitive {pi}: vertex {k} uses joint {slot}, beyond its skin"))
