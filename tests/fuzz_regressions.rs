@@ -148,18 +148,26 @@ fn a_closed_spike_path_is_refused_not_widened_forever() {
     );
 }
 
-/// A bird model (a formation `.glb` with bytes changed by the fuzzer) whose inverse bind matrix
-/// of `body` is singular: its inverse was NaN, so the `.glb` export failed with "internal error"
-/// (exit 1) and the `.usda` text held NaN. Now the model is refused naming the joint.
-#[test]
-fn a_bird_model_with_a_singular_bind_matrix_is_refused() {
-    let path = data("bird_model-nan-5da5f56a.glb");
+/// The refusal of the bird model `name` (in `tests/data/fuzz/`): exit 2 and one line, returned.
+fn refused_bird_model(name: &str) -> String {
+    let path = data(name);
     let bytes = std::fs::read(&path).unwrap();
     let e =
         formation::export::bird_model::parse(&path, &bytes, formation::wingbeat::Species::Goose)
             .unwrap_err();
     assert_eq!(e.exit_code(), 2);
-    assert!(e.to_string().contains("cannot be inverted"), "{e}");
+    let msg = e.to_string();
+    assert_eq!(msg.lines().count(), 1, "{msg}");
+    msg
+}
+
+/// A bird model (a formation `.glb` with bytes changed by the fuzzer) whose inverse bind matrix
+/// of `body` is singular: its inverse was NaN, so the `.glb` export failed with "internal error"
+/// (exit 1) and the `.usda` text held NaN. Now the model is refused naming the joint.
+#[test]
+fn a_bird_model_with_a_singular_bind_matrix_is_refused() {
+    let msg = refused_bird_model("bird_model-nan-5da5f56a.glb");
+    assert!(msg.contains("cannot be inverted"), "{msg}");
 }
 
 /// A bird model (bytes changed by the fuzzer) whose NORMAL accessor has fewer vectors than its
@@ -167,31 +175,17 @@ fn a_bird_model_with_a_singular_bind_matrix_is_refused() {
 /// model is refused naming the mesh, the primitive and the counts.
 #[test]
 fn a_bird_model_with_fewer_normals_than_vertices_is_refused() {
-    let path = data("bird_model-crash-4e3181e8.glb");
-    let bytes = std::fs::read(&path).unwrap();
-    let e =
-        formation::export::bird_model::parse(&path, &bytes, formation::wingbeat::Species::Goose)
-            .unwrap_err();
-    assert_eq!(e.exit_code(), 2);
-    let msg = e.to_string();
+    let msg = refused_bird_model("bird_model-crash-4e3181e8.glb");
     assert!(
         msg.contains("NORMAL has") && msg.contains("vertices"),
         "{msg}"
     );
-    assert_eq!(msg.lines().count(), 1, "{msg}");
 }
 
 /// A bird model (bytes changed by the fuzzer) with an infinite skin weight: the vertex's
 /// normalised weights became NaN and reached the USD text. Now refused naming the vertex.
 #[test]
 fn a_bird_model_with_an_infinite_skin_weight_is_refused() {
-    let path = data("bird_model-nan-e3e38933.glb");
-    let bytes = std::fs::read(&path).unwrap();
-    let e =
-        formation::export::bird_model::parse(&path, &bytes, formation::wingbeat::Species::Goose)
-            .unwrap_err();
-    assert_eq!(e.exit_code(), 2);
-    let msg = e.to_string();
+    let msg = refused_bird_model("bird_model-nan-e3e38933.glb");
     assert!(msg.contains("skin weight"), "{msg}");
-    assert_eq!(msg.lines().count(), 1, "{msg}");
 }
