@@ -27,7 +27,7 @@
 //!                  │
 //! data types    annotations · extract::params · shape · animation (+ animation::wing) · sniff
 //!                  │
-//! foundation    error · io · limits · finite · rng · progress
+//! foundation    error · io · limits · finite · rng · progress · memory
 //! ```
 //!
 //! | stage | module |
@@ -67,6 +67,7 @@ pub mod initiate;
 pub mod io;
 pub mod keyshape;
 pub mod limits;
+pub mod memory;
 pub mod pipeline;
 pub mod plot;
 pub mod progress;

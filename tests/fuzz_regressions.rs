@@ -189,3 +189,16 @@ fn a_bird_model_with_an_infinite_skin_weight_is_refused() {
     let msg = refused_bird_model("bird_model-nan-e3e38933.glb");
     assert!(msg.contains("skin weight"), "{msg}");
 }
+
+/// A bird model (bytes changed by the fuzzer) whose `upper_arm.R` joint sits 10³⁸ spans of the
+/// mesh away: its place was finite, but its offsets composed down the chain and scaled to a
+/// wingspan overflowed to `inf` in the USD text (`render -o a.usda` wrote it, exit 0). Now refused
+/// naming the joint.
+#[test]
+fn a_bird_model_with_a_joint_far_from_its_mesh_is_refused() {
+    let msg = refused_bird_model("bird_model-nan-3b394836.glb");
+    assert!(
+        msg.contains("joint \"upper_arm.R\"") && msg.contains("spans"),
+        "{msg}"
+    );
+}

@@ -41,6 +41,8 @@ pub const MAX_VERTICES: usize = 200_000;
 /// Largest skin weight read (glTF's are fractions; a little over 1 is rounding, far more an
 /// error that would make a vertex's normalised weights NaN or zero).
 pub const MAX_SKIN_WEIGHT: f32 = 1.5;
+/// The farthest a joint may sit from the centre of the mesh, in spans of the mesh.
+pub const MAX_JOINT_SPANS: f32 = 100.0;
 /// Largest number of elements of one accessor (indices of up to 4 triangles per vertex).
 pub const MAX_ACCESSOR_ELEMENTS: usize = 12 * MAX_VERTICES;
 
@@ -954,6 +956,18 @@ impl Reader<'_> {
             return Err(self.err(
                 "its transforms are degenerate (a matrix that cannot be inverted or overflows 32-bit floats); fix the model's joints and nodes",
             ));
+        }
+        // A joint far from the mesh it moves is an error of the model's transforms, and its
+        // offsets overflow 32-bit floats once scaled to a wingspan and composed down the chain
+        // (found by fuzzing: a joint 10³⁷ spans away gave `inf` in the USD text).
+        if let Some(j) =
+            (0..bird::N_JOINTS).find(|&j| skel.bind_pos[j].abs().max_element() > MAX_JOINT_SPANS)
+        {
+            return Err(self.err(format!(
+                "skin: joint \"{}\" sits {:.3e} of the mesh's spans from the mesh's centre along an axis (at most {MAX_JOINT_SPANS}); fix the joint's bind matrix or its node's transform",
+                JOINTS[j],
+                skel.bind_pos[j].abs().max_element()
+            )));
         }
         // A static model keeps the species' skeleton: `body` at the centre, so bank turns the
         // model about the centre of its bounding box.

@@ -28,13 +28,14 @@
 //!   formation); formations do not interact beyond the clearance (Hummel's g at 5 wingspans is
 //!   given in `docs/large-flocks.md`).
 
+mod join;
 pub mod layout;
 pub mod sizes;
 
 use glam::{DVec2, DVec3};
 use serde::{Deserialize, Serialize};
 
-use crate::animation::{Animation, FormationRecord, Frame, Stage};
+use crate::animation::Animation;
 use crate::error::{Error, Result};
 use crate::extract::params::FormationParams;
 use crate::initiate::{self, InitiateOptions, InitiateStats, InitiationRun};
@@ -272,6 +273,17 @@ pub fn initiate_flock(
     finish(anims, reports, o, None, progress)
 }
 
+/// Freed memory, bytes, between two returns of it to the system while a flock is joined.
+const RELEASE_BYTES: usize = 8 << 20;
+
+/// About what joining frees for a bird-frame of a formation: its frames (11 values in vectors of
+/// a few birds, about 100 bytes) and, after a take-off, the run it was made from (5 values).
+const FREED_BYTES_PER_BIRD_FRAME: usize = 140;
+
+/// A formation's take-off: the run, the tries it took, and the steady flight drawn afresh (with
+/// its report) when a later try needed one.
+type TakeoffRun = (InitiationRun, usize, Option<(Animation, FormationReport)>);
+
 /// Formation `f`'s steady flight drawn afresh for try `t` of its take-off.
 type Redo<'a> = &'a (dyn Fn(usize, usize) -> Result<(Animation, FormationReport)> + Sync);
 
@@ -287,6 +299,7 @@ fn finish(
 ) -> Result<(Animation, SkeinReport)> {
     let k = anims.len();
     let sizes: Vec<usize> = anims.iter().map(|a| a.birds).collect();
+    let mut takeoffs: Vec<Option<(TakeoffRun, usize)>> = Vec::new();
     if let Some(init) = o.initiate {
         if matches!(init.start, initiate::Start::Given(_)) {
             // From formation parameters the flock can be flown as one formation; a steady
@@ -309,7 +322,17 @@ fn finish(
         })?;
         progress.finish();
         let frames = runs.iter().map(|(r, _, _)| r.pos.len()).max().unwrap_or(1);
-        for (f, (run, tries, fresh)) in runs.into_iter().enumerate() {
+        takeoffs = runs.into_iter().map(|r| Some((r, frames))).collect();
+    }
+    // Each formation is finished (its take-off handed over) and joined in turn, so its frames
+    // are dropped before the next one's are made.
+    let mut joiner = join::Joiner::new(sizes.iter().sum());
+    let mut env: Vec<Envelope> = Vec::with_capacity(k);
+    let mut freed = 0;
+    for f in 0..k {
+        if let (Some(init), Some(((run, tries, fresh), frames))) =
+            (o.initiate, takeoffs.get_mut(f).and_then(Option::take))
+        {
             if let Some((a, r)) = fresh {
                 anims[f] = a;
                 reports[f] = r;
@@ -327,8 +350,17 @@ fn finish(
             anims[f] = a;
             reports[f].initiate = Some(stats);
         }
+        env.push(Envelope::of(&anims[f]));
+        joiner.push(&mut anims[f])?;
+        // The formation's small vectors, freed, cannot hold the flock's large ones: give them
+        // back every few tens of megabytes (crate::memory).
+        freed += sizes[f] * joiner.frames() * FREED_BYTES_PER_BIRD_FRAME;
+        if freed >= RELEASE_BYTES {
+            crate::memory::release_free();
+            freed = 0;
+        }
     }
-    let env: Vec<Envelope> = anims.iter().map(Envelope::of).collect();
+    crate::memory::release_free();
     let departures: Vec<f64> = reports.iter().map(|r| r.takeoff_delay_s).collect();
     let placements = layout::arrange(
         &env,
@@ -345,7 +377,7 @@ fn finish(
             ..p.clone()
         };
     }
-    let anim = join(anims, &reports)?;
+    let anim = joiner.finish(&reports)?;
     let min_separation = min_separation(&anim);
     if min_separation < o.skein.clearance - 1e-9 {
         return Err(Error::Internal(format!(
@@ -432,10 +464,10 @@ fn takeoff_run(
     seed: u64,
     f: usize,
     redo: Option<Redo>,
-) -> Result<(InitiationRun, usize, Option<(Animation, FormationReport)>)> {
+) -> Result<TakeoffRun> {
     let n = steady.birds;
     let mut last = None;
-    let mut close: Option<(InitiationRun, usize, Option<(Animation, FormationReport)>)> = None;
+    let mut close: Option<TakeoffRun> = None;
     let mut fresh: Option<(Animation, FormationReport)> = None;
     for t in 0..TAKEOFF_TRIES {
         if t > 0 {
@@ -535,91 +567,6 @@ fn centre_of(env: &[Envelope], p: &[Placement], takeoff: bool) -> [f64; 2] {
         return [0.0, 0.0];
     }
     [0.5 * (x0 + x1), if takeoff { 0.5 * (y0 + y1) } else { y1 }]
-}
-
-/// One animation of the formations `anims` (equal frame counts), each moved by its placement;
-/// birds numbered formation by formation. The formations' frames are consumed as the flock's are made, so the flock is in memory about
-/// once, not twice.
-fn join(mut anims: Vec<Animation>, reports: &[FormationReport]) -> Result<Animation> {
-    let first = anims
-        .first()
-        .ok_or_else(|| Error::Internal("a flock without formations".into()))?;
-    let n: usize = anims.iter().map(|a| a.birds).sum();
-    let frames = first.frames.len();
-    if anims.iter().any(|a| a.frames.len() != frames) {
-        return Err(Error::Internal("formations of different lengths".into()));
-    }
-    let mut out = Animation::new(first.seed, first.fps, first.wingspan_m, n);
-    out.species = first.species.clone();
-    out.flight = first.flight;
-    out.savings_model = first.savings_model.clone();
-    out.wingbeat = first.wingbeat.clone();
-    out.stages = first.stages.clone();
-    let steady_start = first.stage("steady").map(|s: &Stage| s.start);
-    let mut records = Vec::with_capacity(anims.len());
-    let mut base = 0;
-    for a in &anims {
-        let leader = a.leaders().first().copied().unwrap_or(0);
-        records.push(FormationRecord {
-            birds: (base..base + a.birds).collect(),
-            leader: base + leader,
-            key_shapes: a.key_shapes.clone(),
-            xi_ranges: a.xi_ranges.clone(),
-            steady_start,
-        });
-        out.events.extend(a.events.iter().map(|e| {
-            let mut e = e.clone();
-            e.birds.iter_mut().for_each(|b| *b += base);
-            e
-        }));
-        base += a.birds;
-    }
-    out.events.sort_by(|a, b| a.t.total_cmp(&b.t));
-    out.xi_ranges = anims
-        .iter()
-        .map(|a| a.xi_ranges.clone())
-        .collect::<Option<Vec<_>>>()
-        .map(|v| v.concat());
-    let mut sources: Vec<std::vec::IntoIter<Frame>> = anims
-        .iter_mut()
-        .map(|a| std::mem::take(&mut a.frames).into_iter())
-        .collect();
-    out.frames = (0..frames)
-        .map(|_| {
-            // This frame of every formation, dropped once copied.
-            let parts: Vec<Frame> = sources
-                .iter_mut()
-                .map(|s| s.next().unwrap_or_default())
-                .collect();
-            let cat = |get: &dyn Fn(&Frame) -> &Vec<f64>, add: Option<usize>| -> Vec<f64> {
-                let mut v = Vec::with_capacity(n);
-                for (f, r) in parts.iter().zip(reports) {
-                    let d = add.map_or(0.0, |c| r.placement.offset[c]);
-                    v.extend(get(f).iter().map(|x| x + d));
-                }
-                v
-            };
-            let opt = |get: &dyn Fn(&Frame) -> Option<&Vec<f64>>| -> Option<Vec<f64>> {
-                let got: Option<Vec<&Vec<f64>>> = parts.iter().map(get).collect();
-                got.map(|p| p.into_iter().flatten().copied().collect())
-            };
-            Frame {
-                t: parts[0].t,
-                x: cat(&|f| &f.x, Some(0)),
-                y: cat(&|f| &f.y, Some(1)),
-                z: cat(&|f| &f.z, None),
-                heading: cat(&|f| &f.heading, None),
-                speed: cat(&|f| &f.speed, None),
-                bank: opt(&|f| f.bank.as_ref()),
-                pitch: opt(&|f| f.pitch.as_ref()),
-                e: opt(&|f| f.e.as_ref()),
-                xi: opt(&|f| f.xi.as_ref()),
-                wing_phase: opt(&|f| f.wing_phase.as_ref()),
-            }
-        })
-        .collect();
-    out.formations = Some(records);
-    Ok(out)
 }
 
 /// Smallest 3-D distance between two birds of different formations over every frame of `anim`,
