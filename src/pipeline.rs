@@ -545,6 +545,8 @@ pub fn fit_shot(anim: &mut Animation, config: &Config) -> Result<()> {
 /// stand or sit, birds in their flare pitch up, the wingbeats, and the values rounded to the
 /// animation file's precision ([`Animation::quantize`]).
 pub fn finish(anim: &mut Animation, config: &Config) -> Result<()> {
+    // What the flock's making freed goes back before the wingbeats' tables are made.
+    crate::memory::release_free();
     wingbeat::rest::stand_on_ground(anim, config.wingbeat.species);
     landing::flare_pitch(anim, landing::FLARE_PITCH);
     wingbeat::assign_phases(anim, &config.wingbeat)?;

@@ -34,6 +34,7 @@ pub mod hull;
 pub mod landing;
 mod options;
 pub mod perception;
+mod rows;
 pub mod sim;
 mod start;
 mod takeoff;
@@ -52,6 +53,7 @@ use crate::error::{Error, Result};
 use crate::progress::Progress;
 
 pub use perception::{PerceptionMode, PerceptionParams, HPR_GAMMA_DEFAULT};
+pub use rows::Rows;
 pub use sim::{Phase, Simulation, StepParams, Tolerances};
 pub use target::{Side, TargetShape};
 
@@ -113,16 +115,16 @@ pub struct InitiateStats {
 pub struct InitiationRun {
     /// Output frame rate of the samples, frames per second.
     pub fps: f64,
-    /// Horizontal positions of every frame (index 0 = start), wingspans.
-    pub pos: Vec<Vec<DVec2>>,
+    /// Horizontal positions of every frame (row 0 = start), wingspans.
+    pub pos: Rows<DVec2>,
     /// Altitudes of every frame, wingspans.
-    pub z: Vec<Vec<f64>>,
+    pub z: Rows<f64>,
     /// Headings of every frame, radians.
-    pub heading: Vec<Vec<f64>>,
+    pub heading: Rows<f64>,
     /// Speeds of every frame, wingspans per second.
-    pub speed: Vec<Vec<f64>>,
+    pub speed: Rows<f64>,
     /// Bank angles of every frame, radians (right wing down positive).
-    pub bank: Vec<Vec<f64>>,
+    pub bank: Rows<f64>,
     /// Slot of every bird at the end (meaningful when converged: a permutation).
     pub slot: Vec<Option<usize>>,
     /// Statistics.
@@ -202,11 +204,11 @@ pub fn simulate(
     let tol = opts.tolerances();
     let mut run = InitiationRun {
         fps,
-        pos: Vec::new(),
-        z: Vec::new(),
-        heading: Vec::new(),
-        speed: Vec::new(),
-        bank: Vec::new(),
+        pos: Rows::new(n),
+        z: Rows::new(n),
+        heading: Rows::new(n),
+        speed: Rows::new(n),
+        bank: Rows::new(n),
         slot: Vec::new(),
         stats: InitiateStats {
             birds: n,
@@ -227,36 +229,19 @@ pub fn simulate(
         },
     };
     let mut prev: Vec<sim::BirdState> = (0..n).map(|i| sim.bird(i)).collect();
-    let push = |run: &mut InitiationRun, a: &[sim::BirdState], b: &[sim::BirdState], u: f64| {
-        run.pos
-            .push(a.iter().zip(b).map(|(a, b)| a.pos.lerp(b.pos, u)).collect());
-        run.z.push(
-            a.iter()
-                .zip(b)
-                .map(|(a, b)| a.z + u * (b.z - a.z))
-                .collect(),
-        );
-        run.heading.push(
-            a.iter()
-                .zip(b)
-                .map(|(a, b)| {
-                    sim::wrap_angle(a.heading + u * sim::wrap_angle(b.heading - a.heading))
-                })
-                .collect(),
-        );
-        run.speed.push(
-            a.iter()
-                .zip(b)
-                .map(|(a, b)| a.speed + u * (b.speed - a.speed))
-                .collect(),
-        );
-        run.bank.push(
-            a.iter()
-                .zip(b)
-                .map(|(a, b)| a.bank + u * (b.bank - a.bank))
-                .collect(),
-        );
-    };
+    let push =
+        |run: &mut InitiationRun, a: &[sim::BirdState], b: &[sim::BirdState], u: f64| {
+            let ab = || a.iter().zip(b);
+            run.pos.push_row(ab().map(|(a, b)| a.pos.lerp(b.pos, u)));
+            run.z.push_row(ab().map(|(a, b)| a.z + u * (b.z - a.z)));
+            run.heading.push_row(ab().map(|(a, b)| {
+                sim::wrap_angle(a.heading + u * sim::wrap_angle(b.heading - a.heading))
+            }));
+            run.speed
+                .push_row(ab().map(|(a, b)| a.speed + u * (b.speed - a.speed)));
+            run.bank
+                .push_row(ab().map(|(a, b)| a.bank + u * (b.bank - a.bank)));
+        };
     push(&mut run, &prev, &prev, 0.0);
     let total = (limit / dt).ceil() as u64;
     progress.start("initiate", total);
@@ -317,6 +302,10 @@ pub fn simulate(
     }
     progress.finish();
     run.slot = sim.flock.slot.clone();
+    run.pos.shrink_to_fit();
+    for rows in [&mut run.z, &mut run.heading, &mut run.speed, &mut run.bank] {
+        rows.shrink_to_fit();
+    }
     run.stats.steps = run.pos.len() - 1;
     run.stats.seconds = sim.time;
     run.stats.converged = converged;

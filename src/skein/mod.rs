@@ -521,26 +521,20 @@ fn delayed(mut run: InitiationRun, wait: usize) -> InitiationRun {
         return run;
     }
     let fps = run.fps;
-    let p0 = run.pos[0].clone();
-    let before: Vec<Vec<DVec2>> = (0..wait)
-        .map(|j| {
-            let back = (wait - j) as f64 / fps;
-            p0.iter()
-                .zip(&run.heading[0])
-                .zip(&run.speed[0])
-                .map(|((p, &h), &v)| *p - DVec2::new(h.sin(), h.cos()) * (v * back))
-                .collect()
-        })
-        .collect();
-    fn front<T: Clone>(v: &mut Vec<Vec<T>>, wait: usize) {
-        let first = v[0].clone();
-        v.splice(0..0, std::iter::repeat(first).take(wait));
+    let p0 = run.pos[0].to_vec();
+    let (h0, v0) = (run.heading[0].to_vec(), run.speed[0].to_vec());
+    run.pos.prepend(wait, |j| {
+        let back = (wait - j) as f64 / fps;
+        p0.iter()
+            .zip(&h0)
+            .zip(&v0)
+            .map(|((p, &h), &v)| *p - DVec2::new(h.sin(), h.cos()) * (v * back))
+            .collect::<Vec<_>>()
+    });
+    for rows in [&mut run.z, &mut run.heading, &mut run.speed, &mut run.bank] {
+        let first = rows[0].to_vec();
+        rows.prepend(wait, |_| first.iter().copied());
     }
-    run.pos.splice(0..0, before);
-    front(&mut run.z, wait);
-    front(&mut run.heading, wait);
-    front(&mut run.speed, wait);
-    front(&mut run.bank, wait);
     run.stats.steps = run.pos.len() - 1;
     run
 }
@@ -796,13 +790,18 @@ mod tests {
 
     #[test]
     fn a_delayed_run_waits_at_its_start_state() {
+        fn rows<T: Copy>(values: [T; 2]) -> initiate::Rows<T> {
+            let mut r = initiate::Rows::new(1);
+            values.into_iter().for_each(|v| r.push_row([v]));
+            r
+        }
         let run = InitiationRun {
             fps: 10.0,
-            pos: vec![vec![DVec2::new(1.0, 2.0)], vec![DVec2::new(1.0, 3.0)]],
-            z: vec![vec![0.0], vec![0.1]],
-            heading: vec![vec![0.0], vec![0.0]],
-            speed: vec![vec![10.0], vec![10.0]],
-            bank: vec![vec![0.0], vec![0.0]],
+            pos: rows([DVec2::new(1.0, 2.0), DVec2::new(1.0, 3.0)]),
+            z: rows([0.0, 0.1]),
+            heading: rows([0.0, 0.0]),
+            speed: rows([10.0, 10.0]),
+            bank: rows([0.0, 0.0]),
             slot: vec![Some(0)],
             stats: InitiateStats {
                 birds: 1,
@@ -825,8 +824,10 @@ mod tests {
         let d = delayed(run, 3);
         assert_eq!(d.pos.len(), 5);
         // Flying straight north at 10 wingspans/s before the start: one wingspan per frame.
-        let ys: Vec<f64> = d.pos.iter().map(|p| p[0].y).collect();
+        let ys: Vec<f64> = (0..d.pos.len()).map(|t| d.pos[t][0].y).collect();
         assert_eq!(ys, vec![-1.0, 0.0, 1.0, 2.0, 3.0]);
+        let zs: Vec<f64> = (0..d.z.len()).map(|t| d.z[t][0]).collect();
+        assert_eq!(zs, vec![0.0, 0.0, 0.0, 0.0, 0.1]);
         assert_eq!(d.stats.steps, 4);
     }
 }

@@ -736,6 +736,9 @@ pub fn assign_phases(anim: &mut Animation, opts: &WingbeatOptions) -> Result<()>
     let n = anim.birds;
     drop(run.birds);
     drop(run.fold);
+    // The simulation's scratch, freed, would otherwise stay with the process while the rows are
+    // made and the outputs written.
+    crate::memory::release_free();
     // Frame by frame from the last, each row moved out and the table shrunk behind it, so the
     // phases are never held twice.
     let mut phase = run.phase;
