@@ -323,26 +323,12 @@ pub struct KeyBird {
 /// The birds `birds` (indices into `f`'s arrays, in that order) of frame `f`; a missing index
 /// reads as 0.
 fn formation_frame(f: &Frame, birds: &[usize]) -> Frame {
-    let pick = |v: &Vec<f64>| -> Vec<f64> {
+    f.map_values(|v| {
         birds
             .iter()
             .map(|&b| v.get(b).copied().unwrap_or(0.0))
             .collect()
-    };
-    let pick_opt = |v: &Option<Vec<f64>>| v.as_ref().map(pick);
-    Frame {
-        t: f.t,
-        x: pick(&f.x),
-        y: pick(&f.y),
-        z: pick(&f.z),
-        heading: pick(&f.heading),
-        speed: pick(&f.speed),
-        bank: pick_opt(&f.bank),
-        pitch: pick_opt(&f.pitch),
-        e: pick_opt(&f.e),
-        xi: pick_opt(&f.xi),
-        wing_phase: pick_opt(&f.wing_phase),
-    }
+    })
 }
 
 /// The state of every bird at one instant (world frame).
@@ -405,6 +391,25 @@ pub struct Frame {
 }
 
 impl Frame {
+    /// A frame at the same time whose every per-bird array is `map` of this frame's (the
+    /// optional ones where this frame has them).
+    pub fn map_values(&self, map: impl Fn(&[f64]) -> Vec<f64>) -> Frame {
+        let opt = |v: &Option<Vec<f64>>| v.as_deref().map(&map);
+        Frame {
+            t: self.t,
+            x: map(&self.x),
+            y: map(&self.y),
+            z: map(&self.z),
+            heading: map(&self.heading),
+            speed: map(&self.speed),
+            bank: opt(&self.bank),
+            pitch: opt(&self.pitch),
+            e: opt(&self.e),
+            xi: opt(&self.xi),
+            wing_phase: opt(&self.wing_phase),
+        }
+    }
+
     /// Rounds every bird's values to the precision the animation file stores
     /// ([`precision`]), so that what is written and read back is exactly what every other output
     /// of the same run was made from.

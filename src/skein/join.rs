@@ -79,26 +79,15 @@ impl Joiner {
         };
         let parts = std::mem::take(&mut a.frames);
         if self.ranges.is_empty() {
-            let with = |v: &[f64]| {
-                let mut w = Vec::with_capacity(n);
-                w.extend_from_slice(v);
-                w
-            };
-            let with_opt = |v: &Option<Vec<f64>>| v.as_deref().map(with);
+            // Room for the whole flock, filled as the other formations follow.
             self.frames = parts
                 .into_iter()
-                .map(|f| Frame {
-                    t: f.t,
-                    x: with(&f.x),
-                    y: with(&f.y),
-                    z: with(&f.z),
-                    heading: with(&f.heading),
-                    speed: with(&f.speed),
-                    bank: with_opt(&f.bank),
-                    pitch: with_opt(&f.pitch),
-                    e: with_opt(&f.e),
-                    xi: with_opt(&f.xi),
-                    wing_phase: with_opt(&f.wing_phase),
+                .map(|f| {
+                    f.map_values(|v| {
+                        let mut w = Vec::with_capacity(n);
+                        w.extend_from_slice(v);
+                        w
+                    })
                 })
                 .collect();
         } else {

@@ -299,7 +299,9 @@ fn finish(
 ) -> Result<(Animation, SkeinReport)> {
     let k = anims.len();
     let sizes: Vec<usize> = anims.iter().map(|a| a.birds).collect();
-    let mut takeoffs: Vec<Option<(TakeoffRun, usize)>> = Vec::new();
+    let mut takeoffs: Vec<TakeoffRun> = Vec::new();
+    // Frames of the longest take-off: the others wait on the ground to hand over with it.
+    let mut takeoff_frames = 0;
     if let Some(init) = o.initiate {
         if matches!(init.start, initiate::Start::Given(_)) {
             // From formation parameters the flock can be flown as one formation; a steady
@@ -321,24 +323,23 @@ fn finish(
             r
         })?;
         progress.finish();
-        let frames = runs.iter().map(|(r, _, _)| r.pos.len()).max().unwrap_or(1);
-        takeoffs = runs.into_iter().map(|r| Some((r, frames))).collect();
+        takeoff_frames = runs.iter().map(|(r, _, _)| r.pos.len()).max().unwrap_or(1);
+        takeoffs = runs;
     }
     // Each formation is finished (its take-off handed over) and joined in turn, so its frames
     // are dropped before the next one's are made.
     let mut joiner = join::Joiner::new(sizes.iter().sum());
     let mut env: Vec<Envelope> = Vec::with_capacity(k);
     let mut freed = 0;
+    let mut takeoffs = takeoffs.into_iter();
     for f in 0..k {
-        if let (Some(init), Some(((run, tries, fresh), frames))) =
-            (o.initiate, takeoffs.get_mut(f).and_then(Option::take))
-        {
+        if let (Some(init), Some((run, tries, fresh))) = (o.initiate, takeoffs.next()) {
             if let Some((a, r)) = fresh {
                 anims[f] = a;
                 reports[f] = r;
             }
             reports[f].takeoff_tries = tries;
-            let wait = frames - run.pos.len();
+            let wait = takeoff_frames - run.pos.len();
             reports[f].takeoff_delay_s = wait as f64 / anims[f].fps;
             let run = delayed(run, wait);
             // The formation's steady frames move into its take-off's animation (no copy).
