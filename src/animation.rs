@@ -8,6 +8,7 @@ use std::path::Path;
 use crate::error::{Error, Result};
 
 pub mod axes;
+pub mod binary;
 pub mod landing;
 pub mod relative;
 pub mod resample;
@@ -81,7 +82,12 @@ pub struct Animation {
     /// The landing's touch-downs, when the animation ends in a `landing` stage.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub landing: Option<landing::LandingRecord>,
-    /// One entry per frame.
+    /// The binary file holding the frames instead of `frames` (written when
+    /// `RenderOptions::binary_frames` asks; see [`binary`]). In memory always `None`: [`Animation::read`] reads the frames in.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub frames_file: Option<binary::FramesFile>,
+    /// One entry per frame (absent from a file whose frames are in `frames_file`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub frames: Vec<Frame>,
 }
 
@@ -635,6 +641,7 @@ impl Animation {
             savings_model,
             events,
             landing,
+            frames_file,
             frames: _,
         } = self;
         Animation {
@@ -658,6 +665,7 @@ impl Animation {
             savings_model: savings_model.clone(),
             events: events.clone(),
             landing: landing.clone(),
+            frames_file: frames_file.clone(),
             frames,
         }
     }
@@ -685,6 +693,7 @@ impl Animation {
             savings_model: None,
             events: Vec::new(),
             landing: None,
+            frames_file: None,
             frames: Vec::new(),
         }
     }
@@ -705,6 +714,7 @@ impl Animation {
                 _ => e,
             }
         })?;
+        binary::read_frames(&mut a, path)?;
         let metres = !a.units.is_default();
         if metres && !(a.wingspan_m.is_finite() && a.wingspan_m > 0.0) {
             return Err(Error::format(

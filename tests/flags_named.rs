@@ -21,6 +21,7 @@ const SWITCHES: &[&str] = &[
     "--loop",
     "--strict",
     "--pretty",
+    "--binary-frames",
     "--land",
 ];
 

@@ -103,13 +103,49 @@ pub fn params(data: &[u8]) {
 /// `check_times`, `initiate` adds `check_steady`.
 /// Whatever is accepted is exported in memory (CSV, glTF) and one picture frame is drawn small.
 pub fn animation(data: &[u8]) {
-    use formation::export::{gltf, pictures::Film, raster, sample, table};
     use formation::Animation;
     let path = Path::new(PATH);
     let input = formation::io::TextInput::new(path, data, formation::io::MAX_INPUT_BYTES);
     let Ok(a) = formation::io::parse_json_streaming::<Animation, _>(input) else {
         return;
     };
+    accepted_animation(a);
+}
+
+/// An animation file whose frames are in a frames file: the input is the animation file's
+/// text, a zero byte, then the frames file's bytes; read as `Animation::read` reads the pair
+/// (the header parsed, then `animation::binary::read_frames_from`), then as [`animation`].
+pub fn animation_frames(data: &[u8]) {
+    use formation::Animation;
+    let path = Path::new(PATH);
+    let (head, frames) = match data.iter().position(|&b| b == 0) {
+        Some(i) => (&data[..i], &data[i + 1..]),
+        None => (data, &data[data.len()..]),
+    };
+    let input = formation::io::TextInput::new(path, head, formation::io::MAX_INPUT_BYTES);
+    let Ok(mut a) = formation::io::parse_json_streaming::<Animation, _>(input) else {
+        return;
+    };
+    let frames_path = Path::new("fuzz-input.frames");
+    if formation::animation::binary::read_frames_from(
+        &mut a,
+        path,
+        frames_path,
+        frames,
+        frames.len() as u64,
+    )
+    .is_err()
+    {
+        return;
+    }
+    accepted_animation(a);
+}
+
+/// What reading an animation file goes on to do with one it parsed: validation, then the checks
+/// of `initiate` and `render`, and small exports of whatever is accepted.
+fn accepted_animation(a: formation::Animation) {
+    use formation::export::{gltf, pictures::Film, raster, sample, table};
+    let path = Path::new(PATH);
     if a.validate(path).is_err() {
         return;
     }

@@ -178,6 +178,22 @@ def test_write_every_format_and_bad_render_option(tmp_path, anim):
     assert not (tmp_path / "b.gif").exists()
 
 
+def test_binary_frames_with_numpy_and_read_back(tmp_path, anim):
+    anim.write(tmp_path / "b.json", binary_frames=True)
+    head = json.loads((tmp_path / "b.json").read_text())
+    ff = head["frames_file"]
+    assert "frames" not in head and ff["path"] == "b.frames"
+    # The recipe of docs/formats.md: one record a frame, the time then each field's birds.
+    record = np.dtype([("t", "<f8")] + [(f, "<f4", (head["birds"],)) for f in ff["fields"]])
+    frames = np.fromfile(tmp_path / ff["path"], dtype=record, offset=16)
+    assert frames.shape == (ff["frames"],) == (len(anim),)
+    np.testing.assert_array_equal(frames["t"], anim.times)
+    np.testing.assert_array_equal(frames["x"], anim.positions[..., 0].astype(np.float32))
+    np.testing.assert_array_equal(frames["e"], anim.savings.astype(np.float32))
+    again = formation.read_animation(tmp_path / "b.json")
+    np.testing.assert_array_equal(again.positions, anim.positions.astype(np.float32).astype(np.float64))
+
+
 def test_gil_released_during_animate():
     # With a long switch interval, a thread waiting for the GIL only runs when the holder
     # releases it of its own accord: a counter that moves while `animate` runs proves that

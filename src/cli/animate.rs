@@ -143,12 +143,7 @@ pub fn run(args: AnimateArgs, g: Global) -> Result<()> {
     super::warn(super::flags::Cmd::Animate, g, &warnings)?;
     super::course::warn(super::flags::Cmd::Animate, g, &report.course)?;
     super::write_animation(&anim, &args.output, &config.render, g)?;
-    let written: Vec<std::path::PathBuf> = args
-        .output
-        .iter()
-        .chain(config.render.path_out.iter())
-        .cloned()
-        .collect();
+    let written = formation::export::written_files(&args.output, &config.render);
     super::summary::animate(g, &anim, &report, &written);
     if let (Some(f), false) = (&report.skein, g.quiet) {
         super::stdout::diagnostic(&super::steady::flock_summary(f));

@@ -348,7 +348,8 @@ pub fn run(args: InitiateArgs, g: Global) -> Result<()> {
         let text = formation::finite::to_json_pretty("statistics", &stats)?;
         super::stdout::println(&text)?;
     }
-    super::summary::initiate(g, &anim, stats.converged, &args.output);
+    let written = formation::export::written_files(&args.output, &args.scene.options());
+    super::summary::initiate(g, &anim, stats.converged, &written);
     Ok(())
 }
 

@@ -283,7 +283,7 @@ pub fn run(args: SteadyArgs, g: Global) -> Result<()> {
                 flock_summary(f)
             ),
         };
-        let mut files = args.output.clone();
+        let mut files = formation::export::written_files(&args.output, &args.scene.options());
         files.extend(args.report.iter().cloned());
         super::summary::defer(text, &files);
     }

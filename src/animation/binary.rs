@@ -1,0 +1,389 @@
+//! Frames in a binary file beside the animation file: the animation JSON keeps everything but
+//! its frames (stages, key shapes, formations, the savings model, ...) and names the binary file
+//! that holds them in single precision, about 40 bytes a bird-frame against about 90 as JSON text.
+//!
+//! Layout (little-endian): the 16 bytes `formation-frames`, then one record per frame: `t` as a
+//! 64-bit float, then for each field the file's `fields` list names, in that order, one 32-bit
+//! float per bird. A frame without an optional field (`bank`, `pitch`, `e`, `xi`,
+//! `wing_phase`) holds NaN for each of its birds. The values are the animation file's (rounded
+//! to its precision, in its units and up axis) in single precision. docs/formats.md has the
+//! reading recipe for NumPy.
+
+use std::io::{BufReader, BufWriter, Read, Write};
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use super::{precision, Animation, Frame};
+use crate::error::{Error, Result};
+
+/// The frames file's format tag, in the animation file's `frames_file.format`.
+pub const FRAMES_FORMAT: &str = "formation-frames/1";
+
+/// The first bytes of a frames file.
+pub const MAGIC: &[u8; 16] = b"formation-frames";
+
+/// The frames' fields a frames file may hold, in the order they are written.
+pub const FIELDS: [&str; 10] = [
+    "x",
+    "y",
+    "z",
+    "heading",
+    "speed",
+    "bank",
+    "pitch",
+    "e",
+    "xi",
+    "wing_phase",
+];
+
+/// The fields every frame has.
+const REQUIRED: usize = 5;
+
+/// What the animation file says of its frames file.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FramesFile {
+    /// Always [`FRAMES_FORMAT`].
+    pub format: String,
+    /// The frames file's name, in the animation file's directory.
+    pub path: String,
+    /// Number of frames (records).
+    pub frames: usize,
+    /// The fields of each record after `t`, in order (a subset of [`FIELDS`] holding the five
+    /// positions and motion fields).
+    pub fields: Vec<String>,
+}
+
+/// The frames file written beside the animation file `json`: its name with the extension
+/// `.frames` (`flock.json` → `flock.frames`).
+pub fn frames_path(json: &Path) -> PathBuf {
+    json.with_extension("frames")
+}
+
+/// Bytes of one record of `birds` birds and `fields` fields.
+fn record_bytes(birds: usize, fields: usize) -> Option<u64> {
+    (birds as u64)
+        .checked_mul(fields as u64)?
+        .checked_mul(4)?
+        .checked_add(8)
+}
+
+/// The values of field `k` ([`FIELDS`] order) of a frame, `None` where the frame has none.
+fn field(f: &Frame, k: usize) -> Option<&[f64]> {
+    match k {
+        0 => Some(&f.x),
+        1 => Some(&f.y),
+        2 => Some(&f.z),
+        3 => Some(&f.heading),
+        4 => Some(&f.speed),
+        5 => f.bank.as_deref(),
+        6 => f.pitch.as_deref(),
+        7 => f.e.as_deref(),
+        8 => f.xi.as_deref(),
+        _ => f.wing_phase.as_deref(),
+    }
+}
+
+/// Steps per unit of field `k` in the animation file ([`precision`]).
+fn steps(k: usize) -> f64 {
+    match k {
+        0..=2 => precision::POSITION,
+        4 => precision::SPEED,
+        7 | 8 => precision::SAVING,
+        _ => precision::ANGLE,
+    }
+}
+
+/// Writes `anim`'s frames to `out`, the file that will be `frames_target` (see the module's
+/// layout), and returns what the animation file says of them (`path` = the target's file name).
+/// A value that is not finite is an error naming its frame, bird and field. Nothing is moved into
+/// place: the caller commits both files together.
+pub fn write_frames(
+    anim: &Animation,
+    out: &mut impl Write,
+    frames_target: &Path,
+) -> std::io::Result<FramesFile> {
+    let present: Vec<usize> = (0..FIELDS.len())
+        .filter(|&k| k < REQUIRED || anim.frames.iter().any(|f| field(f, k).is_some()))
+        .collect();
+    let mut out = BufWriter::with_capacity(1 << 20, out);
+    out.write_all(MAGIC)?;
+    let mut record = Vec::with_capacity(anim.birds * 4);
+    for (i, f) in anim.frames.iter().enumerate() {
+        out.write_all(&f.t.to_le_bytes())?;
+        for &k in &present {
+            record.clear();
+            match field(f, k) {
+                Some(v) => {
+                    let s = steps(k);
+                    if let Some(b) = v.iter().position(|x| !x.is_finite()) {
+                        return Err(std::io::Error::new(
+                            std::io::ErrorKind::InvalidData,
+                            format!("frame {i}, bird {b}: {} is not a finite number", FIELDS[k]),
+                        ));
+                    }
+                    for &x in v {
+                        record.extend_from_slice(&(precision::to(x, s) as f32).to_le_bytes());
+                    }
+                }
+                None => {
+                    for _ in 0..anim.birds {
+                        record.extend_from_slice(&f32::NAN.to_le_bytes());
+                    }
+                }
+            }
+            out.write_all(&record)?;
+        }
+    }
+    out.flush()?;
+    Ok(FramesFile {
+        format: FRAMES_FORMAT.to_string(),
+        path: frames_target
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default(),
+        frames: anim.frames.len(),
+        fields: present.iter().map(|&k| FIELDS[k].to_string()).collect(),
+    })
+}
+
+/// Reads the frames file `anim.frames_file` names (beside `origin`, the animation file) into
+/// `anim.frames`. Errors name the frames file and what is wrong with it (missing, its size against
+/// the records the animation file announces, its first bytes) or the animation file's
+/// `frames_file` field at fault.
+pub fn read_frames(anim: &mut Animation, origin: &Path) -> Result<()> {
+    let Some(ff) = &anim.frames_file else {
+        return Ok(());
+    };
+    let name = Path::new(&ff.path);
+    let plain = name.components().count() == 1
+        && matches!(
+            name.components().next(),
+            Some(std::path::Component::Normal(_))
+        );
+    if !plain {
+        return Err(Error::format(
+            origin,
+            format!(
+                "frames_file.path: \"{}\" must be a file name in the animation file's directory",
+                ff.path
+            ),
+        ));
+    }
+    let path = origin
+        .parent()
+        .map_or_else(|| name.to_path_buf(), |d| d.join(name));
+    let file = std::fs::File::open(&path).map_err(|e| {
+        if e.kind() == std::io::ErrorKind::NotFound {
+            Error::format(
+                &path,
+                format!(
+                    "missing: {} keeps its frames in this file; keep the two files together",
+                    origin.display()
+                ),
+            )
+        } else {
+            Error::io(&path, e)
+        }
+    })?;
+    let size = file.metadata().map_err(|e| Error::io(&path, e))?.len();
+    read_frames_from(
+        anim,
+        origin,
+        &path,
+        BufReader::with_capacity(1 << 20, file),
+        size,
+    )
+}
+
+/// [`read_frames`] from `input`, the `size` bytes of the frames file `path`.
+pub fn read_frames_from(
+    anim: &mut Animation,
+    origin: &Path,
+    path: &Path,
+    mut input: impl Read,
+    size: u64,
+) -> Result<()> {
+    let Some(ff) = anim.frames_file.take() else {
+        return Ok(());
+    };
+    let bad = |msg: String| Err(Error::format(origin, msg));
+    if ff.format != FRAMES_FORMAT {
+        return bad(format!(
+            "frames_file.format: expected \"{FRAMES_FORMAT}\", found \"{}\"",
+            ff.format
+        ));
+    }
+    if !anim.frames.is_empty() {
+        return bad(
+            "frames_file: the file has frames of its own too; give either \"frames\" or \"frames_file\""
+                .into(),
+        );
+    }
+    let mut order = Vec::with_capacity(ff.fields.len().min(FIELDS.len()));
+    for (i, f) in ff.fields.iter().enumerate() {
+        let Some(k) = FIELDS.iter().position(|g| g == f) else {
+            return bad(format!(
+                "frames_file.fields[{i}]: unknown field \"{f}\" (expected some of {})",
+                FIELDS.join(", ")
+            ));
+        };
+        if order.contains(&k) {
+            return bad(format!("frames_file.fields[{i}]: \"{f}\" is listed twice"));
+        }
+        order.push(k);
+    }
+    if let Some(k) = (0..REQUIRED).find(|k| !order.contains(k)) {
+        return bad(format!(
+            "frames_file.fields: \"{}\" is missing (every frame has x, y, z, heading and speed)",
+            FIELDS[k]
+        ));
+    }
+    if anim.birds == 0 {
+        return bad("birds: must be at least 1".into());
+    }
+    crate::limits::check_animation_size(&origin.display().to_string(), anim.birds, ff.frames)?;
+    let expected = record_bytes(anim.birds, order.len())
+        .and_then(|r| r.checked_mul(ff.frames as u64))
+        .and_then(|b| b.checked_add(MAGIC.len() as u64));
+    if expected != Some(size) {
+        return Err(Error::format(
+            path,
+            format!(
+                "{size} bytes, but {} announces {} frames of {} birds and {} fields ({} bytes); the two files do not belong together, or this one was cut short",
+                origin.display(),
+                ff.frames,
+                anim.birds,
+                order.len(),
+                expected.map_or_else(|| "too many".to_string(), |b| b.to_string())
+            ),
+        ));
+    }
+    let io = |e| Error::io(path, e);
+    let mut magic = [0u8; 16];
+    input.read_exact(&mut magic).map_err(io)?;
+    if &magic != MAGIC {
+        return Err(Error::format(
+            path,
+            "not a frames file (its first bytes are not \"formation-frames\")",
+        ));
+    }
+    let n = anim.birds;
+    let mut bytes = vec![0u8; n * 4];
+    let mut frames = Vec::with_capacity(ff.frames);
+    for _ in 0..ff.frames {
+        let mut t = [0u8; 8];
+        input.read_exact(&mut t).map_err(io)?;
+        let mut f = Frame {
+            t: f64::from_le_bytes(t),
+            ..Frame::default()
+        };
+        for &k in &order {
+            input.read_exact(&mut bytes).map_err(io)?;
+            let v: Vec<f64> = bytes
+                .chunks_exact(4)
+                .map(|b| f64::from(f32::from_le_bytes([b[0], b[1], b[2], b[3]])))
+                .collect();
+            // An optional field all NaN is one this frame does not have.
+            let absent = k >= REQUIRED && v.iter().all(|x| x.is_nan());
+            let v = (!absent).then_some(v);
+            match k {
+                0 => f.x = v.unwrap_or_default(),
+                1 => f.y = v.unwrap_or_default(),
+                2 => f.z = v.unwrap_or_default(),
+                3 => f.heading = v.unwrap_or_default(),
+                4 => f.speed = v.unwrap_or_default(),
+                5 => f.bank = v,
+                6 => f.pitch = v,
+                7 => f.e = v,
+                8 => f.xi = v,
+                _ => f.wing_phase = v,
+            }
+        }
+        frames.push(f);
+    }
+    anim.frames = frames;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn two_frames() -> Animation {
+        let mut a = Animation::new(3, 30.0, 1.5, 2);
+        for (i, t) in [0.0, 1.0 / 30.0].into_iter().enumerate() {
+            let k = i as f64;
+            a.frames.push(Frame {
+                t,
+                x: vec![-0.5 + k, 1_234.567_891],
+                y: vec![2.0, -3.25 - k],
+                z: vec![10.0, 10.000_01],
+                heading: vec![0.001, -0.002],
+                speed: vec![10.0, 9.5],
+                bank: Some(vec![0.1, -0.1]),
+                pitch: None,
+                e: (i == 1).then(|| vec![0.25, 0.5]),
+                xi: None,
+                wing_phase: Some(vec![1.0, 6.0]),
+            });
+        }
+        a
+    }
+
+    #[test]
+    fn frames_read_back_in_single_precision_with_absent_fields_absent() {
+        let dir = std::env::temp_dir().join(format!("formation-binary-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let json = dir.join("a.json");
+        let target = frames_path(&json);
+        let a = two_frames();
+        let mut file = std::fs::File::create(&target).unwrap();
+        let ff = write_frames(&a, &mut file, &target).unwrap();
+        drop(file);
+        assert_eq!(ff.path, "a.frames");
+        assert_eq!(
+            ff.fields,
+            ["x", "y", "z", "heading", "speed", "bank", "e", "wing_phase"]
+        );
+        assert_eq!(
+            std::fs::metadata(&target).unwrap().len(),
+            16 + 2 * (8 + 8 * 2 * 4)
+        );
+        let mut b = a.with_frames(Vec::new());
+        b.frames_file = Some(ff.clone());
+        read_frames(&mut b, &json).unwrap();
+        assert_eq!(b.frames.len(), 2);
+        for (fa, fb) in a.frames.iter().zip(&b.frames) {
+            assert_eq!(fa.t, fb.t);
+            for (k, name) in FIELDS.iter().enumerate() {
+                match (field(fa, k), field(fb, k)) {
+                    (None, None) => {}
+                    (Some(va), Some(vb)) => {
+                        for (x, y) in va.iter().zip(vb) {
+                            let want = f64::from(precision::to(*x, steps(k)) as f32);
+                            assert_eq!(want, *y, "field {name}");
+                        }
+                    }
+                    other => panic!("field {name}: {other:?}"),
+                }
+            }
+        }
+        // Cut short, or named outside the directory: refused, naming the file.
+        let bytes = std::fs::read(&target).unwrap();
+        std::fs::write(&target, &bytes[..bytes.len() - 4]).unwrap();
+        let mut c = a.with_frames(Vec::new());
+        c.frames_file = Some(ff.clone());
+        let e = read_frames(&mut c, &json).unwrap_err().to_string();
+        assert!(e.contains("a.frames") && e.contains("cut short"), "{e}");
+        let mut d = a.with_frames(Vec::new());
+        d.frames_file = Some(FramesFile {
+            path: "../a.frames".into(),
+            ..ff
+        });
+        let e = read_frames(&mut d, &json).unwrap_err().to_string();
+        assert!(e.contains("frames_file.path"), "{e}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
