@@ -3,7 +3,7 @@
 cd "$(dirname "$0")"
 echo "| target | minutes | executions | exec/s | edges (cov) | corpus | peak RSS | slowest input | crashes, hangs, OOM |"
 echo "|---|---|---|---|---|---|---|---|---|"
-for t in native_json long_csv dltdv_csv labelme_json params animation shape target path bird_model sleap_csv dlc_csv mot_txt idtracker_csv trex_npz sleap_h5; do
+for t in native_json long_csv dltdv_csv labelme_json params animation animation_frames shape target path bird_model sleap_csv dlc_csv mot_txt idtracker_csv trex_npz sleap_h5; do
     log="work/$t.log"
     [ -f "$log" ] || continue
     grep -q "stat::number_of_executed_units" "$log" || continue

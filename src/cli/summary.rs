@@ -40,7 +40,31 @@ pub fn print_deferred() {
         } else {
             super::stdout::diagnostic(&format!("{text}\nwrote {}", files.join(", ")));
         }
+        for p in &outputs {
+            if let Some(hint) = binary_frames_hint(p) {
+                super::stdout::diagnostic(&hint);
+            }
+        }
     }
+}
+
+/// Text animation files from this size up get a hint of `--binary-frames`.
+const LARGE_JSON_BYTES: u64 = 1_000_000_000;
+
+/// For an animation `.json` of [`LARGE_JSON_BYTES`] or more (a frames file beside a JSON keeps
+/// it small): that `--binary-frames` would write it in less than half the size.
+fn binary_frames_hint(p: &std::path::Path) -> Option<String> {
+    let json = p
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("json"));
+    let size = std::fs::metadata(p).ok()?.len();
+    (json && size >= LARGE_JSON_BYTES).then(|| {
+        format!(
+            "{}: {} of text; --binary-frames writes its frames to a single-precision file beside it, less than half the size, which every command reads back (docs/formats.md)",
+            super::stdout::file_name(p),
+            human_size(&size)
+        )
+    })
 }
 
 /// Bytes of a file, or of every file in a directory (PNG frames).
