@@ -416,27 +416,85 @@ impl Frame {
         }
     }
 
+    /// The per-bird arrays of a frame, in the order the animation file writes them, each with its
+    /// precision in steps per unit ([`precision`]); the first [`Frame::REQUIRED`] are in every
+    /// frame, the others optional.
+    pub const FIELDS: [(&'static str, f64); 10] = [
+        ("x", precision::POSITION),
+        ("y", precision::POSITION),
+        ("z", precision::POSITION),
+        ("heading", precision::ANGLE),
+        ("speed", precision::SPEED),
+        ("bank", precision::ANGLE),
+        ("pitch", precision::ANGLE),
+        ("e", precision::SAVING),
+        ("xi", precision::SAVING),
+        ("wing_phase", precision::ANGLE),
+    ];
+
+    /// How many of [`Frame::FIELDS`] every frame has.
+    pub const REQUIRED: usize = 5;
+
+    /// The values of field `k` of [`Frame::FIELDS`], `None` where this frame has none.
+    pub fn values(&self, k: usize) -> Option<&[f64]> {
+        match k {
+            0 => Some(&self.x),
+            1 => Some(&self.y),
+            2 => Some(&self.z),
+            3 => Some(&self.heading),
+            4 => Some(&self.speed),
+            5 => self.bank.as_deref(),
+            6 => self.pitch.as_deref(),
+            7 => self.e.as_deref(),
+            8 => self.xi.as_deref(),
+            _ => self.wing_phase.as_deref(),
+        }
+    }
+
+    /// The slot of field `k` of [`Frame::FIELDS`] (a required field's always holds values).
+    fn slot(&mut self, k: usize) -> Slot<'_> {
+        match k {
+            0 => Slot::Required(&mut self.x),
+            1 => Slot::Required(&mut self.y),
+            2 => Slot::Required(&mut self.z),
+            3 => Slot::Required(&mut self.heading),
+            4 => Slot::Required(&mut self.speed),
+            5 => Slot::Optional(&mut self.bank),
+            6 => Slot::Optional(&mut self.pitch),
+            7 => Slot::Optional(&mut self.e),
+            8 => Slot::Optional(&mut self.xi),
+            _ => Slot::Optional(&mut self.wing_phase),
+        }
+    }
+
+    /// Sets field `k` of [`Frame::FIELDS`] (`None`: absent; a required field is left empty).
+    pub fn set_values(&mut self, k: usize, v: Option<Vec<f64>>) {
+        match self.slot(k) {
+            Slot::Required(x) => *x = v.unwrap_or_default(),
+            Slot::Optional(x) => *x = v,
+        }
+    }
+
     /// Rounds every bird's values to the precision the animation file stores
     /// ([`precision`]), so that what is written and read back is exactly what every other output
     /// of the same run was made from.
     pub fn quantize(&mut self) {
-        use precision::*;
-        let round = |v: &mut Vec<f64>, steps: f64| v.iter_mut().for_each(|x| *x = to(*x, steps));
-        for v in [&mut self.x, &mut self.y, &mut self.z] {
-            round(v, POSITION);
-        }
-        round(&mut self.heading, ANGLE);
-        round(&mut self.speed, SPEED);
-        for v in [&mut self.bank, &mut self.pitch, &mut self.wing_phase]
-            .into_iter()
-            .flatten()
-        {
-            round(v, ANGLE);
-        }
-        for v in [&mut self.e, &mut self.xi].into_iter().flatten() {
-            round(v, SAVING);
+        for (k, &(_, steps)) in Frame::FIELDS.iter().enumerate() {
+            let v = match self.slot(k) {
+                Slot::Required(x) => Some(x),
+                Slot::Optional(x) => x.as_mut(),
+            };
+            for x in v.into_iter().flatten() {
+                *x = precision::to(*x, steps);
+            }
         }
     }
+}
+
+/// Where one of a frame's per-bird arrays is held ([`Frame::FIELDS`]).
+enum Slot<'a> {
+    Required(&'a mut Vec<f64>),
+    Optional(&'a mut Option<Vec<f64>>),
 }
 
 /// The precision of the animation file's per-bird values, in steps per unit: positions to 10⁻⁵

@@ -9,7 +9,7 @@
 //! to its precision, in its units and up axis) in single precision. docs/formats.md has the
 //! reading recipe for NumPy.
 
-use std::io::{BufReader, BufWriter, Read, Write};
+use std::io::{BufReader, Read, Write};
 use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
@@ -23,23 +23,6 @@ pub const FRAMES_FORMAT: &str = "formation-frames/1";
 /// The first bytes of a frames file.
 pub const MAGIC: &[u8; 16] = b"formation-frames";
 
-/// The frames' fields a frames file may hold, in the order they are written.
-pub const FIELDS: [&str; 10] = [
-    "x",
-    "y",
-    "z",
-    "heading",
-    "speed",
-    "bank",
-    "pitch",
-    "e",
-    "xi",
-    "wing_phase",
-];
-
-/// The fields every frame has.
-const REQUIRED: usize = 5;
-
 /// What the animation file says of its frames file.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -50,8 +33,8 @@ pub struct FramesFile {
     pub path: String,
     /// Number of frames (records).
     pub frames: usize,
-    /// The fields of each record after `t`, in order (a subset of [`FIELDS`] holding the five
-    /// positions and motion fields).
+    /// The fields of each record after `t`, in order (names of [`Frame::FIELDS`], the first
+    /// [`Frame::REQUIRED`] among them).
     pub fields: Vec<String>,
 }
 
@@ -69,34 +52,8 @@ fn record_bytes(birds: usize, fields: usize) -> Option<u64> {
         .checked_add(8)
 }
 
-/// The values of field `k` ([`FIELDS`] order) of a frame, `None` where the frame has none.
-fn field(f: &Frame, k: usize) -> Option<&[f64]> {
-    match k {
-        0 => Some(&f.x),
-        1 => Some(&f.y),
-        2 => Some(&f.z),
-        3 => Some(&f.heading),
-        4 => Some(&f.speed),
-        5 => f.bank.as_deref(),
-        6 => f.pitch.as_deref(),
-        7 => f.e.as_deref(),
-        8 => f.xi.as_deref(),
-        _ => f.wing_phase.as_deref(),
-    }
-}
-
-/// Steps per unit of field `k` in the animation file ([`precision`]).
-fn steps(k: usize) -> f64 {
-    match k {
-        0..=2 => precision::POSITION,
-        4 => precision::SPEED,
-        7 | 8 => precision::SAVING,
-        _ => precision::ANGLE,
-    }
-}
-
-/// Writes `anim`'s frames to `out`, the file that will be `frames_target` (see the module's
-/// layout), and returns what the animation file says of them (`path` = the target's file name).
+/// Writes `anim`'s frames to `out` (buffered: records are written a field at a time), the file
+/// that will be `frames_target` (see the module's layout), and returns what the animation file says of them (`path` = the target's file name).
 /// A value that is not finite is an error naming its frame, bird and field. Nothing is moved into
 /// place: the caller commits both files together.
 pub fn write_frames(
@@ -104,27 +61,26 @@ pub fn write_frames(
     out: &mut impl Write,
     frames_target: &Path,
 ) -> std::io::Result<FramesFile> {
-    let present: Vec<usize> = (0..FIELDS.len())
-        .filter(|&k| k < REQUIRED || anim.frames.iter().any(|f| field(f, k).is_some()))
+    let present: Vec<usize> = (0..Frame::FIELDS.len())
+        .filter(|&k| k < Frame::REQUIRED || anim.frames.iter().any(|f| f.values(k).is_some()))
         .collect();
-    let mut out = BufWriter::with_capacity(1 << 20, out);
     out.write_all(MAGIC)?;
     let mut record = Vec::with_capacity(anim.birds * 4);
     for (i, f) in anim.frames.iter().enumerate() {
         out.write_all(&f.t.to_le_bytes())?;
         for &k in &present {
             record.clear();
-            match field(f, k) {
+            let (name, steps) = Frame::FIELDS[k];
+            match f.values(k) {
                 Some(v) => {
-                    let s = steps(k);
-                    if let Some(b) = v.iter().position(|x| !x.is_finite()) {
-                        return Err(std::io::Error::new(
-                            std::io::ErrorKind::InvalidData,
-                            format!("frame {i}, bird {b}: {} is not a finite number", FIELDS[k]),
-                        ));
-                    }
-                    for &x in v {
-                        record.extend_from_slice(&(precision::to(x, s) as f32).to_le_bytes());
+                    for (b, &x) in v.iter().enumerate() {
+                        if !x.is_finite() {
+                            return Err(std::io::Error::new(
+                                std::io::ErrorKind::InvalidData,
+                                format!("frame {i}, bird {b}: {name} is not a finite number"),
+                            ));
+                        }
+                        record.extend_from_slice(&(precision::to(x, steps) as f32).to_le_bytes());
                     }
                 }
                 None => {
@@ -144,7 +100,10 @@ pub fn write_frames(
             .map(|n| n.to_string_lossy().into_owned())
             .unwrap_or_default(),
         frames: anim.frames.len(),
-        fields: present.iter().map(|&k| FIELDS[k].to_string()).collect(),
+        fields: present
+            .iter()
+            .map(|&k| Frame::FIELDS[k].0.to_string())
+            .collect(),
     })
 }
 
@@ -157,11 +116,8 @@ pub fn read_frames(anim: &mut Animation, origin: &Path) -> Result<()> {
         return Ok(());
     };
     let name = Path::new(&ff.path);
-    let plain = name.components().count() == 1
-        && matches!(
-            name.components().next(),
-            Some(std::path::Component::Normal(_))
-        );
+    // A bare file name is its own last component: no directory, no `..`, not absolute.
+    let plain = name.file_name() == Some(name.as_os_str());
     if !plain {
         return Err(Error::format(
             origin,
@@ -221,12 +177,13 @@ pub fn read_frames_from(
                 .into(),
         );
     }
-    let mut order = Vec::with_capacity(ff.fields.len().min(FIELDS.len()));
+    let mut order = Vec::with_capacity(ff.fields.len().min(Frame::FIELDS.len()));
     for (i, f) in ff.fields.iter().enumerate() {
-        let Some(k) = FIELDS.iter().position(|g| g == f) else {
+        let Some(k) = Frame::FIELDS.iter().position(|(g, _)| g == f) else {
+            let names: Vec<&str> = Frame::FIELDS.iter().map(|(g, _)| *g).collect();
             return bad(format!(
                 "frames_file.fields[{i}]: unknown field \"{f}\" (expected some of {})",
-                FIELDS.join(", ")
+                names.join(", ")
             ));
         };
         if order.contains(&k) {
@@ -234,10 +191,10 @@ pub fn read_frames_from(
         }
         order.push(k);
     }
-    if let Some(k) = (0..REQUIRED).find(|k| !order.contains(k)) {
+    if let Some(k) = (0..Frame::REQUIRED).find(|k| !order.contains(k)) {
         return bad(format!(
             "frames_file.fields: \"{}\" is missing (every frame has x, y, z, heading and speed)",
-            FIELDS[k]
+            Frame::FIELDS[k].0
         ));
     }
     if anim.birds == 0 {
@@ -286,20 +243,8 @@ pub fn read_frames_from(
                 .map(|b| f64::from(f32::from_le_bytes([b[0], b[1], b[2], b[3]])))
                 .collect();
             // An optional field all NaN is one this frame does not have.
-            let absent = k >= REQUIRED && v.iter().all(|x| x.is_nan());
-            let v = (!absent).then_some(v);
-            match k {
-                0 => f.x = v.unwrap_or_default(),
-                1 => f.y = v.unwrap_or_default(),
-                2 => f.z = v.unwrap_or_default(),
-                3 => f.heading = v.unwrap_or_default(),
-                4 => f.speed = v.unwrap_or_default(),
-                5 => f.bank = v,
-                6 => f.pitch = v,
-                7 => f.e = v,
-                8 => f.xi = v,
-                _ => f.wing_phase = v,
-            }
+            let absent = k >= Frame::REQUIRED && v.iter().all(|x| x.is_nan());
+            f.set_values(k, (!absent).then_some(v));
         }
         frames.push(f);
     }
@@ -357,12 +302,12 @@ mod tests {
         assert_eq!(b.frames.len(), 2);
         for (fa, fb) in a.frames.iter().zip(&b.frames) {
             assert_eq!(fa.t, fb.t);
-            for (k, name) in FIELDS.iter().enumerate() {
-                match (field(fa, k), field(fb, k)) {
+            for (k, &(name, steps)) in Frame::FIELDS.iter().enumerate() {
+                match (fa.values(k), fb.values(k)) {
                     (None, None) => {}
                     (Some(va), Some(vb)) => {
                         for (x, y) in va.iter().zip(vb) {
-                            let want = f64::from(precision::to(*x, steps(k)) as f32);
+                            let want = f64::from(precision::to(*x, steps) as f32);
                             assert_eq!(want, *y, "field {name}");
                         }
                     }
