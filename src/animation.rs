@@ -9,6 +9,7 @@ use crate::error::{Error, Result};
 
 pub mod axes;
 pub mod binary;
+pub mod clearance;
 pub mod landing;
 pub mod relative;
 pub mod resample;
