@@ -45,7 +45,7 @@ pub struct Clearance {
     pub body: usize,
     /// Frames with at least one clash.
     pub frames_with_clash: usize,
-    /// The closest pair within [`REACH`] of each other, if any came that close.
+    /// The closest pair within the clash reach (1.2 wingspans) of each other, if any came that close.
     pub closest: Option<Closest>,
 }
 
