@@ -100,6 +100,7 @@ fn leader_changes_happen_are_recorded_and_stay_apart_and_smooth() {
             // Apart, bounded acceleration and turn rate in every frame.
             let dt = 1.0 / anim.fps;
             let (mut closest, mut acc, mut turn) = (f64::INFINITY, 0.0f64, 0.0f64);
+            let mut acc_at = (0, 0);
             for (k, fr) in anim.frames.iter().enumerate() {
                 for i in 0..fr.x.len() {
                     for j in 0..i {
@@ -109,10 +110,27 @@ fn leader_changes_happen_are_recorded_and_stay_apart_and_smooth() {
                         let (a, b) = (&anim.frames[k - 1], &anim.frames[k - 2]);
                         let ax = (fr.x[i] - 2.0 * a.x[i] + b.x[i]) / (dt * dt);
                         let ay = (fr.y[i] - 2.0 * a.y[i] + b.y[i]) / (dt * dt);
-                        acc = acc.max(ax.hypot(ay));
+                        if ax.hypot(ay) > acc {
+                            acc = ax.hypot(ay);
+                            acc_at = (k, i);
+                        }
                         turn = turn.max((fr.heading[i] - a.heading[i]).abs() / dt);
                     }
                 }
+            }
+            if std::env::var_os("DEBUG_ACC").is_some() {
+                for k in acc_at.0 - 6..acc_at.0 + 4 {
+                    let f = &anim.frames[k];
+                    let i = acc_at.1;
+                    eprintln!(
+                        "{k} x {:.5} y {:.5} z {:.5} h {:.5}",
+                        f.x[i],
+                        f.y[i] - 10.0 * f.t,
+                        f.z[i],
+                        f.heading[i]
+                    );
+                }
+                eprintln!("{:?}", anim.events);
             }
             eprintln!(
                 "{name} seed {seed}: {} leader changes, {swaps} swaps, closest {closest:.3}, accel {acc:.2}, turn {:.1} °/s",
@@ -125,7 +143,9 @@ fn leader_changes_happen_are_recorded_and_stay_apart_and_smooth() {
             );
             assert!(
                 acc <= 4.0,
-                "{name} seed {seed}: acceleration {acc} wingspans/s²"
+                "{name} seed {seed}: acceleration {acc} wingspans/s² (frame {}, bird {})",
+                acc_at.0,
+                acc_at.1
             );
             assert!(
                 turn <= 30f64.to_radians(),

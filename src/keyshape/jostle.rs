@@ -7,8 +7,9 @@
 //! frame rate: a sum of M cosines with frequencies drawn from N(0, 1/ℓ²) and uniform phases,
 //! u(t) = s·√(2/M)·Σ cos(ω_m t + φ_m) (random Fourier features of a Gaussian-kernel process:
 //! standard deviation s, autocorrelation exp(−τ²/(2ℓ²))). It is bounded smoothly,
-//! d = u/(1 + (u/A)⁸)^(1/8) (the identity well inside A = `limit`, never beyond it, so no bird
-//! strays far enough to meet a neighbour), and faded in
+//! d = u/(1 + (u/A)⁴)^(1/4) (close to the identity well inside A, never beyond it), where A is
+//! the smaller of `limit` and the bird's room among its neighbours ([`rooms`]: while every bird
+//! stays inside its room, no two birds' wings or bodies meet), and faded in
 //! over the first `ramp_s` seconds with a smoothstep (the steady flight starts where the
 //! take-off hands over, at the first key shape, at rest in the flock's frame). Velocity and
 //! acceleration are analytic and bounded: |ü| ≤ s·√(2/M)·Σ ω_m².
@@ -142,36 +143,183 @@ fn normal_quantile(p: f64) -> f64 {
     }
 }
 
-/// Closest two birds may come by their deviations, wingspans.
-pub const CLEARANCE: f64 = 0.45;
-/// Smallest room, wingspans.
-const MIN_BOUND: f64 = 0.02;
-/// Room (half the clearance left by the nearest neighbour) at which a bird keeps position fully,
-/// wingspans.
+/// The wing envelope of the clash test: two flying birds clash when, in the heading frame,
+/// they are under this far apart laterally, fore and aft and vertically (wingspans).
+pub const WING_ENVELOPE: [f64; 3] = [1.0, 0.15, 0.08];
+/// The body test: any one coordinate this far apart keeps two bodies apart (wingspans).
+pub const BODY_ENVELOPE: f64 = 0.3;
+/// What the position keeping leaves of each envelope on each axis, wingspans: the lateral and
+/// fore-aft margins cover the turn of a bird's heading frame by its own small moves (a few
+/// degrees over a wingspan's distance).
+const MARGIN: [f64; 3] = [0.04, 0.06, 0.02];
+/// How strongly an axis that does not keep a pair apart is freed, per wingspan of the other
+/// axis's lead (dimensionless).
+const RELEASE: f64 = 1.0;
+/// Width over which the release sets in, wingspans (it is C¹: the bounds change without kinks).
+const RELEASE_WIDTH: f64 = 0.05;
+/// Pairs farther apart than this on either horizontal axis do not bound each other (their
+/// bounds would be above 1.5 wingspans, a term under 10⁻⁴ of the limit's in the soft minimum).
+const NEIGHBOURHOOD: f64 = 4.0;
+/// Smallest pair bound, wingspans (a placement that already clashes leaves the birds still).
+const FLOOR: f64 = 1e-3;
+/// Room (a bound) below which the motion on that axis is scaled down rather than only clipped,
+/// so its acceleration stays bounded, wingspans.
 pub const FULL_ROOM: f64 = 0.25;
 
-/// Each bird's distance to its nearest neighbour, as the smooth minimum
-/// D = (Σ_j d_j⁻⁸)^(−1/8) ≤ min_j d_j over the other birds (wingspans), and its rate of change
-/// (wingspans per second), from positions `x`, `y` and velocities `vx`, `vy`. Smooth, so the
-/// bound it sets changes without kinks when the nearest neighbour changes.
-pub fn nearest(x: &[f64], y: &[f64], vx: &[f64], vy: &[f64]) -> Vec<(f64, f64)> {
-    let n = x.len();
-    (0..n)
-        .map(|i| {
-            let (mut sum, mut dsum) = (0.0, 0.0);
-            for j in (0..n).filter(|&j| j != i) {
-                let (dx, dy) = (x[i] - x[j], y[i] - y[j]);
-                let d = dx.hypot(dy).max(1e-9);
-                let rate = (dx * (vx[i] - vx[j]) + dy * (vy[i] - vy[j])) / d;
-                let w = d.powi(-8);
-                sum += w;
-                dsum += -8.0 * w / d * rate;
+/// The birds' placement before position keeping (key shapes and manoeuvres): lateral, depth
+/// behind the leader and height, and their rates, one entry a bird.
+#[derive(Debug, Clone, Copy)]
+pub struct Placement<'a> {
+    /// Lateral positions, wingspans.
+    pub x: &'a [f64],
+    /// Depths (positive behind), wingspans.
+    pub y: &'a [f64],
+    /// Heights, wingspans.
+    pub z: &'a [f64],
+    /// d x / d t, wingspans per second.
+    pub vx: &'a [f64],
+    /// d y / d t.
+    pub vy: &'a [f64],
+    /// d z / d t.
+    pub vz: &'a [f64],
+}
+
+/// How far one bird may deviate on each horizontal axis without meeting a neighbour, and how
+/// fast that changes: (lateral, its rate, fore-aft, its rate), wingspans and wingspans per
+/// second. Infinite with no neighbour near.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Room {
+    /// Lateral bound.
+    pub x: f64,
+    /// Its rate.
+    pub dx: f64,
+    /// Fore-aft bound.
+    pub y: f64,
+    /// Its rate.
+    pub dy: f64,
+    /// Share of its position keeping the bird flies (0 while it manoeuvres, 1 else).
+    pub keep: f64,
+    /// Its rate.
+    pub dkeep: f64,
+}
+
+impl Room {
+    /// No neighbour near.
+    pub const FREE: Room = Room {
+        x: f64::INFINITY,
+        dx: 0.0,
+        y: f64::INFINITY,
+        dy: 0.0,
+        keep: 1.0,
+        dkeep: 0.0,
+    };
+}
+
+/// max(0, d) with its corner rounded over [`RELEASE_WIDTH`] (C¹), and its derivative.
+fn release(d: f64) -> (f64, f64) {
+    let w = RELEASE_WIDTH;
+    if d <= 0.0 {
+        (0.0, 0.0)
+    } else if d < w {
+        (d * d / (2.0 * w), d / w)
+    } else {
+        (d - w / 2.0, 1.0)
+    }
+}
+
+/// One pair's bounds on the two horizontal axes from one envelope: the slack s_a on each axis
+/// (distance beyond the envelope and its margin) and its rate. The axis with the most slack
+/// keeps the pair apart: each bird may use half of it. An axis that does not is freed by
+/// [`RELEASE`] times the others' lead over it, so a bird moves freely sideways behind a
+/// neighbour it is well clear of fore and aft, and the other way round; at a tie both are held
+/// to half their slack; an axis without slack frees nothing. (bound, rate) on x and y.
+fn pair_bounds(s: [(f64, f64); 3]) -> [(f64, f64); 2] {
+    let mut out = [(0.0, 0.0); 2];
+    for (a, o) in out.iter_mut().enumerate() {
+        let (mut b, mut db) = (0.5 * s[a].0, 0.5 * s[a].1);
+        for (c, &(sc, dsc)) in s.iter().enumerate() {
+            if c != a {
+                // Only an axis that keeps the pair apart itself (positive slack) frees another:
+                // its lead over the other, or its whole slack when the other has none.
+                let (lead, dlead) = if sc - s[a].0 <= sc {
+                    (sc - s[a].0, dsc - s[a].1)
+                } else {
+                    (sc, dsc)
+                };
+                let (r, dr) = release(lead);
+                b += RELEASE * r;
+                db += RELEASE * dr * dlead;
             }
-            if sum == 0.0 {
-                return (f64::INFINITY, 0.0);
+        }
+        *o = if b > FLOOR { (b, db) } else { (FLOOR, 0.0) };
+    }
+    out
+}
+
+/// Each bird's [`Room`] in the placement `p`: the soft minimum (Σ b⁻⁸)^(−1/8) ≤ min b over the
+/// bounds b its neighbours set on each axis by the wing envelope (under [`WING_ENVELOPE`] on
+/// every axis is a clash) and the body envelope (a clash needs every axis under
+/// [`BODY_ENVELOPE`]), each with its margin. While every bird stays within its bounds no pair
+/// can meet: for each pair, on the axis with the most slack, the two birds together use less
+/// than it (the height is not moved by the position keeping). Smooth in the placement, so the
+/// bounds change without kinks as neighbours move.
+pub fn rooms(p: &Placement) -> Vec<Room> {
+    let n = p.x.len();
+    // Σ b⁻⁸ and Σ −8 b⁻⁹ b′ per bird and axis.
+    let mut acc = vec![[(0.0f64, 0.0f64); 2]; n];
+    let mut idx: Vec<usize> = (0..n).collect();
+    idx.sort_by(|&a, &b| p.x[a].total_cmp(&p.x[b]).then(a.cmp(&b)));
+    for (k, &i) in idx.iter().enumerate() {
+        for &j in &idx[k + 1..] {
+            if !(p.x[j] - p.x[i] < NEIGHBOURHOOD) {
+                break;
             }
-            let big = sum.powf(-1.0 / 8.0);
-            (big, -big / (8.0 * sum) * dsum)
+            let dy = p.y[i] - p.y[j];
+            if !(dy.abs() < NEIGHBOURHOOD) {
+                continue;
+            }
+            let d = [p.x[i] - p.x[j], dy, p.z[i] - p.z[j]];
+            let v = [p.vx[i] - p.vx[j], p.vy[i] - p.vy[j], p.vz[i] - p.vz[j]];
+            let abs = |a: usize| (d[a].abs(), if d[a] < 0.0 { -v[a] } else { v[a] });
+            let slack = |env: [f64; 3]| -> [(f64, f64); 3] {
+                std::array::from_fn(|a| {
+                    let (m, dm) = abs(a);
+                    (m - env[a] - MARGIN[a], dm)
+                })
+            };
+            let body = [BODY_ENVELOPE; 3];
+            for bounds in [pair_bounds(slack(WING_ENVELOPE)), pair_bounds(slack(body))] {
+                for (a, &(b, db)) in bounds.iter().enumerate() {
+                    let w = b.powi(-8);
+                    let dw = -8.0 * w / b * db;
+                    for q in [i, j] {
+                        acc[q][a].0 += w;
+                        acc[q][a].1 += dw;
+                    }
+                }
+            }
+        }
+    }
+    acc.iter()
+        .map(|[(sx, dsx), (sy, dsy)]| {
+            // R = S^(−1/8), R′ = −S′ R / (8 S).
+            let axis = |s: f64, ds: f64| {
+                if s > 0.0 {
+                    let r = s.powf(-0.125);
+                    (r, -ds * r / (8.0 * s))
+                } else {
+                    (f64::INFINITY, 0.0)
+                }
+            };
+            let (x, dx) = axis(*sx, *dsx);
+            let (y, dy) = axis(*sy, *dsy);
+            Room {
+                x,
+                dx,
+                y,
+                dy,
+                ..Room::FREE
+            }
         })
         .collect()
 }
@@ -335,13 +483,13 @@ impl<'a> JostleClock<'a> {
         self.frame = Some(k);
     }
 
-    /// Bird `i`'s deviation at the current frame (see [`Jostle::at`]).
-    pub fn at(&self, i: usize, nearest: f64, nearest_rate: f64) -> Deviation {
+    /// Bird `i`'s deviation at the current frame with its room `room` (see [`Jostle::at`]).
+    pub fn at(&self, i: usize, room: Room) -> Deviation {
         let t = self.frame.unwrap_or(0) as f64 / self.fps;
         let [(cx, _), (cy, _)] = &self.state[i];
         let [ax, ay] = &self.jostle.birds[i];
         self.jostle
-            .shape(t, nearest, nearest_rate, ax.eval_from(cx), ay.eval_from(cy))
+            .shape(t, room, ax.eval_from(cx), ay.eval_from(cy))
     }
 }
 
@@ -399,15 +547,14 @@ impl Jostle {
         })
     }
 
-    /// Bird `i`'s deviation at `t` seconds from the start of the steady flight, with the
-    /// bird's nearest neighbour `nearest` wingspans away in the key-shape placement and that
-    /// distance changing at `nearest_rate` wingspans per second ([`nearest`]). Each axis is
-    /// bounded by `limit`, and the whole motion is scaled by softmin(1, room/FULL_ROOM) with
-    /// room = 0.02 + (nearest − CLEARANCE)/2, so a bird crowded by a neighbour keeps still (the
-    /// tests check every frame's closest pair).
-    pub fn at(&self, i: usize, t: f64, nearest: f64, nearest_rate: f64) -> Deviation {
+    /// Bird `i`'s deviation at `t` seconds from the start of the steady flight, with its room
+    /// `room` among its neighbours ([`rooms`]). On each axis the deviation is bounded by
+    /// A = softmin(`limit`, room) and, where A is under [`FULL_ROOM`], scaled down with it, so a
+    /// crowded bird keeps still on that axis rather than pressing against its bound (the tests
+    /// check every frame against the clash test).
+    pub fn at(&self, i: usize, t: f64, room: Room) -> Deviation {
         let [ax, ay] = &self.birds[i];
-        self.shape(t, nearest, nearest_rate, ax.eval(t), ay.eval(t))
+        self.shape(t, room, ax.eval(t), ay.eval(t))
     }
 
     /// A clock for the frames t = k / fps in order ([`JostleClock`]).
@@ -438,43 +585,44 @@ impl Jostle {
         }
     }
 
-    /// The deviation from the raw axis motions (u, u′) of both axes: the ramp, the room scaling
-    /// and the bound of [`Jostle::at`].
-    fn shape(
-        &self,
-        t: f64,
-        nearest: f64,
-        nearest_rate: f64,
-        ux: (f64, f64),
-        uy: (f64, f64),
-    ) -> Deviation {
+    /// The deviation from the raw axis motions (u, u′) of both axes: the ramp, and each axis's
+    /// bound and scaling by its room ([`Jostle::at`]).
+    fn shape(&self, t: f64, room: Room, ux: (f64, f64), uy: (f64, f64)) -> Deviation {
         let (e, de) = if self.ramp > 0.0 && t < self.ramp {
             let s = (t / self.ramp).max(0.0);
             (s * s * (3.0 - 2.0 * s), 6.0 * s * (1.0 - s) / self.ramp)
         } else {
             (1.0, 0.0)
         };
-        // The motion is scaled down, g = softmin(1, room/FULL_ROOM) = (1 + (room/FULL_ROOM)⁻⁸)^(−1/8),
-        // where the key-shape placement leaves a bird little room: scaling (not clipping harder)
-        // keeps the acceleration bounded.
-        let (room, droom) = if nearest > CLEARANCE {
-            (MIN_BOUND + (nearest - CLEARANCE) / 2.0, nearest_rate / 2.0)
-        } else {
-            (MIN_BOUND, 0.0)
+        // The fade-in and the share the bird keeps (0 while it manoeuvres).
+        let (e, de) = (e * room.keep, de * room.keep + e * room.dkeep);
+        let limit = self.limit;
+        let axis = |(u, du): (f64, f64), r: f64, dr: f64| -> (f64, f64) {
+            // A = (L⁻⁸ + R⁻⁸)^(−1/8) ≤ min(L, R), A′ = A⁹ R⁻⁹ R′.
+            let (a, da) = if r.is_finite() {
+                let q = (limit / r).powi(8);
+                let a = limit * (1.0 + q).powf(-0.125);
+                (a, (a / r).powi(9) * dr)
+            } else {
+                (limit, 0.0)
+            };
+            // g = softmin(1, A / FULL_ROOM): the motion scaled down where the room is small
+            // (scaling, not clipping harder, keeps the acceleration bounded).
+            let p = (FULL_ROOM / a).powi(8);
+            let g = (1.0 + p).powf(-0.125);
+            let dg = (1.0 + p).powf(-1.125) * p / a * da;
+            // f(v) = v / (1 + (v/A)⁴)^(1/4): close to the identity inside A, never beyond it
+            // (a fourth power, not a higher one, so a bird meeting its bound turns gently).
+            let v = g * u;
+            let dv = dg * u + g * du;
+            let r4 = (v / a).powi(4);
+            let f = v * (1.0 + r4).powf(-0.25);
+            let df_dv = (1.0 + r4).powf(-1.25);
+            let df_da = v * r4 / a * (1.0 + r4).powf(-1.25);
+            (e * f, de * f + e * (df_dv * dv + df_da * da))
         };
-        let q = room / FULL_ROOM;
-        let g = (1.0 + q.powi(-8)).powf(-1.0 / 8.0);
-        let dg = (g / q).powi(9) * droom / FULL_ROOM;
-        let a = self.limit;
-        let bound = |(u, du): (f64, f64)| {
-            // f(u) = u / (1 + (u/A)⁸)^(1/8): the identity well inside A, never beyond it.
-            let r = (u / a).powi(8);
-            let f = u * (1.0 + r).powf(-1.0 / 8.0);
-            let df = (1.0 + r).powf(-9.0 / 8.0) * du;
-            (e * g * f, (de * g + e * dg) * f + e * g * df)
-        };
-        let (x, vx) = bound(ux);
-        let (y, vy) = bound(uy);
+        let (x, vx) = axis(ux, room.x, room.dx);
+        let (y, vy) = axis(uy, room.y, room.dy);
         Deviation { x, y, vx, vy }
     }
 }
@@ -521,14 +669,21 @@ mod tests {
         let j = Jostle::draw(3, &keep, &opts, &mut stream(1, "t")).unwrap();
         for &t in &[0.3, 1.7, 5.0, 40.2] {
             let h = 1e-6;
-            // A neighbour closing in at 0.2 wingspans per second, tightening the bound.
-            let near = |t: f64| 0.6 - 0.2 * (t - 5.0);
-            let at = |t: f64| j.at(1, t, near(t), -0.2);
+            // Neighbours closing in, tightening both bounds.
+            let room = |t: f64| Room {
+                x: 0.3 - 0.005 * (t - 5.0),
+                dx: -0.005,
+                y: 0.08 + 0.001 * (t - 5.0),
+                dy: 0.001,
+                ..Room::FREE
+            };
+            let at = |t: f64| j.at(1, t, room(t));
             let (a, b, d) = (at(t - h), at(t + h), at(t));
             assert!(((b.x - a.x) / (2.0 * h) - d.vx).abs() < 1e-6);
             assert!(((b.y - a.y) / (2.0 * h) - d.vy).abs() < 1e-6);
+            assert!(d.y.abs() < room(t).y && d.x.abs() < room(t).x);
         }
-        assert_eq!(j.at(2, 0.0, 2.0, 0.0), Deviation::default());
+        assert_eq!(j.at(2, 0.0, Room::FREE), Deviation::default());
     }
 
     #[test]
@@ -544,7 +699,14 @@ mod tests {
                 clock.seek(k);
                 let t = k as f64 / fps;
                 for i in 0..4 {
-                    let (a, b) = (clock.at(i, 1.0, 0.1), j.at(i, t, 1.0, 0.1));
+                    let room = Room {
+                        x: 1.0,
+                        dx: 0.1,
+                        y: 0.2,
+                        dy: -0.1,
+                        ..Room::FREE
+                    };
+                    let (a, b) = (clock.at(i, room), j.at(i, t, room));
                     worst = worst
                         .max((a.x - b.x).abs())
                         .max((a.y - b.y).abs())
@@ -555,8 +717,107 @@ mod tests {
                     }
                 }
             }
-            assert!(worst < 1e-12, "{fps} fps: {worst}");
+            assert!(worst < 1e-11, "{fps} fps: {worst}");
         }
+    }
+
+    /// A placement moving at constant rates: (x, y, z) at time t.
+    fn moving(t: f64) -> [Vec<f64>; 3] {
+        let x0 = [0.0, 0.8, -0.9, 1.7, 0.85, 2.5];
+        let y0 = [0.0, 0.45, 0.5, 1.0, 0.9, 1.3];
+        let z0 = [0.0, 0.05, -0.04, 0.02, 0.15, 0.0];
+        let v = [0.05, -0.1, 0.02, 0.07, -0.03, 0.0];
+        [
+            x0.iter().zip(&v).map(|(a, b)| a + b * t).collect(),
+            y0.iter().zip(&v).map(|(a, b)| a - 0.5 * b * t).collect(),
+            z0.iter().zip(&v).map(|(a, b)| a + 0.2 * b * t).collect(),
+        ]
+    }
+
+    #[test]
+    fn rooms_change_at_the_rate_they_report() {
+        let v = [0.05, -0.1, 0.02, 0.07, -0.03, 0.0];
+        let vy: Vec<f64> = v.iter().map(|b| -0.5 * b).collect();
+        let vz: Vec<f64> = v.iter().map(|b| 0.2 * b).collect();
+        let at = |t: f64| {
+            let [x, y, z] = moving(t);
+            rooms(&Placement {
+                x: &x,
+                y: &y,
+                z: &z,
+                vx: &v,
+                vy: &vy,
+                vz: &vz,
+            })
+        };
+        for t in [0.0, 0.7, 1.9, 3.3] {
+            let h = 1e-6;
+            let (a, b, r) = (at(t - h), at(t + h), at(t));
+            for i in 0..6 {
+                assert!(
+                    ((b[i].x - a[i].x) / (2.0 * h) - r[i].dx).abs() < 1e-5,
+                    "{t} {i}"
+                );
+                assert!(
+                    ((b[i].y - a[i].y) / (2.0 * h) - r[i].dy).abs() < 1e-5,
+                    "{t} {i}"
+                );
+                assert!(r[i].x > 0.0 && r[i].y > 0.0);
+            }
+        }
+    }
+
+    #[test]
+    fn birds_inside_their_rooms_never_clash() {
+        let mut rng = stream(7, "rooms");
+        let mut checked = 0;
+        for _ in 0..4000 {
+            // Random placements of four birds near each other that do not clash.
+            let n = 4;
+            let x: Vec<f64> = (0..n).map(|_| rng.random_range(-1.5..1.5)).collect();
+            let y: Vec<f64> = (0..n).map(|_| rng.random_range(-1.0..1.0)).collect();
+            let z: Vec<f64> = (0..n).map(|_| rng.random_range(-0.15..0.15)).collect();
+            let zero = vec![0.0; n];
+            let clash = |x: &[f64], y: &[f64]| {
+                (0..n).any(|i| {
+                    (i + 1..n).any(|j| {
+                        let d = [
+                            (x[i] - x[j]).abs(),
+                            (y[i] - y[j]).abs(),
+                            (z[i] - z[j]).abs(),
+                        ];
+                        (d[0] < 1.0 && d[1] < 0.15 && d[2] < 0.08)
+                            || d.iter().all(|&v| v < BODY_ENVELOPE)
+                    })
+                })
+            };
+            let r = rooms(&Placement {
+                x: &x,
+                y: &y,
+                z: &z,
+                vx: &zero,
+                vy: &zero,
+                vz: &zero,
+            });
+            let crowded = |r: &Room| r.x.min(r.y) <= 2.0 * FLOOR;
+            if clash(&x, &y) || r.iter().any(crowded) {
+                continue;
+            }
+            checked += 1;
+            // Every bird at a corner of its room, in every direction.
+            for _ in 0..8 {
+                let mut xs = x.clone();
+                let mut ys = y.clone();
+                for i in 0..n {
+                    let sx = if rng.random::<bool>() { 1.0 } else { -1.0 };
+                    let sy = if rng.random::<bool>() { 1.0 } else { -1.0 };
+                    xs[i] += sx * 0.999 * r[i].x.min(0.5);
+                    ys[i] += sy * 0.999 * r[i].y.min(0.5);
+                }
+                assert!(!clash(&xs, &ys), "{x:?} {y:?} {z:?} -> {xs:?} {ys:?}");
+            }
+        }
+        assert!(checked > 500, "{checked}");
     }
 
     #[test]

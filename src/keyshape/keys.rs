@@ -221,6 +221,9 @@ pub struct Structure {
     /// ([`crate::keyshape::spacing`]), wingspans: the footage's spacing, as the initial shapes
     /// span it. `None`: not checked.
     pub spacing: Option<(f64, f64)>,
+    /// Fore-aft step every two birds under [`crate::keyshape::separate::STEP_SPAN`] apart
+    /// laterally must keep, wingspans (0: not checked).
+    pub min_step: f64,
 }
 
 impl Structure {
@@ -249,11 +252,13 @@ impl Structure {
             max_depth,
             monotone_tolerance: 0.1,
             spacing: None,
+            min_step: 0.0,
         }
     }
 
     /// True when the depths `y` at lateral positions `x` keep the leader front-most, the depth
-    /// limit, the arms' monotone steps and the spacing band.
+    /// limit, the arms' monotone steps, the spacing band and the fore-aft step between birds
+    /// near each other laterally.
     pub fn accepts(&self, x: &[f64], y: &[f64]) -> bool {
         let Some(&yl) = y.get(self.leader) else {
             return false;
@@ -270,6 +275,8 @@ impl Structure {
         ok_leader
             && ok_depth
             && ok_arms
+            && (self.min_step <= 0.0
+                || crate::keyshape::separate::abreast(x, y, self.min_step).is_none())
             && self.spacing.map_or(true, |(lo, hi)| {
                 let m = crate::keyshape::spacing::spacing([(x, y)]).1;
                 m >= lo && m <= hi

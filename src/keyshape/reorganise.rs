@@ -258,7 +258,14 @@ pub struct Exchange {
     /// Unit vector (lateral, fore-aft) on which the bird moving back passes; the other passes
     /// on the opposite side.
     pub side: (f64, f64),
+    /// The other birds within [`NEAR`] of either slot: they hold still while the two pass.
+    pub near: Vec<usize>,
 }
+
+/// Distance from either exchanged slot within which the other birds hold their position
+/// keeping while two birds pass, wingspans (the passing birds' envelopes sweep past them
+/// faster than a bird's small moves about its slot could give way).
+pub const NEAR: f64 = 2.0;
 
 /// The arms of a formation of slots at lateral positions `x` and depths `y` (behind the
 /// leader): each side's slots ordered from the leader outwards.
@@ -300,12 +307,47 @@ fn bump(u: f64) -> (f64, f64) {
     (64.0 * w * w * w, 192.0 * w * w * (1.0 - 2.0 * u))
 }
 
+/// Height by which each of two exchanging birds leaves its line while they pass, wingspans:
+/// the one moving back sinks and the other rises, so they are 0.2 wingspans apart vertically (the wing clash
+/// needs them within 0.08), about 30 cm for a goose, as birds changing places are filmed to
+/// slip past a little above or below one another.
+pub const PASS_HEIGHT: f64 = 0.1;
+
+/// Share of an exchange over which the vertical parting rises (and, at its end, falls) with a
+/// smootherstep: the birds are fully parted from this share to one minus it, while they are
+/// within [`crate::keyshape::separate::MIN_STEP`] fore and aft.
+const PLATEAU_RAMP: f64 = 0.2;
+
+/// The plateau p(u): 0 at both ends, 1 over [`PLATEAU_RAMP`] ≤ u ≤ 1 − it, smootherstep
+/// ramps between (value, slope and curvature continuous), and its derivative.
+fn plateau(u: f64) -> (f64, f64) {
+    let r = PLATEAU_RAMP;
+    if u <= 0.0 || u >= 1.0 {
+        (0.0, 0.0)
+    } else if u < r {
+        let (s, ds) = smootherstep(u / r);
+        (s, ds / r)
+    } else if u > 1.0 - r {
+        let (s, ds) = smootherstep((1.0 - u) / r);
+        (s, -ds / r)
+    } else {
+        (1.0, 0.0)
+    }
+}
+
+/// Seconds over which a bird's position keeping fades out before a manoeuvre and back in after
+/// it ([`Plan::keeping`]).
+pub const CALM_S: f64 = 1.0;
+
 /// The plan: exchanges in time order, never overlapping, and the slot of every bird after
 /// each of them.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Plan {
     /// The late birds, if any; the exchanges come after they have joined.
     pub join: Option<Join>,
+    /// The formed birds within [`NEAR`] of a joiner's slot: they hold still while the late
+    /// birds close in.
+    pub join_near: Vec<usize>,
     /// The exchanges.
     pub exchanges: Vec<Exchange>,
     /// `slot_of[k][b]`: bird b's slot after the first k exchanges (`slot_of[0]` is the identity).
@@ -326,6 +368,8 @@ pub struct SlotState {
     pub vx: f64,
     /// d y / d t.
     pub vy: f64,
+    /// d z / d t.
+    pub vz: f64,
 }
 
 impl Plan {
@@ -349,6 +393,7 @@ impl Plan {
         let n = x.len();
         let mut plan = Plan {
             join: None,
+            join_near: Vec::new(),
             exchanges: Vec::new(),
             slot_of: vec![(0..n).collect()],
         };
@@ -369,6 +414,14 @@ impl Plan {
             };
             let join = Join::plan(&arms, arm, opts.joiners.min(n - 1), cruise);
             free_from = free_from.max(join.end() + GAP_S);
+            plan.join_near = (0..n)
+                .filter(|q| !join.birds.contains(q))
+                .filter(|&q| {
+                    join.birds
+                        .iter()
+                        .any(|&r| (x[q] - x[r]).hypot(y[q] - y[r]) < NEAR)
+                })
+                .collect();
             plan.join = Some(join);
         }
         let (leader_changes, swaps) = opts.rates(living);
@@ -431,6 +484,15 @@ impl Plan {
             let mut next = current.clone();
             next[birds.0] = sb;
             next[birds.1] = sa;
+            let near = (0..n)
+                .filter(|&q| q != sa && q != sb)
+                .filter(|&q| {
+                    [sa, sb]
+                        .iter()
+                        .any(|&r| (x[q] - x[r]).hypot(y[q] - y[r]) < NEAR)
+                })
+                .map(&bird_in)
+                .collect();
             plan.exchanges.push(Exchange {
                 t0,
                 duration,
@@ -438,6 +500,7 @@ impl Plan {
                 slots: (sa, sb),
                 birds,
                 side,
+                near,
             });
             plan.slot_of.push(next);
             free_from = t0 + duration + GAP_S;
@@ -464,11 +527,21 @@ impl Plan {
             let (b, db) = bump(u);
             let (ds, db) = (ds / e.duration, db / e.duration);
             let (pa, pb) = (slots[e.slots.0], slots[e.slots.1]);
+            // The two birds also part vertically while they pass, the one moving back
+            // sinking and the other rising, so they never fly wing over wing (a fixed side:
+            // one chosen from the slots' heights would flip when those cross).
+            let (p, dp) = plateau(u);
+            let dp = dp / e.duration;
+            let up = -1.0;
             // `from` → `to`, passing on `sign` · side.
             let blend = |from: SlotState, to: SlotState, sign: f64| SlotState {
                 x: (1.0 - s) * from.x + s * to.x + sign * h * b * e.side.0,
                 y: (1.0 - s) * from.y + s * to.y + sign * h * b * e.side.1,
-                z: (1.0 - s) * from.z + s * to.z,
+                z: (1.0 - s) * from.z + s * to.z + sign * up * PASS_HEIGHT * p,
+                vz: (1.0 - s) * from.vz
+                    + s * to.vz
+                    + ds * (to.z - from.z)
+                    + sign * up * PASS_HEIGHT * dp,
                 vx: (1.0 - s) * from.vx
                     + s * to.vx
                     + ds * (to.x - from.x)
@@ -489,6 +562,48 @@ impl Plan {
             }
         }
         out
+    }
+
+    /// The share of its position keeping bird `b` flies at `t`, and its rate: 0 while it
+    /// exchanges places, two birds pass near it, or it flies in to join (the manoeuvre is the motion then; its neighbours'
+    /// envelopes change too fast for the small moves about a slot), back to 1 over
+    /// [`CALM_S`] before and after with a smootherstep.
+    pub fn keeping(&self, b: usize, t: f64) -> (f64, f64) {
+        let spans = self
+            .exchanges
+            .iter()
+            .filter(|e| e.birds.0 == b || e.birds.1 == b || e.near.contains(&b))
+            .map(|e| (e.t0, e.t0 + e.duration))
+            .chain(
+                self.join
+                    .iter()
+                    .filter(|j| j.birds.contains(&b))
+                    .map(|j| (f64::NEG_INFINITY, j.end())),
+            )
+            .chain(
+                self.join
+                    .iter()
+                    .filter(|_| self.join_near.contains(&b))
+                    .map(|j| (j.end() - j.brake, j.end())),
+            );
+        let (mut k, mut dk) = (1.0, 0.0);
+        for (a, z) in spans {
+            // 1 − the fade: down over [a − CALM_S, a], 0 to z, up over [z, z + CALM_S].
+            let (f, df) = if t <= a - CALM_S || t >= z + CALM_S {
+                (1.0, 0.0)
+            } else if t < a {
+                let (s, ds) = smootherstep((a - t) / CALM_S);
+                (s, -ds / CALM_S)
+            } else if t > z {
+                let (s, ds) = smootherstep((t - z) / CALM_S);
+                (s, ds / CALM_S)
+            } else {
+                (0.0, 0.0)
+            };
+            dk = dk * f + k * df;
+            k *= f;
+        }
+        (k, dk)
     }
 
     /// Whether bird `b` is still flying in to join at `t`.

@@ -33,7 +33,8 @@ use crate::keyshape::initial::{
 };
 use crate::keyshape::interpolate::Track;
 use crate::keyshape::jostle::{
-    keeping_for, key_spread, nearest, residual_keeping, slow_drift, Jostle, JostleOptions,
+    keeping_for, key_spread, residual_keeping, rooms, slow_drift, Jostle, JostleOptions, Placement,
+    Room,
 };
 use crate::keyshape::keys::{
     key_shapes, KeyContext, KeyOptions, KeyPlan, KeyShape, KeyStats, LateralKey, Structure,
@@ -474,6 +475,7 @@ pub fn steady_flight_in(
         max_depth,
         monotone_tolerance: 0.0,
         spacing: None,
+        min_step: 0.0,
     };
     let first_key_from = shapes
         .iter()
@@ -482,7 +484,8 @@ pub fn steady_flight_in(
         Some(i) => shapes[i].ys(),
         None => {
             let (sl, sr) = scales;
-            x.iter()
+            let y: Vec<f64> = x
+                .iter()
                 .enumerate()
                 .map(|(i, &xi)| {
                     if i == corr.leader {
@@ -491,7 +494,8 @@ pub fn steady_flight_in(
                         curve_y(&first.shape, xi, sl, sr).max(init_opts.lead_margin)
                     }
                 })
-                .collect()
+                .collect();
+            separate(&x, &y, aero)
         }
     };
     let p0 = aero.power_reduction(&x, &y0).map_err(|e| match e {
@@ -526,6 +530,7 @@ pub fn steady_flight_in(
         });
     let structure = Structure {
         spacing: spacing_band,
+        min_step: crate::keyshape::separate::min_step(aero),
         ..Structure::of(&x, &y0, corr.leader, max_depth)
     };
 
@@ -704,18 +709,21 @@ pub fn steady_flight_in(
         // The key-shape placement, then each bird's position keeping about it.
         let mut ys = Vec::with_capacity(n);
         let (mut vxs, mut vys) = (Vec::with_capacity(n), Vec::with_capacity(n));
+        let mut vzs = Vec::with_capacity(n);
         if reorganised {
             let slots: Vec<SlotState> = tracks
                 .iter()
                 .map(|[ty, tx, tz]| {
                     let (y, vy) = ty.eval(t);
                     let (x, vx) = tx.eval(t);
+                    let (z, vz) = tz.eval(t);
                     SlotState {
                         x,
                         y,
-                        z: tz.eval(t).0,
+                        z,
                         vx,
                         vy,
+                        vz,
                     }
                 })
                 .collect();
@@ -725,23 +733,34 @@ pub fn steady_flight_in(
                 fr.z.push(b.z);
                 vxs.push(b.vx);
                 vys.push(b.vy);
+                vzs.push(b.vz);
             }
         } else {
             for [ty, tx, tz] in &tracks {
                 let (y, dy) = ty.eval(t);
                 let (xl, dx) = tx.eval(t);
+                let (z, dz) = tz.eval(t);
                 ys.push(y);
                 fr.x.push(xl);
-                fr.z.push(tz.eval(t).0);
+                fr.z.push(z);
                 vxs.push(dx);
                 vys.push(dy);
+                vzs.push(dz);
             }
         }
         if let Some(clock) = &mut clock {
             clock.seek(j);
-            let near = nearest(&fr.x, &ys, &vxs, &vys);
-            for (i, &(d, rate)) in near.iter().enumerate() {
-                let dev = clock.at(i, d, rate);
+            let room = rooms(&Placement {
+                x: &fr.x,
+                y: &ys,
+                z: &fr.z,
+                vx: &vxs,
+                vy: &vys,
+                vz: &vzs,
+            });
+            for (i, &r) in room.iter().enumerate() {
+                let (keep, dkeep) = plan.keeping(i, t);
+                let dev = clock.at(i, Room { keep, dkeep, ..r });
                 fr.x[i] += dev.x;
                 ys[i] += dev.y;
                 vxs[i] += dev.vx;
