@@ -789,6 +789,27 @@ fn finish(tmp: PathBuf, target: PathBuf) -> Result<()> {
     })
 }
 
+/// Whether `a` and `b` name one existing file: the same device and inode on Unix (whatever the
+/// spelling, `..` or links), the same canonical path elsewhere. A name that does not exist is
+/// no file's.
+pub fn same_file(a: &Path, b: &Path) -> bool {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        match (fs::metadata(a), fs::metadata(b)) {
+            (Ok(x), Ok(y)) => x.dev() == y.dev() && x.ino() == y.ino(),
+            _ => false,
+        }
+    }
+    #[cfg(not(unix))]
+    {
+        match (fs::canonicalize(a), fs::canonicalize(b)) {
+            (Ok(x), Ok(y)) => x == y,
+            _ => false,
+        }
+    }
+}
+
 /// What makes two output names the same file: the canonical directory and the file name
 /// (`a.json`, `./a.json` and `../d/a.json` from inside `d` are one output).
 pub fn output_identity(target: &Path) -> PathBuf {
