@@ -38,6 +38,30 @@ pub fn resample(anim: &Animation, fps: f64) -> Result<Animation> {
         ));
     }
     let n = anim.frames.len();
+    // The size at the new rate is held to the limits of an animation before any of it is made
+    // (or the animation copied): a long animation at a high rate would otherwise fill memory and
+    // disk with a file formation refuses to read.
+    if n >= 1 {
+        let seconds = if anim.looped && n >= 2 {
+            n as f64 / anim.fps
+        } else {
+            anim.frames[n - 1].t - anim.frames[0].t
+        };
+        let count = (seconds * fps).max(0.0) + 1.0;
+        let most =
+            (crate::limits::MAX_BIRD_FRAMES / anim.birds.max(1)).min(crate::limits::MAX_FRAMES);
+        if count.is_nan() || count > most as f64 + 0.5 {
+            return Err(Error::parameter(
+                "fps",
+                format!(
+                    "{fps} frames per second makes {count:.0} frames of {} birds ({seconds:.0} s), more than the {most} an animation may have (at most {} frames and {} bird-frames); give a lower rate",
+                    anim.birds,
+                    crate::limits::MAX_FRAMES,
+                    crate::limits::MAX_BIRD_FRAMES
+                ),
+            ));
+        }
+    }
     let mut out = anim.clone();
     out.fps = fps;
     if n == 0 {

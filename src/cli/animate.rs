@@ -126,6 +126,7 @@ pub fn run(args: AnimateArgs, g: Global) -> Result<()> {
     // Everything that can be checked is checked before any work.
     config.validate()?;
     formation::export::plan_outputs(&args.output)?;
+    super::course::check_path_kept(&args.path, &args.output, &config.render)?;
     super::check_bird_model(
         super::flags::Cmd::Animate,
         g,

@@ -202,6 +202,7 @@ pub const FLAGS: &[(&str, &str, &[Cmd])] = &[
     ("render.units", "--units", SCENE),
     ("render.up", "--up", SCENE),
     ("render.path_out", "--path-out", SCENE),
+    ("render.binary_frames", "--binary-frames", SCENE),
     ("render.usd_mode", "--usd-mode", SCENE),
     ("render.gltf_mode", "--gltf-mode", SCENE),
     ("render.animation_fps", "--fps", &[Render]),

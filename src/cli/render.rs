@@ -281,6 +281,7 @@ pub fn run(args: RenderArgs, g: Global) -> Result<()> {
     opts.validate()?;
     // Check the outputs before reading a possibly large animation.
     formation::export::plan_outputs(&args.output)?;
+    formation::export::check_written(&args.output, &opts, &[])?;
     let anim = Animation::read(&args.animation)?;
     formation::export::sample::check_times(&anim, &args.animation)?;
     super::check_bird_model(

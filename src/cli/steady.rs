@@ -244,6 +244,7 @@ pub fn run(args: SteadyArgs, g: Global) -> Result<()> {
         }
     }
     let plan = formation::export::plan_outputs(&args.output)?;
+    super::course::check_path_kept(&args.path, &args.output, &args.scene.options())?;
     if let Some(r) = &args.report {
         formation::export::plan_report(r, &plan)?;
     }

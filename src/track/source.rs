@@ -274,20 +274,44 @@ impl VideoFrames {
 
 /// Reads one image file as grey.
 pub fn read_image(path: &Path) -> Result<Gray> {
+    use image::ImageDecoder as _;
+    crate::io::set_current_input(path);
     let bytes = crate::io::read_bytes(path)?;
-    let img = image::load_from_memory(&bytes).map_err(|e| {
+    let undecodable = |e: image::ImageError| {
         Error::format(
             path,
             format!("cannot decode this image ({e}); give PNG or JPEG frames"),
         )
-    })?;
-    let (w, h) = (img.width() as usize, img.height() as usize);
+    };
+    // The size from the header, checked before any pixel is decoded: a small file can announce
+    // a picture of gigabytes, whose allocation would end the run without naming the image.
+    let decoder = image::ImageReader::new(std::io::Cursor::new(&bytes))
+        .with_guessed_format()
+        .map_err(|e| Error::io(path, e))?
+        .into_decoder()
+        .map_err(undecodable)?;
+    let (w, h) = decoder.dimensions();
+    let (w, h) = (w as usize, h as usize);
     if (w as u64) * (h as u64) > crate::limits::MAX_FRAME_PIXELS {
         return Err(Error::format(
             path,
             format!("{w}x{h} is larger than 8K UHD"),
         ));
     }
+    // The decoded picture and its grey copy must fit in the memory left.
+    let need = decoder
+        .total_bytes()
+        .saturating_add((w as u64) * (h as u64));
+    if crate::limits::memory_budget().is_some_and(|m| need > m) {
+        return Err(Error::format(
+            path,
+            format!(
+                "{w}x{h}: decoding it needs {} MB, more than the memory left; give smaller frames or raise the memory limit",
+                need.div_ceil(1_000_000)
+            ),
+        ));
+    }
+    let img = image::DynamicImage::from_decoder(decoder).map_err(undecodable)?;
     let g = img.to_luma8();
     Ok(Gray {
         width: w,
