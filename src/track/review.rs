@@ -162,6 +162,8 @@ pub fn annotations_page(
         fps: ann.fps,
         polarity: super::Polarity::Dark,
         frames,
+        decoded: None,
+        warnings: Vec::new(),
     };
     Ok(page(&tracked, &jpegs, save_as))
 }
