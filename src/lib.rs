@@ -59,6 +59,7 @@ pub mod aero;
 pub mod animation;
 pub mod annotations;
 pub mod course;
+pub mod embed;
 pub mod error;
 pub mod export;
 pub mod extract;
