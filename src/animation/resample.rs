@@ -27,6 +27,20 @@ pub const MAX_RESAMPLE_FPS: f64 = 1000.0;
 /// Tolerance, in frame intervals, within which a sample time counts as a frame's time.
 const ON_FRAME: f64 = 1e-9;
 
+/// How many frames [`resample`] gives `anim` at `fps` (without sampling them; 0 for a rate
+/// it refuses).
+pub fn resampled_count(anim: &Animation, fps: f64) -> usize {
+    let n = anim.frames.len();
+    if !(fps.is_finite() && (1.0..=MAX_RESAMPLE_FPS).contains(&fps)) || n == 0 {
+        return 0;
+    }
+    if anim.looped && n >= 2 {
+        return (n as f64 / anim.fps * fps).round() as usize;
+    }
+    let span = anim.frames[n - 1].t - anim.frames[0].t;
+    (span * fps + 1e-6).floor().max(0.0) as usize + 1
+}
+
 /// `anim` sampled at `fps` frames per second (see the module documentation). Errors name
 /// `fps`: a rate that is not finite or outside 1..=[`MAX_RESAMPLE_FPS`], or for a loop, a
 /// period that is not a whole number of frames at `fps`.

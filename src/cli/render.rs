@@ -294,6 +294,6 @@ pub fn run(args: RenderArgs, g: Global) -> Result<()> {
     let _ = g.seed;
     write_outputs(&anim, &args.output, &opts, &TermProgress::new(g.quiet))?;
     let written = formation::export::written_files(&args.output, &opts);
-    super::summary::render(g, &anim, &args.animation, &written);
+    super::summary::render(g, &anim, &opts, &args.animation, &written);
     Ok(())
 }

@@ -18,6 +18,8 @@ pub mod bird;
 pub mod bird_model;
 pub mod camera;
 pub mod crowd;
+pub mod fidelity;
+pub mod field;
 pub mod gltf;
 pub mod keys;
 pub mod lzw;
@@ -477,7 +479,7 @@ pub fn plan_report(report: &Path, plan: &[Output]) -> Result<()> {
 }
 
 /// Frame rate used for a picture output of `kind`.
-fn picture_fps(anim: &Animation, kind: OutputKind, opts: &RenderOptions) -> f64 {
+pub fn picture_fps(anim: &Animation, kind: OutputKind, opts: &RenderOptions) -> f64 {
     match (kind, opts.fps) {
         (OutputKind::Gif, Some(f)) => 100.0 / (100.0 / f).round().max(2.0),
         (OutputKind::Gif, None) => GIF_FPS,
