@@ -931,13 +931,23 @@ impl Animation {
             }
         }
         self.check_fps(origin)?;
+        if let Some(f) = &self.flight {
+            // A mass or airspeed no bird has would make every saving of total power NaN.
+            crate::aero::flight::validate_settings(f).map_err(|e| match e {
+                Error::Parameter { name, message } => Error::format(
+                    origin,
+                    format!("{}: {message}", name.trim_start_matches("steady.")),
+                ),
+                other => other,
+            })?;
+        }
         if let Some(sp) = &self.species {
             if sp.parse::<wing::Species>().is_err() {
                 return Err(Error::format(
                     origin,
                     format!(
                         "species: \"{sp}\" is not a species formation draws ({}); give one of them or leave the field out",
-                        wing::Species::ALL.map(|s| s.name()).join(", ")
+                        crate::aero::species::known_names().join(", ")
                     ),
                 ));
             }

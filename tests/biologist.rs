@@ -401,10 +401,10 @@ fn csv_columns_match_the_json_in_every_frame() {
         "{err}"
     );
     assert!(
-        first.contains("flock saving ")
-            && first.contains(" % of induced power (")
-            && first.contains(" % of total power) in steady flight by Hummel's model")
-            && first.contains("(models applied to measured spacings: 14–36 %)"),
+        first.contains("flock saving in steady flight, a model estimate: ")
+            && first.contains(" % of induced power (field: models at measured spacings 14–36 %)")
+            && first.contains(" % of total power (field and flapping studies 2–11 %)")
+            && first.contains("over models, wakes and cores; by hummel, planar wake, core"),
         "{first}"
     );
     assert!(

@@ -38,6 +38,10 @@ pub const BODY_DRAG_COEF: f64 = 0.1;
 /// a small power margin, which is why they run to take off), see docs/initiation.md.
 pub const CLIMB_POWER_MARGIN: f64 = 1.6;
 
+/// Lightest body mass accepted, kg (the smallest hummingbirds weigh about 2 g): a lighter mass
+/// is a unit slip, and far lighter ones make the power curve's numbers underflow.
+pub const MIN_MASS_KG: f64 = 0.0015;
+
 /// A bird's size: what the power curve needs.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Morphology {
@@ -106,6 +110,15 @@ impl Morphology {
         check("flight.mass_kg", self.mass_kg, "body mass (kg)")?;
         check("flight.span_m", self.span_m, "wingspan (m)")?;
         check("flight.wing_area_m2", self.wing_area_m2, "wing area (m²)")?;
+        if self.mass_kg < MIN_MASS_KG {
+            return Err(Error::parameter(
+                "flight.mass_kg",
+                format!(
+                    "{}: no flying bird is lighter than about 2 g; give the mass in kilograms",
+                    self.mass_kg
+                ),
+            ));
+        }
         if self.mass_kg > 50.0 {
             return Err(Error::parameter(
                 "flight.mass_kg",
@@ -273,11 +286,16 @@ pub fn curve_of(anim: &Animation) -> PowerCurve {
 }
 
 fn animation_curve_plain(species: Option<&str>, wingspan_m: f64) -> PowerCurve {
-    let sp = species
-        .and_then(|s| s.parse::<Species>().ok())
-        .unwrap_or(Species::Goose);
-    let bird = Morphology::of(sp);
-    let bird = if wingspan_m.is_finite() && wingspan_m > 0.0 {
+    let bird = match species.and_then(crate::aero::species::lookup) {
+        Some(b) => b.morphology(),
+        None => Morphology::of(
+            species
+                .and_then(|s| s.parse::<Species>().ok())
+                .unwrap_or(Species::Goose),
+        ),
+    };
+    // The species' own span is kept exactly (no rescaling round-off).
+    let bird = if wingspan_m.is_finite() && wingspan_m > 0.0 && wingspan_m != bird.span_m {
         bird.scaled_to(wingspan_m)
     } else {
         bird
@@ -450,7 +468,7 @@ mod tests {
         let big = g.scaled_to(3.0);
         assert!((big.mass_kg / g.mass_kg - 8.0).abs() < 1e-12);
         assert!((big.aspect_ratio() - g.aspect_ratio()).abs() < 1e-12);
-        for bad in [0.0, -1.0, f64::NAN, 200.0] {
+        for bad in [0.0, -1.0, f64::NAN, 200.0, 1e-200, 1e-300, 1e300, 0.001] {
             let m = Morphology { mass_kg: bad, ..g };
             assert!(m.validate().unwrap_err().to_string().contains("mass"));
         }

@@ -49,13 +49,20 @@ impl FromStr for Species {
 
     fn from_str(s: &str) -> Result<Species> {
         let t = s.trim().to_ascii_lowercase();
+        // A real species is drawn by its family's rig (docs/species.md).
+        if let Some(b) = crate::aero::species::lookup(&t) {
+            return Ok(b.family);
+        }
         Species::ALL
             .into_iter()
             .find(|sp| sp.name() == t)
             .ok_or_else(|| {
                 Error::parameter(
                     "wingbeat.species",
-                    format!("unknown species \"{s}\": expected goose, crane or pelican"),
+                    format!(
+                        "unknown species \"{s}\": expected one of {}",
+                        crate::aero::species::known_names().join(", ")
+                    ),
                 )
             })
     }

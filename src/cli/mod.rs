@@ -17,6 +17,7 @@ mod power;
 pub mod progress;
 mod render;
 mod report;
+mod savings;
 mod solve;
 mod start;
 mod stdout;

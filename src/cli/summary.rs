@@ -130,17 +130,11 @@ pub fn animation_text(what: &str, anim: &Animation, params: Option<&FormationPar
     if let Some(t) = s.landing_s {
         parts.push(format!("landing {t:.1} s"));
     }
-    if let Some(e) = s.steady_saving {
-        let total = formation::aero::flight::steady_saving_total(anim).map_or(String::new(), |t| {
-            format!(" ({:.1} % of total power)", 100.0 * t)
-        });
-        parts.push(format!(
-            "flock saving {:.1} % of induced power{total} in steady flight by {} (models applied to measured spacings: 14–36 %)",
-            100.0 * e,
-            anim.savings_model
-                .as_ref()
-                .map_or("Hummel's model".to_string(), |m| m.to_string())
-        ));
+    if let Some(line) = s
+        .steady_saving
+        .and_then(|e| super::savings::animation_line(anim, e))
+    {
+        parts.push(line);
     }
     parts.join(", ")
 }
