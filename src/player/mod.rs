@@ -409,8 +409,7 @@ pub fn page(anim: &Animation, opts: &PlayerOptions) -> Result<String> {
     let (mut max_e, mut max_t) = (0f64, 0f64);
     for (i, &k) in kept.iter().enumerate() {
         let f = &anim.frames[k];
-        for b in 0..nb {
-            let p = &poses[i][b];
+        for (b, p) in poses[i].iter().enumerate() {
             let v = [
                 f.bank
                     .as_ref()
@@ -454,14 +453,13 @@ pub fn page(anim: &Animation, opts: &PlayerOptions) -> Result<String> {
     let mut tot = Vec::with_capacity(nk * nb * 2);
     for (i, &k) in kept.iter().enumerate() {
         let f = &anim.frames[k];
-        for b in 0..nb {
+        for (b, p) in poses[i].iter().enumerate() {
             for v in [&f.x, &f.y, &f.z] {
                 pos.extend((v.get(b).copied().unwrap_or(0.0) as f32).to_le_bytes());
             }
             let h =
                 crate::export::sample::angle_diff(0.0, f.heading.get(b).copied().unwrap_or(0.0));
             hdg.extend(q16(Some(h), scales.heading));
-            let p = &poses[i][b];
             let v = [
                 f.bank
                     .as_ref()
