@@ -70,6 +70,7 @@ pub mod keyshape;
 pub mod limits;
 pub mod memory;
 pub mod pipeline;
+pub mod player;
 pub mod plot;
 pub mod progress;
 pub mod report;
