@@ -1,6 +1,6 @@
 //! How far an animated GIF strays from the full-colour pictures it was made from, the measure
-//! of what the GIF writer's frame differencing leaves behind (`cargo run --release --example
-//! gif_error` on any GIF beside its PNG frames drawn at the GIF's rate).
+//! of what the GIF writer's frame differencing leaves behind (the example `gif_error`, in
+//! `examples/gif_error.rs`, measures any GIF beside its PNG frames drawn at the GIF's rate).
 //!
 //! A GIF has 256 colours, so every pixel is off by the dither and the palette: that is fine
 //! noise. What shows is error that is *coherent*: a stale rectangle of old cloud left where the

@@ -291,7 +291,7 @@ impl Tracking {
             return Err(Error::parameter(
                 "track.frames",
                 format!(
-                    "more than {} frames to track, the most annotations hold (frame {index} is one too many); choose fewer with --every or --frames",
+                    "more than {} frames to track, the most annotations hold (frame {index} is one too many); choose fewer with track.every or track.frames",
                     crate::limits::MAX_ANNOTATED_FRAMES
                 ),
             ));
@@ -608,7 +608,7 @@ pub fn track_path(
                 return Err(Error::parameter(
                     "track.frames",
                     format!(
-                        "{} frames to track, at most {} (the most annotations hold); choose fewer with --every or --frames",
+                        "{} frames to track, at most {} (the most annotations hold); choose fewer with track.every or track.frames",
                         wanted.len(),
                         crate::limits::MAX_ANNOTATED_FRAMES
                     ),

@@ -751,8 +751,8 @@ pub fn assign_phases(anim: &mut Animation, opts: &WingbeatOptions) -> Result<()>
     let real = anim
         .species
         .as_deref()
-        .and_then(crate::aero::species::lookup)
-        .filter(|b| b.family == opts.species);
+        .and_then(crate::animation::species::lookup)
+        .filter(|b| b.family == opts.species.name());
     anim.species = Some(real.map_or(opts.species.name(), |b| b.name).to_string());
     anim.wingbeat = Some(opts.clone());
     Ok(())
