@@ -13,7 +13,12 @@
 
 /// `value` as JSON safe inside a `<script>` element: no `<`, `>` or `&` anywhere in the text.
 pub fn script_json(value: &serde_json::Value) -> String {
-    let text = value.to_string();
+    script_json_text(&value.to_string())
+}
+
+/// JSON text (as `serde_json` writes it) made safe inside a `<script>` element the same way as
+/// [`script_json`]: every `<`, `>` and `&` (which JSON has only inside strings) as a `\u` escape.
+pub fn script_json_text(text: &str) -> String {
     let mut out = String::with_capacity(text.len() + 16);
     for c in text.chars() {
         match c {

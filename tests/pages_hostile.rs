@@ -74,5 +74,23 @@ fn review_annotate_and_report_pages_survive_hostile_names() {
         // Not an animation the report reads: the page is not the subject here.
         assert_eq!(code, 2, "{err}");
     }
+
+    // An animation in the hostile directory, under a hostile name: its report and its 3-D
+    // player keep every script element; the player's metadata (the title is the file name)
+    // parses back.
+    let anim = frames.join("a<!--<script>.json");
+    std::fs::copy(data("flock_small.json"), &anim).unwrap();
+    let report = dir.join("report-anim.html");
+    let (code, err) = run_quiet(&["report", s(&anim), "-o", s(&report)]);
+    assert_eq!(code, 0, "{err}");
+    intact(&std::fs::read_to_string(&report).unwrap());
+    let player = dir.join("view.html");
+    let (code, err) = run_quiet(&["view", s(&anim), "-o", s(&player)]);
+    assert_eq!(code, 0, "{err}");
+    let html = std::fs::read_to_string(&player).unwrap();
+    let scripts = intact(&html);
+    let meta: Value = serde_json::from_str(&scripts[0]).expect("the player's metadata is JSON");
+    assert_eq!(meta["title"].as_str(), Some("a<!--<script>.json"));
+    assert!(!html.contains("<title>formation view: <!--"));
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -21,6 +21,7 @@ use std::fmt::Write as _;
 use serde::Serialize;
 
 use crate::animation::Animation;
+use crate::embed::{html_text, script_json_text};
 use crate::error::{Error, Result};
 use crate::export::silhouette::{self, Part};
 use crate::wingbeat::{Flapper, Species, WingPose, WingbeatOptions};
@@ -146,25 +147,6 @@ pub fn base64(bytes: &[u8]) -> String {
         });
     }
     s
-}
-
-/// `json` made safe inside a `<script>` element: every `<` (so no `</script>` and no `<!--`),
-/// `>` and `&` as JSON's `\u` escapes, and the line separators JavaScript once refused.
-pub fn script_safe(json: &str) -> String {
-    json.replace('<', "\\u003c")
-        .replace('>', "\\u003e")
-        .replace('&', "\\u0026")
-        .replace('\u{2028}', "\\u2028")
-        .replace('\u{2029}', "\\u2029")
-}
-
-/// `s` escaped for HTML text and attribute values.
-pub fn html_escape(s: &str) -> String {
-    s.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-        .replace('"', "&quot;")
-        .replace('\'', "&#39;")
 }
 
 fn species_of(anim: &Animation) -> Species {
@@ -567,7 +549,7 @@ pub fn page(anim: &Animation, opts: &PlayerOptions) -> Result<String> {
     })
     .map_err(|e| Error::Internal(format!("player metadata to JSON: {e}")))?;
     let mut out = String::with_capacity(data_bytes * 4 / 3 + PLAYER_JS.len() + 8192);
-    let title = html_escape(&format!("formation view: {}", opts.title));
+    let title = html_text(&format!("formation view: {}", opts.title));
     let _ = write!(
         out,
         "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n\
@@ -581,12 +563,12 @@ pub fn page(anim: &Animation, opts: &PlayerOptions) -> Result<String> {
     let _ = writeln!(
         out,
         "<script type=\"application/json\" id=\"fp-meta\">{}</script>",
-        script_safe(&meta_json)
+        script_json_text(&meta_json)
     );
     let _ = writeln!(
         out,
         "<script type=\"application/json\" id=\"fp-fold\">{}</script>",
-        script_safe(&fold)
+        script_json_text(&fold)
     );
     for (id, bytes) in [
         ("pos", &pos),
@@ -622,8 +604,8 @@ mod tests {
     use super::*;
 
     #[test]
-    fn script_safe_leaves_no_tag_or_comment() {
-        let s = script_safe(r#"{"title":"</script><!-- x & y"}"#);
+    fn script_json_text_leaves_no_tag_or_comment() {
+        let s = script_json_text(r#"{"title":"</script><!-- x & y"}"#);
         assert!(!s.contains('<') && !s.contains('>') && !s.contains('&'));
         let back: serde_json::Value = serde_json::from_str(&s).unwrap();
         assert_eq!(back["title"], "</script><!-- x & y");
