@@ -60,10 +60,14 @@ fr = anim["frames"][k]
 err = max(max(abs(p[0] - fr["x"][b]), abs(p[1] - fr["y"][b]), abs(p[2] - fr["z"][b])) for b, p in enumerate(r["drawn"]))
 size = os.path.getsize(sys.argv[3])
 print(f"{n} birds: page {size / 1e6:.2f} MB, loaded in {r['loadMs']:.0f} ms; frame {r['frame']}: drawn positions within {err:.2g} wingspans of the file; "
-      f"{r['seen']['seen']} of {r['seen']['inView']} birds in view drawn; {r['changed']} pixels changed over 0.5 s of play (to frame {r['after']}); "
+      f"{r['seen']['seen']} of {r['seen']['inView']} birds in view drawn ({r['seen']['bigSeen']} of the {r['seen']['big']} at least 3 px wide); {r['changed']} pixels changed over 0.5 s of play (to frame {r['after']}); "
       f"{r['msPerFrame']:.1f} ms a frame ({1000 / r['msPerFrame']:.0f} frames/s, SwiftShader)")
 assert err < 1e-3, "positions drawn differ from the animation"
-assert r["seen"]["inView"] > 0 and r["seen"]["seen"] >= 0.5 * r["seen"]["inView"], "birds not drawn"  # far birds can be under a pixel
+# Every bird drawn at least 3 pixels wide must show, and nearly every bird in view (the canvas is
+# multisampled, so even a bird of a pixel or two changes its pixels; one far under a pixel may not).
+assert r["seen"]["inView"] > 0 and (n != 14 or r["seen"]["big"] == n), "birds out of view"
+assert r["seen"]["bigSeen"] == r["seen"]["big"], f"birds at least 3 px wide not drawn: {r['seen']['missed']}"
+assert r["seen"]["seen"] >= 0.9 * r["seen"]["inView"], "birds in view not drawn"
 assert r["changed"] > 100 and r["after"] > r["frame"], "the view did not change while playing"
 limit = {14: 8e6, 1000: 40e6}[n]
 assert size <= limit, f"page over {limit / 1e6:.0f} MB"

@@ -19,7 +19,7 @@
   const B = M.birds, F = M.frames, SC = M.scales, T = M.times;
   const ui = $("fp-ui"), cv = $("fp-canvas");
   const fail = msg => { ui.innerHTML = "<b>This page needs WebGL 2:</b> " + msg; window.formationPlayer = { ready: false, error: msg }; };
-  const gl = cv.getContext("webgl2", { antialias: false });
+  const gl = cv.getContext("webgl2", { antialias: true });
   if (!gl) { fail("the browser gave no WebGL 2 context."); return; }
   // ---- small maths ----
   const sub = (a, b) => [a[0] - b[0], a[1] - b[1], a[2] - b[2]], dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
@@ -391,16 +391,22 @@ saving ${pc(s.e)} of induced power, ${pc(s.total)} of total
     project,
     pixels(noBirds) { render({ noBirds, quiet: true }); const p = new Uint8Array(cv.width * cv.height * 4); gl.readPixels(0, 0, cv.width, cv.height, gl.RGBA, gl.UNSIGNED_BYTE, p); return p; },
     // Birds whose drawn place on screen differs from the picture without birds, of those in view.
-    birdsSeen() {
-      const a = this.pixels(false), n = this.pixels(true), W = cv.width, H = cv.height, s = W / cv.clientWidth; let seen = 0, inView = 0;
+    // Birds in view, and how many of them change the pixels at their projected place; `big`
+    // counts those whose wingspan spans at least `minPx` pixels across the view (`bigSeen` of
+    // them drawn; `missed`: the first ten of the others): a far bird under a pixel may vanish
+    // (no antialiasing), a bird that large must not.
+    birdsSeen(minPx = 3) {
+      const a = this.pixels(false), n = this.pixels(true), W = cv.width, H = cv.height, s = W / cv.clientWidth; let seen = 0, inView = 0, big = 0, bigSeen = 0; const missed = [];
+      let right = cross(norm(sub(last.tgt, last.eye)), [0, 0, 1]); right = Math.hypot(...right) < 1e-6 ? [1, 0, 0] : norm(right);
       for (let b = 0; b < B; b++) {
-        const q = project([INST[16 * b], INST[16 * b + 1], INST[16 * b + 2]]); if (!q) continue;
+        const p = [INST[16 * b], INST[16 * b + 1], INST[16 * b + 2]], q = project(p); if (!q) continue;
         const px = Math.round(q[0] * s), py = H - 1 - Math.round(q[1] * s); if (px < 3 || py < 3 || px >= W - 3 || py >= H - 3) continue;
-        inView++; let hit = false;
+        const r = project([p[0] + right[0], p[1] + right[1], p[2] + right[2]]), large = !!r && Math.hypot(r[0] - q[0], r[1] - q[1]) * s >= minPx;
+        inView++; if (large) big++; let hit = false;
         for (let dy = -3; dy <= 3 && !hit; dy++) for (let dx = -3; dx <= 3 && !hit; dx++) { const i = 4 * ((py + dy) * W + px + dx); if (Math.abs(a[i] - n[i]) + Math.abs(a[i + 1] - n[i + 1]) + Math.abs(a[i + 2] - n[i + 2]) > 12) hit = true; }
-        if (hit) seen++;
+        if (hit) { seen++; if (large) bigSeen++; } else if (large && missed.length < 10) missed.push({ bird: b, px, py, wide: Math.hypot(r[0] - q[0], r[1] - q[1]) * s, at: p });
       }
-      render(); return { seen, inView };
+      render(); return { seen, inView, big, bigSeen, missed };
     },
     // Milliseconds a frame takes to draw (JS interpolation + WebGL, waited for), over n frames.
     benchmark(n) { const p = new Uint8Array(4), t = performance.now(); for (let i = 0; i < n; i++) { tick(1000 / 30); render({ quiet: true }); gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, p); } return (performance.now() - t) / n; },
