@@ -10,7 +10,7 @@ cd "$(dirname "$0")"
 secs="${SECONDS_PER_TARGET:-600}"
 targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then
-    targets=(native_json long_csv dltdv_csv labelme_json params animation animation_frames shape target path bird_model sleap_csv dlc_csv mot_txt idtracker_csv trex_npz sleap_h5)
+    targets=(native_json long_csv dltdv_csv labelme_json params animation animation_frames shape target path bird_model sleap_csv dlc_csv mot_txt idtracker_csv trex_npz sleap_h5 pages)
 fi
 export RUSTC_BOOTSTRAP=1
 if [ -z "${FUZZ_NO_BUILD:-}" ]; then

@@ -13,6 +13,7 @@ pub mod clearance;
 pub mod landing;
 pub mod relative;
 pub mod resample;
+pub mod species;
 pub mod stats;
 pub mod wing;
 
@@ -148,6 +149,19 @@ impl FlightSettings {
     /// Whether nothing is set.
     pub fn is_empty(&self) -> bool {
         self.mass_kg.is_none() && self.speed_ms.is_none()
+    }
+
+    /// Checks what is set: a body mass a flying bird can have and an airspeed in (0, 100] m/s
+    /// ([`crate::limits::check_bird_mass`], [`crate::limits::check_airspeed`]); errors name
+    /// `{prefix}.mass_kg` or `{prefix}.speed_ms`.
+    pub fn validate(&self, prefix: &str) -> Result<()> {
+        if let Some(m) = self.mass_kg {
+            crate::limits::check_bird_mass(&format!("{prefix}.mass_kg"), m)?;
+        }
+        if let Some(v) = self.speed_ms {
+            crate::limits::check_airspeed(&format!("{prefix}.speed_ms"), v)?;
+        }
+        Ok(())
     }
 }
 
@@ -931,13 +945,22 @@ impl Animation {
             }
         }
         self.check_fps(origin)?;
+        if let Some(f) = &self.flight {
+            // A mass or airspeed no bird has would make every saving of total power NaN.
+            f.validate("flight").map_err(|e| match e {
+                Error::Parameter { name, message } => {
+                    Error::format(origin, format!("{name}: {message}"))
+                }
+                other => other,
+            })?;
+        }
         if let Some(sp) = &self.species {
             if sp.parse::<wing::Species>().is_err() {
                 return Err(Error::format(
                     origin,
                     format!(
                         "species: \"{sp}\" is not a species formation draws ({}); give one of them or leave the field out",
-                        wing::Species::ALL.map(|s| s.name()).join(", ")
+                        wing::Species::known_names().join(", ")
                     ),
                 ));
             }

@@ -789,6 +789,27 @@ fn finish(tmp: PathBuf, target: PathBuf) -> Result<()> {
     })
 }
 
+/// Whether `a` and `b` name one existing file: the same device and inode on Unix (whatever the
+/// spelling, `..` or links), the same canonical path elsewhere. A name that does not exist is
+/// no file's.
+pub fn same_file(a: &Path, b: &Path) -> bool {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        match (fs::metadata(a), fs::metadata(b)) {
+            (Ok(x), Ok(y)) => x.dev() == y.dev() && x.ino() == y.ino(),
+            _ => false,
+        }
+    }
+    #[cfg(not(unix))]
+    {
+        match (fs::canonicalize(a), fs::canonicalize(b)) {
+            (Ok(x), Ok(y)) => x == y,
+            _ => false,
+        }
+    }
+}
+
 /// What makes two output names the same file: the canonical directory and the file name
 /// (`a.json`, `./a.json` and `../d/a.json` from inside `d` are one output).
 pub fn output_identity(target: &Path) -> PathBuf {
@@ -1070,9 +1091,24 @@ fn with_registry<R>(f: impl FnOnce(&mut Registry) -> R) -> R {
 /// The output being written now (set by the writers), named when memory runs out.
 static CURRENT_OUTPUT: std::sync::Mutex<Option<PathBuf>> = std::sync::Mutex::new(None);
 
-/// Records `path` as the output being written, for [`out_of_memory`]'s message.
+/// Records `path` as the output being written, for [`out_of_memory`]'s message (the input
+/// recorded before is done with).
 pub fn set_current_output(path: &Path) {
     let mut g = CURRENT_OUTPUT.lock().unwrap_or_else(|p| p.into_inner());
+    *g = Some(path.to_path_buf());
+    drop(g);
+    let mut i = CURRENT_INPUT.lock().unwrap_or_else(|p| p.into_inner());
+    *i = None;
+}
+
+/// The input being worked on now (an image being decoded and searched), named when memory runs
+/// out before any output is being written.
+static CURRENT_INPUT: std::sync::Mutex<Option<PathBuf>> = std::sync::Mutex::new(None);
+
+/// Records `path` as the input being worked on, for [`out_of_memory`]'s message, until an
+/// output is being written.
+pub fn set_current_input(path: &Path) {
+    let mut g = CURRENT_INPUT.lock().unwrap_or_else(|p| p.into_inner());
     *g = Some(path.to_path_buf());
 }
 
@@ -1097,7 +1133,15 @@ pub fn out_of_memory(bytes: usize) -> ! {
         let mut w: &mut [u8] = &mut line;
         let output = CURRENT_OUTPUT.try_lock().ok();
         let what = output.as_ref().and_then(|g| g.as_deref());
-        let _ = match what {
+        let input = CURRENT_INPUT.try_lock().ok();
+        let input = input.as_ref().and_then(|g| g.as_deref());
+        let _ = match (input, what) {
+            (Some(p), _) => writeln!(
+                w,
+                "error: {}: out of memory while working on this input: {bytes} more bytes could not be allocated; give a smaller one or raise the memory limit; no output written",
+                p.display()
+            ),
+            (None, what) => match what {
             Some(p) => writeln!(
                 w,
                 "error: {}: out of memory: {bytes} more bytes could not be allocated; lower the picture size, the frame rate, the flock or the length, or raise the memory limit; no output written",
@@ -1107,6 +1151,7 @@ pub fn out_of_memory(bytes: usize) -> ! {
                 w,
                 "error: out of memory: {bytes} more bytes could not be allocated; lower the flock, the length or the picture size, or raise the memory limit; no output written"
             ),
+            },
         };
         1024 - w.len()
     };

@@ -155,6 +155,51 @@ pub fn check_animation_size(what: &str, birds: usize, frames: usize) -> crate::R
     }
 }
 
+/// Lightest body mass accepted, kg (the smallest hummingbirds weigh about 2 g): a lighter mass
+/// is a unit slip, and far lighter ones make the power curve's numbers underflow.
+pub const MIN_BIRD_MASS_KG: f64 = 0.0015;
+
+/// Heaviest body mass accepted, kg (no flying bird is heavier than about 20 kg).
+pub const MAX_BIRD_MASS_KG: f64 = 50.0;
+
+/// Fastest airspeed accepted, m/s.
+pub const MAX_AIRSPEED_MS: f64 = 100.0;
+
+/// Checks a body mass in kilograms (positive, from [`MIN_BIRD_MASS_KG`] to
+/// [`MAX_BIRD_MASS_KG`]); the error names `what`. A mass no bird has would make every saving
+/// of total power NaN or nonsense.
+pub fn check_bird_mass(what: &str, kg: f64) -> crate::Result<()> {
+    let err = |msg: String| Err(crate::Error::parameter(what, msg));
+    if !(kg.is_finite() && kg > 0.0) {
+        return err(format!(
+            "{kg}: the body mass (kg) must be a positive number"
+        ));
+    }
+    if kg < MIN_BIRD_MASS_KG {
+        return err(format!(
+            "{kg}: no flying bird is lighter than about 2 g; give the mass in kilograms"
+        ));
+    }
+    if kg > MAX_BIRD_MASS_KG {
+        return err(format!(
+            "{kg}: no flying bird is heavier than about 20 kg; give the mass in kilograms"
+        ));
+    }
+    Ok(())
+}
+
+/// Checks an airspeed in m/s (in (0, [`MAX_AIRSPEED_MS`]]); the error names `what`.
+pub fn check_airspeed(what: &str, ms: f64) -> crate::Result<()> {
+    if ms.is_finite() && ms > 0.0 && ms <= MAX_AIRSPEED_MS {
+        Ok(())
+    } else {
+        Err(crate::Error::parameter(
+            what,
+            format!("{ms}: the airspeed must be a number of metres per second in (0, 100]"),
+        ))
+    }
+}
+
 /// Largest first frame number of an animation's outputs (`start_frame`): far beyond a studio's
 /// 1001, and small enough that 32-bit glTF key times keep sub-frame samples apart.
 pub const MAX_START_FRAME: u64 = 1_000_000;

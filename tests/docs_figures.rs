@@ -54,6 +54,8 @@ fn the_readme_job_s_figures_are_the_run_s() {
         .args([
             "--birds",
             "14",
+            "--species",
+            "barnacle-goose",
             "-o",
             "flock.gif",
             "-o",

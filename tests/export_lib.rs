@@ -93,10 +93,16 @@ fn every_output_opens_in_an_independent_reader() {
     let r = &rows[steady * anim.birds + 3];
     assert_eq!(r[0].parse::<usize>().unwrap(), steady);
     assert_eq!(r[2].parse::<usize>().unwrap(), 3);
-    assert_eq!(r[3].parse::<f64>().unwrap(), anim.frames[steady].x[3]);
+    // Each number exactly the value at the animation file's precision (10⁻⁵ wingspans for
+    // positions, 10⁻⁶ for savings).
+    use formation::animation::precision::{to, POSITION, SAVING};
+    assert_eq!(
+        r[3].parse::<f64>().unwrap(),
+        to(anim.frames[steady].x[3], POSITION)
+    );
     assert_eq!(
         r[9].parse::<f64>().unwrap(),
-        anim.frames[steady].xi.as_ref().unwrap()[3]
+        to(anim.frames[steady].xi.as_ref().unwrap()[3], SAVING)
     );
 
     // JSON round-trips and validates against SPEC §4.4, at the file's precision: positions to

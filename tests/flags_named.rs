@@ -231,6 +231,16 @@ fn commands() -> Vec<Command> {
             ],
         },
         Command {
+            name: &["view"],
+            base: strings(&["view", &flock, "-o", "OUT/v.html"]),
+            cases: vec![
+                ("--start-frame", "-1", None),
+                ("--every", "0", None),
+                o("OUT/v.txt"),
+                seed.clone(),
+            ],
+        },
+        Command {
             name: &["annotate"],
             base: strings(&[
                 "annotate",

@@ -73,22 +73,24 @@ fn the_csv_carries_each_birds_orientation_and_pitch() {
     let mut turned = 0;
     for r in &rows {
         let num = |i: usize| r[i].parse::<f64>().unwrap();
+        // The CSV writes quaternion components and angles to 10⁻⁶ (the animation file's
+        // precision), so the unit norm and the axes below hold to a few 10⁻⁶.
         let q = [num(qx), num(qy), num(qz), num(qw)];
         let norm = q.iter().map(|v| v * v).sum::<f64>().sqrt();
-        assert!((norm - 1.0).abs() < 1e-12);
+        assert!((norm - 1.0).abs() < 2.5e-6, "{norm}");
         assert!(q[3] >= 0.0);
         // The bird's forward axis (+y) points along its heading, lifted by its pitch.
         let (h, p) = (num(col("heading")), num(col("pitch")));
         let fwd = rotate(q, [0.0, 1.0, 0.0]);
         let want = [h.sin() * p.cos(), h.cos() * p.cos(), p.sin()];
         for i in 0..3 {
-            assert!((fwd[i] - want[i]).abs() < 1e-9, "{fwd:?} {want:?}");
+            assert!((fwd[i] - want[i]).abs() < 1e-5, "{fwd:?} {want:?}");
         }
         // Its right wing (+x) drops by the bank.
         let right = rotate(q, [1.0, 0.0, 0.0]);
         let bank = num(col("bank"));
         assert!(
-            (right[2] + bank.sin() * p.cos()).abs() < 1e-9,
+            (right[2] + bank.sin() * p.cos()).abs() < 1e-5,
             "{right:?} {bank}"
         );
         if p.abs() > 1e-6 {
@@ -129,7 +131,9 @@ fn metres_and_y_up_for_csv_and_json_and_the_json_reads_back() {
         for i in 0..3 {
             worst = worst.max((got[i] - want[i]).abs());
         }
-        assert!((num(col("speed")) - f.speed[b] * ws).abs() < 1e-9);
+        // Positions and speeds to 10⁻⁵ m (and m/s), angles and quaternions to 10⁻⁶, as the
+        // animation file stores them: each cell the value rounded to that step.
+        assert!((num(col("speed")) - f.speed[b] * ws).abs() <= 0.5e-5 + 1e-9);
         let q = [
             num(col("qx")),
             num(col("qy")),
@@ -137,9 +141,12 @@ fn metres_and_y_up_for_csv_and_json_and_the_json_reads_back() {
             num(col("qw")),
         ];
         let o = orientation(Up::Y, f.heading[b], num(col("pitch")), num(col("bank")));
-        assert_eq!(q, o);
+        for i in 0..4 {
+            // Rounded once in the CSV, and pitch and bank rounded before `o` was made.
+            assert!((q[i] - o[i]).abs() <= 1.5e-6, "{q:?} {o:?}");
+        }
     }
-    assert!(worst < 1e-9, "{worst}");
+    assert!(worst <= 0.5e-5 + 1e-9, "{worst}");
     // The JSON says what it is in and reads back in wingspans, z up.
     let doc: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
     assert_eq!(

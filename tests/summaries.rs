@@ -26,7 +26,7 @@ fn render_plot_report_and_solve_say_what_they_wrote() {
     let glb = dir.join("a.glb");
     let err = summary_of(&["render", s(&anim), "-o", s(&glb)]);
     assert!(
-        err.starts_with("render: 5 birds, 50 frames (2.5 s at 20 fps"),
+        err.starts_with("render: 5 birds, 50 frames at 20 fps (2.5 s; initiation + steady) from "),
         "{err}"
     );
     assert!(

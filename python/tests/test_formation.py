@@ -185,7 +185,7 @@ def test_binary_frames_with_numpy_and_read_back(tmp_path, anim):
     assert "frames" not in head and ff["path"] == "b.frames"
     # The recipe of docs/formats.md: one record a frame, the time then each field's birds.
     record = np.dtype([("t", "<f8")] + [(f, "<f4", (head["birds"],)) for f in ff["fields"]])
-    frames = np.fromfile(tmp_path / ff["path"], dtype=record, offset=16)
+    frames = np.fromfile(tmp_path / ff["path"], dtype=record, count=ff["frames"], offset=16)
     assert frames.shape == (ff["frames"],) == (len(anim),)
     np.testing.assert_array_equal(frames["t"], anim.times)
     np.testing.assert_array_equal(frames["x"], anim.positions[..., 0].astype(np.float32))

@@ -38,6 +38,9 @@ pub const BODY_DRAG_COEF: f64 = 0.1;
 /// a small power margin, which is why they run to take off), see docs/initiation.md.
 pub const CLIMB_POWER_MARGIN: f64 = 1.6;
 
+/// Lightest body mass accepted, kg ([`crate::limits::MIN_BIRD_MASS_KG`]).
+pub const MIN_MASS_KG: f64 = crate::limits::MIN_BIRD_MASS_KG;
+
 /// A bird's size: what the power curve needs.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Morphology {
@@ -103,18 +106,9 @@ impl Morphology {
                 ))
             }
         };
-        check("flight.mass_kg", self.mass_kg, "body mass (kg)")?;
+        crate::limits::check_bird_mass("flight.mass_kg", self.mass_kg)?;
         check("flight.span_m", self.span_m, "wingspan (m)")?;
         check("flight.wing_area_m2", self.wing_area_m2, "wing area (m²)")?;
-        if self.mass_kg > 50.0 {
-            return Err(Error::parameter(
-                "flight.mass_kg",
-                format!(
-                    "{}: no flying bird is heavier than about 20 kg; give the mass in kilograms",
-                    self.mass_kg
-                ),
-            ));
-        }
         Ok(())
     }
 }
@@ -273,11 +267,16 @@ pub fn curve_of(anim: &Animation) -> PowerCurve {
 }
 
 fn animation_curve_plain(species: Option<&str>, wingspan_m: f64) -> PowerCurve {
-    let sp = species
-        .and_then(|s| s.parse::<Species>().ok())
-        .unwrap_or(Species::Goose);
-    let bird = Morphology::of(sp);
-    let bird = if wingspan_m.is_finite() && wingspan_m > 0.0 {
+    let bird = match species.and_then(crate::animation::species::lookup) {
+        Some(b) => b.morphology(),
+        None => Morphology::of(
+            species
+                .and_then(|s| s.parse::<Species>().ok())
+                .unwrap_or(Species::Goose),
+        ),
+    };
+    // The species' own span is kept exactly (no rescaling round-off).
+    let bird = if wingspan_m.is_finite() && wingspan_m > 0.0 && wingspan_m != bird.span_m {
         bird.scaled_to(wingspan_m)
     } else {
         bird
@@ -339,35 +338,12 @@ pub fn steady_saving_total(anim: &Animation) -> Option<f64> {
 /// Checks an animation's flight settings; errors name `steady.flight.mass_kg` or
 /// `steady.flight.speed_ms`.
 pub fn validate_settings(s: &crate::animation::FlightSettings) -> Result<()> {
-    fn named(name: &'static str) -> impl Fn(Error) -> Error {
-        move |e| match e {
-            Error::Parameter { message, .. } => Error::parameter(name, message),
-            other => other,
-        }
-    }
-    if let Some(m) = s.mass_kg {
-        let bird = Morphology {
-            mass_kg: m,
-            ..Morphology::of(Species::Goose)
-        };
-        bird.validate().map_err(named("steady.flight.mass_kg"))?;
-    }
-    if let Some(v) = s.speed_ms {
-        validate_speed(v).map_err(named("steady.flight.speed_ms"))?;
-    }
-    Ok(())
+    s.validate("steady.flight")
 }
 
 /// Checks an airspeed given on the command line or in options (`flight.speed_ms`).
 pub fn validate_speed(v: f64) -> Result<()> {
-    if v.is_finite() && v > 0.0 && v <= 100.0 {
-        Ok(())
-    } else {
-        Err(Error::parameter(
-            "flight.speed_ms",
-            format!("{v}: the airspeed must be a number of metres per second in (0, 100]"),
-        ))
-    }
+    crate::limits::check_airspeed("flight.speed_ms", v)
 }
 
 #[cfg(test)]
@@ -450,7 +426,7 @@ mod tests {
         let big = g.scaled_to(3.0);
         assert!((big.mass_kg / g.mass_kg - 8.0).abs() < 1e-12);
         assert!((big.aspect_ratio() - g.aspect_ratio()).abs() < 1e-12);
-        for bad in [0.0, -1.0, f64::NAN, 200.0] {
+        for bad in [0.0, -1.0, f64::NAN, 200.0, 1e-200, 1e-300, 1e300, 0.001] {
             let m = Morphology { mass_kg: bad, ..g };
             assert!(m.validate().unwrap_err().to_string().contains("mass"));
         }

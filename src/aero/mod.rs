@@ -27,8 +27,9 @@
 //! j's trailing vortices meets the end of i's wing and ln(r_c − y) → −∞ for y > 0. A **vortex
 //! core** of radius δ ([`AeroOptions::core_radius`]) replaces the squared distance c² from a
 //! trailing vortex by ρ_c² = c² + δ²·exp(−c²/δ²) inside the logarithm (r̃_c = √(ρ_c² + y²)): the
-//! trailing vortex's velocity (1 + y/r̃)·c(1 − e^{−c²/δ²})/ρ_c² is Lamb–Oseen's profile
-//! (1 − e^{−c²/δ²})/c away from the wing, finite at the vortex, and equal to the ideal one to
+//! trailing vortex's velocity (1 + y/r̃)·c(1 − e^{−c²/δ²})/ρ_c² is a regularised core, not a true
+//! Lamb–Oseen core: it follows Lamb–Oseen's profile (1 − e^{−c²/δ²})/c a few core radii out but
+//! is weaker inside the core (it divides by ρ_c², not c²); finite at the vortex, and equal to the ideal one to
 //! within e^{−c²/δ²} a few core radii away. The bound-vortex term is kept exact: its only
 //! singularity, a 1/y pole for x < a at y = 0, is two wings overlapping side by side, which is a
 //! collision ([`AeroOptions::collision_chord`]) and an error.
@@ -62,6 +63,7 @@ mod far;
 mod field;
 pub mod flight;
 pub mod lissaman;
+pub mod species;
 mod tree;
 mod wake3d;
 pub use field::{ApproxField, Field};
@@ -829,9 +831,11 @@ pub fn relative(e: &[f64]) -> (Vec<f64>, f64) {
 }
 
 /// Fills `e` (the saving) and `xi` of every frame of `anim` that lacks them (the take-off),
-/// from the frame's positions in the formation frame of the leader's heading: the leader is
-/// the front-most bird of the first key shape (bird 0 without key shapes), x = offset to the
-/// right of its heading, y = distance behind along it. Pairs whose wings overlap side by side
+/// from the frame's positions in the flock's course frame: without a path the world frame
+/// (flight along +y), the frame the steady flight's own savings are computed in, so a
+/// recomputation with the same model reproduces them; on a path, the formation frame of the
+/// leader's heading (the leader is the front-most bird of the first key shape, bird 0 without
+/// key shapes): x = offset to the right of the heading, y = distance behind along it. Pairs whose wings overlap side by side
 /// (birds still on the ground, or crossing) are evaluated at the collision distance
 /// ([`AeroOptions::power_lenient`]), so every cell is a finite number. Frames that already
 /// carry e and ξ (the steady flight) are left as they are.
@@ -849,6 +853,7 @@ pub fn fill_frame_savings(anim: &mut Animation, opts: &AeroOptions) {
         })
         .filter(|&i| i < n)
         .unwrap_or(0);
+    let course_is_world = anim.path.is_none();
     for f in &mut anim.frames {
         if f.e.is_some() && f.xi.is_some() {
             continue;
@@ -856,7 +861,14 @@ pub fn fill_frame_savings(anim: &mut Animation, opts: &AeroOptions) {
         if f.x.len() != n || f.y.len() != n || f.heading.len() != n || n < 2 {
             continue;
         }
-        let h = f.heading[leader];
+        // The course frame: without a path it is the world frame (flight along +y, heading 0),
+        // the frame the steady flight computed its own savings in; on a path, the leader's
+        // heading stands for the path's (its small jostling turns included).
+        let h = if course_is_world {
+            0.0
+        } else {
+            f.heading[leader]
+        };
         let (s, c) = h.sin_cos();
         // d = (sin θ, cos θ) is the flight direction, (cos θ, −sin θ) its right.
         let lx: Vec<f64> = (0..n).map(|i| f.x[i] * c - f.y[i] * s).collect();
@@ -892,7 +904,7 @@ impl AeroOptions {
 
 /// Recomputes `e` and `xi` of every frame of `anim` with `opts` (another model, wake or core
 /// than the one the animation was made with), as [`fill_frame_savings`] does for the take-off:
-/// in the formation frame of the leader's heading. Records `opts` as the animation's savings
+/// in the course frame. Records `opts` as the animation's savings
 /// model.
 pub fn recompute_frame_savings(anim: &mut Animation, opts: &AeroOptions) {
     for f in &mut anim.frames {

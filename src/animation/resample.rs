@@ -27,6 +27,20 @@ pub const MAX_RESAMPLE_FPS: f64 = 1000.0;
 /// Tolerance, in frame intervals, within which a sample time counts as a frame's time.
 const ON_FRAME: f64 = 1e-9;
 
+/// How many frames [`resample`] gives `anim` at `fps` (without sampling them; 0 for a rate
+/// it refuses).
+pub fn resampled_count(anim: &Animation, fps: f64) -> usize {
+    let n = anim.frames.len();
+    if !(fps.is_finite() && (1.0..=MAX_RESAMPLE_FPS).contains(&fps)) || n == 0 {
+        return 0;
+    }
+    if anim.looped && n >= 2 {
+        return (n as f64 / anim.fps * fps).round() as usize;
+    }
+    let span = anim.frames[n - 1].t - anim.frames[0].t;
+    (span * fps + 1e-6).floor().max(0.0) as usize + 1
+}
+
 /// `anim` sampled at `fps` frames per second (see the module documentation). Errors name
 /// `fps`: a rate that is not finite or outside 1..=[`MAX_RESAMPLE_FPS`], or for a loop, a
 /// period that is not a whole number of frames at `fps`.
@@ -38,6 +52,30 @@ pub fn resample(anim: &Animation, fps: f64) -> Result<Animation> {
         ));
     }
     let n = anim.frames.len();
+    // The size at the new rate is held to the limits of an animation before any of it is made
+    // (or the animation copied): a long animation at a high rate would otherwise fill memory and
+    // disk with a file formation refuses to read.
+    if n >= 1 {
+        let seconds = if anim.looped && n >= 2 {
+            n as f64 / anim.fps
+        } else {
+            anim.frames[n - 1].t - anim.frames[0].t
+        };
+        let count = (seconds * fps).max(0.0) + 1.0;
+        let most =
+            (crate::limits::MAX_BIRD_FRAMES / anim.birds.max(1)).min(crate::limits::MAX_FRAMES);
+        if count.is_nan() || count > most as f64 + 0.5 {
+            return Err(Error::parameter(
+                "fps",
+                format!(
+                    "{fps} frames per second makes {count:.0} frames of {} birds ({seconds:.0} s), more than the {most} an animation may have (at most {} frames and {} bird-frames); give a lower rate",
+                    anim.birds,
+                    crate::limits::MAX_FRAMES,
+                    crate::limits::MAX_BIRD_FRAMES
+                ),
+            ));
+        }
+    }
     let mut out = anim.clone();
     out.fps = fps;
     if n == 0 {

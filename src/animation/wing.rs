@@ -36,6 +36,16 @@ impl Species {
             Species::Pelican => "pelican",
         }
     }
+
+    /// Every name a species may be given by: the real species (`barnacle-goose`, see
+    /// [`super::species`]), then the families.
+    pub fn known_names() -> Vec<&'static str> {
+        super::species::SPECIES
+            .iter()
+            .map(|s| s.name)
+            .chain(Species::ALL.iter().map(|s| s.name()))
+            .collect()
+    }
 }
 
 impl fmt::Display for Species {
@@ -49,13 +59,20 @@ impl FromStr for Species {
 
     fn from_str(s: &str) -> Result<Species> {
         let t = s.trim().to_ascii_lowercase();
+        // A real species is drawn by its family's rig (docs/species.md).
+        if let Some(b) = super::species::lookup(&t) {
+            return b.family.parse();
+        }
         Species::ALL
             .into_iter()
             .find(|sp| sp.name() == t)
             .ok_or_else(|| {
                 Error::parameter(
                     "wingbeat.species",
-                    format!("unknown species \"{s}\": expected goose, crane or pelican"),
+                    format!(
+                        "unknown species \"{s}\": expected one of {}",
+                        Species::known_names().join(", ")
+                    ),
                 )
             })
     }

@@ -100,6 +100,7 @@ pub fn run(args: AnimateArgs, g: Global) -> Result<()> {
         skein: args.skein.options(),
         ..Config::default()
     };
+    super::savings::apply_species(&mut config.steady, &args.wingbeat.species);
     // In the order the stages run: the steady flight's options are checked first.
     config.steady_options()?;
     // The take-off's length (and the --takeoff warning) is its largest formation's; the whole
@@ -126,6 +127,7 @@ pub fn run(args: AnimateArgs, g: Global) -> Result<()> {
     // Everything that can be checked is checked before any work.
     config.validate()?;
     formation::export::plan_outputs(&args.output)?;
+    super::course::check_path_kept(&args.path, &args.output, &config.render)?;
     super::check_bird_model(
         super::flags::Cmd::Animate,
         g,
@@ -133,7 +135,11 @@ pub fn run(args: AnimateArgs, g: Global) -> Result<()> {
         config.wingbeat.species,
     )?;
     let progress = TermProgress::new(g.quiet);
-    let (anim, report) = Pipeline::from_path(&args.input).run_with(&config, &progress)?;
+    let (mut anim, report) = Pipeline::from_path(&args.input).run_with(&config, &progress)?;
+    // A real species is named in the animation (its family's rig draws it).
+    if let Some(b) = formation::aero::species::lookup(&args.wingbeat.species) {
+        anim.species = Some(b.name.to_string());
+    }
     let warnings = report
         .params
         .summary

@@ -37,6 +37,19 @@ impl PathFlags {
     }
 }
 
+/// Refuses a run that would write over its own `--path` file (`--path-out`, an `-o` output or
+/// a frames file naming it), naming both.
+pub fn check_path_kept(
+    flags: &PathFlags,
+    outputs: &[PathBuf],
+    opts: &formation::export::RenderOptions,
+) -> formation::Result<()> {
+    match &flags.path {
+        Some(p) => formation::export::check_written(outputs, opts, &[("course.path", p)]),
+        None => formation::export::check_written(outputs, opts, &[]),
+    }
+}
+
 /// Prints the course step's warnings on stderr, one line each (with `--strict`, the first is
 /// the error instead).
 pub fn warn(

@@ -186,7 +186,7 @@ pub fn run(args: ExtractArgs, g: Global) -> Result<()> {
     if args.json {
         let s = formation::finite::to_json_pretty("params", &params)?;
         super::stdout::println(&s)?;
-    } else {
+    } else if !g.quiet {
         super::stdout::print(&summary_table(
             &ann,
             &params,

@@ -42,6 +42,8 @@ pub enum Cmd {
     Track,
     /// `formation annotate`.
     Annotate,
+    /// `formation view`.
+    View,
 }
 
 use Cmd::*;
@@ -198,10 +200,12 @@ pub const FLAGS: &[(&str, &str, &[Cmd])] = &[
     ("render.keys", "--keys", SCENE),
     ("render.clips", "--clips", SCENE),
     ("render.start_frame", "--start-frame", SCENE),
+    ("view.every", "--every", &[View]),
     ("render.subframes", "--subframes", SCENE),
     ("render.units", "--units", SCENE),
     ("render.up", "--up", SCENE),
     ("render.path_out", "--path-out", SCENE),
+    ("render.binary_frames", "--binary-frames", SCENE),
     ("render.usd_mode", "--usd-mode", SCENE),
     ("render.gltf_mode", "--gltf-mode", SCENE),
     ("render.animation_fps", "--fps", &[Render]),

@@ -284,6 +284,7 @@ impl InitiateFlags {
 pub fn run(args: InitiateArgs, g: Global) -> Result<()> {
     let wing = args.wingbeat.options()?;
     formation::export::plan_outputs(&args.output)?;
+    super::course::check_path_kept(&args.path, &args.output, &args.scene.options())?;
     let steady = Animation::read(&args.steady)?;
     if steady.formations.is_none() {
         initiate::check_steady(&steady, &args.steady)?;

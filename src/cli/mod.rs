@@ -17,12 +17,14 @@ mod power;
 pub mod progress;
 mod render;
 mod report;
+mod savings;
 mod solve;
 mod start;
 mod stdout;
 mod steady;
 pub mod summary;
 mod track;
+mod view;
 mod wake;
 mod wingbeat;
 
@@ -83,6 +85,9 @@ enum Command {
     /// A review page for annotations made elsewhere (any format extract reads) over the
     /// footage's frames, to check and correct them in a browser.
     Annotate(annotate::AnnotateArgs),
+    /// One self-contained HTML page that plays an animation in 3-D (WebGL): cameras, timeline
+    /// with stages and events, birds coloured by saving, rank or formation.
+    View(view::ViewArgs),
 }
 
 /// Runs the parsed command line.
@@ -107,6 +112,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Report(a) => (Cmd::Report, report::run(a, g)),
         Command::Track(a) => (Cmd::Track, track::run(a, g)),
         Command::Annotate(a) => (Cmd::Annotate, annotate::run(a, g)),
+        Command::View(a) => (Cmd::View, view::run(a, g)),
     };
     // Library errors name option paths; the user typed this command's flags.
     result.map_err(|e| flags::name_flags(cmd, e))?;

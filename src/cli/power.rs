@@ -46,13 +46,16 @@ pub struct PowerArgs {
 /// The bird whose power curve turns savings of induced power into savings of total power.
 #[derive(Debug, Args, Clone)]
 pub struct FlightArgs {
-    /// Species whose typical size sets the power curve (goose, crane or pelican; docs/model.md).
+    /// Species whose size and cruise airspeed set the power curve: a real species
+    /// (barnacle-goose, greylag-goose, canada-goose, white-fronted-goose, pink-footed-goose,
+    /// common-crane, white-pelican, northern-bald-ibis; docs/species.md) or a family's typical
+    /// bird (goose, crane or pelican; docs/model.md).
     #[arg(long, value_name = "NAME", default_value = "goose")]
     pub species: String,
     /// Body mass, kg (default: the species' typical mass, scaled to --wingspan-m).
     #[arg(long = "mass-kg", value_name = "KG", allow_negative_numbers = true)]
     pub mass_kg: Option<f64>,
-    /// Airspeed, m/s (default: the bird's minimum-power speed).
+    /// Airspeed, m/s (default: a real species' cruise airspeed, a family's minimum-power speed).
     #[arg(long = "speed-ms", value_name = "M/S", allow_negative_numbers = true)]
     pub speed_ms: Option<f64>,
     /// Wingspan, m (default: the species' typical span).
@@ -62,7 +65,8 @@ pub struct FlightArgs {
 
 /// The power curve and airspeed the flags give.
 pub struct Flight {
-    pub species: formation::animation::wing::Species,
+    /// The name given: a real species or the family.
+    pub name: &'static str,
     pub curve: aero::flight::PowerCurve,
     pub speed_ms: f64,
 }
@@ -81,7 +85,8 @@ impl FlightArgs {
             .species
             .parse()
             .map_err(|e: Error| reflag(e, "--species"))?;
-        let preset = aero::flight::Morphology::of(species);
+        let real = aero::species::lookup(&self.species);
+        let preset = real.map_or(aero::flight::Morphology::of(species), |b| b.morphology());
         let mut bird = match self.wingspan_m {
             Some(b) => {
                 let least = formation::limits::MIN_WINGSPAN_M;
@@ -105,10 +110,10 @@ impl FlightArgs {
                 aero::flight::validate_speed(v).map_err(|e| reflag(e, "--speed-ms"))?;
                 v
             }
-            None => curve.minimum_power_speed(),
+            None => real.map_or(curve.minimum_power_speed(), |b| b.cruise_ms),
         };
         Ok(Flight {
-            species,
+            name: real.map_or(species.name(), |b| b.name),
             curve,
             speed_ms,
         })
@@ -166,9 +171,18 @@ struct FlightJson {
     method: &'static str,
 }
 
+/// The flock saving's lowest and highest over the band (and the chosen model), fractions of
+/// induced and of total power.
+#[derive(Serialize)]
+struct RangeJson {
+    induced: [f64; 2],
+    total: [f64; 2],
+}
+
 #[derive(Serialize)]
 struct PowerJson {
     total: f64,
+    saving_range: RangeJson,
     flock_saving: f64,
     flock_saving_total: f64,
     model: ModelJson,
@@ -291,10 +305,21 @@ pub fn run(args: PowerArgs, _g: Global) -> Result<()> {
         }
     }
     let core_used = model.model.is_hummel().then_some(model.core_radius);
+    // The range leads: the band's lowest and highest, the chosen model's value included.
+    let (lo, hi) = band
+        .iter()
+        .map(|b| b.flock_saving)
+        .fold((flock_saving, flock_saving), |(l, h), v| {
+            (l.min(v), h.max(v))
+        });
     let mut out = String::new();
     if args.json {
         let doc = PowerJson {
             total: pr.total,
+            saving_range: RangeJson {
+                induced: [lo, hi],
+                total: [lo * share, hi * share],
+            },
             flock_saving,
             flock_saving_total: flock_saving * share,
             model: ModelJson {
@@ -303,7 +328,7 @@ pub fn run(args: PowerArgs, _g: Global) -> Result<()> {
                 core_radius: core_used,
             },
             flight: FlightJson {
-                species: flight.species.to_string(),
+                species: flight.name.to_string(),
                 mass_kg: flight.curve.bird.mass_kg,
                 wingspan_m: flight.curve.bird.span_m,
                 wing_area_m2: flight.curve.bird.wing_area_m2,
@@ -333,6 +358,10 @@ pub fn run(args: PowerArgs, _g: Global) -> Result<()> {
     } else {
         let leader = shape.leader().unwrap_or(0);
         out.push_str(&format!(
+            "{}\n",
+            super::savings::range_line(lo, hi, share, flock_saving, &super::savings::label(&model))
+        ));
+        out.push_str(&format!(
             "{:>5} {:>10} {:>10} {:>9} {:>9} {:>9}\n",
             "bird", "x", "y", "induced", "total", "xi"
         ));
@@ -345,8 +374,18 @@ pub fn run(args: PowerArgs, _g: Global) -> Result<()> {
                 100.0 * pr.e[i],
                 100.0 * pr.e[i] * share,
                 pr.xi[i],
-                if i == leader { "  leader" } else { "" }
+                if i == leader {
+                    "  leader"
+                } else if pr.e[i] > 1.0 {
+                    "  e > 1"
+                } else {
+                    ""
+                }
             ));
+        }
+        if pr.e.iter().any(|&e| e > 1.0) {
+            out.push_str(super::savings::E_ABOVE_ONE);
+            out.push('\n');
         }
         out.push_str(&format!(
             "flock saving {:.2}% of induced power, {:.2}% of total power (mean over {} birds; E = {:.6})\n",
@@ -402,7 +441,7 @@ pub fn run(args: PowerArgs, _g: Global) -> Result<()> {
                 Some(c) => format!("core {c} wingspans"),
                 None => "no core (a continuous vortex sheet; --core-radius is not used)".into(),
             },
-            flight.species,
+            flight.name,
             bird.mass_kg,
             bird.span_m,
             flight.speed_ms,

@@ -281,6 +281,7 @@ pub fn run(args: RenderArgs, g: Global) -> Result<()> {
     opts.validate()?;
     // Check the outputs before reading a possibly large animation.
     formation::export::plan_outputs(&args.output)?;
+    formation::export::check_written(&args.output, &opts, &[])?;
     let anim = Animation::read(&args.animation)?;
     formation::export::sample::check_times(&anim, &args.animation)?;
     super::check_bird_model(
@@ -293,6 +294,6 @@ pub fn run(args: RenderArgs, g: Global) -> Result<()> {
     let _ = g.seed;
     write_outputs(&anim, &args.output, &opts, &TermProgress::new(g.quiet))?;
     let written = formation::export::written_files(&args.output, &opts);
-    super::summary::render(g, &anim, &args.animation, &written);
+    super::summary::render(g, &anim, &opts, &args.animation, &written);
     Ok(())
 }

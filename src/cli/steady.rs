@@ -230,6 +230,7 @@ pub fn run(args: SteadyArgs, g: Global) -> Result<()> {
         skein: args.skein.options(),
         ..Config::default()
     };
+    super::savings::apply_species(&mut config.steady, &args.wingbeat.species);
     args.land.apply(&mut config);
     config.steady_options()?;
     config.wingbeat.validate()?;
@@ -244,6 +245,7 @@ pub fn run(args: SteadyArgs, g: Global) -> Result<()> {
         }
     }
     let plan = formation::export::plan_outputs(&args.output)?;
+    super::course::check_path_kept(&args.path, &args.output, &args.scene.options())?;
     if let Some(r) = &args.report {
         formation::export::plan_report(r, &plan)?;
     }
@@ -257,6 +259,10 @@ pub fn run(args: SteadyArgs, g: Global) -> Result<()> {
     let course = formation::pipeline::course_stage(&mut anim, path.as_ref(), &config)?;
     super::course::warn(super::flags::Cmd::Steady, g, &course)?;
     formation::pipeline::finish(&mut anim, &config)?;
+    // A real species is named in the animation (its family's rig draws it).
+    if let Some(b) = formation::aero::species::lookup(&args.wingbeat.species) {
+        anim.species = Some(b.name.to_string());
+    }
     super::check_bird_model(
         super::flags::Cmd::Steady,
         g,

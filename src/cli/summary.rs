@@ -130,17 +130,11 @@ pub fn animation_text(what: &str, anim: &Animation, params: Option<&FormationPar
     if let Some(t) = s.landing_s {
         parts.push(format!("landing {t:.1} s"));
     }
-    if let Some(e) = s.steady_saving {
-        let total = formation::aero::flight::steady_saving_total(anim).map_or(String::new(), |t| {
-            format!(" ({:.1} % of total power)", 100.0 * t)
-        });
-        parts.push(format!(
-            "flock saving {:.1} % of induced power{total} in steady flight by {} (models applied to measured spacings: 14–36 %)",
-            100.0 * e,
-            anim.savings_model
-                .as_ref()
-                .map_or("Hummel's model".to_string(), |m| m.to_string())
-        ));
+    if let Some(line) = s
+        .steady_saving
+        .and_then(|e| super::savings::animation_line(anim, e))
+    {
+        parts.push(line);
     }
     parts.join(", ")
 }
@@ -207,28 +201,86 @@ pub fn solve(
     );
 }
 
-/// `render`'s summary: what was rendered, from which file.
-pub fn render(g: super::Global, anim: &Animation, input: &std::path::Path, outputs: &[PathBuf]) {
+/// `render`'s summary: what was written (the animation's frames at the rate they were written
+/// at, resampled by `--fps` or not, and the picture outputs' frames and rate), from which file.
+pub fn render(
+    g: super::Global,
+    anim: &Animation,
+    opts: &formation::export::RenderOptions,
+    input: &std::path::Path,
+    outputs: &[PathBuf],
+) {
     if g.quiet {
         return;
     }
-    let frames = anim.frames.len();
+    defer(render_text(anim, opts, input, outputs), outputs);
+}
+
+/// The text of [`render`]'s summary line.
+pub fn render_text(
+    anim: &Animation,
+    opts: &formation::export::RenderOptions,
+    input: &std::path::Path,
+    outputs: &[PathBuf],
+) -> String {
+    use formation::io::OutputKind;
     let stages: Vec<&str> = anim.stages.iter().map(|s| s.name.as_str()).collect();
-    defer(
+    let stages = if stages.is_empty() {
+        "no stages".to_string()
+    } else {
+        stages.join(" + ")
+    };
+    let (frames, fps) = match opts.animation_fps {
+        Some(f) if f != anim.fps => (formation::animation::resample::resampled_count(anim, f), f),
+        _ => (anim.frames.len(), anim.fps),
+    };
+    let resampled = if fps != anim.fps {
         format!(
-            "render: {} birds, {frames} frames ({:.1} s at {} fps; {}) from {}",
-            anim.birds,
-            frames as f64 / anim.fps,
-            anim.fps,
-            if stages.is_empty() {
-                "no stages".to_string()
-            } else {
-                stages.join(" + ")
-            },
-            super::stdout::file_name(input)
-        ),
-        outputs,
+            ", resampled from {} frames at {} fps",
+            anim.frames.len(),
+            anim.fps
+        )
+    } else {
+        String::new()
+    };
+    let mut text = format!(
+        "render: {} birds, {frames} frames at {fps} fps ({:.1} s; {stages}{resampled}) from {}",
+        anim.birds,
+        frames as f64 / fps,
+        super::stdout::file_name(input)
     );
+    // The picture outputs: their frame count at their own rate.
+    let mut shown = Vec::new();
+    for o in outputs {
+        let ext = o
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(|e| e.to_ascii_lowercase());
+        let kind = match ext.as_deref() {
+            Some("gif") => OutputKind::Gif,
+            Some("mp4") => OutputKind::Mp4,
+            Some("webm") => OutputKind::Webm,
+            _ if o.is_dir() => OutputKind::Directory,
+            _ => continue,
+        };
+        // The pictures are drawn from the (resampled) animation; their count depends only on
+        // its time span and the picture rate.
+        let pfps = formation::export::picture_fps(anim, kind, opts);
+        let n = formation::export::sample::output_count(anim, pfps);
+        let t = format!("{n} pictures at {} fps", (pfps * 1000.0).round() / 1000.0);
+        if !shown.contains(&t) {
+            shown.push(t);
+        }
+    }
+    if !shown.is_empty() {
+        text.push_str(&format!(
+            "; {} ({}x{})",
+            shown.join(", "),
+            opts.width,
+            opts.height
+        ));
+    }
+    text
 }
 
 /// A chart's or a page's summary: `what` says what it shows.

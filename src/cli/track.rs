@@ -157,6 +157,8 @@ pub fn run(args: TrackArgs, g: Global) -> Result<()> {
     if let Some(e) = failed {
         return Err(e);
     }
+    let warnings: Vec<&str> = tracked.warnings.iter().map(String::as_str).collect();
+    super::warn_lines(super::flags::Cmd::Track, g, &warnings)?;
     let text = tracked.to_native();
     write_bytes_atomic(&args.output, text.as_bytes())?;
     if let Some(r) = &args.review {
@@ -168,8 +170,12 @@ pub fn run(args: TrackArgs, g: Global) -> Result<()> {
         write_bytes_atomic(r, review::page(&tracked, &jpegs, &name).as_bytes())?;
     }
     if !g.quiet {
+        let decoded = tracked
+            .decoded
+            .map(|n| format!(" of {n} decoded"))
+            .unwrap_or_default();
         eprintln!(
-            "{}: {} frames tracked, {} tracks, wingspan {:.1} px, heading {:.1} deg",
+            "{}: {} frames tracked{decoded}, {} tracks, wingspan {:.1} px, heading {:.1} deg",
             args.input.display(),
             tracked.frames.len(),
             tracked.track_count(),

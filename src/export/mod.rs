@@ -18,6 +18,8 @@ pub mod bird;
 pub mod bird_model;
 pub mod camera;
 pub mod crowd;
+pub mod fidelity;
+pub mod field;
 pub mod gltf;
 pub mod keys;
 pub mod lzw;
@@ -477,7 +479,7 @@ pub fn plan_report(report: &Path, plan: &[Output]) -> Result<()> {
 }
 
 /// Frame rate used for a picture output of `kind`.
-fn picture_fps(anim: &Animation, kind: OutputKind, opts: &RenderOptions) -> f64 {
+pub fn picture_fps(anim: &Animation, kind: OutputKind, opts: &RenderOptions) -> f64 {
     match (kind, opts.fps) {
         (OutputKind::Gif, Some(f)) => 100.0 / (100.0 / f).round().max(2.0),
         (OutputKind::Gif, None) => GIF_FPS,
@@ -515,6 +517,7 @@ pub fn write_outputs(
     }
     let anim: &Animation = &shot;
     let plan = plan_outputs(outputs)?;
+    check_written(outputs, opts, &[])?;
     for o in &plan {
         let video = matches!(o.kind, OutputKind::Mp4 | OutputKind::Webm);
         if (video || o.kind == OutputKind::Gif) && opts.background == Background::None {
@@ -777,6 +780,76 @@ fn write_binary_frames(anim: &Animation, target: &Path, pretty: bool) -> Result<
     header.frames_file = Some(ff);
     f.commit()?;
     crate::io::write_json_atomic_as(target, &header, pretty)
+}
+
+/// Checks the files a run writes besides its outputs against each other and against its inputs,
+/// before any work: with `opts.binary_frames`, no two `.json` outputs may share a frames file
+/// (`a.json` and `a.JSON` both keep their frames in `a.frames`), nor may one be another output;
+/// and no file written ([`written_files`]) may be one of `inputs` (an option path such as
+/// `course.path` with the file it reads), which it would replace. The same file is found by
+/// device and inode where it exists, so `./p.json`, `d/../p.json` and a link to it are one.
+pub fn check_written(
+    outputs: &[PathBuf],
+    opts: &RenderOptions,
+    inputs: &[(&str, &Path)],
+) -> Result<()> {
+    if opts.binary_frames {
+        let mut seen: Vec<(PathBuf, &PathBuf)> = Vec::new();
+        for p in outputs {
+            if !p
+                .extension()
+                .is_some_and(|e| e.eq_ignore_ascii_case("json"))
+            {
+                continue;
+            }
+            let frames = crate::animation::binary::frames_path(p);
+            let id = crate::io::output_identity(&frames);
+            if let Some((_, first)) = seen.iter().find(|(f, _)| *f == id) {
+                return Err(Error::parameter(
+                    "output",
+                    format!(
+                        "{}: its frames would go to {}, as those of {} do (render.binary_frames); give the two .json outputs names that differ before the extension",
+                        p.display(),
+                        frames.display(),
+                        first.display()
+                    ),
+                ));
+            }
+            if let Some(o) = outputs.iter().find(|o| crate::io::output_identity(o) == id) {
+                return Err(Error::parameter(
+                    "output",
+                    format!(
+                        "{}: is also where the frames of {} go (render.binary_frames); give it another name",
+                        o.display(),
+                        p.display()
+                    ),
+                ));
+            }
+            seen.push((id, p));
+        }
+    }
+    for (flag, input) in inputs {
+        for w in written_files(outputs, opts) {
+            if crate::io::same_file(input, &w) {
+                let (name, what) = if opts.path_out.as_ref() == Some(&w) {
+                    ("render.path_out", "the flown path")
+                } else if outputs.contains(&w) {
+                    ("output", "an output")
+                } else {
+                    ("output", "a frames file (render.binary_frames)")
+                };
+                return Err(Error::parameter(
+                    name,
+                    format!(
+                        "{}: is the file {flag} reads ({}); writing {what} there would replace it: give another name",
+                        w.display(),
+                        input.display()
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Every file [`write_outputs`] writes for `outputs` with `opts`: the outputs, then each `.json`

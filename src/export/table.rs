@@ -22,24 +22,77 @@
 //!
 //! `e` (the saving), `xi` and `wing_phase` are numbers in every frame of a file written by this
 //! tool; they are empty only for a hand-made animation file without them. Numbers use the
-//! shortest text that reads back to the same `f64`. `docs/formats.md` documents every column.
+//! shortest decimal of the value rounded to the precision the animation file stores it at
+//! (positions, lengths and speeds to 10⁻⁵, angles, quaternion components and savings to 10⁻⁶,
+//! times to 10⁻⁶ s): no float noise and no `-0`. `docs/formats.md` documents every column.
 
 use std::io::Write;
 
 use crate::animation::axes::{self, Units, Up};
+use crate::animation::precision::{ANGLE, POSITION, SAVING, SPEED};
 use crate::animation::Animation;
+
+/// Steps per second of the `t` column: frame times are written to the microsecond.
+const TIME: f64 = 1e6;
 
 /// The header line, without newline.
 pub const CSV_HEADER: &str =
     "frame,t,bird,x,y,z,heading,speed,e,xi,stage,formation,rank,leader,lateral,behind,wing_phase,bank,saving_total,qx,qy,qz,qw,pitch";
 
-/// An optional number as a CSV cell: the number, or nothing (written without a `String`).
-struct Cell(Option<f64>);
+/// A number as a CSV cell, rounded to `1 / steps` (`steps` a power of ten, the precision the
+/// animation file stores such a value at, [`precision`]) and written as the shortest decimal of
+/// the rounded value: no float noise (`0.10500000000000001`), no `-0`, no exponent.
+#[derive(Clone, Copy)]
+struct Num(f64, f64);
+
+impl std::fmt::Display for Num {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write_decimal(f, self.0, self.1)
+    }
+}
+
+/// Writes `x` rounded to `1 / steps` (`steps` = 10^d, d ≤ 9) as a plain decimal with trailing
+/// zeros dropped: the text reads back to exactly [`crate::animation::precision::to`]`(x, steps)`. Values too
+/// large to round that way (and non-finite ones, refused before any output is written) are
+/// written as Rust's shortest round-trip form; zero of either sign as `0`.
+pub fn write_decimal<W: std::fmt::Write + ?Sized>(
+    f: &mut W,
+    x: f64,
+    steps: f64,
+) -> std::fmt::Result {
+    let digits = steps.log10().round().clamp(0.0, 9.0) as u32;
+    let scale = 10u64.pow(digits);
+    let n = (x * scale as f64).round();
+    if !(n.is_finite() && n.abs() < 9e15) {
+        return if x == 0.0 {
+            f.write_str("0")
+        } else {
+            write!(f, "{x}")
+        };
+    }
+    let n = n as i64;
+    if n == 0 {
+        return f.write_str("0");
+    }
+    let sign = if n < 0 { "-" } else { "" };
+    let (int, mut frac, mut width) = (n.unsigned_abs() / scale, n.unsigned_abs() % scale, digits);
+    if frac == 0 {
+        return write!(f, "{sign}{int}");
+    }
+    while frac % 10 == 0 {
+        frac /= 10;
+        width -= 1;
+    }
+    write!(f, "{sign}{int}.{frac:0width$}", width = width as usize)
+}
+
+/// An optional number as a CSV cell: [`Num`], or nothing (written without a `String`).
+struct Cell(Option<f64>, f64);
 
 impl std::fmt::Display for Cell {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self.0 {
-            Some(x) => write!(f, "{x}"),
+            Some(x) => write_decimal(f, x, self.1),
             None => Ok(()),
         }
     }
@@ -83,44 +136,51 @@ pub fn write_csv_in<W: Write>(
         let rel = anim.relative_with(k, &of, &leaders);
         for (b, r) in rel.iter().enumerate() {
             let v = |a: &Vec<f64>| a.get(b).copied().unwrap_or(f64::NAN);
-            let o = |a: &Option<Vec<f64>>| Cell(a.as_ref().and_then(|a| a.get(b)).copied());
+            let o = |a: &Option<Vec<f64>>, steps: f64| {
+                Cell(a.as_ref().and_then(|a| a.get(b)).copied(), steps)
+            };
             let or0 =
                 |a: &Option<Vec<f64>>| a.as_ref().and_then(|a| a.get(b)).copied().unwrap_or(0.0);
             let bank = or0(&f.bank);
             let pitch = or0(&f.pitch);
-            let total = Cell(f.e.as_ref().and_then(|a| a.get(b)).map(|e| {
-                let v = anim.flight.and_then(|f| f.speed_ms).unwrap_or_else(|| {
-                    crate::aero::flight::airspeed_ms(&curve, v(&f.speed), anim.wingspan_m)
-                });
-                e * curve.induced_share(v)
-            }));
+            let total = Cell(
+                f.e.as_ref().and_then(|a| a.get(b)).map(|e| {
+                    let v = anim.flight.and_then(|f| f.speed_ms).unwrap_or_else(|| {
+                        crate::aero::flight::airspeed_ms(&curve, v(&f.speed), anim.wingspan_m)
+                    });
+                    e * curve.induced_share(v)
+                }),
+                SAVING,
+            );
             let p = up
                 .from_world([v(&f.x), v(&f.y), v(&f.z)])
                 .map(|c| c * scale);
             let q = axes::orientation(up, v(&f.heading), pitch, bank);
             writeln!(
                 w,
-                "{},{},{b},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{bank},{total},{},{},{},{},{pitch}",
+                "{},{},{b},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{total},{},{},{},{},{}",
                 anim.start_frame + k as u64,
-                f.t,
-                p[0],
-                p[1],
-                p[2],
-                v(&f.heading),
-                v(&f.speed) * scale,
-                o(&f.e),
-                o(&f.xi),
+                Num(f.t, TIME),
+                Num(p[0], POSITION),
+                Num(p[1], POSITION),
+                Num(p[2], POSITION),
+                Num(v(&f.heading), ANGLE),
+                Num(v(&f.speed) * scale, SPEED),
+                o(&f.e, SAVING),
+                o(&f.xi, SAVING),
                 stages[k],
                 r.formation,
                 r.rank,
                 u8::from(r.leader),
-                r.lateral * scale,
-                r.behind * scale,
-                o(&f.wing_phase),
-                q[0],
-                q[1],
-                q[2],
-                q[3],
+                Num(r.lateral * scale, POSITION),
+                Num(r.behind * scale, POSITION),
+                o(&f.wing_phase, ANGLE),
+                Num(bank, ANGLE),
+                Num(q[0], ANGLE),
+                Num(q[1], ANGLE),
+                Num(q[2], ANGLE),
+                Num(q[3], ANGLE),
+                Num(pitch, ANGLE),
             )?;
         }
     }

@@ -122,7 +122,7 @@ pub fn footage_band(p: &FormationParams) -> Vec<BandEntry> {
 /// An animation's flock saving in steady flight (all frames without a steady stage) with every
 /// option of [`band_options`], on at most [`BAND_FRAMES`] evenly spaced frames (fewer, down to 3,
 /// for flocks of more than 200 birds; none above [`BAND_MAX_BIRDS`]), each evaluated
-/// in the formation frame of the leader's heading as [`crate::aero::fill_frame_savings`] does.
+/// in the course frame as [`crate::aero::fill_frame_savings`] does.
 pub fn animation_band(a: &Animation) -> Vec<BandEntry> {
     let range = a
         .stage("steady")

@@ -183,6 +183,10 @@ pub struct Tracked {
     pub polarity: Polarity,
     /// Processed frames in order.
     pub frames: Vec<TrackedFrame>,
+    /// Frames ffmpeg decoded, for a video (read until the chosen range ended).
+    pub decoded: Option<usize>,
+    /// What the user should know about the footage (a damaged video), one line each.
+    pub warnings: Vec<String>,
 }
 
 /// Runs detection and tracking frame by frame.
@@ -270,6 +274,25 @@ impl Tracking {
                 name,
                 format!(
                     "frame {index}: no bird found; check track.polarity (dark birds on a bright sky, or bright on dark), track.roi, or leave the frame out with track.frames"
+                ),
+            ));
+        }
+        if blobs.len() > crate::limits::MAX_ANNOTATED_BIRDS {
+            return Err(Error::format(
+                name,
+                format!(
+                    "frame {index}: {} birds found, more than the {} a frame that annotations hold; search part of the frame with track.roi, or check track.polarity (noise or texture taken for birds)",
+                    blobs.len(),
+                    crate::limits::MAX_ANNOTATED_BIRDS
+                ),
+            ));
+        }
+        if self.frames.len() >= crate::limits::MAX_ANNOTATED_FRAMES {
+            return Err(Error::parameter(
+                "track.frames",
+                format!(
+                    "more than {} frames to track, the most annotations hold (frame {index} is one too many); choose fewer with track.every or track.frames",
+                    crate::limits::MAX_ANNOTATED_FRAMES
                 ),
             ));
         }
@@ -425,6 +448,8 @@ impl Tracking {
             fps: self.opts.fps.or(fps),
             polarity: self.polarity.unwrap_or(Polarity::Dark),
             frames,
+            decoded: None,
+            warnings: Vec::new(),
         })
     }
 }
@@ -579,6 +604,16 @@ pub fn track_path(
                 .enumerate()
                 .filter(|(k, _)| opts.wants(*k))
                 .collect();
+            if wanted.len() > crate::limits::MAX_ANNOTATED_FRAMES {
+                return Err(Error::parameter(
+                    "track.frames",
+                    format!(
+                        "{} frames to track, at most {} (the most annotations hold); choose fewer with track.every or track.frames",
+                        wanted.len(),
+                        crate::limits::MAX_ANNOTATED_FRAMES
+                    ),
+                ));
+            }
             if wanted.is_empty() {
                 return Err(Error::parameter(
                     "track.frames",
@@ -599,14 +634,14 @@ pub fn track_path(
             progress.finish();
             run.finish(&source, None)
         }
-        source::Input::Video {
-            path,
-            width,
-            height,
-            fps,
-        } => {
-            opts.roi_in(width, height)?;
-            let mut v = source::VideoFrames::start(&path, width, height)?;
+        source::Input::Video { path, .. } => {
+            let mut v = source::VideoFrames::start(&path)?;
+            let fps = v.fps;
+            if let Err(e) = opts.roi_in(v.width, v.height) {
+                v.stop();
+                return Err(e);
+            }
+            let mut warning = None;
             progress.start("tracking", 0);
             let mut k = 0usize;
             loop {
@@ -617,7 +652,7 @@ pub fn track_path(
                 let frame = match v.next_frame() {
                     Ok(Some(g)) => g,
                     Ok(None) => {
-                        v.finish(k)?;
+                        warning = v.finish(k)?;
                         break;
                     }
                     Err(e) => {
@@ -642,13 +677,16 @@ pub fn track_path(
                     "ffmpeg gave no frame: the video is empty or cannot be decoded",
                 ));
             }
-            run.finish(&source, fps).map_err(|e| match e {
+            let mut tracked = run.finish(&source, fps).map_err(|e| match e {
                 Error::Format { .. } => Error::parameter(
                     "track.frames",
                     format!("no frame in the chosen range: the video has {k} frames"),
                 ),
                 e => e,
-            })
+            })?;
+            tracked.decoded = Some(k);
+            tracked.warnings.extend(warning);
+            Ok(tracked)
         }
     }
 }

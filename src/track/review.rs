@@ -77,13 +77,6 @@ fn base64(bytes: &[u8]) -> String {
     s
 }
 
-fn html_escape(s: &str) -> String {
-    s.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-        .replace('"', "&quot;")
-}
-
 /// The review page of annotations made elsewhere (any input format) over their footage's frames
 /// `images` (in order): each annotated frame shows the image its `image` field names, else the
 /// image at its frame index. Positions become pixels from the top-left (y down) as the page
@@ -169,6 +162,8 @@ pub fn annotations_page(
         fps: ann.fps,
         polarity: super::Polarity::Dark,
         frames,
+        decoded: None,
+        warnings: Vec::new(),
     };
     Ok(page(&tracked, &jpegs, save_as))
 }
@@ -191,9 +186,9 @@ pub fn page(tracked: &Tracked, jpegs: &BTreeMap<usize, Vec<u8>>, save_as: &str) 
         "annotations": serde_json::from_str::<serde_json::Value>(&tracked.to_native())
             .unwrap_or(serde_json::Value::Null),
     });
-    // Inside a <script> element nothing may close it.
-    let data = data.to_string().replace("</", "<\\/");
-    let title = html_escape(&tracked.source);
+    // Inside a <script> element nothing may close it or open a comment: no `<` at all.
+    let data = crate::embed::script_json(&data);
+    let title = crate::embed::html_text(&tracked.source);
     format!(
         r##"<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8">

@@ -48,6 +48,138 @@ fn median(v: &mut [f64]) -> f64 {
     }
 }
 
+/// The minimum-cost assignment of detections to predictions (`usize::MAX`: none), costs capped
+/// at `(2 gate)²`. A detection and a prediction further apart than that cost the cap whatever
+/// they are paired with, so the problem falls apart into the groups linked by nearer pairs, each
+/// solved alone (Hungarian): the same optimum, in time cubic in a group's size rather than the
+/// frame's.
+fn assign(
+    blobs: &[Blob],
+    pred: &[(f64, f64)],
+    gate: f64,
+    cost: impl Fn(usize, usize) -> f64,
+) -> Vec<usize> {
+    let (n, m) = (blobs.len(), pred.len());
+    let mut of_blob = vec![usize::MAX; n];
+    if n == 0 || m == 0 {
+        return of_blob;
+    }
+    // Union-find over detections 0..n and predictions n..n+m.
+    let mut parent: Vec<usize> = (0..n + m).collect();
+    fn root(p: &mut [usize], mut i: usize) -> usize {
+        while p[i] != i {
+            p[i] = p[p[i]];
+            i = p[i];
+        }
+        i
+    }
+    let reach = 2.0 * gate;
+    let grid = Grid::new(blobs, reach);
+    for (j, q) in pred.iter().enumerate() {
+        grid.each_within(blobs, *q, reach, |i| {
+            let (a, b) = (root(&mut parent, i), root(&mut parent, n + j));
+            if a != b {
+                parent[a.max(b)] = a.min(b);
+            }
+        });
+    }
+    let mut groups: std::collections::BTreeMap<usize, (Vec<usize>, Vec<usize>)> =
+        std::collections::BTreeMap::new();
+    for i in 0..n {
+        let r = root(&mut parent, i);
+        groups.entry(r).or_default().0.push(i);
+    }
+    for j in 0..m {
+        let r = root(&mut parent, n + j);
+        groups.entry(r).or_default().1.push(j);
+    }
+    for (rows, cols) in groups.values() {
+        if rows.is_empty() || cols.is_empty() {
+            continue;
+        }
+        if rows.len() <= cols.len() {
+            let a = crate::annotations::hungarian(rows.len(), cols.len(), |i, j| {
+                cost(rows[i], cols[j])
+            });
+            for (i, &j) in a.iter().enumerate() {
+                if j < cols.len() {
+                    of_blob[rows[i]] = cols[j];
+                }
+            }
+        } else {
+            let a = crate::annotations::hungarian(cols.len(), rows.len(), |j, i| {
+                cost(rows[i], cols[j])
+            });
+            for (j, &i) in a.iter().enumerate() {
+                if i < rows.len() {
+                    of_blob[rows[i]] = cols[j];
+                }
+            }
+        }
+    }
+    of_blob
+}
+
+/// The detections binned in square cells of one gate, to find those near a point.
+struct Grid {
+    cell: f64,
+    cells: std::collections::HashMap<(i64, i64), Vec<usize>>,
+}
+
+impl Grid {
+    fn new(blobs: &[Blob], cell: f64) -> Grid {
+        let cell = cell.max(1e-9);
+        let mut cells: std::collections::HashMap<(i64, i64), Vec<usize>> =
+            std::collections::HashMap::new();
+        for (i, b) in blobs.iter().enumerate() {
+            cells
+                .entry(((b.x / cell).floor() as i64, (b.y / cell).floor() as i64))
+                .or_default()
+                .push(i);
+        }
+        Grid { cell, cells }
+    }
+
+    /// Calls `f` with every detection within `r` (at most one cell) of `p`.
+    fn each_within(&self, blobs: &[Blob], p: (f64, f64), r: f64, mut f: impl FnMut(usize)) {
+        let (cx, cy) = (
+            (p.0 / self.cell).floor() as i64,
+            (p.1 / self.cell).floor() as i64,
+        );
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                if let Some(v) = self.cells.get(&(cx + dx, cy + dy)) {
+                    for &i in v {
+                        if (blobs[i].x - p.0).powi(2) + (blobs[i].y - p.1).powi(2) < r * r {
+                            f(i);
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// Whether a detection lies within `r` (at most one cell) of `p`.
+    fn any_within(&self, blobs: &[Blob], p: (f64, f64), r: f64) -> bool {
+        let (cx, cy) = (
+            (p.0 / self.cell).floor() as i64,
+            (p.1 / self.cell).floor() as i64,
+        );
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                if let Some(v) = self.cells.get(&(cx + dx, cy + dy)) {
+                    if v.iter()
+                        .any(|&i| (blobs[i].x - p.0).powi(2) + (blobs[i].y - p.1).powi(2) <= r * r)
+                    {
+                        return true;
+                    }
+                }
+            }
+        }
+        false
+    }
+}
+
 impl Tracker {
     /// The flock's shift per frame for tracks without a velocity of their own.
     fn flock_shift(&self, blobs: &[Blob], gate: f64) -> (f64, f64) {
@@ -65,20 +197,50 @@ impl Tracker {
             return (median(&mut vx), median(&mut vy));
         }
         // Vote: the candidate shift (a detection minus a track) that brings the most tracks
-        // within the gate of some detection; ties to the smaller shift.
+        // within the gate of some detection; ties to the smaller shift. Every pair's shift is
+        // binned in cells of one gate; the fullest cells' pairs are the candidates, each
+        // counted exactly over a grid of the detections: pairs plus the tracks times a few
+        // candidates, not the tracks squared times the detections squared.
+        let cell = gate.max(1e-9);
+        let key = |v: (f64, f64)| ((v.0 / cell).floor() as i64, (v.1 / cell).floor() as i64);
+        let mut bins: std::collections::HashMap<(i64, i64), usize> =
+            std::collections::HashMap::new();
+        for t in &self.tracks {
+            for b in blobs {
+                *bins.entry(key((b.x - t.pos.0, b.y - t.pos.1))).or_default() += 1;
+            }
+        }
+        let mut full: Vec<((i64, i64), usize)> = bins.into_iter().collect();
+        full.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
+        // A shift's votes spread over up to four neighbouring cells: every cell within a few
+        // of the fullest count's quarter is looked at.
+        let top = full.first().map_or(0, |c| c.1);
+        let cells: std::collections::HashSet<(i64, i64)> = full
+            .iter()
+            .take_while(|c| 4 * c.1 >= top)
+            .take(16)
+            .map(|c| c.0)
+            .collect();
+        let grid = Grid::new(blobs, gate);
+        let mut tried: std::collections::HashMap<(i64, i64), usize> =
+            std::collections::HashMap::new();
         let mut best = ((0.0, 0.0), 0usize, 0.0f64);
         for t in &self.tracks {
             for b in blobs {
                 let s = (b.x - t.pos.0, b.y - t.pos.1);
+                if !cells.contains(&key(s)) {
+                    continue;
+                }
+                // A few pairs of a cell stand for it (they agree within a gate).
+                let n = tried.entry(key(s)).or_default();
+                if *n >= 8 {
+                    continue;
+                }
+                *n += 1;
                 let votes = self
                     .tracks
                     .iter()
-                    .filter(|u| {
-                        blobs.iter().any(|c| {
-                            (c.x - u.pos.0 - s.0).powi(2) + (c.y - u.pos.1 - s.1).powi(2)
-                                <= gate * gate
-                        })
-                    })
+                    .filter(|u| grid.any_within(blobs, (u.pos.0 + s.0, u.pos.1 + s.1), gate))
                     .count();
                 let size = s.0.hypot(s.1);
                 if votes > best.1 || (votes == best.1 && size < best.2) {
@@ -112,21 +274,7 @@ impl Tracker {
             let d = (blobs[i].x - pred[j].0).powi(2) + (blobs[i].y - pred[j].1).powi(2);
             d.min(cap)
         };
-        let mut of_blob = vec![usize::MAX; n];
-        if n > 0 && m > 0 {
-            if n <= m {
-                for (i, &j) in crate::annotations::hungarian(n, m, cost).iter().enumerate() {
-                    of_blob[i] = j;
-                }
-            } else {
-                for (j, &i) in crate::annotations::hungarian(m, n, |j, i| cost(i, j))
-                    .iter()
-                    .enumerate()
-                {
-                    of_blob[i] = j;
-                }
-            }
-        }
+        let of_blob = assign(blobs, &pred, gate, cost);
         let mut matched = vec![false; m];
         let mut ids = vec![usize::MAX; n];
         for i in 0..n {

@@ -747,7 +747,13 @@ pub fn assign_phases(anim: &mut Animation, opts: &WingbeatOptions) -> Result<()>
         phase.shrink_to_fit();
         frame.wing_phase = Some(row);
     }
-    anim.species = Some(opts.species.name().to_string());
+    // A real species the animation already names keeps its name when its family flaps.
+    let real = anim
+        .species
+        .as_deref()
+        .and_then(crate::animation::species::lookup)
+        .filter(|b| b.family == opts.species.name());
+    anim.species = Some(real.map_or(opts.species.name(), |b| b.name).to_string());
     anim.wingbeat = Some(opts.clone());
     Ok(())
 }
