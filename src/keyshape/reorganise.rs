@@ -308,10 +308,11 @@ fn bump(u: f64) -> (f64, f64) {
 }
 
 /// Height by which each of two exchanging birds leaves its line while they pass, wingspans:
-/// the one moving back sinks and the other rises, so they are 0.2 wingspans apart vertically (the wing clash
-/// needs them within 0.08), about 30 cm for a goose, as birds changing places are filmed to
-/// slip past a little above or below one another.
-pub const PASS_HEIGHT: f64 = 0.1;
+/// the one moving back sinks and the other rises, so they are 0.3 wingspans apart vertically
+/// (the wing clash needs them within 0.08), about 22 cm each way for a goose, as birds changing
+/// places slip past a little above or below one another. Enough also to clear the bird beside
+/// the leader's slot, which a bird taking the lead passes within a wingspan.
+pub const PASS_HEIGHT: f64 = 0.15;
 
 /// Share of an exchange over which the vertical parting rises (and, at its end, falls) with a
 /// smootherstep: the birds are fully parted from this share to one minus it, while they are
