@@ -394,7 +394,9 @@ fn plan_from(
     // Length of the descent of a bird starting at height z (the area of its sink profile is z),
     // at least the ramp and the flare (a bird low down sinks more slowly).
     let descent_len = |z: f64| (z / sink + 0.5 * (ramp + flare)).max(ramp + flare);
-    let lag = |y: f64| opts.stagger * (y_front - y) / va;
+    let loosen = clear_loosen(&start, v, opts.loosen);
+    let beta = clear_stagger(&start, x_mid, v, loosen, opts.stagger);
+    let lag = |y: f64| beta * (y_front - y) / va;
     // The front bird's touch-down: after the slowdown and the flare, and late enough that no
     // bird needs to start descending before the landing starts (at half the slowdown).
     let mut t_front = opts.slow_seconds + flare;
@@ -410,7 +412,7 @@ fn plan_from(
                 x0: s[0],
                 y0: s[1],
                 z0: s[2],
-                x1: x_mid + opts.loosen * (s[0] - x_mid),
+                x1: x_mid + loosen * (s[0] - x_mid),
                 descend: touchdown - len,
                 sink: s[2] / (len - 0.5 * (ramp + flare)),
                 flare: touchdown - flare,
@@ -434,6 +436,71 @@ fn plan_from(
         birds,
     };
     Ok((p, last.t + dt))
+}
+
+/// Largest factor the landing loosens the formation by to bring birds abreast a span apart.
+pub const MAX_CLEAR_LOOSEN: f64 = 2.0;
+
+/// The loosening actually used: `loosen`, or more (up to [`MAX_CLEAR_LOOSEN`]), so that two
+/// birds flying abreast within the wing envelope at the landing's start (after the blend of
+/// their velocities, see [`clear_stagger`]) end it at least a span and a margin apart aside.
+fn clear_loosen(start: &[[f64; 5]], v: f64, loosen: f64) -> f64 {
+    use crate::animation::clearance::{CHORD, SPAN};
+    let span = SPAN + STAGGER_MARGIN;
+    let drift = 0.5 * BLEND_S;
+    let x = |i: usize| start[i][0] + start[i][3] * drift;
+    let y = |i: usize| start[i][1] + (start[i][4] - v) * drift;
+    let mut order: Vec<usize> = (0..start.len()).collect();
+    order.sort_by(|&a, &b| x(a).total_cmp(&x(b)));
+    let mut out = loosen;
+    for (k, &a) in order.iter().enumerate() {
+        for &b in &order[k + 1..] {
+            let dx = x(b) - x(a);
+            if dx >= span {
+                break;
+            }
+            if (y(a) - y(b)).abs() < CHORD + STAGGER_MARGIN && dx > 1e-6 {
+                out = out.max((span / dx).min(MAX_CLEAR_LOOSEN));
+            }
+        }
+    }
+    out
+}
+
+/// Margin kept beyond the clash test's span and chord by the landing's stagger, wingspans.
+pub const STAGGER_MARGIN: f64 = 0.03;
+
+/// The stagger actually used: `stagger`, or less, so that no two birds end the landing within
+/// the wing envelope of the clash test (less than a span aside and a chord fore and aft) unless
+/// they started it so. The landing's lateral offsets only grow (by `loosen`, done before the
+/// first touch-down) and its along-track gaps only shrink (to (1 − β) of the start's, after the
+/// first touch-down), so a pair clear at the start and at the end is clear throughout; a pair
+/// abreast at the end (loosened offset under a span) keeps (1 − β) g ≥ chord + margin.
+/// `start` holds each bird's [x, y, vx, vy] at the landing's start, `x_mid` the flock's middle,
+/// `v` the flight speed: each bird's velocity difference from the plan is blended out over the
+/// first [`BLEND_S`], moving it by half that difference times the blend, which counts here.
+fn clear_stagger(start: &[[f64; 5]], x_mid: f64, v: f64, loosen: f64, stagger: f64) -> f64 {
+    use crate::animation::clearance::{CHORD, SPAN};
+    let span = SPAN + STAGGER_MARGIN;
+    let chord = CHORD + STAGGER_MARGIN;
+    let mut order: Vec<usize> = (0..start.len()).collect();
+    let drift = 0.5 * BLEND_S;
+    let x1 = |i: usize| x_mid + loosen * (start[i][0] - x_mid) + start[i][3] * drift;
+    let y1 = |i: usize| start[i][1] + (start[i][4] - v) * drift;
+    order.sort_by(|&a, &b| x1(a).total_cmp(&x1(b)));
+    let mut beta = stagger;
+    for (k, &a) in order.iter().enumerate() {
+        for &b in &order[k + 1..] {
+            if x1(b) - x1(a) >= span {
+                break;
+            }
+            let g = (y1(a) - y1(b)).abs();
+            if g >= chord {
+                beta = beta.min(1.0 - chord / g);
+            }
+        }
+    }
+    beta.max(0.0)
 }
 
 /// Along-track distance from the front bird's place at the end of the flight to the landed
