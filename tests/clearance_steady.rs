@@ -15,7 +15,14 @@ use support::{example_arg, run, s, scratch};
 /// what it wrote.
 fn clearance(dir: &std::path::Path, input: &str, args: &[&str]) -> Clearance {
     let out = dir.join("a.json");
-    let mut all = vec!["animate", input, "--no-initiation", "-o", s(&out), "--quiet"];
+    let mut all = vec![
+        "animate",
+        input,
+        "--no-initiation",
+        "-o",
+        s(&out),
+        "--quiet",
+    ];
     all.extend_from_slice(args);
     let o = run(&all);
     assert!(
@@ -42,7 +49,11 @@ fn assert_clear(c: &Clearance, what: &str) {
 /// (name, input, read flags) of every example footage.
 fn examples() -> Vec<(&'static str, String, Vec<&'static str>)> {
     vec![
-        ("barnacle geese V", example_arg("barnacle_geese_v.json"), vec![]),
+        (
+            "barnacle geese V",
+            example_arg("barnacle_geese_v.json"),
+            vec![],
+        ),
         ("snow geese J", example_arg("snow_geese_j.csv"), vec![]),
         (
             "cranes",
@@ -62,7 +73,14 @@ fn every_example_and_seed_flies_clear_at_any_frame_rate() {
                 let seed = seed.to_string();
                 let mut args = read.clone();
                 args.extend_from_slice(&[
-                    "--birds", "14", "--seconds", "20", "--fps", fps, "--seed", &seed,
+                    "--birds",
+                    "14",
+                    "--seconds",
+                    "20",
+                    "--fps",
+                    fps,
+                    "--seed",
+                    &seed,
                 ]);
                 let c = clearance(&dir, &input, &args);
                 assert!(c.frames > 0);
@@ -94,11 +112,23 @@ fn busy_flights_stay_clear() {
                 seed,
             ],
         );
-        assert_clear(&c, &format!("3 leader changes and 6 swaps a minute, seed {seed}"));
+        assert_clear(
+            &c,
+            &format!("3 leader changes and 6 swaps a minute, seed {seed}"),
+        );
         let c = clearance(
             &dir,
             &geese,
-            &["--birds", "9", "--seconds", "30", "--joiners", "2", "--seed", seed],
+            &[
+                "--birds",
+                "9",
+                "--seconds",
+                "30",
+                "--joiners",
+                "2",
+                "--seed",
+                seed,
+            ],
         );
         assert_clear(&c, &format!("two late birds joining, seed {seed}"));
     }

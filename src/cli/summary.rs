@@ -172,7 +172,39 @@ pub fn animate(
     if report.initiate.as_ref().is_some_and(|s| !s.converged) {
         text.push_str(" (the take-off did not converge)");
     }
+    text.push_str(&clearance_text(anim));
     defer(text, outputs);
+}
+
+/// The clearance of what was written: the clash count per stage (the wing and body test of
+/// docs/formats.md; 0 is the expectation) and the closest approach.
+pub fn clearance_text(anim: &Animation) -> String {
+    use formation::animation::clearance::Clearance;
+    let mut all = Clearance::default();
+    let mut where_ = Vec::new();
+    for (name, c) in Clearance::by_stage(anim) {
+        if c.clashes() > 0 {
+            where_.push(format!("{} in the {name}", c.clashes()));
+        }
+        all.add(&c);
+    }
+    let closest = all.closest.map_or(String::new(), |c| {
+        format!(
+            ", closest {:.2} wingspans (birds {} and {}, frame {})",
+            c.distance, c.birds.0, c.birds.1, c.frame
+        )
+    });
+    if all.clashes() == 0 {
+        format!("; clearance: no two birds clash in any frame{closest}")
+    } else {
+        format!(
+            "; clearance: {} wing and {} body clashes in {} frames ({}){closest}",
+            all.wing,
+            all.body,
+            all.frames_with_clash,
+            where_.join(", ")
+        )
+    }
 }
 
 /// `solve`'s summary: converged or not, the residual, the evaluations, the flock's total E.

@@ -201,17 +201,19 @@ impl<'a> Film<'a> {
         scene::draw_birds(canvas, &self.states(k), &self.views[k], self.species, mask);
     }
 
-    /// The GIF palette: NeuQuant over pixels of up to 9 frames spread over the film (every
-    /// 7th pixel of each), plus the species' plumage exactly.
+    /// The GIF palette: NeuQuant over pixels of up to 17 frames spread over the film (every
+    /// 13th pixel of each: as many pixels as 9 frames at every 7th, over more of the film's
+    /// skies, so a camera that tilts to a deeper blue for a few seconds still finds it), plus the
+    /// species' plumage exactly.
     pub fn palette(&self) -> Palette {
-        const PALETTE_FRAMES: usize = 9;
-        const PALETTE_STEP: usize = 7;
+        const PALETTE_FRAMES: usize = 17;
+        const PALETTE_STEP: usize = 13;
         let (w, h) = (self.width, self.height);
         let n = self.len();
         let picks: Vec<usize> = if n == 0 {
             Vec::new()
         } else {
-            // Frames spread over the film; as many training pixels as 9 frames at every 7th.
+            // Frames spread over the film.
             let m = n.min(PALETTE_FRAMES);
             let mut v: Vec<usize> = (0..m).map(|i| i * (n - 1) / (m - 1).max(1)).collect();
             v.dedup();
