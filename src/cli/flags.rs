@@ -131,6 +131,7 @@ pub const FLAGS: &[(&str, &str, &[Cmd])] = &[
     ("initiation false", "--no-initiation", &[Animate]),
     ("skein.formation_size", "--formation-size", STEADY),
     ("skein.clearance", "--clearance", STEADY),
+    ("skein.layout", "--skein-layout", STEADY),
     ("initiate.max_steps", "--max-steps", INITIATE),
     ("initiate.max_time", "--max-seconds", INITIATE),
     ("initiate.perception.mode", "--perception", INITIATE),

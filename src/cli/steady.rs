@@ -192,6 +192,14 @@ pub struct SkeinFlags {
     /// Smallest distance between birds of different formations, wingspans.
     #[arg(long, default_value_t = SkeinOptions::default().clearance, allow_negative_numbers = true)]
     pub clearance: f64,
+    /// How the formations are arranged: natural (scattered at irregular distances, heights and
+    /// headings, as skeins of a migrating flock), grid (lanes, one formation behind the other)
+    /// or compound (one large V of formations, as large shorebird flocks fly).
+    #[arg(long = "skein-layout", value_name = "LAYOUT", default_value = "natural",
+          value_parser = clap::builder::TypedValueParser::map(
+              clap::builder::PossibleValuesParser::new(["natural", "grid", "compound"]),
+              |s| s.parse::<formation::skein::SkeinLayout>().unwrap_or_default()))]
+    pub skein_layout: formation::skein::SkeinLayout,
 }
 
 impl SkeinFlags {
@@ -201,6 +209,7 @@ impl SkeinFlags {
             formations: self.formations,
             formation_size: self.formation_size,
             clearance: self.clearance,
+            layout: self.skein_layout,
             ..SkeinOptions::default()
         }
     }

@@ -123,7 +123,21 @@ impl Joiner {
             .out
             .ok_or_else(|| Error::Internal("a flock without formations".into()))?;
         let mut frames = self.frames;
+        // Height offsets: from the start without a take-off, reached over the first seconds of
+        // the steady flight after one.
+        let climb = out
+            .stage("initiation")
+            .and_then(|_| out.stage("steady"))
+            .and_then(|s| frames.get(s.start))
+            .map(|f| f.t);
         for f in &mut frames {
+            let share = climb.map_or(1.0, |t0| super::natural::height_ramp(f.t - t0));
+            for (r, rep) in self.ranges.iter().zip(reports) {
+                let dz = share * rep.placement.height;
+                if dz != 0.0 {
+                    f.z[r.clone()].iter_mut().for_each(|z| *z += dz);
+                }
+            }
             // `x + 0.0` as the values were always joined (it makes a -0.0 +0.0).
             for v in [&mut f.z, &mut f.heading, &mut f.speed] {
                 v.iter_mut().for_each(|x| *x += 0.0);

@@ -33,6 +33,9 @@ use crate::keyshape::spacing::median;
 /// Range of the drift period, seconds.
 pub const DRIFT_PERIOD_S: [f64; 2] = [60.0, 120.0];
 
+/// Length of the windows of [`Envelope::windows`], seconds.
+pub const WINDOW_S: f64 = 0.5;
+
 /// Width : depth of the whole arrangement (wingspans over wingspans) the lane count aims at.
 pub const ASPECT: f64 = 2.0;
 
@@ -119,6 +122,10 @@ pub struct Envelope {
     pub rear: Vec<f64>,
     /// Northmost (front) y of each frame.
     pub front: Vec<f64>,
+    /// Boxes [west, south, east, north] of the birds over consecutive windows of
+    /// [`WINDOW_S`] seconds (the last one shorter), wingspans: what the natural and compound
+    /// arrangements keep apart.
+    pub windows: Vec<[f64; 4]>,
 }
 
 impl Envelope {
@@ -127,10 +134,14 @@ impl Envelope {
         let mut x = [f64::INFINITY, f64::NEG_INFINITY];
         let mut rear = Vec::with_capacity(anim.frames.len());
         let mut front = Vec::with_capacity(anim.frames.len());
-        for f in &anim.frames {
+        let per = ((WINDOW_S * anim.fps).round() as usize).max(1);
+        let mut windows = Vec::with_capacity(anim.frames.len() / per + 1);
+        for (j, f) in anim.frames.iter().enumerate() {
+            let (mut x0, mut x1) = (f64::INFINITY, f64::NEG_INFINITY);
             for &v in &f.x {
-                x = [x[0].min(v), x[1].max(v)];
+                (x0, x1) = (x0.min(v), x1.max(v));
             }
+            x = [x[0].min(x0), x[1].max(x1)];
             let (lo, hi) =
                 f.y.iter()
                     .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
@@ -138,8 +149,38 @@ impl Envelope {
                     });
             rear.push(lo);
             front.push(hi);
+            if j % per == 0 {
+                windows.push([x0, lo, x1, hi]);
+            } else if let Some(w) = windows.last_mut() {
+                *w = [w[0].min(x0), w[1].min(lo), w[2].max(x1), w[3].max(hi)];
+            }
         }
-        Envelope { x, rear, front }
+        Envelope {
+            x,
+            rear,
+            front,
+            windows,
+        }
+    }
+
+    /// The box [west, south, east, north] of every window together, wingspans.
+    pub fn bounds(&self) -> [f64; 4] {
+        self.windows.iter().fold(
+            [
+                f64::INFINITY,
+                f64::INFINITY,
+                f64::NEG_INFINITY,
+                f64::NEG_INFINITY,
+            ],
+            |b, w| {
+                [
+                    b[0].min(w[0]),
+                    b[1].min(w[1]),
+                    b[2].max(w[2]),
+                    b[3].max(w[3]),
+                ]
+            },
+        )
     }
 
     /// Width across the course, wingspans.
@@ -166,6 +207,8 @@ pub struct Placement {
     pub lane: usize,
     /// Position in its lane, front to back.
     pub row: usize,
+    /// Height offset from the flock's cruise height, wingspans (0 on the grid).
+    pub height: f64,
 }
 
 /// w̃ and the median depth of `env`, wingspans: the library's one median
@@ -221,6 +264,7 @@ pub fn arrange(
             offset: [0.0, 0.0],
             lane: 0,
             row: 0,
+            height: 0.0,
         };
         k
     ];
@@ -248,6 +292,7 @@ pub fn arrange(
                 offset: [x, y],
                 lane: l,
                 row,
+                height: 0.0,
             };
             ahead = Some((f, y));
         }
@@ -310,6 +355,7 @@ mod tests {
             x: [-w / 2.0, w / 2.0],
             rear: vec![-d, -0.5 * d],
             front: vec![0.0, 0.0],
+            windows: vec![[-w / 2.0, -d, w / 2.0, 0.0]],
         };
         // An even count: the mean of the middle two (the upper one, 30 and 3, before).
         let four = [

@@ -30,6 +30,7 @@
 
 mod join;
 pub mod layout;
+pub mod natural;
 pub mod sizes;
 
 use glam::{DVec2, DVec3};
@@ -44,6 +45,7 @@ use crate::progress::{Progress, Silent};
 use crate::rng::{stream, Scope, Stream};
 
 pub use layout::{Drift, Envelope, Placement};
+pub use natural::SkeinLayout;
 pub use sizes::{formation_count, formation_sizes};
 
 /// Options of flocks of several formations (the `skein` section of
@@ -60,10 +62,14 @@ pub struct SkeinOptions {
     /// Looseness of the arrangement: extra gap between neighbouring formations, up to this
     /// factor times the median formation width (across) or depth (along), dimensionless.
     pub spread: f64,
-    /// Largest heading difference of a formation's drift from the course, degrees.
-    pub max_heading_deg: f64,
+    /// Largest heading difference of a formation's drift from the course, degrees (`None`: the
+    /// layout's, [`SkeinLayout::max_heading_deg`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_heading_deg: Option<f64>,
     /// Largest speed difference of a formation's drift, as a fraction of the cruise speed.
     pub max_speed_diff: f64,
+    /// How the formations are arranged: natural (the default), grid or compound.
+    pub layout: SkeinLayout,
 }
 
 impl Default for SkeinOptions {
@@ -73,8 +79,9 @@ impl Default for SkeinOptions {
             formation_size: None,
             clearance: 5.0,
             spread: 0.5,
-            max_heading_deg: 1.0,
+            max_heading_deg: None,
             max_speed_diff: 0.02,
+            layout: SkeinLayout::default(),
         }
     }
 }
@@ -147,10 +154,11 @@ impl SkeinOptions {
                 format!("{}: must be in [0, 100]", self.spread),
             );
         }
-        if !(self.max_heading_deg.is_finite() && (0.0..=10.0).contains(&self.max_heading_deg)) {
+        let h = self.heading_deg();
+        if !(h.is_finite() && (0.0..=10.0).contains(&h)) {
             return p(
                 "skein.max_heading_deg",
-                format!("{}: must be in [0, 10] degrees", self.max_heading_deg),
+                format!("{h}: must be in [0, 10] degrees"),
             );
         }
         if !(self.max_speed_diff.is_finite() && (0.0..=0.2).contains(&self.max_speed_diff)) {
@@ -163,6 +171,13 @@ impl SkeinOptions {
             );
         }
         Ok(())
+    }
+
+    /// Largest heading difference of a formation's drift from the course, degrees: the given
+    /// one or the layout's.
+    pub fn heading_deg(&self) -> f64 {
+        self.max_heading_deg
+            .unwrap_or_else(|| self.layout.max_heading_deg())
     }
 
     /// The sizes of the formations of `n` birds when the footage's formation has `n_hat` birds,
@@ -363,14 +378,23 @@ fn finish(
     }
     crate::memory::release_free();
     let departures: Vec<f64> = reports.iter().map(|r| r.takeoff_delay_s).collect();
-    let placements = layout::arrange(
-        &env,
-        &departures,
-        o.skein.clearance,
-        o.skein.spread,
-        &mut stream(o.seed, Stream::SkeinLayout),
-    );
-    let lanes = placements.iter().map(|p| p.lane + 1).max().unwrap_or(1);
+    let mut rng = stream(o.seed, Stream::SkeinLayout);
+    let (c, s) = (o.skein.clearance, o.skein.spread);
+    let mut placements = match o.skein.layout {
+        SkeinLayout::Grid => layout::arrange(&env, &departures, c, s, &mut rng),
+        SkeinLayout::Natural => natural::arrange_natural(&env, c, s, &mut rng),
+        SkeinLayout::Compound => natural::arrange_compound(&env, c, s, &mut rng),
+    };
+    for (p, h) in placements
+        .iter_mut()
+        .zip(natural::heights(o.skein.layout, k, &mut rng))
+    {
+        p.height = h;
+    }
+    let lanes = match o.skein.layout {
+        SkeinLayout::Grid => placements.iter().map(|p| p.lane + 1).max().unwrap_or(1),
+        _ => 0,
+    };
     let centre = centre_of(&env, &placements, o.initiate.is_some());
     for (r, p) in reports.iter_mut().zip(&placements) {
         r.placement = Placement {
@@ -422,7 +446,7 @@ fn steady_of(
         .map_err(|e| in_formation(e, f, n))?;
     let drift = Drift::draw(
         opts.speed,
-        o.skein.max_heading_deg,
+        o.skein.heading_deg(),
         o.skein.max_speed_diff,
         &mut own,
     );
