@@ -348,7 +348,8 @@ impl Simulation {
     /// The wing envelope of airborne bird `i` among `near`: for every flockmate within its wing
     /// reach ([`Self::within_wing_reach`]) and less than a wingspan away in height, the lower of
     /// the two (the later in index order when level) keeps [`ENVELOPE_GAP`] under the other,
-    /// the upper that far over it. Birds climbing at the same rate side by side (their slots a
+    /// the upper that far over it ([`ENVELOPE_PASS_GAP`] when one passes under the other).
+    /// Birds climbing at the same rate side by side (their slots a
     /// step apart fore and aft, one overtaking the other while they settle) so climb at
     /// different rates until one has passed; the bounds are altitudes the bird flies towards
     /// with its bounded climb rate and vertical acceleration, so nothing jumps. Returns the
@@ -385,5 +386,20 @@ impl Simulation {
         }
         // Never down into the ground: a bird just off it holds its height instead.
         (floor, ceiling.max(f.z[i].min(0.3)))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_envelope_bounds_the_altitude_and_meets_halfway_when_squeezed() {
+        let inf = f64::INFINITY;
+        assert_eq!(envelope_altitude(10.0, -inf, inf), 10.0);
+        assert_eq!(envelope_altitude(10.0, -inf, 9.84), 9.84);
+        assert_eq!(envelope_altitude(10.0, 10.16, inf), 10.16);
+        assert_eq!(envelope_altitude(10.0, 9.0, 11.0), 10.0);
+        assert!((envelope_altitude(10.0, 10.2, 9.8) - 10.0).abs() < 1e-12);
     }
 }
