@@ -628,6 +628,7 @@ pub fn land_stage(
         speed,
         altitude,
         world_height,
+        along_scale: path.map_or(1.0, |_| config.course.min_speed),
     };
     let fps = anim.fps;
     match (path, config.shot_seconds) {

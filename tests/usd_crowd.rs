@@ -50,7 +50,7 @@ fn samples(text: &str, name: &str) -> Vec<(f64, Vec<String>)> {
 #[test]
 fn instances_follow_the_birds_and_flap_through_the_prototypes() {
     let dir = scratch("usd-crowd");
-    let a = flock(14, 3.0);
+    let a = flock(14, 4.0);
     let usda = dir.join("c.usda");
     // Birds of one size: an instance's position is then the bird's own (sizes shift it, see
     // tests/size_variation.rs).
