@@ -365,12 +365,19 @@ impl Simulation {
         };
         if sim.params.opts.assign_slots && n > 0 {
             let offset = sim.airborne_start().then_some(AIR_LEADER_OFFSET);
-            let (slot, leader) = assign_slots(
+            let given = sim.params.opts.start.given_slots(
                 &sim.target,
                 &sim.flock.pos,
                 sim.params.cruise_heading,
-                offset,
             );
+            let (slot, leader) = given.unwrap_or_else(|| {
+                assign_slots(
+                    &sim.target,
+                    &sim.flock.pos,
+                    sim.params.cruise_heading,
+                    offset,
+                )
+            });
             sim.flock.leader = leader;
             // The departure times, earliest first, go to the birds by the depth of their slot
             // behind the leader's (the leader leaves first; the tails of the arms last).
