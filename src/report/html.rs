@@ -3,6 +3,7 @@
 use std::fmt::Write as _;
 
 use super::{footage_savings_with, Subject};
+use crate::animation::clearance::{Clearance, Closest};
 use crate::animation::stats::{AnimationStats, BirdStats};
 use crate::animation::Animation;
 use crate::error::Result;
@@ -597,7 +598,13 @@ fn animation_sections(page: &mut Page, a: &Animation, s: &Subject<'_>) -> Result
             pct(t),
         ]);
     }
+    let clearance = clearance_by_stage(a);
+    rows.push(vec![
+        "clearance (wing and body clashes; 0 is the expectation)".into(),
+        clearance_summary(a, &clearance),
+    ]);
     page.table(&["quantity", "value"], &rows);
+    clearance_section(page, a, &clearance);
     if a.birds > crate::report::BAND_MAX_BIRDS {
         page.p(&format!(
             "The saving's sensitivity to the model, wake and vortex core is left out for flocks of more than {} birds: each choice sums over every pair of birds.",
@@ -636,18 +643,10 @@ fn animation_sections(page: &mut Page, a: &Animation, s: &Subject<'_>) -> Result
         let f0 = &a.frames[k0];
         let f1 = &a.frames[k1];
         let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64;
-        let mut closest = f64::INFINITY;
-        for f in &a.frames[k0..=k1] {
-            for i in 0..a.birds {
-                for j in (i + 1)..a.birds {
-                    let d = ((f.x[i] - f.x[j]).powi(2)
-                        + (f.y[i] - f.y[j]).powi(2)
-                        + (f.z[i] - f.z[j]).powi(2))
-                    .sqrt();
-                    closest = closest.min(d);
-                }
-            }
-        }
+        let closest = clearance
+            .iter()
+            .find(|(name, _)| name == "initiation")
+            .map(|(_, c)| c.closest);
         let save =
             |f: &crate::animation::Frame| f.e.as_deref().map_or("–".into(), |e| pct(mean(e)));
         let rows = vec![
@@ -675,7 +674,13 @@ fn animation_sections(page: &mut Page, a: &Animation, s: &Subject<'_>) -> Result
             ],
             vec![
                 "closest approach of two birds".into(),
-                format!("{closest:.2} wingspans"),
+                match closest {
+                    Some(Some(c)) => closest_text(a, &c),
+                    _ => format!(
+                        "{:.1} wingspans or more",
+                        crate::animation::clearance::REACH
+                    ),
+                },
             ],
         ];
         page.table(&["quantity", "value"], &rows);
@@ -687,6 +692,93 @@ fn animation_sections(page: &mut Page, a: &Animation, s: &Subject<'_>) -> Result
         )?;
     }
     Ok(())
+}
+
+/// The clearance of each stage (the whole animation as one "frames" entry without stages).
+fn clearance_by_stage(a: &Animation) -> Vec<(String, Clearance)> {
+    if a.stages.is_empty() {
+        vec![("frames".to_string(), Clearance::of(a))]
+    } else {
+        Clearance::by_stage(a)
+    }
+}
+
+/// "0.78 wingspans (birds 0 and 1, frame 1169, 39.0 s)", the frame in the shot's numbering.
+fn closest_text(a: &Animation, c: &Closest) -> String {
+    format!(
+        "{:.2} wingspans (birds {} and {}, frame {}, {:.1} s)",
+        c.distance,
+        c.birds.0,
+        c.birds.1,
+        a.start_frame + c.frame as u64,
+        c.frame as f64 / a.fps
+    )
+}
+
+/// One line: the clashes over all stages and the closest approach.
+fn clearance_summary(a: &Animation, stages: &[(String, Clearance)]) -> String {
+    let mut all = Clearance::default();
+    for (_, c) in stages {
+        all.add(c);
+    }
+    let closest = all.closest.map_or_else(
+        || {
+            format!(
+                "no two birds came within {:.1} wingspans",
+                crate::animation::clearance::REACH
+            )
+        },
+        |c| format!("closest approach {}", closest_text(a, &c)),
+    );
+    if all.clashes() == 0 {
+        format!("no two birds clash in any of {} frames; {closest}", all.frames)
+    } else {
+        format!(
+            "{} wing and {} body clashes in {} of {} frames; {closest}",
+            all.wing, all.body, all.frames_with_clash, all.frames
+        )
+    }
+}
+
+/// The clearance per stage: the test, then a table of clashes and closest approaches.
+fn clearance_section(page: &mut Page, a: &Animation, stages: &[(String, Clearance)]) {
+    use crate::animation::clearance::{BODY, CHORD, FLYING, SPAN, THICKNESS};
+    page.h2("clearance", "Clearance: no wing over wing, no body into body");
+    page.p(&format!(
+        "Two flying birds (ground speed at least {FLYING} wingspan per second) clash by wing when, in the first bird's heading frame, the other is less than {SPAN} wingspan aside, {CHORD} fore and aft and {THICKNESS} in height: their wings would overlap. Any two birds, at rest included, clash by body when their centres are closer than {BODY} wingspans. Each pair is counted once a frame. Real birds never clash; the animation is built to keep 0 in every stage."
+    ));
+    let rows: Vec<Vec<String>> = stages
+        .iter()
+        .map(|(name, c)| {
+            vec![
+                name.clone(),
+                c.frames.to_string(),
+                c.wing.to_string(),
+                c.body.to_string(),
+                c.frames_with_clash.to_string(),
+                c.closest.map_or_else(
+                    || {
+                        format!(
+                            "{:.1} wingspans or more",
+                            crate::animation::clearance::REACH
+                        )
+                    },
+                    |c| closest_text(a, &c),
+                ),
+            ]
+        })
+        .collect();
+    page.table(
+        &[
+            "stage",
+            "frames",
+            "wing clashes",
+            "body clashes",
+            "frames with a clash",
+            "closest approach",
+        ],
+        &rows,
+    );
 }
 
 /// Per bird and per position (rank rounded) tables.
