@@ -274,7 +274,12 @@ impl Chart for LeaderChangeSide {
                 (|g: &(f64, f64, f64, f64)| g.1) as fn(&(f64, f64, f64, f64)) -> f64,
             ),
             (green, CHORD, "fore and aft", |g| g.2),
-            (LEADER, THICKNESS, "height of the one moving back over the other", |g| g.3),
+            (
+                LEADER,
+                THICKNESS,
+                "height of the one moving back over the other",
+                |g| g.3,
+            ),
         ] {
             chart
                 .draw_series(LineSeries::new(
@@ -290,7 +295,10 @@ impl Chart for LeaderChangeSide {
             for k in (0..n).step_by(2) {
                 let a = t0 + (t1 - t0) * k as f64 / n as f64;
                 let b = t0 + (t1 - t0) * (k + 1) as f64 / n as f64;
-                dashes.push(PathElement::new(vec![(a, limit), (b, limit)], colour.stroke_width(1)));
+                dashes.push(PathElement::new(
+                    vec![(a, limit), (b, limit)],
+                    colour.stroke_width(1),
+                ));
                 if colour == LEADER {
                     dashes.push(PathElement::new(
                         vec![(a, -limit), (b, -limit)],

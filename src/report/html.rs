@@ -27,6 +27,16 @@ fn esc(s: &str) -> String {
         .replace('"', "&quot;")
 }
 
+/// `v` with 3 decimals, never "-0.000".
+fn clean3(v: f64) -> String {
+    let s = format!("{v:.3}");
+    if s == "-0.000" {
+        "0.000".into()
+    } else {
+        s
+    }
+}
+
 fn pct(v: f64) -> String {
     format!("{:.1} %", 100.0 * v)
 }
@@ -461,11 +471,19 @@ fn params_sections(page: &mut Page, p: &FormationParams, s: &Subject<'_>) -> Res
                 f.order.len().to_string(),
                 f.shape.kind().to_uppercase(),
                 f.leader.to_string(),
-                format!("{:.3}", f.mu_x),
-                format!("{:.3}", f.sigma_x),
-                format!("{:.3}", f.mu_y),
-                format!("{:.3}", f.sigma_y),
-                format!("{:?}", f.outliers),
+                clean3(f.mu_x),
+                clean3(f.sigma_x),
+                clean3(f.mu_y),
+                clean3(f.sigma_y),
+                if f.outliers.is_empty() {
+                    "none".to_string()
+                } else {
+                    f.outliers
+                        .iter()
+                        .map(|b| b.to_string())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                },
                 o(g.and_then(|g| g.apex_deg), 1),
                 o(g.and_then(|g| g.arm_left_deg), 1),
                 o(g.and_then(|g| g.arm_right_deg), 1),
@@ -532,6 +550,11 @@ fn params_sections(page: &mut Page, p: &FormationParams, s: &Subject<'_>) -> Res
             stats: st.clone(),
             takeoff: None,
             time_label: "annotated frame".into(),
+            range: crate::plot::savings::range_of(
+                &crate::report::footage_band(p),
+                st.steady_saving,
+            ),
+            model: model_text(&aero),
         };
         page.chart(
             "footage-savings",
@@ -731,7 +754,10 @@ fn clearance_summary(a: &Animation, stages: &[(String, Clearance)]) -> String {
         |c| format!("closest approach {}", closest_text(a, &c)),
     );
     if all.clashes() == 0 {
-        format!("no two birds clash in any of {} frames; {closest}", all.frames)
+        format!(
+            "no two birds clash in any of {} frames; {closest}",
+            all.frames
+        )
     } else {
         format!(
             "{} wing and {} body clashes in {} of {} frames; {closest}",
@@ -743,9 +769,12 @@ fn clearance_summary(a: &Animation, stages: &[(String, Clearance)]) -> String {
 /// The clearance per stage: the test, then a table of clashes and closest approaches.
 fn clearance_section(page: &mut Page, a: &Animation, stages: &[(String, Clearance)]) {
     use crate::animation::clearance::{BODY, CHORD, FLYING, SPAN, THICKNESS};
-    page.h2("clearance", "Clearance: no wing over wing, no body into body");
+    page.h2(
+        "clearance",
+        "Clearance: no wing over wing, no body into body",
+    );
     page.p(&format!(
-        "Two flying birds (ground speed at least {FLYING} wingspan per second) clash by wing when, in the first bird's heading frame, the other is less than {SPAN} wingspan aside, {CHORD} fore and aft and {THICKNESS} in height: their wings would overlap. Any two birds, at rest included, clash by body when their centres are closer than {BODY} wingspans. Each pair is counted once a frame. Real birds never clash; the animation is built to keep 0 in every stage."
+        "Two flying birds (ground speed at least {FLYING} wingspan per second) clash by wing when, in the first bird's heading frame, the other is less than {SPAN} wingspan aside, {CHORD} fore and aft and {THICKNESS} in height: their wings would overlap. Any two birds, at rest included, clash by body when their centres are closer than {BODY} wingspans. Each pair is counted once a frame. Real birds never clash: 0 is the expectation in every stage."
     ));
     let rows: Vec<Vec<String>> = stages
         .iter()
