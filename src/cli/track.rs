@@ -149,7 +149,12 @@ pub fn run(args: TrackArgs, g: Global) -> Result<()> {
     let opts = options(&args)?;
     formation::io::check_output_dir("-o", &args.output)?;
     if let Some(d) = &args.debug_frames {
-        std::fs::create_dir_all(d).map_err(|e| Error::io(d, e))?;
+        std::fs::create_dir_all(d).map_err(|e| {
+            Error::parameter(
+                "track.debug_frames",
+                format!("cannot make the directory {} ({e}); give a directory to write the debug frames into", d.display()),
+            )
+        })?;
     }
     if let Some(r) = &args.review {
         formation::io::check_output_dir("--review", r)?;
