@@ -225,6 +225,8 @@ fn commands() -> Vec<Command> {
                 ("--frames", "3..1", None),
                 ("--roi", "0,0,999,10", None),
                 ("--fps", "-2", None),
+                ("--wingspan-px", "0", None),
+                ("--debug-frames", "/dev/null/frames", None),
                 ("--review", "OUT/r.txt", None),
                 o("OUT/a.txt"),
                 seed.clone(),

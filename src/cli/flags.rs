@@ -72,6 +72,8 @@ pub const FLAGS: &[(&str, &str, &[Cmd])] = &[
     ("track.frames", "--frames", &[Track]),
     ("track.roi", "--roi", &[Track]),
     ("track.fps", "--fps", &[Track]),
+    ("track.wingspan_px", "--wingspan-px", &[Track]),
+    ("track.debug_frames", "--debug-frames", &[Track]),
     ("annotate.images", "--images", &[Annotate]),
     ("read.heading", "--heading", READ),
     ("read.wingspan_px", "--wingspan-px", READ),
