@@ -210,6 +210,7 @@ pub const FLAGS: &[(&str, &str, &[Cmd])] = &[
     ("render.binary_frames", "--binary-frames", SCENE),
     ("render.usd_mode", "--usd-mode", SCENE),
     ("render.gltf_mode", "--gltf-mode", SCENE),
+    ("render.crowd_pose_error", "--crowd-pose-error", SCENE),
     ("render.animation_fps", "--fps", &[Render]),
     ("render.bird_model", "--bird-model", SCENE),
     ("render.joint_map", "--joint-map", SCENE),
