@@ -167,6 +167,7 @@ fn commands() -> Vec<Command> {
         ("--usd-mode", "pixie", None),
         ("--gltf-mode", "pixie", None),
         ("--joint-map", "OUT/no-map.json", None),
+        ("--crowd-pose-error", "0", None),
     ];
     // The savings flags of `report` and `plot savings`.
     let savings: Vec<(&str, &str, Option<String>)> = vec![

@@ -54,7 +54,10 @@ impl SavingsChart {
             .savings_model
             .as_ref()
             .map_or("Hummel's model".to_string(), |m| m.to_string());
-        let range = range_of(&crate::report::animation_band(anim), stats.steady_saving);
+        let range = range_of(
+            &crate::aero::band::animation_band(anim),
+            stats.steady_saving,
+        );
         Ok(SavingsChart {
             title: format!(
                 "{name}: savings of {} birds ({})",
@@ -72,7 +75,7 @@ impl SavingsChart {
 
 /// The least and the largest of a band's savings and the point value `point` (the range
 /// contains the value stated beside it), or `None` for an empty band.
-pub fn range_of(band: &[crate::report::BandEntry], point: Option<f64>) -> Option<(f64, f64)> {
+pub fn range_of(band: &[crate::aero::band::BandEntry], point: Option<f64>) -> Option<(f64, f64)> {
     if band.is_empty() {
         return None;
     }

@@ -1,4 +1,4 @@
-//! Debug pictures (`track --debug-frames DIR`): every processed frame as a PNG, for a user to see
+//! Debug pictures (the `track.debug_frames` option): every processed frame as a PNG, for a user to see
 //! why a bird was missed or something else was taken for one.
 //!
 //! The left half is the frame with what the tracker made of it: a green circle (one wingspan
@@ -6,7 +6,7 @@
 //! a track still young (it counts only if it lasts and moves with the flock), magenta for a bird
 //! cut out of a larger region (touching birds), a red square for a region that stood out but was
 //! turned down (far fainter or smaller than the birds), the last positions of each track as a
-//! cyan trail, and the searched region (`--roi`) in blue when it is not the whole frame. The right
+//! cyan trail, and the searched region (`track.roi`) in blue when it is not the whole frame. The right
 //! half is the background the birds were measured against (the sky model and its local
 //! closing), in grey: clouds should show there, birds should not.
 
