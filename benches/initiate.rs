@@ -139,6 +139,7 @@ fn landing(c: &mut Criterion) {
         speed: 10.0,
         altitude: 10.0,
         world_height: 10.0,
+        along_scale: 1.0,
     };
     let mut group = c.benchmark_group("landing");
     group.sample_size(10);

@@ -1,6 +1,7 @@
 //! The pictures of docs/steady-flight.md: the lateral position of three birds over a minute of
 //! steady flight, with key-shape interpolation only and with the living flight (position
-//! keeping, leader changes and swaps); and a leader change seen from above in the flock's frame.
+//! keeping, leader changes and swaps); and a leader change seen from above in the flock's frame
+//! and from the side.
 //!
 //! ```text
 //! formation steady examples_data/barnacle_geese_v.json --birds 9 --seconds 60 --jostle 0 -o still.json
@@ -152,6 +153,165 @@ impl Chart for LeaderChange {
     }
 }
 
+/// The same leader change seen from the side: fore-aft (ahead, flock frame) against height
+/// over the other birds' mean height, and the pair's gaps on each axis over time against the
+/// wing-clash test.
+struct LeaderChangeSide {
+    title: String,
+    /// Every bird's (ahead, height) during the manoeuvre.
+    side: Vec<Vec<(f64, f64)>>,
+    /// The pair's gaps over time: (t, |across|, |ahead|, height of the one moving back over
+    /// the other's).
+    gaps: Vec<(f64, f64, f64, f64)>,
+    /// The old and the new leader.
+    pair: (usize, usize),
+}
+
+impl Chart for LeaderChangeSide {
+    fn size(&self) -> (u32, u32) {
+        (1000, 900)
+    }
+
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult<DB> {
+        use formation::animation::clearance::{CHORD, SPAN, THICKNESS};
+        let grey = RGBColor(150, 150, 150);
+        let blue = RGBColor(33, 100, 180);
+        let root = root.titled(&self.title, (FONT_FAMILY, 20))?;
+        let (top, bottom) = root.split_vertically(470);
+        // The side view: the pair's span fore and aft, a wingspan around.
+        let pair_pts = || {
+            self.side[self.pair.0]
+                .iter()
+                .chain(&self.side[self.pair.1])
+                .copied()
+        };
+        let (a0, a1) = pair_pts().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
+            (a.min(p.0), b.max(p.0))
+        });
+        let (a0, a1) = (a0 - 1.0, a1 + 1.0);
+        let zmax = self
+            .side
+            .iter()
+            .flatten()
+            .filter(|p| p.0 >= a0 && p.0 <= a1)
+            .fold(0.2f64, |m, p| m.max(p.1.abs()))
+            * 1.25;
+        let mut chart = ChartBuilder::on(&top)
+            .caption(
+                "From the side (flight to the right; height drawn about 10 times the fore-aft scale)",
+                (FONT_FAMILY, 16),
+            )
+            .margin(12)
+            .x_label_area_size(40)
+            .y_label_area_size(70)
+            .build_cartesian_2d(a0..a1, -zmax..zmax)?;
+        draw_mesh(
+            &mut chart,
+            "ahead (flock frame), wingspans",
+            "height over the others, wingspans",
+            15,
+        )?;
+        for (i, p) in self.side.iter().enumerate() {
+            if i == self.pair.0 || i == self.pair.1 {
+                continue;
+            }
+            let p: Vec<(f64, f64)> = p
+                .iter()
+                .copied()
+                .filter(|q| q.0 >= a0 && q.0 <= a1)
+                .collect();
+            chart.draw_series(LineSeries::new(p.iter().copied(), grey.stroke_width(1)))?;
+            if let (Some(&a), Some(&b)) = (p.first(), p.last()) {
+                chart.draw_series([
+                    Circle::new(a, 5, grey.stroke_width(1)),
+                    Circle::new(b, 5, grey.filled()),
+                ])?;
+            }
+        }
+        for (who, colour, label) in [
+            (self.pair.0, LEADER, "leader before: dips and drops back"),
+            (self.pair.1, blue, "leader after: lifts and moves up"),
+        ] {
+            let p = &self.side[who];
+            chart
+                .draw_series(LineSeries::new(p.iter().copied(), colour.stroke_width(3)))?
+                .label(format!("bird {who}, {label}"))
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 18, y)], colour.stroke_width(3))
+                });
+            if let (Some(&a), Some(&b)) = (p.first(), p.last()) {
+                chart.draw_series([
+                    Circle::new(a, 6, colour.stroke_width(2)),
+                    Circle::new(b, 6, colour.filled()),
+                ])?;
+            }
+        }
+        formation::plot::draw_legend(&mut chart, 14, SeriesLabelPosition::UpperLeft)?;
+
+        // The gaps over time against the clash test.
+        let t0 = self.gaps.first().map_or(0.0, |g| g.0);
+        let t1 = self.gaps.last().map_or(1.0, |g| g.0);
+        let gmax = self
+            .gaps
+            .iter()
+            .fold(1.2f64, |m, g| m.max(g.1.min(3.0)).max(g.2.min(3.0)));
+        let mut chart = ChartBuilder::on(&bottom)
+            .caption(
+                "The pair's gaps: a wing clash needs all three under their dashed limits at once",
+                (FONT_FAMILY, 16),
+            )
+            .margin(12)
+            .x_label_area_size(40)
+            .y_label_area_size(70)
+            .build_cartesian_2d(t0..t1, -0.4..gmax * 1.05)?;
+        draw_mesh(&mut chart, "time, s", "wingspans", 15)?;
+        let green = RGBColor(40, 140, 60);
+        for (colour, limit, label, pick) in [
+            (
+                blue,
+                SPAN,
+                "across",
+                (|g: &(f64, f64, f64, f64)| g.1) as fn(&(f64, f64, f64, f64)) -> f64,
+            ),
+            (green, CHORD, "fore and aft", |g| g.2),
+            (
+                LEADER,
+                THICKNESS,
+                "height of the one moving back over the other",
+                |g| g.3,
+            ),
+        ] {
+            chart
+                .draw_series(LineSeries::new(
+                    self.gaps.iter().map(|g| (g.0, pick(g).min(gmax * 1.05))),
+                    colour.stroke_width(2),
+                ))?
+                .label(format!("{label} (clash under {limit})"))
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 18, y)], colour.stroke_width(3))
+                });
+            let mut dashes = Vec::new();
+            let n = 60;
+            for k in (0..n).step_by(2) {
+                let a = t0 + (t1 - t0) * k as f64 / n as f64;
+                let b = t0 + (t1 - t0) * (k + 1) as f64 / n as f64;
+                dashes.push(PathElement::new(
+                    vec![(a, limit), (b, limit)],
+                    colour.stroke_width(1),
+                ));
+                if colour == LEADER {
+                    dashes.push(PathElement::new(
+                        vec![(a, -limit), (b, -limit)],
+                        colour.stroke_width(1),
+                    ));
+                }
+            }
+            chart.draw_series(dashes)?;
+        }
+        formation::plot::draw_legend(&mut chart, 14, SeriesLabelPosition::UpperRight)
+    }
+}
+
 /// The lateral position of `birds` over the whole flight.
 fn lateral(a: &Animation, birds: &[usize]) -> Vec<Vec<(f64, f64)>> {
     birds
@@ -227,6 +387,59 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         pair: (e.birds[0], e.birds[1]),
     };
     save(&chart, &out.join("steady-leader-change.png"))?;
+
+    // The same from the side: ahead in the flock's frame (along the flight), height over the
+    // mean height of the birds not in the exchange.
+    let (old, new) = (e.birds[0], e.birds[1]);
+    let window: Vec<&formation::animation::Frame> = living
+        .frames
+        .iter()
+        .filter(|f| f.t >= t0 && f.t <= t1)
+        .collect();
+    let base = |f: &formation::animation::Frame| {
+        let others: Vec<f64> = (0..living.birds)
+            .filter(|&b| b != old && b != new)
+            .map(|b| f.z[b])
+            .collect();
+        others.iter().sum::<f64>() / others.len().max(1) as f64
+    };
+    let side: Vec<Vec<(f64, f64)>> = (0..living.birds)
+        .map(|b| {
+            window
+                .iter()
+                .map(|f| (f.y[b] - speed * f.t, f.z[b] - base(f)))
+                .collect()
+        })
+        .collect();
+    let gaps: Vec<(f64, f64, f64, f64)> = window
+        .iter()
+        .map(|f| {
+            (
+                f.t,
+                (f.x[old] - f.x[new]).abs(),
+                (f.y[old] - f.y[new]).abs(),
+                f.z[old] - f.z[new],
+            )
+        })
+        .collect();
+    let level = gaps
+        .iter()
+        .filter(|g| g.1 < 1.0 && g.2 < 0.15)
+        .map(|g| g.3.abs())
+        .fold(f64::INFINITY, f64::min);
+    let chart = LeaderChangeSide {
+        title: format!(
+            "The leader change of {:.1}–{:.1} s seen from the side (open: start, filled: end)",
+            t0, t1
+        ),
+        side,
+        gaps,
+        pair: (old, new),
+    };
+    save(&chart, &out.join("steady-leader-change-side.png"))?;
+    println!(
+        "wrote steady-leader-change-side.png: while under a wingspan across and a chord fore and aft, the pair is at least {level:.3} wingspans apart in height"
+    );
     println!(
         "wrote steady-lateral.png (birds {birds:?}) and steady-leader-change.png (birds {:?}, {:.1} s from {:.1} s)",
         e.birds, e.duration, e.t

@@ -140,11 +140,15 @@ impl Config {
     /// formations is checked with its largest possible formation (the flock as a whole only
     /// against [`crate::limits::MAX_BIRDS`] and the bird-frame limit).
     pub fn steady_options(&self) -> Result<SteadyOptions> {
-        let steady = SteadyOptions {
+        let mut steady = SteadyOptions {
             frames: self.frames()?,
             seed: self.seed,
             ..self.steady.clone()
         };
+        // A start file whose birds already fly a formation: its arms are the key shapes'.
+        if let (true, initiate::Start::Given(s)) = (self.initiation, &self.initiate.start) {
+            steady.given = s.joining(0.0).map(|j| j.given_arms());
+        }
         let n = steady.birds;
         if self.skein.formations == Some(1) || n <= crate::limits::MAX_FORMATION_BIRDS {
             steady.validate()?;
@@ -628,6 +632,7 @@ pub fn land_stage(
         speed,
         altitude,
         world_height,
+        along_scale: path.map_or(1.0, |_| config.course.min_speed),
     };
     let fps = anim.fps;
     match (path, config.shot_seconds) {

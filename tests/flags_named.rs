@@ -167,6 +167,7 @@ fn commands() -> Vec<Command> {
         ("--usd-mode", "pixie", None),
         ("--gltf-mode", "pixie", None),
         ("--joint-map", "OUT/no-map.json", None),
+        ("--crowd-pose-error", "0", None),
     ];
     // The savings flags of `report` and `plot savings`.
     let savings: Vec<(&str, &str, Option<String>)> = vec![
@@ -225,6 +226,8 @@ fn commands() -> Vec<Command> {
                 ("--frames", "3..1", None),
                 ("--roi", "0,0,999,10", None),
                 ("--fps", "-2", None),
+                ("--wingspan-px", "0", None),
+                ("--debug-frames", "/dev/null/frames", None),
                 ("--review", "OUT/r.txt", None),
                 o("OUT/a.txt"),
                 seed.clone(),

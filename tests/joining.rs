@@ -119,6 +119,12 @@ fn late_birds_fly_in_from_a_side_and_take_the_free_end_of_an_arm() {
                 })
             };
             let arms_after = arms(&after, lead);
+            // All of them at the tail of one arm, the one on their side.
+            let joined: Vec<&Vec<usize>> = arms_after
+                .iter()
+                .filter(|arm| arm.iter().any(|b| e.birds.contains(b)))
+                .collect();
+            assert_eq!(joined.len(), 1, "seed {seed}: late birds on both arms");
             for (k, arm) in arms_after.iter().enumerate() {
                 let old: Vec<usize> = arm
                     .iter()
@@ -233,4 +239,103 @@ fn birds_far_aside_at_the_take_off_join_at_the_tail_keeping_the_order() {
             "seed {seed}: late birds not at the tail"
         );
     }
+}
+
+/// The joining filmed in the wild (white-fronted geese): a lopsided V of five (three to the
+/// right of the leader, one to its left, the last right bird a straggler 2.7 wingspans out) and
+/// two late birds 31 and 33 wingspans to the right, flying in at about 4.4 wingspans/s sideways.
+/// The real five kept their places (ending 0.39, 1.08 and 2.0 to the right and 1.06 to the
+/// left) and the two joined behind the last bird of the right arm (3.7 and 4.8 aside).
+#[test]
+fn the_filmed_joining_keeps_the_formed_birds_places_and_order() {
+    use formation::animation::clearance::Clearance;
+    let dir = scratch("joining-filmed");
+    let h = -0.45f64;
+    let x = [0.0, 0.47, 0.89, 3.6, -0.96, 31.0, 32.9];
+    let y = [0.0, -0.97, -1.91, -3.2, -0.94, -13.8, -11.5];
+    let start = serde_json::json!({
+        "x": x,
+        "y": y,
+        "heading": [0.0, 0.0, 0.0, 0.0, 0.0, h, h],
+        "speed": [10.0, 10.0, 10.0, 10.0, 10.0, 10.0, 10.0],
+    });
+    std::fs::write(dir.join("start.json"), start.to_string()).unwrap();
+    for (seed, fps) in [
+        ("0", "30"),
+        ("1", "30"),
+        ("2", "30"),
+        ("0", "24"),
+        ("0", "60"),
+    ] {
+        let out = bin()
+            .current_dir(&dir)
+            .args(["animate", &example_arg("barnacle_geese_v.json")])
+            .args(["--birds", "7", "--start", "start.json", "--seconds", "10"])
+            .args(["--seed", seed, "--fps", fps, "--quiet", "-o", "a.json"])
+            .output()
+            .unwrap();
+        assert_eq!(code(&out), 0, "{}", stderr(&out));
+        let a = Animation::read(&dir.join("a.json")).unwrap();
+        // Which start bird each animated bird is (frame 0 holds the start positions).
+        let f0 = &a.frames[0];
+        let who: Vec<usize> = (0..7)
+            .map(|b| {
+                (0..7)
+                    .min_by(|&p, &q| {
+                        let d = |i: usize| (f0.x[b] - x[i]).hypot(f0.y[b] - y[i]);
+                        d(p).total_cmp(&d(q))
+                    })
+                    .unwrap()
+            })
+            .collect();
+        let lead = who.iter().position(|&i| i == 0).unwrap();
+        let end = a.stages[0].end;
+        let fin = relative(&a.frames[end], lead);
+        let [left, right] = arms(&fin, lead);
+        let named = |arm: &[usize]| arm.iter().map(|&b| who[b]).collect::<Vec<_>>();
+        let what = format!("seed {seed} at {fps} fps");
+        assert_eq!(named(&left), [4], "{what}: left arm");
+        assert_eq!(named(&right), [1, 2, 3, 5, 6], "{what}: right arm");
+        assert_eq!(
+            (0..7)
+                .max_by(|&p, &q| fin[q].1.total_cmp(&fin[p].1))
+                .unwrap(),
+            lead,
+            "{what}: the leader changed"
+        );
+        // The five formed birds end near where they were (within a wingspan aside; the
+        // straggler closes in towards its neighbour), the late birds beyond them.
+        for (i, real) in [(1, 0.47), (2, 0.89), (4, -0.96)] {
+            let b = who.iter().position(|&w| w == i).unwrap();
+            assert!(
+                (fin[b].0 - real).abs() < 0.5,
+                "{what}: bird {i} ends {} aside, {real} at the start",
+                fin[b].0
+            );
+        }
+        // The late birds are within a wingspan aside of their places in under 7 s.
+        let late: Vec<usize> = [5, 6]
+            .iter()
+            .map(|&i| who.iter().position(|&w| w == i).unwrap())
+            .collect();
+        let joined = a
+            .frames
+            .iter()
+            .position(|f| {
+                let r = relative(f, lead);
+                late.iter().all(|&b| (r[b].0 - fin[b].0).abs() < 1.0)
+            })
+            .unwrap();
+        let t = a.frames[joined].t;
+        assert!(t < 7.0, "{what}: joined after {t} s");
+        // No clash in any frame of any stage.
+        let c = Clearance::of(&a);
+        assert_eq!(
+            (c.wing, c.body),
+            (0, 0),
+            "{what}: clashes, closest {:?}",
+            c.closest
+        );
+    }
+    let _ = std::fs::remove_dir_all(dir);
 }

@@ -259,7 +259,7 @@ fn the_point_instanced_crowd_scales_its_birds_like_the_rig() {
         .collect();
     let frames = anim["frames"].as_array().unwrap();
     assert_eq!(lines.len(), frames.len());
-    // Whole millimetres about the crowd's translation (the flock's centre at that time).
+    // Metres about the crowd's translation (the flock's centre at that time).
     let start = text.find("xformOp:translate.timeSamples = {").unwrap();
     let centres: Vec<&str> = text[start..].lines().skip(1).take(frames.len()).collect();
     let mut worst: f64 = 0.0;
@@ -268,7 +268,7 @@ fn the_point_instanced_crowd_scales_its_birds_like_the_rig() {
         let pos: Vec<f64> = numbers_after(line, &format!("{k}: "))
             .iter()
             .enumerate()
-            .map(|(i, v)| c[i % 3] + v / 1e3)
+            .map(|(i, v)| c[i % 3] + v)
             .collect();
         let f = &frames[k];
         let at = |key: &str, b: usize| f[key][b].as_f64().unwrap();

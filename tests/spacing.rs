@@ -128,6 +128,21 @@ fn overlapping_wingtips_in_the_footage_are_kept() {
 }
 
 #[test]
+fn the_real_v_s_spacing_is_kept_at_15_and_24_birds() {
+    // The stereo-filmed V had 15 birds; one formation of 24 is the largest the README's
+    // examples fly unsplit (more make several formations).
+    let read = ReadOptions {
+        wingspan_px: Some(44.4),
+        ..ReadOptions::default()
+    };
+    check(
+        "barnacle geese V at 0.77",
+        &params("barnacle_geese_v.json", read),
+        &[15, 24],
+    );
+}
+
+#[test]
 fn j_footage_spacing_is_kept_for_any_number_of_birds() {
     let p = params("snow_geese_j.csv", ReadOptions::default());
     check("snow geese J", &p, &[16, 7, 30]);

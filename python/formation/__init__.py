@@ -13,7 +13,12 @@ Options are the library's option paths (``steady.fps``, ``initiate.max_turn_rate
 ``render.width``...), given as ``**{"steady.fps": 30}`` or per section as
 ``steady={"fps": 30}``; ``formation.default_options()`` lists them with their defaults.
 Bad input raises ``ValueError`` (a file that cannot be read or written: ``OSError``) with the
-same one-line message as the command line, naming the option path.
+same one-line message as the command line, naming the option path. Suspicious input (a
+formation that opens forward, an implausible scale, a path the flock outflies) is a warning of
+class ``formation.FormationWarning`` (Python's ``warnings``: filter it, or turn it into an error
+with ``warnings.simplefilter("error", formation.FormationWarning)``); ``strict=True`` makes
+``extract`` and ``animate`` raise ``ValueError`` on the first one instead. ``formation.example(NAME)``
+gives the path of an example bundled with the package (``formation.examples()`` lists them).
 """
 
 from __future__ import annotations
@@ -21,6 +26,9 @@ from __future__ import annotations
 import json as _json
 import os as _os
 from typing import Any as _Any
+
+import re as _re
+import warnings as _warnings
 
 import numpy as _np
 
@@ -32,15 +40,86 @@ __version__ = _native.__version__
 __all__ = [
     "Animation",
     "Annotations",
+    "FormationWarning",
     "Params",
     "animate",
     "default_options",
+    "example",
+    "examples",
     "extract",
     "power",
     "read_animation",
     "read_annotations",
     "solve",
 ]
+
+class FormationWarning(UserWarning):
+    """Suspicious input that still gave a result: a formation that opens forward (the heading or
+    the image's y axis probably wrong), an implausible scale, few frames, a path the flock flies
+    past. The message says what to give to fix it."""
+
+
+_EXAMPLES = _os.path.join(_os.path.dirname(__file__), "examples")
+
+
+def examples() -> list[str]:
+    """The names of the examples bundled with the package (``formation.example(NAME)``)."""
+    return sorted(n for n in _os.listdir(_EXAMPLES) if n != "README.md" and not n.startswith("."))
+
+
+def example(name: str) -> str:
+    """The path of an example bundled with the package: annotated footage of a real formation
+    in each input format the tool reads (``"barnacle_geese_v.json"``, ``"cranes_v_dltdv.csv"``,
+    ``"snow_geese_j.csv"``, ``"pelicans_u_labelme"`` (a directory), ...), the same files as
+    the repository's ``examples_data/``; their README says where each comes from.
+
+    ``formation.animate(formation.example("barnacle_geese_v.json"))`` runs from any directory.
+    Raises ValueError naming the examples there are for an unknown name.
+    """
+    if not isinstance(name, str) or _os.sep in name or name in ("", ".", ".."):
+        raise ValueError(f"example: expected an example's name, got {name!r}; one of {', '.join(examples())}")
+    path = _os.path.join(_EXAMPLES, name)
+    if not _os.path.exists(path):
+        stems = {_os.path.splitext(n)[0]: n for n in examples()}
+        if name in stems:
+            path = _os.path.join(_EXAMPLES, stems[name])
+        else:
+            raise ValueError(f"example: no example named {name!r}; there are {', '.join(examples())}")
+    return path
+
+
+# The library's messages name options by their path (``read.heading``); Python gives the read
+# options as ``read_annotations``' keywords or an option section.
+_READ_KEYS = ("heading", "y_origin", "wingspan_px")
+
+
+def _python_spelling(message: str, annotations_given: bool) -> str:
+    def give(key: str, value: str | None) -> str:
+        if value is None:
+            return f"read_annotations' {key}=" if annotations_given else f'read={{"{key}": ...}}'
+        v = value if _re.fullmatch(r"[-+]?[0-9.]+", value) else f'"{value}"'
+        return f"read_annotations(..., {key}={v})" if annotations_given else f'read={{"{key}": {v}}}'
+
+    keys = "|".join(_READ_KEYS)
+    message = _re.sub(
+        rf"\bread\.({keys}) ([A-Za-z]+|[-+]?[0-9.]+)(?=[\s,;)]|$)",
+        lambda m: give(m.group(1), m.group(2)),
+        message,
+    )
+    message = _re.sub(rf"\bread\.({keys})\b", lambda m: give(m.group(1), None), message)
+    return message
+
+
+def _warn(messages: list[str], strict: bool, annotations_given: bool) -> None:
+    """Raises the run's warnings as ``FormationWarning`` (``strict``: the first as ValueError)."""
+    messages = [_python_spelling(m, annotations_given) for m in messages]
+    if strict and messages:
+        more = len(messages) - 1
+        tail = "" if more == 0 else f" (and {more} more warning{'s' if more > 1 else ''})"
+        raise ValueError(f"strict: {messages[0]}{tail}")
+    for m in messages:
+        _warnings.warn(m, FormationWarning, stacklevel=3)
+
 
 _HEADINGS = {"up": "Up", "right": "Right", "down": "Down", "left": "Left"}
 
@@ -61,6 +140,12 @@ def _pairs(options: dict[str, _Any], prefix: str = "") -> list[tuple[str, str]]:
     for name, value in options.items():
         if prefix and name.startswith(prefix):
             name = name[len(prefix) :]
+        # The heading as read_annotations takes it ("down", degrees), in an option too.
+        if prefix + name == "read.heading" and isinstance(value, (str, int, float)):
+            out.append((name, _heading(value)))
+            continue
+        if prefix + name == "read" and isinstance(value, dict) and isinstance(value.get("heading"), (str, int, float)):
+            value = {**value, "heading": _json.loads(_heading(value["heading"]))}
         try:
             text = _json.dumps(value, default=_json_default, allow_nan=True)
         except TypeError as e:
@@ -135,7 +220,11 @@ def read_annotations(
 
 
 def extract(
-    annotations: Annotations | str | _os.PathLike, *, seed: int = 0, **options: _Any
+    annotations: Annotations | str | _os.PathLike,
+    *,
+    seed: int = 0,
+    strict: bool = False,
+    **options: _Any,
 ) -> Params:
     """Formation parameters of annotated footage (RANSAC over every frame).
 
@@ -146,10 +235,17 @@ def extract(
 
     Returns ``Params``: ``.birds``, ``.frames`` (one dict per frame), ``.summary``,
     ``.to_dict()``, ``.to_json()``. Raises ValueError for bad input or options.
+
+    Suspicious input (``.summary["warnings"]``) is also raised as ``FormationWarning``s;
+    ``strict=True`` raises ValueError on the first instead.
     """
+    given = isinstance(annotations, Annotations)
     if isinstance(annotations, _os.PathLike):
         annotations = _os.fspath(annotations)
-    return _native.extract(annotations, [("seed", str(int(seed)))] + _pairs(options))
+    params = _native.extract(annotations, [("seed", str(int(seed)))] + _pairs(options))
+    summary = params.summary or {}
+    _warn([w["message"] for w in summary.get("warnings", [])], strict, given)
+    return params
 
 
 def animate(
@@ -162,6 +258,7 @@ def animate(
     progress: _Any = False,
     land: bool = False,
     land_on: str | None = None,
+    strict: bool = False,
     **options: _Any,
 ) -> Animation:
     """The whole pipeline: extraction, steady flight, take-off, wingbeats, savings.
@@ -180,6 +277,9 @@ def animate(
     line on ``sys.stderr`` rewritten in place; a callable is called as
     ``progress(stage, done, total)`` at the start of each stage, at most ten times a second
     while it runs and at its end (an exception it raises ends the run and is raised here).
+
+    ``strict``: raise ValueError on the first warning instead of a ``FormationWarning``
+    (the command line's ``--strict``).
 
     ``options``: any other option by its path in the library's configuration, dotted
     (``**{"steady.fps": 30, "initiate.max_turn_rate": 1.2}``) or per section
@@ -211,17 +311,21 @@ def animate(
         if not isinstance(land_on, str):
             raise ValueError(f"landing.surface: expected 'ground' or 'water', got {land_on!r}")
         pairs.append(("landing.surface", _json.dumps(land_on)))
+    given = isinstance(input, Annotations)
     if isinstance(input, _os.PathLike):
         input = _os.fspath(input)
     if callable(progress):
-        return _native.animate(input, pairs + _pairs(options), False, progress)
-    if progress and not _stderr_is_terminal():
+        anim, warned = _native.animate(input, pairs + _pairs(options), False, progress)
+    elif progress and not _stderr_is_terminal():
         bar = _StageBar()
         try:
-            return _native.animate(input, pairs + _pairs(options), False, bar)
+            anim, warned = _native.animate(input, pairs + _pairs(options), False, bar)
         finally:
             bar.close()
-    return _native.animate(input, pairs + _pairs(options), bool(progress))
+    else:
+        anim, warned = _native.animate(input, pairs + _pairs(options), bool(progress))
+    _warn(warned, strict, given)
+    return anim
 
 
 def _stderr_is_terminal() -> bool:
@@ -331,3 +435,6 @@ def solve(x, xi, y=None, *, tolerance: float | None = None, patience: int | None
     aero = [] if core_radius is None else [("core_radius", _json.dumps(float(core_radius)))]
     return _native.solve(x, xi, y, tolerance, patience, aero)
 
+
+# ``from __future__ import annotations`` binds the name ``annotations``: not part of the API.
+del annotations

@@ -437,8 +437,12 @@ impl PyAnimation {
     }
     /// A tidy pandas DataFrame with exactly the CSV's columns (pandas is imported here only).
     fn to_pandas<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let pandas = py.import("pandas").map_err(|_| {
+            pyo3::exceptions::PyImportError::new_err(
+                "Animation.to_pandas needs pandas, which is not installed: pip install pandas (or install the package as \"formation[pandas]\"); the arrays (positions, savings, ...) need only numpy",
+            )
+        })?;
         let csv = self.to_csv(py)?;
-        let pandas = py.import("pandas")?;
         let text = py.import("io")?.call_method1("StringIO", (csv,))?;
         pandas.call_method1("read_csv", (text,))
     }
@@ -470,6 +474,12 @@ impl PyAnimation {
         let render = merged(&self.config.render, &pairs, "render.")?;
         py.detach(|| formation::export::write_outputs(&self.inner, &paths, &render, &Silent))
             .map_err(py_err)
+    }
+    /// A notebook cell's view: a summary table and the 3-D player (the page `formation view`
+    /// writes) in an isolated frame; above `NOTEBOOK_PLAYER_BIRD_FRAMES` bird-frames, frames
+    /// are thinned (the player interpolates between those kept).
+    fn _repr_html_(&self) -> PyResult<String> {
+        notebook_html(&self.inner)
     }
     fn __repr__(&self) -> String {
         format!(
@@ -561,6 +571,88 @@ impl formation::progress::Progress for CallbackProgress {
     }
 }
 
+/// Most bird-frames the notebook view embeds before it thins frames (about 20 bytes each in
+/// the page: a 30 MB cell at most).
+const NOTEBOOK_PLAYER_BIRD_FRAMES: usize = 1_500_000;
+
+fn html_escape(s: &str) -> String {
+    let mut out = String::with_capacity(s.len() + s.len() / 8);
+    for c in s.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            '\'' => out.push_str("&#39;"),
+            c => out.push(c),
+        }
+    }
+    out
+}
+
+/// The HTML an `Animation` shows in a notebook cell: what it is (birds, frames, stages, the
+/// clearance) and the player in an `<iframe srcdoc>`, so its script and styles cannot touch the
+/// notebook's.
+fn notebook_html(anim: &Animation) -> PyResult<String> {
+    let bird_frames = anim.birds * anim.frames.len();
+    let every = bird_frames.div_ceil(NOTEBOOK_PLAYER_BIRD_FRAMES).max(1);
+    let mut rows = String::new();
+    let seconds = anim.frames.len() as f64 / anim.fps;
+    rows.push_str(&format!(
+        "<tr><th>birds</th><td>{}</td></tr><tr><th>frames</th><td>{} at {} fps ({:.1} s)</td></tr>",
+        anim.birds,
+        anim.frames.len(),
+        anim.fps,
+        seconds
+    ));
+    if let Some(species) = &anim.species {
+        rows.push_str(&format!(
+            "<tr><th>species</th><td>{}</td></tr>",
+            html_escape(species)
+        ));
+    }
+    let stages: Vec<String> = anim
+        .stages
+        .iter()
+        .map(|s| format!("{} {:.1} s", s.name, (s.end - s.start) as f64 / anim.fps))
+        .collect();
+    if !stages.is_empty() {
+        rows.push_str(&format!(
+            "<tr><th>stages</th><td>{}</td></tr>",
+            html_escape(&stages.join(", "))
+        ));
+    }
+    let clearance = cli_main::cli::summary::clearance_text(anim);
+    rows.push_str(&format!(
+        "<tr><th>clearance</th><td>{}</td></tr>",
+        html_escape(clearance.trim_start_matches("; clearance: "))
+    ));
+    let player = if anim.frames.is_empty() || anim.birds == 0 {
+        String::new()
+    } else {
+        let opts = formation::player::PlayerOptions {
+            title: "animation".into(),
+            start_frame: None,
+            every: every.min(formation::player::MAX_EVERY),
+        };
+        let page = formation::player::page(anim, &opts).map_err(py_err)?;
+        let thinned = if every > 1 {
+            format!(
+                "<p style=\"margin:2px 0;font-size:90%\">every {every}th frame kept in this view (the player interpolates); <code>formation view</code> writes them all</p>"
+            )
+        } else {
+            String::new()
+        };
+        format!(
+            "{thinned}<iframe srcdoc=\"{}\" style=\"width:100%;height:520px;border:1px solid #ccc\" sandbox=\"allow-scripts\"></iframe>",
+            html_escape(&page)
+        )
+    };
+    Ok(format!(
+        "<div><table style=\"font-size:90%\"><caption style=\"text-align:left\"><b>formation.Animation</b></caption>{rows}</table>{player}</div>"
+    ))
+}
+
 /// Runs the whole pipeline (see `formation.animate`); `progress`: the command line's progress
 /// bar on stderr (drawn only when stderr is a terminal); `callback`: a callable given the
 /// progress instead (`callback(stage, done, total)`).
@@ -572,10 +664,10 @@ fn animate(
     options: Vec<(String, String)>,
     progress: bool,
     callback: Option<Py<PyAny>>,
-) -> PyResult<PyAnimation> {
+) -> PyResult<(PyAnimation, Vec<String>)> {
     let pipeline = pipeline(input)?;
     let config = config(&options)?;
-    let (anim, _report) = match callback {
+    let (anim, report) = match callback {
         Some(callback) => {
             let bar = CallbackProgress::new(callback);
             let out = py.detach(|| pipeline.run_with(&config, &bar));
@@ -590,10 +682,22 @@ fn animate(
                 .map_err(py_err)?
         }
     };
-    Ok(PyAnimation {
-        inner: anim,
-        config,
-    })
+    // The warnings the command line prints (the input's, then the course's), for the Python
+    // side to raise as `FormationWarning`s.
+    let mut warnings: Vec<String> = report
+        .params
+        .summary
+        .as_ref()
+        .map(|s| s.warnings.iter().map(|w| w.message.clone()).collect())
+        .unwrap_or_default();
+    warnings.extend(report.course.warnings.iter().cloned());
+    Ok((
+        PyAnimation {
+            inner: anim,
+            config,
+        },
+        warnings,
+    ))
 }
 
 /// Reads an animation JSON file written by `formation animate`.

@@ -356,3 +356,94 @@ def test_progress_callable_and_notebook_bar(capsys):
     formation.animate(EXAMPLE, progress=True, **kw)
     err = capsys.readouterr().err
     assert "[" in err and "/" in err
+
+
+def test_bundled_examples_are_the_repositorys():
+    names = formation.examples()
+    for n in ["barnacle_geese_v.json", "cranes_v_dltdv.csv", "snow_geese_j.csv", "pelicans_u_labelme"]:
+        assert n in names
+        path = Path(formation.example(n))
+        assert path.exists()
+        mine = ROOT / "examples_data" / n
+        if mine.is_file():
+            assert path.read_bytes() == mine.read_bytes(), f"{n} differs from examples_data/"
+        elif mine.is_dir():
+            assert sorted(p.name for p in path.iterdir()) == sorted(p.name for p in mine.iterdir())
+    # The name without its extension works too; an unknown one names those there are.
+    assert formation.example("barnacle_geese_v") == formation.example("barnacle_geese_v.json")
+    with pytest.raises(ValueError, match="barnacle_geese_v.json"):
+        formation.example("ravens")
+    with pytest.raises(ValueError):
+        formation.example("../README.md")
+
+
+def test_the_readme_snippet_runs_from_any_directory(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    params = formation.extract(formation.example("barnacle_geese_v.json"), seed=1)
+    anim = formation.animate(params, birds=5, seconds=2, seed=1, initiation=False)
+    assert anim.positions.shape[1] == 5
+
+
+def test_warnings_are_formation_warnings_in_pythons_spelling():
+    # The barnacle geese read as flying down the image: the formation opens forward.
+    ann = formation.read_annotations(EXAMPLE, heading="down")
+    with pytest.warns(formation.FormationWarning) as got:
+        params = formation.extract(ann, seed=1)
+    text = " ".join(str(w.message) for w in got)
+    assert "opens forward" in text
+    assert "read_annotations(..., heading=" in text and "read.heading" not in text
+    assert params.summary["warnings"], "the warning is also kept in the summary"
+    # Given by option, the message names the option section.
+    with pytest.warns(formation.FormationWarning, match=r'read=\{"heading": "up"\}'):
+        formation.extract(EXAMPLE, seed=1, read={"heading": "down"})
+    # strict: the first warning is a ValueError, nothing returned.
+    with pytest.raises(ValueError, match="^strict: .*opens forward"):
+        formation.extract(ann, seed=1, strict=True)
+    # A clean input warns nothing, strict or not.
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", formation.FormationWarning)
+        formation.extract(EXAMPLE, seed=1, strict=True)
+
+
+def test_animate_raises_the_runs_warnings():
+    ann = formation.read_annotations(EXAMPLE, heading="down")
+    with pytest.warns(formation.FormationWarning, match=r"opens forward.*read_annotations\(\.\.\., heading=\"up\"\)"):
+        anim = formation.animate(ann, birds=5, seconds=2, seed=1, initiation=False)
+    assert anim.birds == 5
+    # A heading option given as the CLI spells it ("down") is accepted by path too.
+    with pytest.warns(formation.FormationWarning, match=r'read=\{"heading": "up"\}'):
+        formation.animate(EXAMPLE, birds=5, seconds=2, seed=1, initiation=False, **{"read.heading": "down"})
+    with pytest.raises(ValueError, match="^strict: .*opens forward"):
+        formation.animate(ann, birds=5, seconds=2, seed=1, initiation=False, strict=True)
+
+
+def test_no_leaked_names_and_all_is_the_api():
+    public = {n for n in dir(formation) if not n.startswith("_")}
+    assert "annotations" not in public
+    for n in formation.__all__:
+        assert hasattr(formation, n), n
+    assert "FormationWarning" in formation.__all__ and "example" in formation.__all__
+
+
+def test_notebook_view_is_a_player_in_an_isolated_frame(anim):
+    html = anim._repr_html_()
+    assert html.startswith("<div>") and "<iframe srcdoc=" in html
+    assert "clearance" in html and "9</td>" in html
+    # The player's own markup is escaped inside srcdoc: no raw script tag in the cell.
+    assert "<script" not in html and "&lt;script" in html
+
+
+def test_to_pandas_without_pandas_says_how_to_install_it(anim, monkeypatch):
+    monkeypatch.setitem(sys.modules, "pandas", None)
+    with pytest.raises(ImportError, match="pip install pandas"):
+        anim.to_pandas()
+
+
+def test_installed_command_help_is_the_tools():
+    out = subprocess.run(
+        [sys.executable, "-m", "formation._cli", "--help"], capture_output=True, text=True, check=True
+    ).stdout
+    first = out.splitlines()[0]
+    assert "Animate bird flocks" in first and "maturin" not in first and "bindings" not in first

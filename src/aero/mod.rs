@@ -59,6 +59,7 @@
 
 use serde::{Deserialize, Serialize};
 
+pub mod band;
 mod far;
 mod field;
 pub mod flight;

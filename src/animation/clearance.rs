@@ -21,7 +21,7 @@ pub const BODY: f64 = 0.3;
 /// Ground speed from which a bird counts as flying, wingspans per second.
 pub const FLYING: f64 = 1.0;
 /// Pairs farther apart than this can not clash (wingspans): the grid's cell.
-const REACH: f64 = 1.2;
+pub const REACH: f64 = 1.2;
 
 /// The closest two birds came.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -151,6 +151,10 @@ pub struct SceneArgs {
     /// below].
     #[arg(long, value_name = "birds|flock")]
     pub gltf_mode: Option<formation::export::GltfMode>,
+    /// Mean wing-pose error, degrees, that a point-instanced USD crowd's prototypes must meet in
+    /// every stage (take-off and landing included): smaller means more prototypes [default: 5].
+    #[arg(long, value_name = "DEG")]
+    pub crowd_pose_error: Option<f64>,
     /// Indent the written .json for reading (it is one compact line by default).
     #[arg(long)]
     pub pretty: bool,
@@ -199,6 +203,7 @@ impl SceneArgs {
             path_out: self.path_out.clone(),
             usd_mode: self.usd_mode,
             gltf_mode: self.gltf_mode,
+            crowd_pose_error: self.crowd_pose_error,
             pretty: self.pretty,
             binary_frames: self.binary_frames,
             ..RenderOptions::default()

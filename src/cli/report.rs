@@ -76,12 +76,13 @@ pub fn run(args: ReportArgs, g: Global) -> Result<()> {
             footage_aero.unwrap_or_default().record()
         ),
         (None, Some(a)) => format!(
-            "a page on an animation of {} birds, {} frames (savings by {}, take-off, steady flight)",
+            "a page on an animation of {} birds, {} frames (savings by {}, take-off, steady flight){}",
             a.birds,
             a.frames.len(),
             a.savings_model
                 .as_ref()
-                .map_or("Hummel's model".to_string(), |m| m.to_string())
+                .map_or("Hummel's model".to_string(), |m| m.to_string()),
+            super::summary::clearance_text(a)
         ),
         (None, None) => "a page".to_string(),
     };

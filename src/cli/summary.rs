@@ -44,6 +44,13 @@ pub fn print_deferred() {
             if let Some(hint) = binary_frames_hint(p) {
                 super::stdout::diagnostic(&hint);
             }
+            // A point-instanced crowd: its prototypes and the wing-pose error they make.
+            if let Some((n, err)) = formation::export::crowd::recorded_pose_error(p) {
+                super::stdout::diagnostic(&format!(
+                    "{}: {n} prototypes; wing-pose error {err}",
+                    super::stdout::file_name(p)
+                ));
+            }
         }
     }
 }

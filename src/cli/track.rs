@@ -44,6 +44,14 @@ pub struct TrackArgs {
     /// Frames per second of the footage (default: the video's; image frames have none).
     #[arg(long, value_name = "F", allow_hyphen_values = true)]
     pub fps: Option<String>,
+    /// The birds' wingspan on screen, pixels, when known: sets the detection's scale and the
+    /// wingspan written (default: measured from the birds that last).
+    #[arg(long, value_name = "PX", allow_hyphen_values = true)]
+    pub wingspan_px: Option<String>,
+    /// Write every processed frame into DIR as a PNG with the detections, tracks and background
+    /// drawn, to see why a bird was missed.
+    #[arg(long, value_name = "DIR")]
+    pub debug_frames: Option<PathBuf>,
 }
 
 fn bad(name: &str, message: String) -> Error {
@@ -108,12 +116,25 @@ pub fn options(a: &TrackArgs) -> Result<TrackOptions> {
             )
         })?),
     };
+    let wingspan_px = match &a.wingspan_px {
+        None => None,
+        Some(s) => Some(s.trim().parse::<f64>().map_err(|_| {
+            bad(
+                "track.wingspan_px",
+                format!(
+                    "`{s}` is not a number of pixels; give a bird's wingspan on screen, e.g. 26"
+                ),
+            )
+        })?),
+    };
     let opts = TrackOptions {
         polarity,
         every,
         frames,
         roi,
         fps,
+        wingspan_px,
+        debug_frames: a.debug_frames.clone(),
     };
     opts.validate()?;
     Ok(opts)
@@ -127,6 +148,14 @@ pub fn run(args: TrackArgs, g: Global) -> Result<()> {
     }
     let opts = options(&args)?;
     formation::io::check_output_dir("-o", &args.output)?;
+    if let Some(d) = &args.debug_frames {
+        std::fs::create_dir_all(d).map_err(|e| {
+            Error::parameter(
+                "track.debug_frames",
+                format!("cannot make the directory {} ({e}); give a directory to write the debug frames into", d.display()),
+            )
+        })?;
+    }
     if let Some(r) = &args.review {
         formation::io::check_output_dir("--review", r)?;
     }

@@ -71,6 +71,9 @@ pub struct SceneOptions {
     /// part instead of one per bird (and a viewer one draw call a part); `false` = one skin and
     /// mesh node per bird.
     pub one_skin: bool,
+    /// Mean wing-pose error a point-instanced USD crowd's prototypes must meet in every stage,
+    /// degrees ([`super::crowd`]); `None` = [`super::crowd::DEFAULT_POSE_ERROR_DEG`].
+    pub crowd_pose_error_deg: Option<f64>,
 }
 
 impl SceneOptions {

@@ -142,6 +142,10 @@ pub struct RenderOptions {
     /// one armature a part); `None` =
     /// flock from [`crowd::INSTANCER_FROM`] birds, birds below.
     pub gltf_mode: Option<GltfMode>,
+    /// Mean wing-pose error, degrees, that the prototypes of a point-instanced USD crowd must
+    /// meet in every stage (take-off and landing included); `None` =
+    /// [`crowd::DEFAULT_POSE_ERROR_DEG`]. See [`crowd`].
+    pub crowd_pose_error: Option<f64>,
     /// Indent the written animation JSON (and the flown path) for reading; compact by default.
     pub pretty: bool,
     /// Write the animation JSON's frames to a binary file beside it in single precision
@@ -247,6 +251,7 @@ impl Default for RenderOptions {
             path_out: None,
             usd_mode: None,
             gltf_mode: None,
+            crowd_pose_error: None,
             pretty: false,
             binary_frames: false,
         }
@@ -281,6 +286,17 @@ impl RenderOptions {
                 return Err(Error::parameter(
                     "render.fps",
                     format!("{f} frames per second is not a usable frame rate; give a number from 1 to {MAX_FPS}"),
+                ));
+            }
+        }
+        if let Some(d) = self.crowd_pose_error {
+            if !(d.is_finite() && (crowd::MIN_POSE_ERROR_DEG..=90.0).contains(&d)) {
+                return Err(Error::parameter(
+                    "render.crowd_pose_error",
+                    format!(
+                        "{d} degrees is not a usable wing-pose error; give a number from {} to 90, e.g. 5",
+                        crowd::MIN_POSE_ERROR_DEG
+                    ),
                 ));
             }
         }
@@ -394,6 +410,24 @@ pub fn plan_outputs(outputs: &[PathBuf]) -> Result<Vec<Output>> {
     let mut seen = BTreeSet::new();
     let mut plan = Vec::new();
     for p in outputs {
+        // Binary USD is not written: the text stage converts losslessly with usd-core.
+        let ext = p
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        if matches!(ext.as_deref(), Some("usdc") | Some("usd") | Some("usdz")) {
+            let text = p.with_extension("usda");
+            return Err(Error::parameter(
+                "output",
+                format!(
+                    "{}: binary USD is not written by formation; write {} and convert it with usd-core: usdcat {} -o {}",
+                    p.display(),
+                    text.display(),
+                    text.display(),
+                    p.display()
+                ),
+            ));
+        }
         let kind = OutputKind::from_path(p, &OUTPUT_KINDS)?;
         let path = if kind == OutputKind::Directory {
             let s = p.to_string_lossy();
@@ -613,6 +647,7 @@ pub fn write_outputs(
         assets,
         start_frame: anim.start_frame,
         frame_rate: None,
+        crowd_pose_error_deg: opts.crowd_pose_error,
         one_skin: match opts.gltf_mode {
             Some(m) => m == GltfMode::Flock,
             None => anim.birds >= crowd::INSTANCER_FROM,

@@ -166,6 +166,11 @@ pub struct Site {
     /// Height of the flock above the ground in the world where it lands, wingspans (the
     /// course-frame descent is scaled so that the world glide slope is the option's).
     pub world_height: f64,
+    /// Least ratio of a world along-track distance to its course-frame one where the flock
+    /// flies at its cruise width (1 on a straight course; on a path, the inside of a turn: the
+    /// slowest a bird flies in a turn as a fraction of the cruise speed, 0.6 by default). The
+    /// landing keeps its along-track gaps clear of the clash test after the course is bent.
+    pub along_scale: f64,
 }
 
 /// smoothstep on [0, 1], clamped.
@@ -395,7 +400,10 @@ fn plan_from(
     // at least the ramp and the flare (a bird low down sinks more slowly).
     let descent_len = |z: f64| (z / sink + 0.5 * (ramp + flare)).max(ramp + flare);
     let loosen = clear_loosen(&start, v, opts.loosen);
-    let beta = clear_stagger(&start, x_mid, v, loosen, opts.stagger);
+    // On a bent course an along-track gap of the course frame shrinks by up to 1 − κ d on the
+    // inside of a turn, and the loosened flock is wider by `loosen`.
+    let bend = (1.0 - (1.0 - site.along_scale.clamp(0.0, 1.0)) * loosen).max(0.2);
+    let beta = clear_stagger(&start, x_mid, v, loosen, opts.stagger, bend);
     let lag = |y: f64| beta * (y_front - y) / va;
     // The front bird's touch-down: after the slowdown and the flare, and late enough that no
     // bird needs to start descending before the landing starts (at half the slowdown).
@@ -479,10 +487,20 @@ pub const STAGGER_MARGIN: f64 = 0.03;
 /// `start` holds each bird's [x, y, vx, vy] at the landing's start, `x_mid` the flock's middle,
 /// `v` the flight speed: each bird's velocity difference from the plan is blended out over the
 /// first [`BLEND_S`], moving it by half that difference times the blend, which counts here.
-fn clear_stagger(start: &[[f64; 5]], x_mid: f64, v: f64, loosen: f64, stagger: f64) -> f64 {
+/// `bend` is the least ratio of a world along-track gap to its course-frame one (1 on a straight
+/// course): the kept gap is the chord and margin over it.
+fn clear_stagger(
+    start: &[[f64; 5]],
+    x_mid: f64,
+    v: f64,
+    loosen: f64,
+    stagger: f64,
+    bend: f64,
+) -> f64 {
     use crate::animation::clearance::{CHORD, SPAN};
     let span = SPAN + STAGGER_MARGIN;
-    let chord = CHORD + STAGGER_MARGIN;
+    let clear = CHORD + STAGGER_MARGIN;
+    let chord = clear / bend.clamp(0.2, 1.0);
     let mut order: Vec<usize> = (0..start.len()).collect();
     let drift = 0.5 * BLEND_S;
     let x1 = |i: usize| x_mid + loosen * (start[i][0] - x_mid) + start[i][3] * drift;
@@ -497,6 +515,9 @@ fn clear_stagger(start: &[[f64; 5]], x_mid: f64, v: f64, loosen: f64, stagger: f
             let g = (y1(a) - y1(b)).abs();
             if g >= chord {
                 beta = beta.min(1.0 - chord / g);
+            } else if g >= clear {
+                // Clear now, but with no room to close up on a bent course: no stagger.
+                beta = 0.0;
             }
         }
     }
@@ -701,6 +722,7 @@ mod tests {
             speed: 10.0,
             altitude: 10.0,
             world_height: 10.0,
+            along_scale: 1.0,
         }
     }
 

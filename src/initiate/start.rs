@@ -232,6 +232,18 @@ pub struct StartState {
 }
 
 impl StartState {
+    /// The formation its birds fly and how the others join it, flying along `heading`
+    /// (radians clockwise from +y; [`Joining::of`]).
+    pub fn joining(&self, heading: f64) -> Option<Joining> {
+        let pos: Vec<DVec2> = self
+            .x
+            .iter()
+            .zip(&self.y)
+            .map(|(&x, &y)| DVec2::new(x, y))
+            .collect();
+        Joining::of(&pos, heading)
+    }
+
     /// Reads and checks a start file for `birds` birds.
     pub fn read(path: &Path, birds: usize) -> Result<StartState> {
         let s: StartState = crate::io::read_json(path)?;
@@ -294,6 +306,176 @@ impl StartState {
             ));
         }
         Ok(s)
+    }
+}
+
+/// A start file's bird at most this far from the bird ahead of it on an arm flies in the
+/// formation (is *formed*), wingspans: a wide spacing for a V (real neighbours are about 0.8
+/// apart, a straggler 3) and far nearer than a bird still flying in (the late birds of a filmed
+/// joining were 30 aside). The paper is silent; docs/initiation.md, "Joining".
+pub const FORMED_REACH: f64 = 4.0;
+
+/// A formed bird is at least this far behind, and this far farther out to the side than, the bird
+/// ahead of it on its arm, wingspans (a line of birds abreast or in file is not an arm).
+pub const FORMED_STEP: f64 = 0.1;
+
+/// How the birds of a start file make the formation they join: the birds already flying it
+/// (*formed*: the leader and, on each arm, a chain of birds each within [`FORMED_REACH`] of the
+/// bird ahead of it, behind it and farther out) keep their arm and their order; every other
+/// bird (*late*) takes the free end of the arm whose last formed bird is nearest to it, behind
+/// that bird, the nearest first (in order of arrival).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Joining {
+    /// The leading bird (the front-most bird with a neighbour within [`FORMED_REACH`]).
+    pub leader: usize,
+    /// `arms[0]` left, `arms[1]` right: birds from the leader outwards, the formed ones first.
+    pub arms: [Vec<usize>; 2],
+    /// Formed birds on each arm (the first this many of `arms[k]`).
+    pub formed: [usize; 2],
+    /// Each bird's offset to the right of the leader across the heading, wingspans.
+    pub lateral: Vec<f64>,
+}
+
+impl Joining {
+    /// The joining of birds at `pos` (wingspans) flying along `heading` (radians clockwise from
+    /// +y), or `None` when no bird has a formed follower (birds scattered, not a formation: the
+    /// flock forms its own).
+    pub fn of(pos: &[DVec2], heading: f64) -> Option<Joining> {
+        let n = pos.len();
+        if n < 2 {
+            return None;
+        }
+        let dc = perception::direction(heading);
+        let rc = perception::right_of(heading);
+        let along: Vec<f64> = pos.iter().map(|p| p.dot(dc)).collect();
+        let across: Vec<f64> = pos.iter().map(|p| p.dot(rc)).collect();
+        let near = |i: usize| (0..n).any(|j| j != i && (pos[j] - pos[i]).length() <= FORMED_REACH);
+        let leader = (0..n)
+            .filter(|&i| near(i))
+            .max_by(|&a, &b| along[a].total_cmp(&along[b]).then(b.cmp(&a)))?;
+        let lateral: Vec<f64> = across.iter().map(|a| a - across[leader]).collect();
+        let mut taken = vec![false; n];
+        taken[leader] = true;
+        let mut arms: [Vec<usize>; 2] = [Vec::new(), Vec::new()];
+        for (k, arm) in arms.iter_mut().enumerate() {
+            let side = if k == 0 { -1.0 } else { 1.0 };
+            let mut tail = leader;
+            loop {
+                let next = (0..n)
+                    .filter(|&c| !taken[c])
+                    .filter(|&c| {
+                        side * lateral[c] >= side * lateral[tail] + FORMED_STEP
+                            && along[tail] - along[c] >= FORMED_STEP
+                            && (pos[c] - pos[tail]).length() <= FORMED_REACH
+                    })
+                    .min_by(|&a, &b| {
+                        (pos[a] - pos[tail])
+                            .length()
+                            .total_cmp(&(pos[b] - pos[tail]).length())
+                            .then(a.cmp(&b))
+                    });
+                match next {
+                    Some(c) => {
+                        taken[c] = true;
+                        arm.push(c);
+                        tail = c;
+                    }
+                    None => break,
+                }
+            }
+        }
+        if arms[0].is_empty() && arms[1].is_empty() {
+            return None;
+        }
+        let formed = [arms[0].len(), arms[1].len()];
+        let tails = arms.clone().map(|a| a.last().copied().unwrap_or(leader));
+        // Late birds: to the arm whose tail is nearer (ties to the shorter arm), in order of
+        // their distance to it.
+        let mut late: [Vec<(f64, usize)>; 2] = [Vec::new(), Vec::new()];
+        for c in (0..n).filter(|&c| !taken[c]) {
+            let d = tails.map(|t| (pos[c] - pos[t]).length());
+            let k = match d[0].total_cmp(&d[1]) {
+                std::cmp::Ordering::Less => 0,
+                std::cmp::Ordering::Greater => 1,
+                std::cmp::Ordering::Equal => usize::from(formed[1] < formed[0]),
+            };
+            late[k].push((d[k], c));
+        }
+        for (k, l) in late.iter_mut().enumerate() {
+            l.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            arms[k].extend(l.iter().map(|&(_, c)| c));
+        }
+        Some(Joining {
+            leader,
+            arms,
+            formed,
+            lateral,
+        })
+    }
+
+    /// Birds in key-shape order (left to right: the left arm from its tail inwards, the leader,
+    /// the right arm outwards).
+    pub fn order(&self) -> Vec<usize> {
+        let mut v: Vec<usize> = self.arms[0].iter().rev().copied().collect();
+        v.push(self.leader);
+        v.extend(self.arms[1].iter().copied());
+        v
+    }
+
+    /// Whether bird `b` is formed.
+    pub fn is_formed(&self, b: usize) -> bool {
+        b == self.leader || (0..2).any(|k| self.arms[k][..self.formed[k]].contains(&b))
+    }
+
+    /// The formation the key shapes are solved for: the birds left of the leader and the
+    /// lateral gaps between key-shape neighbours that were both formed (the others drawn).
+    pub fn given_arms(&self) -> crate::keyshape::given::GivenArms {
+        let order = self.order();
+        let gaps = order
+            .windows(2)
+            .map(|w| {
+                (self.is_formed(w[0]) && self.is_formed(w[1]))
+                    .then(|| (self.lateral[w[1]] - self.lateral[w[0]]).abs())
+            })
+            .collect();
+        crate::keyshape::given::GivenArms {
+            left: self.arms[0].len(),
+            gaps,
+        }
+    }
+
+    /// The slot of every bird in `target` and the leader: the leader's slot to the leader, and
+    /// each arm's slots from the leader outwards to the arm's birds in order; `None` when the
+    /// target's arms have other lengths (a steady flight made for another formation).
+    pub fn slots(&self, target: &TargetShape) -> Option<(Vec<usize>, usize)> {
+        let n = self.lateral.len();
+        if target.len() != n || (0..2).any(|k| target.arms[k].len() != self.arms[k].len()) {
+            return None;
+        }
+        let mut slot = vec![target.leader; n];
+        for k in 0..2 {
+            for (&b, &s) in self.arms[k].iter().zip(&target.arms[k]) {
+                slot[b] = s;
+            }
+        }
+        Some((slot, self.leader))
+    }
+}
+
+impl Start {
+    /// With a start file whose birds already fly a formation, the slot of every bird in
+    /// `target` and the leader by [`Joining`]: `None` for other starts, birds scattered, or a
+    /// target of another formation (the birds then take slots in order across the heading).
+    pub fn given_slots(
+        &self,
+        target: &TargetShape,
+        pos: &[DVec2],
+        heading: f64,
+    ) -> Option<(Vec<usize>, usize)> {
+        match self {
+            Start::Given(_) => Joining::of(pos, heading)?.slots(target),
+            _ => None,
+        }
     }
 }
 

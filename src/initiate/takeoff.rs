@@ -52,13 +52,13 @@ impl TakeoffPlan {
 
     /// The natural take-off of `n` birds from the ground under `opts` (at their drive 1), seconds:
     /// the longer of the time the flock needs to form, measured at a fast climb (medians about
-    /// 9.5 s for 9–14 birds, 10.7 s for 41, 12.7 s for 100, 23 s for 300: 9.0 + 0.045 N, growing
-    /// with the width of the V), and the time the last bird needs to leave, climb to the cruise
+    /// 10.4 s for 9–14 birds with the wing envelope kept, 9.5 s before; 10.7 s for 41, 12.7 s for
+    /// 100, 23 s for 300: 9.4 + 0.045 N, growing with the width of the V), and the time the last bird needs to leave, climb to the cruise
     /// altitude and hold the formation ([`Self::CLIMB_OVERHEAD`] +
     /// [`InitiateOptions::climb_seconds`]: 23.7 s for geese at their power-limited climb to
     /// 10 wingspans; docs/initiation.md).
     pub fn natural_seconds(n: usize, opts: &InitiateOptions, cruise: &Cruise) -> f64 {
-        (9.0 + 0.045 * n.max(1) as f64).max(Self::CLIMB_OVERHEAD + opts.climb_seconds(cruise))
+        (9.4 + 0.045 * n.max(1) as f64).max(Self::CLIMB_OVERHEAD + opts.climb_seconds(cruise))
     }
 
     /// The automatic take-off duration of `n` birds, seconds: the natural one.

@@ -87,6 +87,33 @@ impl InitialOptions {
 
 /// Builds the correspondence of §5 step 1 from the first movie frame for `n` animated birds.
 pub fn correspondence(first: &FrameParams, n: usize) -> Result<Correspondence> {
+    correspondence_split(first, n, None)
+}
+
+/// Animated birds left of the leader in a formation of `n` birds: the proportional split of the
+/// N − 1 followers, monotone in the first movie frame's left share, so the larger movie side
+/// stays the larger (or equal) animated side.
+pub fn proportional_left(first: &FrameParams, n: usize) -> usize {
+    let n_hat = first.order.len();
+    let lead_pos = first
+        .order
+        .iter()
+        .position(|&id| id == first.leader)
+        .unwrap_or(0);
+    if n_hat <= 1 || n < 2 {
+        0
+    } else {
+        (((n - 1) as f64) * (lead_pos as f64) / ((n_hat - 1) as f64)).round() as usize
+    }
+}
+
+/// [`correspondence`] with the number of animated birds left of the leader given (`left`, at
+/// most N − 1; a start file's formation), instead of the movie's proportional split.
+pub fn correspondence_split(
+    first: &FrameParams,
+    n: usize,
+    left: Option<usize>,
+) -> Result<Correspondence> {
     if n < 2 {
         return Err(Error::parameter(
             "steady.birds",
@@ -98,15 +125,9 @@ pub fn correspondence(first: &FrameParams, n: usize) -> Result<Correspondence> {
         .iter()
         .position(|&id| id == first.leader)
         .ok_or_else(|| Error::Internal("leader not in order (params not validated)".into()))?;
-    let n_hat = order.len();
-    // Proportional split of the N − 1 followers; monotone in the movie's left share, so the
-    // larger movie side stays the larger (or equal) animated side.
-    let left = if n_hat <= 1 {
-        0
-    } else {
-        (((n - 1) as f64) * (lead_pos as f64) / ((n_hat - 1) as f64)).round() as usize
-    };
-    let left = left.min(n - 1);
+    let left = left
+        .unwrap_or_else(|| proportional_left(first, n))
+        .min(n - 1);
     let right = n - 1 - left;
 
     let mut movie = vec![None; n];

@@ -1,6 +1,7 @@
 //! §5 steps 1–4: initial shapes, power ranges, the Levenberg–Marquardt key-shape solve, and the
 //! interpolation into a steady flight.
 
+pub mod given;
 pub mod heights;
 pub mod initial;
 pub mod interpolate;

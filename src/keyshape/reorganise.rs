@@ -336,6 +336,31 @@ fn plateau(u: f64) -> (f64, f64) {
     }
 }
 
+/// Softness of [`clear_of`]'s maximum, wingspans: a log-sum-exp this wide keeps the passing
+/// bird's height smooth where the highest (or lowest) near bird changes.
+const CLEAR_SOFTNESS: f64 = 0.02;
+
+/// How far beyond the line between its slots a passing bird must go, in the direction `dir`
+/// (+1 up, −1 down), to be as far past every near bird's height `near` (height, rate) as
+/// [`PASS_HEIGHT`] takes it past the line: a smooth maximum (log-sum-exp, [`CLEAR_SOFTNESS`]) of
+/// 0 and each near bird's height beyond the line (`line`, its rate `dline`), and its rate.
+fn clear_of(near: &[(f64, f64)], line: f64, dline: f64, dir: f64) -> (f64, f64) {
+    let tau = CLEAR_SOFTNESS;
+    let beyond: Vec<(f64, f64)> = near
+        .iter()
+        .map(|&(z, vz)| (dir * (z - line), dir * (vz - dline)))
+        .collect();
+    let top = beyond.iter().map(|b| b.0).fold(0.0f64, f64::max);
+    let mut sum = (-top / tau).exp();
+    let mut rate = 0.0;
+    for &(v, dv) in &beyond {
+        let w = ((v - top) / tau).exp();
+        sum += w;
+        rate += w * dv;
+    }
+    (top + tau * sum.ln(), rate / sum)
+}
+
 /// Seconds over which a bird's position keeping fades out before a manoeuvre and back in after
 /// it ([`Plan::keeping`]).
 pub const CALM_S: f64 = 1.0;
@@ -534,23 +559,37 @@ impl Plan {
             let (p, dp) = plateau(u);
             let dp = dp / e.duration;
             let up = -1.0;
+            // The birds near the exchange hold their slots (their position keeping fades out):
+            // each passing bird parts from them as well as from its partner, the rising one
+            // PASS_HEIGHT above the highest of them, the sinking one as far below the lowest
+            // (a bird beside the leader's slot may fly higher than the line between the slots).
+            let near: Vec<(f64, f64)> = e
+                .near
+                .iter()
+                .filter_map(|&q| assign.get(q).and_then(|&sq| slots.get(sq)))
+                .map(|st| (st.z, st.vz))
+                .collect();
             // `from` → `to`, passing on `sign` · side.
-            let blend = |from: SlotState, to: SlotState, sign: f64| SlotState {
-                x: (1.0 - s) * from.x + s * to.x + sign * h * b * e.side.0,
-                y: (1.0 - s) * from.y + s * to.y + sign * h * b * e.side.1,
-                z: (1.0 - s) * from.z + s * to.z + sign * up * PASS_HEIGHT * p,
-                vz: (1.0 - s) * from.vz
-                    + s * to.vz
-                    + ds * (to.z - from.z)
-                    + sign * up * PASS_HEIGHT * dp,
-                vx: (1.0 - s) * from.vx
-                    + s * to.vx
-                    + ds * (to.x - from.x)
-                    + sign * h * db * e.side.0,
-                vy: (1.0 - s) * from.vy
-                    + s * to.vy
-                    + ds * (to.y - from.y)
-                    + sign * h * db * e.side.1,
+            let blend = |from: SlotState, to: SlotState, sign: f64| {
+                let dir = sign * up;
+                let line = (1.0 - s) * from.z + s * to.z;
+                let dline = (1.0 - s) * from.vz + s * to.vz + ds * (to.z - from.z);
+                let (m, dm) = clear_of(&near, line, dline, dir);
+                let (lift, dlift) = (PASS_HEIGHT + m, dm);
+                SlotState {
+                    x: (1.0 - s) * from.x + s * to.x + sign * h * b * e.side.0,
+                    y: (1.0 - s) * from.y + s * to.y + sign * h * b * e.side.1,
+                    z: line + dir * lift * p,
+                    vz: dline + dir * (lift * dp + dlift * p),
+                    vx: (1.0 - s) * from.vx
+                        + s * to.vx
+                        + ds * (to.x - from.x)
+                        + sign * h * db * e.side.0,
+                    vy: (1.0 - s) * from.vy
+                        + s * to.vy
+                        + ds * (to.y - from.y)
+                        + sign * h * db * e.side.1,
+                }
             };
             out[e.birds.0] = blend(pa, pb, 1.0);
             out[e.birds.1] = blend(pb, pa, -1.0);

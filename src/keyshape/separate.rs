@@ -10,7 +10,22 @@
 //! enough that the position keeping and the manoeuvres have room fore and aft without a wing
 //! passing over another.
 
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use crate::aero::{AeroOptions, COLLISION_SPAN};
+
+/// Benchmarks only (`benches/clearance.rs`): while set, the steady flight runs without its
+/// clearance machinery, to measure what it costs: [`separate`] moves no bird, [`min_step`] is 0
+/// (key shapes may put neighbours abreast) and every bird's position-keeping room is unbounded
+/// ([`crate::keyshape::jostle::rooms`]). The output may then clash; never set outside benchmarks.
+#[doc(hidden)]
+pub static BENCH_WITHOUT_CLEARANCE: AtomicBool = AtomicBool::new(false);
+
+/// Whether [`BENCH_WITHOUT_CLEARANCE`] is set.
+#[doc(hidden)]
+pub fn bench_without_clearance() -> bool {
+    BENCH_WITHOUT_CLEARANCE.load(Ordering::Relaxed)
+}
 
 /// Smallest fore-aft distance between two birds of a key shape that are less than
 /// [`STEP_SPAN`] apart laterally, wingspans.
@@ -27,6 +42,9 @@ pub const CLEAR_STEP: f64 = 1.15;
 /// The fore-aft step the key shapes keep with these aerodynamic options: [`MIN_STEP`], or a
 /// little more than the collision chord when that is set larger.
 pub fn min_step(aero: &AeroOptions) -> f64 {
+    if bench_without_clearance() {
+        return 0.0;
+    }
     MIN_STEP.max(1.05 * aero.collision_chord)
 }
 
@@ -58,6 +76,9 @@ pub fn abreast(x: &[f64], y: &[f64], step: f64) -> Option<(usize, usize)> {
 pub fn separate(x: &[f64], y: &[f64], aero: &AeroOptions) -> Vec<f64> {
     let n = x.len();
     let mut y = y.to_vec();
+    if bench_without_clearance() {
+        return y;
+    }
     let step = min_step(aero);
     let front = (0..n)
         .min_by(|&a, &b| y[a].total_cmp(&y[b]).then(a.cmp(&b)))

@@ -28,8 +28,8 @@ use crate::error::{Error, Result};
 use crate::extract::params::FormationParams;
 use crate::keyshape::heights::{heights, heights_for, HeightOptions};
 use crate::keyshape::initial::{
-    correspondence, curve_y, initial_shapes_scaled, lateral_gaps, positions_from_gaps, side_scales,
-    Correspondence, InitialOptions,
+    correspondence_split, curve_y, initial_shapes_scaled, lateral_gaps, positions_from_gaps,
+    proportional_left, side_scales, Correspondence, InitialOptions,
 };
 use crate::keyshape::interpolate::Track;
 use crate::keyshape::jostle::{
@@ -86,6 +86,11 @@ pub struct SteadyOptions {
     /// frame, so the frame after the last is the first again (in the flock's moving frame).
     #[serde(rename = "loop")]
     pub looped: bool,
+    /// The arms of a formation the birds already fly (a start file's, `initiate::Joining`):
+    /// the key shapes are solved with its birds left of the leader and its observed lateral
+    /// gaps. Not a config option: set from the start file.
+    #[serde(skip)]
+    pub given: Option<crate::keyshape::given::GivenArms>,
 }
 
 impl Default for SteadyOptions {
@@ -106,6 +111,7 @@ impl Default for SteadyOptions {
             reorganise: ReorganiseOptions::default(),
             flight: crate::animation::FlightSettings::default(),
             looped: false,
+            given: None,
         }
     }
 }
@@ -424,8 +430,24 @@ pub fn steady_flight_in(
     let n = opts.birds;
     let init_opts = &opts.initial;
 
-    // Step 1.
-    let corr: Correspondence = correspondence(first, n)?;
+    // Step 1 (with a given formation's birds left of the leader).
+    if let Some(g) = &opts.given {
+        g.validate(n)?;
+    }
+    // Late birds joining in flight take the tail of one arm and the formed birds keep the
+    // footage's split among themselves: the joiners lengthen the formed flock's longer arm
+    // (its right one on a tie), which `reorganise::Plan` then gives them.
+    let left = match &opts.given {
+        Some(g) => Some(g.left),
+        None if opts.living() && opts.reorganise.joiners > 0 => {
+            let k = opts.reorganise.joiners.min(n - 1);
+            let lf = proportional_left(first, n - k);
+            let rf = n - k - 1 - lf;
+            Some(if rf >= lf { lf } else { lf + k })
+        }
+        None => None,
+    };
+    let corr: Correspondence = correspondence_split(first, n, left)?;
     // The spacing is drawn from the frames that look like the others (an odd frame, e.g. a
     // half-tracked one, would widen every generated flock; `extract` warns about it).
     let spacing_frames = crate::extract::screen::spacing_frames(params);
@@ -438,7 +460,10 @@ pub fn steady_flight_in(
         spacing_frames.iter().map(|f| f.sigma_x).sum::<f64>() / spacing_frames.len().max(1) as f64;
     let u: f64 = rng.random();
     let mean_gap = (lo_mu + u * (hi_mu - lo_mu)).max(init_opts.min_gap);
-    let gaps = lateral_gaps(rng, mean_gap, sigma_bar, n - 1, init_opts);
+    let mut gaps = lateral_gaps(rng, mean_gap, sigma_bar, n - 1, init_opts);
+    if let Some(g) = &opts.given {
+        g.fix_gaps(&mut gaps, mean_gap, init_opts.min_gap);
+    }
     let x = positions_from_gaps(&gaps, corr.leader);
     // At the key shapes' lateral positions a movie frame's placement can put two birds wing to
     // wing; the bird behind is moved back to the collision distance (what a real bird does).

@@ -129,26 +129,163 @@ pub fn one_formation(
 pub type DrawResult<DB> =
     std::result::Result<(), DrawingAreaErrorKind<<DB as DrawingBackend>::ErrorType>>;
 
+/// A number as a reader expects it: at most `decimals` decimals, trailing zeros and a trailing
+/// point dropped, and never "-0" (`-0.0001` with 3 decimals is "0", `20.0` is "20", `0.150` is
+/// "0.15").
+pub fn clean_number(v: f64, decimals: usize) -> String {
+    if !v.is_finite() {
+        return "–".into();
+    }
+    let mut s = format!("{v:.decimals$}");
+    if s.contains('.') {
+        s = s.trim_end_matches('0').trim_end_matches('.').to_string();
+    }
+    if s == "-0" {
+        s = "0".into();
+    }
+    s
+}
+
+/// A tick label of an f64 axis: [`clean_number`] with up to 6 decimals (the ticks are round
+/// numbers; the decimals only absorb their float noise).
+pub fn tick_label(v: &f64) -> String {
+    clean_number(*v, 6)
+}
+
+/// A 2-D f64 chart's coordinate system.
+pub type Cartesian64 =
+    Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>;
+
 /// Draws the grid and the axis descriptions every chart shares (light grey minor lines, tick
-/// labels of `label_size` points).
-pub fn draw_mesh<DB, X, Y>(
-    chart: &mut ChartContext<'_, DB, Cartesian2d<X, Y>>,
+/// labels of `label_size` points, written by [`tick_label`]: `20`, not `20.0`; `0`, not `-0.0`).
+pub fn draw_mesh<DB>(
+    chart: &mut ChartContext<'_, DB, Cartesian64>,
     x_desc: &str,
     y_desc: &str,
     label_size: u32,
 ) -> DrawResult<DB>
 where
     DB: DrawingBackend,
-    X: Ranged + plotters::coord::ranged1d::ValueFormatter<X::ValueType>,
-    Y: Ranged + plotters::coord::ranged1d::ValueFormatter<Y::ValueType>,
 {
     chart
         .configure_mesh()
         .x_desc(x_desc)
         .y_desc(y_desc)
+        .x_label_formatter(&tick_label)
+        .y_label_formatter(&tick_label)
         .label_style((FONT_FAMILY, label_size))
         .light_line_style(RGBColor(235, 235, 235))
         .draw()
+}
+
+/// The polyline `points` cut to the band `lo ≤ v ≤ hi` of its second coordinate: the runs
+/// inside the band, each ended where the line crosses an edge (interpolated), so that nothing
+/// is drawn outside a chart's frame. Non-finite values break the line.
+pub fn clip_to_band(points: &[(f64, f64)], lo: f64, hi: f64) -> Vec<Vec<(f64, f64)>> {
+    let inside = |v: f64| v >= lo && v <= hi;
+    let mut runs: Vec<Vec<(f64, f64)>> = Vec::new();
+    let mut cur: Vec<(f64, f64)> = Vec::new();
+    let mut prev: Option<(f64, f64)> = None;
+    let flush = |cur: &mut Vec<(f64, f64)>, runs: &mut Vec<Vec<(f64, f64)>>| {
+        if cur.len() > 1 {
+            runs.push(std::mem::take(cur));
+        } else {
+            cur.clear();
+        }
+    };
+    for &(t, v) in points {
+        if !(t.is_finite() && v.is_finite()) {
+            flush(&mut cur, &mut runs);
+            prev = None;
+            continue;
+        }
+        if let Some((t0, v0)) = prev {
+            // The part of the segment (t0, v0)–(t, v) inside the band, as parameters [a, b].
+            let at = |edge: f64| (edge - v0) / (v - v0);
+            let (mut a, mut b) = (0.0f64, 1.0f64);
+            if v != v0 {
+                let (ea, eb) = (at(lo), at(hi));
+                a = a.max(ea.min(eb));
+                b = b.min(ea.max(eb));
+            } else if !inside(v) {
+                a = 1.0;
+                b = 0.0;
+            }
+            // Clamped: with a huge value at one end the interpolation loses every digit.
+            let p = |u: f64| (t0 + (t - t0) * u, (v0 + (v - v0) * u).clamp(lo, hi));
+            if a <= b {
+                if a > 0.0 || cur.is_empty() {
+                    flush(&mut cur, &mut runs);
+                    cur.push(p(a));
+                }
+                cur.push(p(b));
+                if b < 1.0 {
+                    flush(&mut cur, &mut runs);
+                }
+            } else {
+                flush(&mut cur, &mut runs);
+            }
+        } else if inside(v) {
+            cur.push((t, v));
+        }
+        prev = Some((t, v));
+    }
+    flush(&mut cur, &mut runs);
+    runs
+}
+
+/// How a [`side_legend`] entry is drawn.
+#[derive(Debug, Clone, Copy)]
+pub enum Key {
+    /// A line of this width.
+    Line(u32),
+    /// A filled box (a shaded span).
+    Box,
+    /// A filled circle.
+    Dot,
+    /// A filled diamond (the leader's marker).
+    Diamond,
+    /// No mark: a note.
+    Note,
+}
+
+/// A legend drawn beside a chart rather than over its data: one entry a line, in `area`
+/// (pixels), from its top left.
+pub fn side_legend<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    entries: &[(String, RGBColor, Key)],
+    label_size: u32,
+) -> DrawResult<DB> {
+    let line_h = (label_size as i32 * 3) / 2 + 2;
+    for (k, (label, colour, key)) in entries.iter().enumerate() {
+        let y = 8 + line_h * k as i32 + line_h / 2;
+        let x = 6;
+        match key {
+            Key::Line(w) => area.draw(&PathElement::new(
+                vec![(x, y), (x + 20, y)],
+                colour.stroke_width(*w),
+            ))?,
+            Key::Box => area.draw(&Rectangle::new(
+                [(x, y - 6), (x + 20, y + 6)],
+                colour.mix(0.4).filled(),
+            ))?,
+            Key::Dot => area.draw(&Circle::new((x + 10, y), 5, colour.filled()))?,
+            Key::Diamond => area.draw(&Polygon::new(
+                vec![(x + 10, y - 8), (x + 16, y), (x + 10, y + 8), (x + 4, y)],
+                colour.filled(),
+            ))?,
+            Key::Note => {}
+        }
+        let tx = if matches!(key, Key::Note) { x } else { x + 28 };
+        area.draw(&Text::new(
+            label.clone(),
+            (tx, y - label_size as i32 / 2 - 1),
+            (FONT_FAMILY, label_size)
+                .into_font()
+                .color(&RGBColor(30, 30, 30)),
+        ))?;
+    }
+    Ok(())
 }
 
 /// Draws the legend box every chart shares (white, black border, labels of `label_size`
@@ -312,3 +449,51 @@ pub fn encode_png_rgb(buf: &[u8], w: u32, h: u32) -> Result<Vec<u8>> {
 }
 
 use image::ImageEncoder as _;
+
+#[cfg(test)]
+mod helper_tests {
+    use super::*;
+
+    #[test]
+    fn numbers_are_clean() {
+        assert_eq!(clean_number(-0.0001, 3), "0");
+        assert_eq!(clean_number(-0.0, 1), "0");
+        assert_eq!(clean_number(20.0, 1), "20");
+        assert_eq!(clean_number(0.15000000000000002, 6), "0.15");
+        assert_eq!(clean_number(-1.25, 2), "-1.25");
+        assert_eq!(tick_label(&2.0), "2");
+    }
+
+    #[test]
+    fn lines_are_cut_at_the_band_and_nothing_leaves_it() {
+        let pts = [(0.0, 0.5), (1.0, 2.0), (2.0, 0.5), (3.0, -1.0), (4.0, 0.2)];
+        let runs = clip_to_band(&pts, 0.0, 1.0);
+        assert_eq!(runs.len(), 3, "{runs:?}");
+        for r in &runs {
+            for p in r {
+                assert!((-1e-12..=1.0 + 1e-12).contains(&p.1), "{runs:?}");
+            }
+        }
+        // The first run ends where the line crosses 1 (t = 1/3).
+        let end = runs[0].last().unwrap();
+        assert!((end.0 - 1.0 / 3.0).abs() < 1e-12 && (end.1 - 1.0).abs() < 1e-12);
+        // A line inside the band is kept whole.
+        assert_eq!(clip_to_band(&[(0.0, 0.1), (1.0, 0.2)], 0.0, 1.0).len(), 1);
+        // A gap breaks it.
+        assert_eq!(
+            clip_to_band(
+                &[
+                    (0.0, 0.1),
+                    (1.0, 0.2),
+                    (2.0, f64::NAN),
+                    (3.0, 0.1),
+                    (4.0, 0.3)
+                ],
+                0.0,
+                1.0
+            )
+            .len(),
+            2
+        );
+    }
+}

@@ -30,6 +30,12 @@ pub struct SavingsChart {
     pub takeoff: Option<(f64, f64)>,
     /// Label of the right panel's horizontal axis.
     pub time_label: String,
+    /// The flock saving's range over the modelling choices (models, wakes, cores: the band of
+    /// `formation report`), fractions of induced power, when computed; drawn as a band and
+    /// stated first, the chosen model's value after it.
+    pub range: Option<(f64, f64)>,
+    /// The chosen model, for the legend ("Hummel's model, planar wake, core 0.04 wingspans").
+    pub model: String,
 }
 
 impl SavingsChart {
@@ -44,70 +50,132 @@ impl SavingsChart {
         }
         let takeoff = super::takeoff_span(anim);
         let name = super::power::file_name(origin);
+        let model = anim
+            .savings_model
+            .as_ref()
+            .map_or("Hummel's model".to_string(), |m| m.to_string());
+        let range = range_of(
+            &crate::aero::band::animation_band(anim),
+            stats.steady_saving,
+        );
         Ok(SavingsChart {
             title: format!(
-                "{name}: savings of {} birds ({}), {}",
+                "{name}: savings of {} birds ({})",
                 anim.birds,
                 stages_title(anim),
-                anim.savings_model
-                    .as_ref()
-                    .map_or("Hummel's model".to_string(), |m| m.to_string())
             ),
             stats,
             takeoff,
             time_label: "time (s)".into(),
+            range,
+            model,
         })
     }
 }
 
+/// The least and the largest of a band's savings and the point value `point` (the range
+/// contains the value stated beside it), or `None` for an empty band.
+pub fn range_of(band: &[crate::aero::band::BandEntry], point: Option<f64>) -> Option<(f64, f64)> {
+    if band.is_empty() {
+        return None;
+    }
+    Some(
+        band.iter()
+            .map(|b| b.saving)
+            .chain(point)
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| {
+                (l.min(v), h.max(v))
+            }),
+    )
+}
+
+/// Colour of the band of this flock's saving over the modelling choices.
+const RANGE: RGBColor = RGBColor(70, 110, 200);
+
 /// Shades the span of flock savings that field studies estimated by applying lifting-line models
 /// to the spacings they measured (not measured savings) across `x`.
 fn band<DB: DrawingBackend>(
-    chart: &mut ChartContext<
-        '_,
-        DB,
-        Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
-    >,
+    chart: &mut ChartContext<'_, DB, super::Cartesian64>,
     x: (f64, f64),
+    range: Option<(f64, f64)>,
 ) -> DrawResult<DB> {
+    if let Some((lo, hi)) = range {
+        chart.draw_series(std::iter::once(Rectangle::new(
+            [(x.0, 100.0 * lo), (x.1, 100.0 * hi)],
+            RANGE.mix(0.12).filled(),
+        )))?;
+        for v in [lo, hi] {
+            chart.draw_series(std::iter::once(PathElement::new(
+                vec![(x.0, 100.0 * v), (x.1, 100.0 * v)],
+                RANGE.mix(0.5).stroke_width(1),
+            )))?;
+        }
+    }
     let (lo, hi) = field::FLOCK_SAVING_SPAN;
     let c = RGBColor(120, 170, 120);
-    chart
-        .draw_series(std::iter::once(Rectangle::new(
-            [(x.0, 100.0 * lo), (x.1, 100.0 * hi)],
-            c.mix(0.18).filled(),
-        )))?
-        .label("models applied to measured spacings of geese: 14–36 % of induced power")
-        .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 14, y + 5)], c.mix(0.4).filled()));
+    chart.draw_series(std::iter::once(Rectangle::new(
+        [(x.0, 100.0 * lo), (x.1, 100.0 * hi)],
+        c.mix(0.18).filled(),
+    )))?;
     Ok(())
 }
 
 impl Chart for SavingsChart {
     fn size(&self) -> (u32, u32) {
-        (1200, 560)
+        (1200, 680)
     }
 
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult<DB> {
+        use super::{clean_number, Key};
         let root = root.titled(&self.title, (FONT_FAMILY, 22))?;
-        let (w, _) = root.dim_in_pixel();
-        let (left, right) = root.split_horizontally(w / 2);
         let s = &self.stats;
-        let top = s
-            .birds
-            .iter()
-            .map(|b| b.saving)
-            .chain(s.saving_over_time.iter().map(|p| p.1))
-            .fold(field::FLOCK_SAVING_SPAN.1, f64::max)
-            * 110.0;
-        let bottom = s
-            .birds
-            .iter()
-            .map(|b| b.saving)
-            .chain(s.saving_over_time.iter().map(|p| p.1))
-            .fold(0.0, f64::min)
-            * 110.0;
+        let n = s.birds.len();
+        let flock = s
+            .steady_saving
+            .unwrap_or_else(|| s.birds.iter().map(|b| b.saving).sum::<f64>() / n.max(1) as f64);
+        let pc = |v: f64| clean_number(100.0 * v, 1);
+        // The range first, then the chosen model's value.
+        let lead = match self.range {
+            Some((lo, hi)) => format!(
+                "flock saving, a model estimate: {}–{} % of induced power over models, wakes and cores; by {}: {} %",
+                pc(lo),
+                pc(hi),
+                self.model,
+                pc(flock)
+            ),
+            None => format!(
+                "flock saving, a model estimate by {}: {} % of induced power",
+                self.model,
+                pc(flock)
+            ),
+        };
+        let (head, rest) = root.split_vertically(26);
+        head.draw(&Text::new(
+            lead,
+            (14, 2),
+            (FONT_FAMILY, 15).into_font().color(&RGBColor(40, 40, 40)),
+        ))?;
+        let (_, h) = rest.dim_in_pixel();
+        let (panels, legends) = rest.split_vertically(h.saturating_sub(96));
+        let (w, _) = panels.dim_in_pixel();
+        let (left, right) = panels.split_horizontally(w / 2);
+        let (left_legend, right_legend) = legends.split_horizontally(w / 2);
+        let values = || {
+            s.birds
+                .iter()
+                .map(|b| b.saving)
+                .chain(s.saving_over_time.iter().map(|p| p.1))
+                .chain(self.range.map(|r| r.0))
+                .chain(self.range.map(|r| r.1))
+        };
+        let hi = values().fold(field::FLOCK_SAVING_SPAN.1, f64::max);
+        let lo = values().fold(0.0, f64::min);
+        // 8 % of the span above and below: no marker is cut at the frame.
+        let pad = 0.08 * (hi - lo).max(0.05);
+        let (bottom, top) = (100.0 * (lo - pad), 100.0 * (hi + pad));
         // Left: saving against rank.
         let max_rank = s.birds.iter().map(|b| b.rank).fold(1.0, f64::max);
+        let (r0, r1) = (-0.6, max_rank + 0.6);
         let mut chart = ChartBuilder::on(&left)
             .caption(
                 "each bird in steady flight, by place in its formation",
@@ -116,51 +184,87 @@ impl Chart for SavingsChart {
             .margin(12)
             .x_label_area_size(40)
             .y_label_area_size(56)
-            .build_cartesian_2d(-0.5..max_rank + 0.5, bottom..top)?;
-        super::draw_mesh(
-            &mut chart,
-            "rank (0 = leader, counted from the front)",
-            "saving, % of solo induced power",
-            13,
-        )?;
-        band(&mut chart, (-0.5, max_rank + 0.5))?;
-        let n = s.birds.len();
+            .build_cartesian_2d(r0..r1, bottom..top)?;
+        // Ranks are whole numbers: only whole ticks are labelled.
+        let rank_label = |v: &f64| {
+            if (v - v.round()).abs() < 1e-9 && *v >= 0.0 {
+                format!("{}", v.round() as i64)
+            } else {
+                String::new()
+            }
+        };
+        chart
+            .configure_mesh()
+            .x_desc("mean rank (0 = leader, counted from the front)")
+            .y_desc("saving, % of solo induced power")
+            .x_label_formatter(&rank_label)
+            .y_label_formatter(&super::tick_label)
+            .label_style((FONT_FAMILY, 13))
+            .light_line_style(RGBColor(235, 235, 235))
+            .draw()?;
+        band(&mut chart, (r0, r1), self.range)?;
         let mut by_rank: Vec<&crate::animation::stats::BirdStats> = s.birds.iter().collect();
         by_rank.sort_by(|a, b| a.rank.total_cmp(&b.rank));
+        let mut leaders = Vec::new();
         for (r, b) in by_rank.iter().enumerate() {
             let p = (b.rank, 100.0 * b.saving);
             if b.leader {
-                chart
-                    .draw_series(std::iter::once(Polygon::new(
-                        vec![
-                            (p.0, p.1 + 0.04 * (top - bottom)),
-                            (p.0 + 0.25, p.1),
-                            (p.0, p.1 - 0.04 * (top - bottom)),
-                            (p.0 - 0.25, p.1),
-                        ],
-                        LEADER.filled(),
-                    )))?
-                    .label(format!("leader (bird {})", b.bird))
-                    .legend(|(x, y)| Circle::new((x + 7, y), 5, LEADER.filled()));
+                leaders.push(b.bird);
+                // A diamond of fixed size in pixels, drawn inside the frame.
+                chart.draw_series(std::iter::once(
+                    EmptyElement::at(p)
+                        + Polygon::new(vec![(0, -9), (7, 0), (0, 9), (-7, 0)], LEADER.filled()),
+                ))?;
             } else {
                 let c = bird_colour(r, n);
                 chart.draw_series(std::iter::once(Circle::new(p, 5, c.filled())))?;
             }
         }
-        let flock = s
-            .steady_saving
-            .unwrap_or_else(|| s.birds.iter().map(|b| b.saving).sum::<f64>() / n.max(1) as f64);
         let grey = RGBColor(90, 90, 90);
-        chart
-            .draw_series(std::iter::once(DashedPathElement::new(
-                vec![(-0.5, 100.0 * flock), (max_rank + 0.5, 100.0 * flock)],
-                6,
-                4,
-                grey.stroke_width(1),
-            )))?
-            .label(format!("this flock's mean: {:.1} %", 100.0 * flock))
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 14, y)], grey));
-        super::draw_legend(&mut chart, 12, SeriesLabelPosition::LowerRight)?;
+        chart.draw_series(std::iter::once(DashedPathElement::new(
+            vec![(r0, 100.0 * flock), (r1, 100.0 * flock)],
+            6,
+            4,
+            grey.stroke_width(1),
+        )))?;
+        let field_colour = RGBColor(120, 170, 120);
+        let field_label = |what: &str| {
+            format!(
+                "{what}models applied to measured spacings of geese: {}–{} % of induced power",
+                pc(field::FLOCK_SAVING_SPAN.0),
+                pc(field::FLOCK_SAVING_SPAN.1)
+            )
+        };
+        let mut legend = Vec::new();
+        if let Some((lo, hi)) = self.range {
+            legend.push((
+                format!(
+                    "this flock over models, wakes and cores: {}–{} %",
+                    pc(lo),
+                    pc(hi)
+                ),
+                RANGE,
+                Key::Box,
+            ));
+        }
+        legend.push((
+            format!("this flock's mean by the chosen model: {} %", pc(flock)),
+            grey,
+            Key::Line(1),
+        ));
+        legend.push((field_label("field: "), field_colour, Key::Box));
+        if !leaders.is_empty() {
+            let ids: Vec<String> = leaders.iter().map(|b| b.to_string()).collect();
+            legend.push((
+                format!(
+                    "leader (bird {}); other birds coloured by rank, front dark",
+                    ids.join(", ")
+                ),
+                LEADER,
+                Key::Diamond,
+            ));
+        }
+        super::side_legend(&left_legend.margin(0, 0, 60, 0), &legend, 12)?;
         // Right: the flock's saving over time.
         let t0 = s.saving_over_time.first().map_or(0.0, |p| p.0);
         let t1 = s
@@ -180,30 +284,43 @@ impl Chart for SavingsChart {
             "flock saving, % of solo induced power",
             13,
         )?;
-        band(&mut chart, (t0, t1))?;
+        band(&mut chart, (t0, t1), self.range)?;
+        let mut legend = Vec::new();
         if let Some((a, b)) = self.takeoff {
             let c = RGBColor(150, 150, 150);
-            chart
-                .draw_series(std::iter::once(Rectangle::new(
-                    [(a, bottom), (b, top)],
-                    c.mix(0.15).filled(),
-                )))?
-                .label(format!("take-off ({:.1} s)", b - a))
-                .legend(move |(x, y)| {
-                    Rectangle::new([(x, y - 5), (x + 14, y + 5)], c.mix(0.4).filled())
-                });
+            chart.draw_series(std::iter::once(Rectangle::new(
+                [(a, bottom), (b, top)],
+                c.mix(0.15).filled(),
+            )))?;
+            legend.push((format!("take-off ({:.1} s)", b - a), c, Key::Box));
         }
         let line = RGBColor(40, 60, 140);
-        chart
-            .draw_series(LineSeries::new(
-                s.saving_over_time.iter().map(|&(t, e)| (t, 100.0 * e)),
-                line.stroke_width(2),
-            ))?
-            .label("flock saving")
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 14, y)], line.stroke_width(2))
-            });
-        super::draw_legend(&mut chart, 12, SeriesLabelPosition::LowerRight)?;
+        let points: Vec<(f64, f64)> = s
+            .saving_over_time
+            .iter()
+            .map(|&(t, e)| (t, 100.0 * e))
+            .collect();
+        for run in super::clip_to_band(&points, bottom, top) {
+            chart.draw_series(LineSeries::new(run, line.stroke_width(2)))?;
+        }
+        legend.push((
+            format!("flock saving by {}", self.model),
+            line,
+            Key::Line(2),
+        ));
+        if let Some((lo, hi)) = self.range {
+            legend.push((
+                format!(
+                    "its steady-flight range over models, wakes and cores: {}–{} %",
+                    pc(lo),
+                    pc(hi)
+                ),
+                RANGE,
+                Key::Box,
+            ));
+        }
+        legend.push((field_label(""), field_colour, Key::Box));
+        super::side_legend(&right_legend.margin(0, 0, 60, 0), &legend, 12)?;
         Ok(())
     }
 }

@@ -90,45 +90,61 @@ impl Chart for XiChart {
         let t0 = self.t.first().copied().unwrap_or(0.0);
         let t1 = self.t.last().copied().unwrap_or(1.0).max(t0 + 1e-6);
         // The axis spans the steady flight's ξ (after the take-off): while the birds are still
-        // scattered E is near 0 and ξ = e/E is huge; those spikes are cut at the top.
+        // scattered E is near 0 and ξ = e/E is huge or negative; those values are cut at the
+        // frame's edge, and the legend says by how much.
         let after = self.takeoff.map_or(f64::NEG_INFINITY, |(_, b)| b);
-        let top = self
-            .xi
-            .iter()
-            .flat_map(|s| s.iter().zip(&self.t))
-            .filter(|(v, &t)| v.is_finite() && t >= after)
-            .map(|(v, _)| *v)
-            .fold(0.0, f64::max);
+        let steady = || {
+            self.xi
+                .iter()
+                .flat_map(|s| s.iter().zip(&self.t))
+                .filter(|(v, &t)| v.is_finite() && t >= after)
+                .map(|(v, _)| *v)
+        };
+        let top = steady().fold(0.0, f64::max);
         let top = if top > 0.0 { top * 1.25 } else { 1.0 };
-        let mut chart = ChartBuilder::on(root)
-            .caption(&self.title, (FONT_FAMILY, 22))
+        let low = steady().fold(0.0, f64::min);
+        let bottom = if low < 0.0 { low * 1.25 } else { 0.0 };
+        // What the axis cuts: (least, largest) of the values outside it, in the take-off and
+        // after it.
+        let mut cut: [Option<(f64, f64)>; 2] = [None, None];
+        for s in &self.xi {
+            for (&v, &t) in s.iter().zip(&self.t) {
+                if v.is_finite() && (v < bottom || v > top) {
+                    let c = &mut cut[usize::from(t >= after)];
+                    *c = Some(c.map_or((v, v), |(a, b)| (a.min(v), b.max(v))));
+                }
+            }
+        }
+        let root = root.titled(&self.title, (FONT_FAMILY, 22))?;
+        let (w, _) = root.dim_in_pixel();
+        let (plot_area, legend_area) = root.split_horizontally(w.saturating_sub(230));
+        let mut chart = ChartBuilder::on(&plot_area)
             .margin(16)
-            .x_label_area_size(44)
+            .x_label_area_size(60)
             .y_label_area_size(70)
-            .build_cartesian_2d(t0..t1, 0.0..top)?;
+            .build_cartesian_2d(t0..t1, bottom..top)?;
         chart
             .configure_mesh()
-            .x_desc("time (s)   ·   colour: rank in the formation, front dark → back green; red: leader   ·   dashed: key shapes")
+            .x_desc("time (s)   ·   dashed: key shapes")
             .y_desc("relative power reduction ξ")
+            .x_label_formatter(&super::tick_label)
+            .y_label_formatter(&super::tick_label)
             .label_style((FONT_FAMILY, 14))
             .light_line_style(WHITE.mix(0.0))
             .draw()?;
+        let mut legend: Vec<(String, RGBColor, super::Key)> = Vec::new();
         if let Some((a, b)) = self.takeoff {
             let c = RGBColor(150, 150, 150);
-            chart
-                .draw_series(std::iter::once(Rectangle::new(
-                    [(a, 0.0), (b, top)],
-                    c.mix(0.15).filled(),
-                )))?
-                .label(format!("take-off ({:.1} s)", b - a))
-                .legend(move |(x, y)| {
-                    Rectangle::new([(x, y - 5), (x + 14, y + 5)], c.mix(0.4).filled())
-                });
+            chart.draw_series(std::iter::once(Rectangle::new(
+                [(a, bottom), (b, top)],
+                c.mix(0.15).filled(),
+            )))?;
+            legend.push((format!("take-off ({:.1} s)", b - a), c, super::Key::Box));
         }
         let grey = RGBColor(170, 170, 170);
         for &k in &self.key_times {
             chart.draw_series(std::iter::once(DashedPathElement::new(
-                vec![(k, 0.0), (k, top)],
+                vec![(k, bottom), (k, top)],
                 6,
                 4,
                 ShapeStyle::from(&grey).stroke_width(1),
@@ -139,6 +155,7 @@ impl Chart for XiChart {
         order.sort_by_key(|&i| std::cmp::Reverse(self.rank.get(i).copied().unwrap_or(0)));
         let n = order.len();
         let labelled = super::legend_ranks(n);
+        let mut entries: Vec<(usize, String, RGBColor, u32)> = Vec::new();
         for &i in &order {
             let rank = self.rank.get(i).copied().unwrap_or(0);
             let leader = self.leaders.contains(&i);
@@ -147,35 +164,64 @@ impl Chart for XiChart {
             } else {
                 (super::bird_colour(rank, n), 2)
             };
-            let series = &self.xi[i];
-            // Split into runs of finite values.
-            let mut runs: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
-            for (&t, &v) in self.t.iter().zip(series) {
-                if v.is_finite() {
-                    if let Some(r) = runs.last_mut() {
-                        r.push((t, v));
-                    }
-                } else if runs.last().is_some_and(|r| !r.is_empty()) {
-                    runs.push(Vec::new());
-                }
-            }
+            let points: Vec<(f64, f64)> = self
+                .t
+                .iter()
+                .zip(&self.xi[i])
+                .map(|(&t, &v)| (t, v))
+                .collect();
             let style = ShapeStyle::from(&color).stroke_width(width);
-            for (j, run) in runs.into_iter().filter(|r| !r.is_empty()).enumerate() {
-                let s = chart.draw_series(LineSeries::new(run, style))?;
-                if j == 0 && (leader || labelled.contains(&rank)) {
-                    let label = if leader {
-                        format!("leader (bird {i})")
-                    } else {
-                        format!("rank {rank} (bird {i})")
-                    };
-                    s.label(label)
-                        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], style));
+            // A thick line's mitred corner at a sharp spike reaches far past the point (out of
+            // the frame): a run is broken at every steep reversal, so no corner is that sharp.
+            let steep = 0.05 * (top - bottom);
+            for run in super::clip_to_band(&points, bottom, top) {
+                let mut start = 0;
+                for k in 1..run.len().saturating_sub(1) {
+                    let (a, b) = (run[k].1 - run[k - 1].1, run[k + 1].1 - run[k].1);
+                    if a * b < 0.0 && (a.abs() > steep || b.abs() > steep) {
+                        chart.draw_series(LineSeries::new(run[start..=k].to_vec(), style))?;
+                        start = k;
+                    }
                 }
+                chart.draw_series(LineSeries::new(run[start..].to_vec(), style))?;
+            }
+            if leader {
+                entries.push((0, format!("leader (bird {i})"), color, width));
+            } else if labelled.contains(&rank) {
+                entries.push((rank, format!("rank {rank} (bird {i})"), color, width));
             }
         }
-        {
-            super::draw_legend(&mut chart, 13, SeriesLabelPosition::UpperRight)?;
+        entries.sort_by_key(|e| e.0);
+        legend.extend(
+            entries
+                .into_iter()
+                .map(|(_, l, c, w)| (l, c, super::Key::Line(w))),
+        );
+        legend.push((
+            "colour: rank in the formation,".into(),
+            BLACK,
+            super::Key::Note,
+        ));
+        legend.push(("front dark, back green".into(), BLACK, super::Key::Note));
+        for (k, what) in ["in the take-off", "after it"].iter().enumerate() {
+            if let Some((a, b)) = cut[k] {
+                legend.push((
+                    format!("ξ cut at the frame {what}:"),
+                    BLACK,
+                    super::Key::Note,
+                ));
+                legend.push((
+                    format!(
+                        "  {} to {}",
+                        super::clean_number(a, 2),
+                        super::clean_number(b, 2)
+                    ),
+                    BLACK,
+                    super::Key::Note,
+                ));
+            }
         }
-        Ok(())
+        let legend_area = legend_area.margin(60, 0, 0, 6);
+        super::side_legend(&legend_area, &legend, 13)
     }
 }

@@ -3,6 +3,7 @@
 use std::fmt::Write as _;
 
 use super::{footage_savings_with, Subject};
+use crate::animation::clearance::{Clearance, Closest};
 use crate::animation::stats::{AnimationStats, BirdStats};
 use crate::animation::Animation;
 use crate::error::Result;
@@ -24,6 +25,16 @@ fn esc(s: &str) -> String {
         .replace('<', "&lt;")
         .replace('>', "&gt;")
         .replace('"', "&quot;")
+}
+
+/// `v` with 3 decimals, never "-0.000".
+fn clean3(v: f64) -> String {
+    let s = format!("{v:.3}");
+    if s == "-0.000" {
+        "0.000".into()
+    } else {
+        s
+    }
 }
 
 fn pct(v: f64) -> String {
@@ -460,11 +471,19 @@ fn params_sections(page: &mut Page, p: &FormationParams, s: &Subject<'_>) -> Res
                 f.order.len().to_string(),
                 f.shape.kind().to_uppercase(),
                 f.leader.to_string(),
-                format!("{:.3}", f.mu_x),
-                format!("{:.3}", f.sigma_x),
-                format!("{:.3}", f.mu_y),
-                format!("{:.3}", f.sigma_y),
-                format!("{:?}", f.outliers),
+                clean3(f.mu_x),
+                clean3(f.sigma_x),
+                clean3(f.mu_y),
+                clean3(f.sigma_y),
+                if f.outliers.is_empty() {
+                    "none".to_string()
+                } else {
+                    f.outliers
+                        .iter()
+                        .map(|b| b.to_string())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                },
                 o(g.and_then(|g| g.apex_deg), 1),
                 o(g.and_then(|g| g.arm_left_deg), 1),
                 o(g.and_then(|g| g.arm_right_deg), 1),
@@ -531,6 +550,11 @@ fn params_sections(page: &mut Page, p: &FormationParams, s: &Subject<'_>) -> Res
             stats: st.clone(),
             takeoff: None,
             time_label: "annotated frame".into(),
+            range: crate::plot::savings::range_of(
+                &crate::report::footage_band(p),
+                st.steady_saving,
+            ),
+            model: model_text(&aero),
         };
         page.chart(
             "footage-savings",
@@ -597,7 +621,13 @@ fn animation_sections(page: &mut Page, a: &Animation, s: &Subject<'_>) -> Result
             pct(t),
         ]);
     }
+    let clearance = clearance_by_stage(a);
+    rows.push(vec![
+        "clearance (wing and body clashes; 0 is the expectation)".into(),
+        clearance_summary(a, &clearance),
+    ]);
     page.table(&["quantity", "value"], &rows);
+    clearance_section(page, a, &clearance);
     if a.birds > crate::report::BAND_MAX_BIRDS {
         page.p(&format!(
             "The saving's sensitivity to the model, wake and vortex core is left out for flocks of more than {} birds: each choice sums over every pair of birds.",
@@ -636,18 +666,10 @@ fn animation_sections(page: &mut Page, a: &Animation, s: &Subject<'_>) -> Result
         let f0 = &a.frames[k0];
         let f1 = &a.frames[k1];
         let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64;
-        let mut closest = f64::INFINITY;
-        for f in &a.frames[k0..=k1] {
-            for i in 0..a.birds {
-                for j in (i + 1)..a.birds {
-                    let d = ((f.x[i] - f.x[j]).powi(2)
-                        + (f.y[i] - f.y[j]).powi(2)
-                        + (f.z[i] - f.z[j]).powi(2))
-                    .sqrt();
-                    closest = closest.min(d);
-                }
-            }
-        }
+        let closest = clearance
+            .iter()
+            .find(|(name, _)| name == "initiation")
+            .map(|(_, c)| c.closest);
         let save =
             |f: &crate::animation::Frame| f.e.as_deref().map_or("–".into(), |e| pct(mean(e)));
         let rows = vec![
@@ -675,7 +697,13 @@ fn animation_sections(page: &mut Page, a: &Animation, s: &Subject<'_>) -> Result
             ],
             vec![
                 "closest approach of two birds".into(),
-                format!("{closest:.2} wingspans"),
+                match closest {
+                    Some(Some(c)) => closest_text(a, &c),
+                    _ => format!(
+                        "{:.1} wingspans or more",
+                        crate::animation::clearance::REACH
+                    ),
+                },
             ],
         ];
         page.table(&["quantity", "value"], &rows);
@@ -687,6 +715,99 @@ fn animation_sections(page: &mut Page, a: &Animation, s: &Subject<'_>) -> Result
         )?;
     }
     Ok(())
+}
+
+/// The clearance of each stage (the whole animation as one "frames" entry without stages).
+fn clearance_by_stage(a: &Animation) -> Vec<(String, Clearance)> {
+    if a.stages.is_empty() {
+        vec![("frames".to_string(), Clearance::of(a))]
+    } else {
+        Clearance::by_stage(a)
+    }
+}
+
+/// "0.78 wingspans (birds 0 and 1, frame 1169, 39.0 s)", the frame in the shot's numbering.
+fn closest_text(a: &Animation, c: &Closest) -> String {
+    format!(
+        "{:.2} wingspans (birds {} and {}, frame {}, {:.1} s)",
+        c.distance,
+        c.birds.0,
+        c.birds.1,
+        a.start_frame + c.frame as u64,
+        c.frame as f64 / a.fps
+    )
+}
+
+/// One line: the clashes over all stages and the closest approach.
+fn clearance_summary(a: &Animation, stages: &[(String, Clearance)]) -> String {
+    let mut all = Clearance::default();
+    for (_, c) in stages {
+        all.add(c);
+    }
+    let closest = all.closest.map_or_else(
+        || {
+            format!(
+                "no two birds came within {:.1} wingspans",
+                crate::animation::clearance::REACH
+            )
+        },
+        |c| format!("closest approach {}", closest_text(a, &c)),
+    );
+    if all.clashes() == 0 {
+        format!(
+            "no two birds clash in any of {} frames; {closest}",
+            all.frames
+        )
+    } else {
+        format!(
+            "{} wing and {} body clashes in {} of {} frames; {closest}",
+            all.wing, all.body, all.frames_with_clash, all.frames
+        )
+    }
+}
+
+/// The clearance per stage: the test, then a table of clashes and closest approaches.
+fn clearance_section(page: &mut Page, a: &Animation, stages: &[(String, Clearance)]) {
+    use crate::animation::clearance::{BODY, CHORD, FLYING, SPAN, THICKNESS};
+    page.h2(
+        "clearance",
+        "Clearance: no wing over wing, no body into body",
+    );
+    page.p(&format!(
+        "Two flying birds (ground speed at least {FLYING} wingspan per second) clash by wing when, in the first bird's heading frame, the other is less than {SPAN} wingspan aside, {CHORD} fore and aft and {THICKNESS} in height: their wings would overlap. Any two birds, at rest included, clash by body when their centres are closer than {BODY} wingspans. Each pair is counted once a frame. Real birds never clash: 0 is the expectation in every stage."
+    ));
+    let rows: Vec<Vec<String>> = stages
+        .iter()
+        .map(|(name, c)| {
+            vec![
+                name.clone(),
+                c.frames.to_string(),
+                c.wing.to_string(),
+                c.body.to_string(),
+                c.frames_with_clash.to_string(),
+                c.closest.map_or_else(
+                    || {
+                        format!(
+                            "{:.1} wingspans or more",
+                            crate::animation::clearance::REACH
+                        )
+                    },
+                    |c| closest_text(a, &c),
+                ),
+            ]
+        })
+        .collect();
+    page.table(
+        &[
+            "stage",
+            "frames",
+            "wing clashes",
+            "body clashes",
+            "frames with a clash",
+            "closest approach",
+        ],
+        &rows,
+    );
 }
 
 /// Per bird and per position (rank rounded) tables.

@@ -38,6 +38,8 @@ pub const MIN_CONTRAST: f32 = 12.0;
 pub const FAINT: f32 = 0.3;
 /// Regions smaller than this many pixels are noise.
 pub const MIN_AREA: usize = 4;
+/// Regions smaller than this fraction of a bird's area (once known) are specks.
+pub const SPECK: f64 = 0.15;
 
 /// A grey frame (0–255 per pixel, row-major).
 #[derive(Debug, Clone)]
@@ -247,22 +249,192 @@ pub fn detect(g: &Gray, polarity: Polarity, roi: [usize; 4]) -> Vec<Blob> {
 /// [`detect`] with the frame's default sky model already made; models the sky again with
 /// larger blocks when the birds are too large for the default ones.
 pub fn detect_frame(g: &Gray, sky: &Sky, polarity: Polarity, roi: [usize; 4]) -> Vec<Blob> {
-    let s = signal(g, sky, polarity);
-    let found = blobs(&s, g.width, sky.sigma, roi);
-    let mut spans: Vec<f64> = found.iter().map(|b| b.span).collect();
-    spans.sort_by(f64::total_cmp);
-    let span = spans.get(spans.len() / 2).copied().unwrap_or(0.0);
+    detect_with(g, sky, polarity, roi, &Hints::default()).blobs
+}
+
+/// What is known of the birds from the frames before (the birds on tracks that lasted), to
+/// guide the detection of the next frame; all `None` on the first frame.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Hints {
+    /// A bird's wingspan, pixels (sets the local-contrast window).
+    pub wingspan_px: Option<f64>,
+    /// A bird's area, pixels (the unit regions are split by, and the smallest region kept).
+    pub area: Option<f64>,
+    /// A bird's peak contrast, grey levels (regions far fainter are sky).
+    pub peak: Option<f64>,
+}
+
+/// The regions of one frame: the birds, and the regions turned down (for debug pictures).
+#[derive(Debug, Clone, Default)]
+pub struct Found {
+    /// The birds.
+    pub blobs: Vec<Blob>,
+    /// Regions that stood out but were too faint or too small beside the birds.
+    pub rejected: Vec<Blob>,
+    /// Noise σ of the frame, grey levels.
+    pub sigma: f32,
+    /// The background the birds were measured against, per pixel (see [`background`]).
+    pub background: Vec<f32>,
+}
+
+/// The local-contrast window, pixels (odd): about 0.8 wingspans when the birds' size is known,
+/// else the sky's block.
+pub fn window(sky: &Sky, hints: &Hints) -> usize {
+    let k = match hints.wingspan_px {
+        Some(w) if w.is_finite() && w > 0.0 => (0.8 * w).round() as usize,
+        _ => sky.block,
+    };
+    k.clamp(5, 129) | 1
+}
+
+/// The background of `g` against which birds stand out: the block sky, and, where the sky
+/// changes faster than its blocks follow (a cloud's edge), the morphological closing (for dark
+/// birds; the opening for bright) over a square of `k` pixels, which keeps any shading wider
+/// than `k` and fills in whatever is narrower: the birds. Per pixel, grey levels.
+pub fn background(g: &Gray, sky: &Sky, polarity: Polarity, k: usize) -> Vec<f32> {
+    let dark = polarity != Polarity::Bright;
+    let r = k / 2;
+    // Dark birds: max then min (closing); bright: min then max (opening).
+    let first = morph(&g.data, g.width, g.height, r, dark);
+    let env = morph(&first, g.width, g.height, r, !dark);
+    let mut out = vec![0f32; g.width * g.height];
+    let mut line = vec![0f32; g.width];
+    for y in 0..g.height {
+        sky.row(y, &mut line);
+        let e = &env[y * g.width..(y + 1) * g.width];
+        let o = &mut out[y * g.width..(y + 1) * g.width];
+        for ((o, &s), &e) in o.iter_mut().zip(&line).zip(e) {
+            *o = if dark {
+                s.min(e as f32)
+            } else {
+                s.max(e as f32)
+            };
+        }
+    }
+    out
+}
+
+/// The max (`max` true) or min filter of a `w × h` picture over a square of `2r + 1` pixels,
+/// separable, each pass in constant time per pixel (van Herk / Gil–Werman).
+fn morph(src: &[u8], w: usize, h: usize, r: usize, max: bool) -> Vec<u8> {
+    let mut tmp = vec![0u8; w * h];
+    let mut buf = Vec::new();
+    let mut out_line = Vec::new();
+    for y in 0..h {
+        filter_1d(&src[y * w..(y + 1) * w], &mut out_line, r, max, &mut buf);
+        tmp[y * w..(y + 1) * w].copy_from_slice(&out_line);
+    }
+    let mut out = vec![0u8; w * h];
+    let mut col = vec![0u8; h];
+    for x in 0..w {
+        for (y, c) in col.iter_mut().enumerate() {
+            *c = tmp[y * w + x];
+        }
+        filter_1d(&col, &mut out_line, r, max, &mut buf);
+        for (y, &v) in out_line.iter().enumerate() {
+            out[y * w + x] = v;
+        }
+    }
+    out
+}
+
+fn filter_1d(src: &[u8], out: &mut Vec<u8>, r: usize, max: bool, buf: &mut Vec<u8>) {
+    let n = src.len();
+    let win = 2 * r + 1;
+    let neutral = if max { 0u8 } else { 255u8 };
+    let op = |a: u8, b: u8| if max { a.max(b) } else { a.min(b) };
+    let m = n + 2 * r;
+    // buf holds the padded line, then the prefix (g) and suffix (h) runs within blocks.
+    buf.clear();
+    buf.resize(3 * m, neutral);
+    buf[r..r + n].copy_from_slice(src);
+    let (p, rest) = buf.split_at_mut(m);
+    let (g, hs) = rest.split_at_mut(m);
+    for i in 0..m {
+        g[i] = if i % win == 0 {
+            p[i]
+        } else {
+            op(g[i - 1], p[i])
+        };
+    }
+    for i in (0..m).rev() {
+        hs[i] = if i % win == win - 1 || i == m - 1 {
+            p[i]
+        } else {
+            op(hs[i + 1], p[i])
+        };
+    }
+    out.clear();
+    out.extend((0..n).map(|j| op(hs[j], g[j + win - 1])));
+}
+
+/// The signal of every pixel of `g` against a per-pixel background (see [`signal`]).
+pub fn signal_against(g: &Gray, bg: &[f32], polarity: Polarity) -> Vec<f32> {
+    let sign = match polarity {
+        Polarity::Bright => 1.0,
+        _ => -1.0,
+    };
+    g.data
+        .iter()
+        .zip(bg)
+        .map(|(&v, &b)| sign * (v as f32 - b))
+        .collect()
+}
+
+/// Finds the birds of `g` in `roi` against the local background ([`background`]), guided by
+/// `hints`; models the sky again leaving the birds out when they are wider than its blocks.
+pub fn detect_with(
+    g: &Gray,
+    sky: &Sky,
+    polarity: Polarity,
+    roi: [usize; 4],
+    hints: &Hints,
+) -> Found {
+    let k = window(sky, hints);
+    let bg = background(g, sky, polarity, k);
+    let s = signal_against(g, &bg, polarity);
+    let mut found = blobs_with(&s, g.width, sky.sigma, roi, hints);
+    let span = weighted_median(found.blobs.iter().map(|b| (b.span, b.area as f64)));
     if span > sky.block as f64 {
         let above = 0.25 * (HIGH_SIGMA * sky.sigma).max(MIN_CONTRAST);
         let sky2 = Sky::model_with(g, sky.block, Some((&s, above)));
-        let s2 = signal(g, &sky2, polarity);
-        return blobs(&s2, g.width, sky2.sigma, roi);
+        let bg2 = background(g, &sky2, polarity, k);
+        let s2 = signal_against(g, &bg2, polarity);
+        let mut found = blobs_with(&s2, g.width, sky2.sigma, roi, hints);
+        found.background = bg2;
+        return found;
     }
+    found.background = bg;
     found
+}
+
+/// The median of values weighted (by area: a region's pixels vote, so that many specks of
+/// cloud texture or compression do not outvote a few birds); 0 when empty.
+pub fn weighted_median(v: impl Iterator<Item = (f64, f64)>) -> f64 {
+    let mut v: Vec<(f64, f64)> = v.filter(|p| p.0.is_finite() && p.1 > 0.0).collect();
+    if v.is_empty() {
+        return 0.0;
+    }
+    v.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let total: f64 = v.iter().map(|p| p.1).sum();
+    let mut acc = 0.0;
+    for p in &v {
+        acc += p.1;
+        if acc >= 0.5 * total {
+            return p.0;
+        }
+    }
+    v[v.len() - 1].0
 }
 
 /// The regions of a signal image (see the module's description).
 pub fn blobs(s: &[f32], width: usize, sigma: f32, roi: [usize; 4]) -> Vec<Blob> {
+    blobs_with(s, width, sigma, roi, &Hints::default()).blobs
+}
+
+/// [`blobs`] guided by what is known of the birds ([`Hints`]): the birds' peak contrast and
+/// area come from the hints when given, else from this frame's regions weighted by area.
+pub fn blobs_with(s: &[f32], width: usize, sigma: f32, roi: [usize; 4], hints: &Hints) -> Found {
     let hi = (HIGH_SIGMA * sigma).max(MIN_CONTRAST);
     let lo = 0.5 * hi;
     let [rx, ry, rw, rh] = roi;
@@ -308,32 +480,30 @@ pub fn blobs(s: &[f32], width: usize, sigma: f32, roi: [usize; 4]) -> Vec<Blob> 
             }
         }
     }
-    // Diffuse regions far fainter than the frame's typical bird are sky (a cloud's edge where
-    // the sky model lags), not birds.
-    let mut peaks: Vec<f32> = regions
-        .iter()
-        .map(|r| r.iter().fold(0f32, |m, p| m.max(p.2)))
-        .collect();
-    let keep: Vec<bool> = {
-        let mut sorted = peaks.clone();
-        sorted.sort_by(f32::total_cmp);
-        let typical = sorted.get(sorted.len() / 2).copied().unwrap_or(0.0);
-        peaks.iter().map(|&p| p >= FAINT * typical).collect()
-    };
-    let regions: Vec<_> = regions
-        .into_iter()
-        .zip(keep)
-        .filter_map(|(r, k)| k.then_some(r))
-        .collect();
-    peaks.clear();
     let noise = sigma.max(1.0) as f64;
-    let mut areas: Vec<usize> = regions.iter().map(|r| r.len()).collect();
-    areas.sort_unstable();
-    let median_area = areas.get(areas.len() / 2).copied().unwrap_or(0) as f64;
+    let peak_of = |r: &[(usize, usize, f32)]| r.iter().fold(0f32, |m, p| m.max(p.2)) as f64;
+    // Regions far fainter than the birds are sky (a cloud's edge, compression's blocks), and
+    // regions far smaller than a bird are specks.
+    let typical = hints
+        .peak
+        .unwrap_or_else(|| weighted_median(regions.iter().map(|r| (peak_of(r), r.len() as f64))));
+    let unit = hints.area.unwrap_or_else(|| {
+        weighted_median(regions.iter().map(|r| (r.len() as f64, r.len() as f64)))
+    });
+    let smallest = if hints.area.is_some() {
+        (SPECK * unit).max(MIN_AREA as f64)
+    } else {
+        MIN_AREA as f64
+    };
     let mut out = Vec::with_capacity(regions.len());
+    let mut rejected = Vec::new();
     for r in &regions {
-        let k = if median_area > 0.0 && r.len() as f64 > 1.7 * median_area {
-            ((r.len() as f64 / median_area).round() as usize).clamp(2, 8)
+        if peak_of(r) < FAINT as f64 * typical || (r.len() as f64) < smallest {
+            rejected.push(measure(r, noise, false));
+            continue;
+        }
+        let k = if unit > 0.0 && r.len() as f64 > 1.7 * unit {
+            ((r.len() as f64 / unit).round() as usize).clamp(2, 8)
         } else {
             1
         };
@@ -347,7 +517,12 @@ pub fn blobs(s: &[f32], width: usize, sigma: f32, roi: [usize; 4]) -> Vec<Blob> 
             }
         }
     }
-    out
+    Found {
+        blobs: out,
+        rejected,
+        sigma,
+        background: Vec::new(),
+    }
 }
 
 /// Weighted moments of a set of pixels: (weight, mean x, mean y, cxx, cxy, cyy).

@@ -8,6 +8,7 @@
 //! reads frames from a video (through the system `ffmpeg`), a directory or a glob.
 //! [`Tracked::to_native`] writes the native annotation JSON that `extract` reads.
 
+pub mod debug;
 pub mod detect;
 pub mod review;
 pub mod source;
@@ -20,7 +21,7 @@ use serde::Serialize;
 
 use crate::error::{Error, Result};
 use crate::progress::Progress;
-use detect::{Blob, Gray, Sky};
+use detect::{Blob, Gray, Hints, Sky};
 
 /// Whether birds are darker or brighter than the sky.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -59,6 +60,12 @@ pub struct TrackOptions {
     pub roi: Option<[usize; 4]>,
     /// Frames per second, overriding the video's (needed for image frames to carry times).
     pub fps: Option<f64>,
+    /// The birds' wingspan, pixels, when the user knows it: sets the detection's scale and the
+    /// wingspan written, instead of the one measured.
+    pub wingspan_px: Option<f64>,
+    /// Write every processed frame here as a PNG with the detections, the tracks and the
+    /// background drawn ([`debug`]).
+    pub debug_frames: Option<std::path::PathBuf>,
 }
 
 impl Default for TrackOptions {
@@ -69,6 +76,8 @@ impl Default for TrackOptions {
             frames: (0, None),
             roi: None,
             fps: None,
+            wingspan_px: None,
+            debug_frames: None,
         }
     }
 }
@@ -95,6 +104,14 @@ impl TrackOptions {
                 return Err(Error::parameter(
                     "track.roi",
                     "the region has zero width or height; give x,y,w,h in pixels",
+                ));
+            }
+        }
+        if let Some(w) = self.wingspan_px {
+            if !(w.is_finite() && (2.0..=4000.0).contains(&w)) {
+                return Err(Error::parameter(
+                    "track.wingspan_px",
+                    format!("{w} is not a wingspan in pixels; give a bird's wingspan on screen, from 2 to 4000"),
                 ));
             }
         }
@@ -198,7 +215,17 @@ pub struct Tracking {
     roi: [usize; 4],
     frames: Vec<TrackedFrame>,
     last_span: Option<f64>,
+    hints: Hints,
+    trails: BTreeMap<usize, Vec<(f64, f64)>>,
 }
+
+/// Processed frames a track must be seen in before it counts (fewer when the footage is short:
+/// half its frames).
+pub const MIN_TRACK_FRAMES: usize = 5;
+
+/// Times a track must have been seen before its birds teach the detection their size and
+/// contrast ([`Hints`]).
+const CONFIRMED_HITS: usize = 3;
 
 /// Processed frames either side over which a bird's widest spread is its wingspan.
 const SPAN_WINDOW: usize = 6;
@@ -237,6 +264,11 @@ impl Tracking {
             roi: [0, 0, 0, 0],
             frames: Vec::new(),
             last_span: None,
+            hints: Hints {
+                wingspan_px: opts.wingspan_px,
+                ..Hints::default()
+            },
+            trails: BTreeMap::new(),
         })
     }
 
@@ -268,7 +300,8 @@ impl Tracking {
         let polarity = *self
             .polarity
             .get_or_insert_with(|| detect::auto_polarity(g, &sky));
-        let blobs = detect::detect_frame(g, &sky, polarity, self.roi);
+        let found = detect::detect_with(g, &sky, polarity, self.roi, &self.hints);
+        let blobs = &found.blobs;
         if blobs.is_empty() {
             return Err(Error::format(
                 name,
@@ -296,13 +329,50 @@ impl Tracking {
                 ),
             ));
         }
-        let span = median(blobs.iter().filter(|b| !b.split).map(|b| b.span).collect())
-            .or_else(|| median(blobs.iter().map(|b| b.span).collect()))
-            .unwrap_or(1.0);
+        // The frame's bird size: the user's, else the size of the birds on lasting tracks, else
+        // this frame's regions weighted by area (specks do not outvote birds).
+        let span = self.opts.wingspan_px.unwrap_or_else(|| {
+            let whole = detect::weighted_median(
+                blobs
+                    .iter()
+                    .filter(|b| !b.split)
+                    .map(|b| (b.span, b.area as f64)),
+            );
+            if whole > 0.0 {
+                whole
+            } else {
+                detect::weighted_median(blobs.iter().map(|b| (b.span, b.area as f64))).max(1.0)
+            }
+        });
+        let gate_span = self.hints.wingspan_px.unwrap_or(span);
         let ids = self
             .tracker
-            .step(&blobs, self.last_span.unwrap_or(span).max(span));
-        self.last_span = Some(span);
+            .step(blobs, self.last_span.unwrap_or(gate_span).max(gate_span));
+        self.last_span = Some(gate_span);
+        self.learn(blobs, &ids, found.sigma);
+        if let Some(dir) = &self.opts.debug_frames {
+            let hits: BTreeMap<usize, usize> =
+                self.tracker.tracks.iter().map(|t| (t.id, t.hits)).collect();
+            for (b, id) in blobs.iter().zip(&ids) {
+                let t = self.trails.entry(*id).or_default();
+                t.push((b.x, b.y));
+                if t.len() > debug::TRAIL {
+                    t.remove(0);
+                }
+            }
+            self.trails.retain(|id, _| hits.contains_key(id));
+            let marks: Vec<debug::Mark> = blobs
+                .iter()
+                .zip(&ids)
+                .map(|(b, id)| debug::Mark {
+                    blob: *b,
+                    id: *id,
+                    lasting: hits.get(id).copied().unwrap_or(0) >= MIN_TRACK_FRAMES,
+                })
+                .collect();
+            let path = dir.join(format!("frame_{index:06}.png"));
+            debug::write(&path, g, &found, &marks, &self.trails, self.roi)?;
+        }
         self.frames.push(TrackedFrame {
             index,
             image,
@@ -310,7 +380,7 @@ impl Tracking {
             heading_deg: f64::NAN,
             birds: blobs
                 .iter()
-                .zip(ids)
+                .zip(ids.iter().copied())
                 .map(|(b, id)| TrackedBird {
                     id,
                     x: b.x,
@@ -323,6 +393,39 @@ impl Tracking {
         Ok(())
     }
 
+    /// Learns the birds' size and contrast from the detections on tracks seen at least
+    /// [`CONFIRMED_HITS`] times (bird-shaped regions that last and move, not the most common
+    /// region of one frame); blended over frames so one frame cannot swing them.
+    fn learn(&mut self, blobs: &[Blob], ids: &[usize], sigma: f32) {
+        let hits: std::collections::HashMap<usize, usize> =
+            self.tracker.tracks.iter().map(|t| (t.id, t.hits)).collect();
+        let lasting: Vec<&Blob> = blobs
+            .iter()
+            .zip(ids)
+            .filter(|(b, id)| !b.split && hits.get(id).is_some_and(|&h| h >= CONFIRMED_HITS))
+            .map(|(b, _)| b)
+            .collect();
+        if lasting.is_empty() {
+            return;
+        }
+        let noise = sigma.max(1.0) as f64;
+        let w = |b: &&Blob| b.area as f64;
+        let span = detect::weighted_median(lasting.iter().map(|b| (b.span, w(b))));
+        let area = detect::weighted_median(lasting.iter().map(|b| (b.area as f64, w(b))));
+        let peak = detect::weighted_median(lasting.iter().map(|b| (b.snr * noise, w(b))));
+        let blend = |old: Option<f64>, new: f64| {
+            Some(match old {
+                Some(o) => 0.7 * o + 0.3 * new,
+                None => new,
+            })
+        };
+        if self.opts.wingspan_px.is_none() {
+            self.hints.wingspan_px = blend(self.hints.wingspan_px, span);
+        }
+        self.hints.area = blend(self.hints.area, area);
+        self.hints.peak = blend(self.hints.peak, peak);
+    }
+
     /// Finishes: headings and confidences.
     pub fn finish(self, source: &str, fps: Option<f64>) -> Result<Tracked> {
         let Some((width, height)) = self.size else {
@@ -332,6 +435,12 @@ impl Tracking {
             ));
         };
         let mut frames = self.frames;
+        let fps_eff = self.opts.fps.or(fps).unwrap_or(25.0);
+        let coherence = keep_lasting(
+            &mut frames,
+            self.hints.wingspan_px,
+            self.opts.every as f64 / fps_eff,
+        );
         // Each track's observations: processed-frame position -> (x, y).
         let mut tracks: BTreeMap<usize, Vec<(usize, f64, f64)>> = BTreeMap::new();
         for (k, f) in frames.iter().enumerate() {
@@ -430,6 +539,9 @@ impl Tracking {
         }
         for (f, h) in frames.iter_mut().zip(headings) {
             f.heading_deg = h;
+            if let Some(w) = self.opts.wingspan_px {
+                f.wingspan_px = w;
+            }
         }
         // Confidence: contrast × track length × not cut from a larger region.
         let lengths: BTreeMap<usize, usize> = tracks.iter().map(|(id, o)| (*id, o.len())).collect();
@@ -438,7 +550,8 @@ impl Tracking {
                 let contrast = 1.0 - 0.5f64.powf(b.blob.snr / detect::HIGH_SIGMA as f64);
                 let length = (lengths[&b.id] as f64 / 5.0).min(1.0);
                 let split = if b.blob.split { 0.8 } else { 1.0 };
-                b.confidence = (contrast * length * split * 1000.0).round() / 1000.0;
+                let along = coherence.get(&b.id).copied().unwrap_or(0.4);
+                b.confidence = (contrast * length * split * along * 1000.0).round() / 1000.0;
             }
         }
         Ok(Tracked {
@@ -452,6 +565,108 @@ impl Tracking {
             warnings: Vec::new(),
         })
     }
+}
+
+/// Line fit of a track's positions over [`SMOOTH_WINDOW`] processed frames either side of
+/// `k`: the velocity there, pixels per processed frame (`None` with fewer than 3 positions).
+fn velocity_at(obs: &[(usize, f64, f64)], k: usize) -> Option<(f64, f64)> {
+    let near: Vec<&(usize, f64, f64)> = obs
+        .iter()
+        .filter(|o| o.0 + SMOOTH_WINDOW >= k && o.0 <= k + SMOOTH_WINDOW)
+        .collect();
+    if near.len() < 3 {
+        return None;
+    }
+    let n = near.len() as f64;
+    let mt = near.iter().map(|o| o.0 as f64).sum::<f64>() / n;
+    let mx = near.iter().map(|o| o.1).sum::<f64>() / n;
+    let my = near.iter().map(|o| o.2).sum::<f64>() / n;
+    let stt = near.iter().map(|o| (o.0 as f64 - mt).powi(2)).sum::<f64>();
+    if stt <= 0.0 {
+        return None;
+    }
+    let stx = near
+        .iter()
+        .map(|o| (o.0 as f64 - mt) * (o.1 - mx))
+        .sum::<f64>();
+    let sty = near
+        .iter()
+        .map(|o| (o.0 as f64 - mt) * (o.2 - my))
+        .sum::<f64>();
+    Some((stx / stt, sty / stt))
+}
+
+/// Birds a frame must hold on lasting tracks for the flock's motion to judge a track by.
+const FLOCK_BIRDS: usize = 6;
+
+/// Keeps the detections that belong to birds: on a track seen in at least
+/// [`MIN_TRACK_FRAMES`] processed frames (half the footage when it is shorter) and, where the
+/// frame holds a flock ([`FLOCK_BIRDS`] lasting tracks or more), moving with it: a track whose
+/// velocity differs from the flock's (the median of the lasting tracks', frame by frame) by
+/// more than half the flock's speed plus half a wingspan a second, in the median over its
+/// frames, is texture of the sky drifting with the clouds, not a bird. A frame that would be
+/// left with no bird keeps its detections. Gives each kept track's coherence factor (1 when
+/// it deviates by at most half the allowance, down to 0.5 at the allowance) for its confidence.
+/// `seconds` is the time between processed frames.
+fn keep_lasting(
+    frames: &mut [TrackedFrame],
+    wingspan: Option<f64>,
+    seconds: f64,
+) -> BTreeMap<usize, f64> {
+    let n = frames.len();
+    let min_len = MIN_TRACK_FRAMES.min(n.div_ceil(2)).max(1);
+    let mut tracks: BTreeMap<usize, Vec<(usize, f64, f64)>> = BTreeMap::new();
+    for (k, f) in frames.iter().enumerate() {
+        for b in &f.birds {
+            tracks.entry(b.id).or_default().push((k, b.x, b.y));
+        }
+    }
+    let lasting: BTreeMap<usize, &Vec<(usize, f64, f64)>> = tracks
+        .iter()
+        .filter(|(_, o)| o.len() >= min_len)
+        .map(|(id, o)| (*id, o))
+        .collect();
+    // Velocities of the lasting tracks, frame by frame, and the flock's.
+    let mut vel: BTreeMap<(usize, usize), (f64, f64)> = BTreeMap::new();
+    let mut flock: Vec<Option<(f64, f64)>> = vec![None; n];
+    for (k, f) in frames.iter().enumerate() {
+        let mut vx = Vec::new();
+        let mut vy = Vec::new();
+        for b in &f.birds {
+            if let Some(o) = lasting.get(&b.id) {
+                if let Some(v) = velocity_at(o, k) {
+                    vel.insert((b.id, k), v);
+                    vx.push(v.0);
+                    vy.push(v.1);
+                }
+            }
+        }
+        if vx.len() >= FLOCK_BIRDS {
+            flock[k] = Some((median(vx).unwrap_or(0.0), median(vy).unwrap_or(0.0)));
+        }
+    }
+    let mut coherence = BTreeMap::new();
+    for (&id, obs) in &lasting {
+        let ratios: Vec<f64> = obs
+            .iter()
+            .filter_map(|&(k, _, _)| {
+                let (f, v) = (flock[k]?, vel.get(&(id, k))?);
+                let ws = wingspan.unwrap_or(frames[k].wingspan_px);
+                let allow = 0.5 * f.0.hypot(f.1) + 0.5 * ws * seconds;
+                Some((v.0 - f.0).hypot(v.1 - f.1) / allow.max(1e-9))
+            })
+            .collect();
+        let ratio = median(ratios).unwrap_or(0.0);
+        if ratio <= 1.0 {
+            coherence.insert(id, (1.5 - ratio).clamp(0.5, 1.0));
+        }
+    }
+    for f in frames.iter_mut() {
+        if f.birds.iter().any(|b| coherence.contains_key(&b.id)) {
+            f.birds.retain(|b| coherence.contains_key(&b.id));
+        }
+    }
+    coherence
 }
 
 /// The flight direction from the birds' shapes alone (no motion): across the wings' mean

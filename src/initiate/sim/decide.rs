@@ -106,6 +106,8 @@ impl Simulation {
             }
             f.request[i] = (d.turn_rate, d.speed);
             f.alt_offset[i] = d.alt_offset;
+            self.alt_floor[i] = d.alt_floor;
+            self.alt_ceiling[i] = d.alt_ceiling;
             self.next_reference[i] = d.reference;
             self.next_side[i] = d.side;
             self.next_branch[i] = d.branch;
@@ -290,10 +292,13 @@ impl Simulation {
                 v = v.min(f.speed[i] - p.opts.max_accel * p.opts.speed_lag);
             }
         }
+        let (alt_floor, alt_ceiling) = self.wing_envelope(i, near);
         Decision {
             turn_rate: w.clamp(-p.opts.max_turn_rate, p.opts.max_turn_rate),
             speed: v.clamp(p.min_speed, p.max_speed),
             alt_offset,
+            alt_floor,
+            alt_ceiling,
             reference,
             side,
             branch,

@@ -42,6 +42,7 @@ mod flight;
 mod grid;
 mod reference;
 mod separation;
+use separation::envelope_altitude;
 mod slots;
 
 pub use flight::*;
@@ -180,6 +181,10 @@ struct Decision {
     speed: f64,
     /// Requested altitude offset, wingspans.
     alt_offset: f64,
+    /// Least and greatest altitude of the wing envelope (below and above a flockmate within
+    /// reach of the wings), wingspans (±∞: none).
+    alt_floor: f64,
+    alt_ceiling: f64,
     reference: Option<usize>,
     side: Option<Side>,
     branch: Option<usize>,
@@ -271,6 +276,10 @@ pub struct Simulation {
     /// With assigned slots, each bird's layer while away from its slot: +½ or −½, alternating
     /// across the formation.
     layer: Vec<f64>,
+    /// Each bird's wing-envelope altitude bounds from its last decision (see
+    /// [`Simulation::wing_envelope`]), wingspans.
+    alt_floor: Vec<f64>,
+    alt_ceiling: Vec<f64>,
     next_reference: Vec<Option<usize>>,
     next_side: Vec<Option<Side>>,
     next_branch: Vec<Option<usize>>,
@@ -347,6 +356,8 @@ impl Simulation {
             slot_err: Vec::new(),
             bird_of_slot: Vec::new(),
             layer: Vec::new(),
+            alt_floor: vec![f64::NEG_INFINITY; n],
+            alt_ceiling: vec![f64::INFINITY; n],
             next_reference: vec![None; n],
             next_side: vec![None; n],
             next_branch: vec![None; n],
@@ -354,12 +365,19 @@ impl Simulation {
         };
         if sim.params.opts.assign_slots && n > 0 {
             let offset = sim.airborne_start().then_some(AIR_LEADER_OFFSET);
-            let (slot, leader) = assign_slots(
+            let given = sim.params.opts.start.given_slots(
                 &sim.target,
                 &sim.flock.pos,
                 sim.params.cruise_heading,
-                offset,
             );
+            let (slot, leader) = given.unwrap_or_else(|| {
+                assign_slots(
+                    &sim.target,
+                    &sim.flock.pos,
+                    sim.params.cruise_heading,
+                    offset,
+                )
+            });
             sim.flock.leader = leader;
             // The departure times, earliest first, go to the birds by the depth of their slot
             // behind the leader's (the leader leaves first; the tails of the arms last).
@@ -624,7 +642,11 @@ impl Simulation {
                 }
                 Phase::Airborne => {
                     let (w, v) = self.flock.request[i];
-                    let z = p.opts.cruise_altitude + self.flock.alt_offset[i];
+                    let z = envelope_altitude(
+                        p.opts.cruise_altitude + self.flock.alt_offset[i],
+                        self.alt_floor[i],
+                        self.alt_ceiling[i],
+                    );
                     fly_at(&s, w, v, z, &p, dt)
                 }
             };

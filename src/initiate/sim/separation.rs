@@ -236,3 +236,170 @@ impl Simulation {
         Some((best.1, ahead, dz))
     }
 }
+
+/// The wing envelope's lateral reach: a flockmate less than this far aside (in either bird's
+/// heading frame) could put a wing over the bird's, wingspans (the clash test's span and a
+/// margin for the lateral drift over a decision).
+pub const ENVELOPE_SPAN: f64 = 1.08;
+
+/// The wing envelope's fore-aft reach, wingspans: the clash test's chord (0.15) and a margin.
+/// Between birds whose slots are a step apart fore and aft it is at most the step less
+/// [`ENVELOPE_SLACK`] (the key shapes keep at least 0.35), so that birds in their slots keep no
+/// envelope between them.
+pub const ENVELOPE_CHORD: f64 = 0.24;
+
+/// The least fore-aft reach of the envelope between birds whose slots are a small step apart
+/// (see [`ENVELOPE_SLACK`]): the clash test's chord and a little, wingspans. Pairs whose slots
+/// are closer than this and the slack fore and aft (within a wingspan aside) keep none: the
+/// key shape's business.
+pub const ENVELOPE_CHORD_MIN: f64 = 0.16;
+
+/// Room fore and aft the envelope leaves two birds settling into slots that are a step apart
+/// (within a wingspan aside): its reach is at most the step less this, wingspans (each bird
+/// counts as settled within 0.1 wingspans of its slot; a little more, so that two birds already
+/// settling do not start an envelope in the last moments of the convergence).
+pub const ENVELOPE_SLACK: f64 = 0.13;
+
+/// How far ahead the wing envelope looks for a flockmate coming within reach (both flying on at
+/// their current velocities), seconds.
+pub const ENVELOPE_LOOKAHEAD: f64 = 0.5;
+
+/// Height between two birds within each other's wing envelope, wingspans: the lower one keeps
+/// at least this far under the other, the upper one this far over it (the clash test's wing
+/// thickness is 0.08).
+pub const ENVELOPE_GAP: f64 = 0.16;
+
+/// Height between two birds of which one passes under the other (less than
+/// [`ENVELOPE_PASS_ASIDE`] aside while within the chord fore and aft), wingspans: their bodies
+/// keep the clash test's 0.3 wingspans and a margin.
+pub const ENVELOPE_PASS_GAP: f64 = 0.38;
+
+/// Lateral distance under which a bird within the wing envelope passes under or over the other
+/// rather than beside it, wingspans.
+pub const ENVELOPE_PASS_ASIDE: f64 = 0.45;
+
+/// Flockmates flying more than this across a bird's heading pass under the short-range
+/// avoidance, not the envelope, radians (45°).
+pub const ENVELOPE_ANGLE: f64 = std::f64::consts::FRAC_PI_4;
+
+/// The altitude a bird flies towards: `base` (the cruise altitude with its offsets), kept
+/// within its wing envelope's bounds (`floor` from the flockmates under it, `ceiling` from those
+/// over it); when both bind, halfway between them.
+pub(super) fn envelope_altitude(base: f64, floor: f64, ceiling: f64) -> f64 {
+    if floor > ceiling {
+        0.5 * (floor + ceiling)
+    } else {
+        base.max(floor).min(ceiling)
+    }
+}
+
+impl Simulation {
+    /// Whether airborne birds `i` and `k` are, or within [`ENVELOPE_LOOKAHEAD`] will be, within
+    /// each other's wing reach in the plane (then the least distance aside while within reach,
+    /// wingspans): under [`ENVELOPE_SPAN`] aside and
+    /// [`ENVELOPE_CHORD`] fore and aft in the heading frame of either (flying on at their
+    /// current velocities). Pairs flying across each other, and pairs whose slots themselves are
+    /// that close (the key shape's business), are not.
+    pub(super) fn within_wing_reach(&self, i: usize, k: usize) -> Option<f64> {
+        let f = &self.flock;
+        if wrap_angle(f.heading[k] - f.heading[i]).abs() > ENVELOPE_ANGLE {
+            return None;
+        }
+        let mut chord = ENVELOPE_CHORD;
+        if let (Some(a), Some(b)) = (f.slot[i], f.slot[k]) {
+            if a < self.target.len() && b < self.target.len() {
+                let o = self.target.slots[b] - self.target.slots[a];
+                if o.x.abs() < ENVELOPE_SPAN {
+                    // Slots a small step apart fore and aft: the envelope leaves the two birds
+                    // room to settle into them (within [`ENVELOPE_SLACK`] of the step).
+                    chord = chord.min(o.y.abs() - ENVELOPE_SLACK);
+                    if chord < ENVELOPE_CHORD_MIN {
+                        return None;
+                    }
+                }
+            }
+        }
+        let rel = f.pos[k] - f.pos[i];
+        if rel.length_squared() > 16.0 {
+            return None;
+        }
+        let vel = |b: usize| {
+            self.vel
+                .get(b)
+                .map_or(direction(f.heading[b]) * f.speed[b], |v| v.truncate())
+        };
+        let dv = vel(k) - vel(i);
+        const SAMPLES: usize = 8;
+        let mut aside: Option<f64> = None;
+        for b in [i, k] {
+            let d = self.dir_of(b);
+            let r = DVec2::new(d.y, -d.x);
+            for s in 0..=SAMPLES {
+                let p = rel + dv * (ENVELOPE_LOOKAHEAD * s as f64 / SAMPLES as f64);
+                let c = p.dot(r).abs();
+                if p.dot(d).abs() < chord && c < ENVELOPE_SPAN {
+                    aside = Some(aside.map_or(c, |a| a.min(c)));
+                }
+            }
+        }
+        aside
+    }
+
+    /// The wing envelope of airborne bird `i` among `near`: for every flockmate within its wing
+    /// reach ([`Self::within_wing_reach`]) and less than a wingspan away in height, the lower of
+    /// the two (the later in index order when level) keeps [`ENVELOPE_GAP`] under the other,
+    /// the upper that far over it ([`ENVELOPE_PASS_GAP`] when one passes under the other).
+    /// Birds climbing at the same rate side by side (their slots a
+    /// step apart fore and aft, one overtaking the other while they settle) so climb at
+    /// different rates until one has passed; the bounds are altitudes the bird flies towards
+    /// with its bounded climb rate and vertical acceleration, so nothing jumps. Returns the
+    /// floor and the ceiling (±∞ when free), wingspans.
+    pub(super) fn wing_envelope(&self, i: usize, near: &[usize]) -> (f64, f64) {
+        let f = &self.flock;
+        let (mut floor, mut ceiling) = (f64::NEG_INFINITY, f64::INFINITY);
+        if f.phase[i] != Phase::Airborne {
+            return (floor, ceiling);
+        }
+        for &k in near {
+            if k == i || f.phase[k] == Phase::Waiting {
+                continue;
+            }
+            let dz = f.z[k] - f.z[i];
+            if dz.abs() >= 1.0 {
+                continue;
+            }
+            let Some(aside) = self.within_wing_reach(i, k) else {
+                continue;
+            };
+            // A bird crossing under or over the other keeps its body clear too.
+            let gap = if aside < ENVELOPE_PASS_ASIDE {
+                ENVELOPE_PASS_GAP
+            } else {
+                ENVELOPE_GAP
+            };
+            let below = if dz.abs() > 1e-9 { dz > 0.0 } else { i > k };
+            if below {
+                ceiling = ceiling.min(f.z[k] - gap);
+            } else {
+                floor = floor.max(f.z[k] + gap);
+            }
+        }
+        // Never down into the ground: a bird just off it holds its height instead.
+        (floor, ceiling.max(f.z[i].min(0.3)))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_envelope_bounds_the_altitude_and_meets_halfway_when_squeezed() {
+        let inf = f64::INFINITY;
+        assert_eq!(envelope_altitude(10.0, -inf, inf), 10.0);
+        assert_eq!(envelope_altitude(10.0, -inf, 9.84), 9.84);
+        assert_eq!(envelope_altitude(10.0, 10.16, inf), 10.16);
+        assert_eq!(envelope_altitude(10.0, 9.0, 11.0), 10.0);
+        assert!((envelope_altitude(10.0, 10.2, 9.8) - 10.0).abs() < 1e-12);
+    }
+}
