@@ -46,11 +46,18 @@ $B plot power "$T/flock.json" --key 2 -o "$I/usage-power.png"
 $B plot savings "$T/flock.json" -o "$I/usage-savings.png"
 $B plot wingbeat --species goose -o "$I/usage-wingbeat.png"
 # Large flocks (docs/large-flocks.md): 200 geese at 1280x720, 1000 at 1920x1080, seed 0.
-$B animate $E/barnacle_geese_v.json --birds 200 -o "$T/sky200.json" --quiet
+$B animate $E/barnacle_geese_v.json --birds 200 --skein-layout grid -o "$T/sky200.json" --quiet
 $B render "$T/sky200.json" -o "$T/sky200/" --size 1280x720 --picture-fps 1 --quiet
 cp "$T/sky200/frame_00025.png" "$I/skeins-200.png"
-$B animate $E/barnacle_geese_v.json --birds 1000 -o "$T/sky1000.json" --quiet
+$B animate $E/barnacle_geese_v.json --birds 1000 --skein-layout grid -o "$T/sky1000.json" --quiet
 $B render "$T/sky1000.json" -o "$T/sky1000/" --size 1920x1080 --picture-fps 1 --quiet
 cp "$T/sky1000/frame_00028.png" "$I/skeins-1000.png"
 cp "$T/sky1000/frame_00005.png" "$I/skeins-1000-takeoff.png"
+# The natural and grid layouts side by side: 1000 geese, 10 s of steady flight, at 8 s.
+for L in natural grid; do
+  $B animate $E/barnacle_geese_v.json --birds 1000 --no-initiation --seconds 10 \
+    --skein-layout $L -o "$T/layout-$L.json" --quiet
+  $B render "$T/layout-$L.json" -o "$T/layout-$L/" --size 1920x1080 --picture-fps 1 --quiet
+  cp "$T/layout-$L/frame_00008.png" "$I/skeins-1000-$L.png"
+done
 echo "pictures written to $I"

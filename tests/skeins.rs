@@ -480,3 +480,94 @@ fn a_flock_taken_apart_gives_each_formation_as_it_reads_alone() {
     let one = each[0].clone();
     assert_eq!(one.clone().into_formations(), vec![one]);
 }
+
+/// Per formation at frame `k`: mean position (x, y, z) and mean heading (radians, clockwise from
+/// north).
+fn formation_means(a: &Animation, k: usize) -> Vec<[f64; 4]> {
+    let fr = &a.frames[k];
+    a.formations
+        .as_ref()
+        .unwrap()
+        .iter()
+        .map(|fm| {
+            let n = fm.birds.len() as f64;
+            let mut m = [0.0; 4];
+            let (mut hs, mut hc) = (0.0, 0.0);
+            for &i in &fm.birds {
+                m[0] += fr.x[i] / n;
+                m[1] += fr.y[i] / n;
+                m[2] += fr.z[i] / n;
+                hs += fr.heading[i].sin();
+                hc += fr.heading[i].cos();
+            }
+            m[3] = hs.atan2(hc);
+            m
+        })
+        .collect()
+}
+
+fn mean_sd(v: &[f64]) -> (f64, f64) {
+    let n = v.len() as f64;
+    let m = v.iter().sum::<f64>() / n;
+    (
+        m,
+        (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / n).sqrt(),
+    )
+}
+
+/// The natural layout of 1000 birds is not a drill pattern: formations' heights spread by at
+/// least a wingspan, the distance from each formation to its nearest varies (coefficient of
+/// variation at least 0.25), headings spread by at least 1° with every formation within 15° of
+/// the course; the grid layout (the earlier lattice) is measured beside it and is the regular
+/// one.
+#[test]
+fn the_natural_layout_scatters_formations_in_height_distance_and_heading() {
+    let measure = |layout: formation::skein::SkeinLayout, seed: u64| {
+        let mut c = config(1000, seed, 12.0);
+        c.initiation = false;
+        c.skein.layout = layout;
+        let (a, report) = Pipeline::from_path(example("barnacle_geese_v.json"))
+            .run(&c)
+            .unwrap();
+        assert!(report.skein.as_ref().unwrap().min_separation >= 5.0);
+        let mut stats = Vec::new();
+        for k in (0..a.frames.len()).step_by(90) {
+            let m = formation_means(&a, k);
+            let heights: Vec<f64> = m.iter().map(|v| v[2]).collect();
+            let headings: Vec<f64> = m.iter().map(|v| v[3].to_degrees()).collect();
+            let nearest: Vec<f64> = m
+                .iter()
+                .enumerate()
+                .map(|(i, p)| {
+                    m.iter()
+                        .enumerate()
+                        .filter(|&(j, _)| j != i)
+                        .map(|(_, q)| (p[0] - q[0]).hypot(p[1] - q[1]))
+                        .fold(f64::INFINITY, f64::min)
+                })
+                .collect();
+            let (_, h_sd) = mean_sd(&heights);
+            let (_, hd_sd) = mean_sd(&headings);
+            let worst = headings.iter().fold(0.0f64, |w, h| w.max(h.abs()));
+            let (nm, nsd) = mean_sd(&nearest);
+            eprintln!(
+                "{layout:?} seed {seed} frame {k}: heights sd {h_sd:.2}, headings sd {hd_sd:.2}° \
+                 (worst {worst:.2}°), nearest-formation distance CV {:.3} (mean {nm:.1})",
+                nsd / nm
+            );
+            stats.push((h_sd, hd_sd, worst, nsd / nm));
+        }
+        stats
+    };
+    let natural = (0..3).flat_map(|seed| measure(formation::skein::SkeinLayout::Natural, seed));
+    for (h_sd, hd_sd, worst, cv) in natural {
+        assert!(h_sd >= 1.0, "formations' heights sd {h_sd} wingspans");
+        assert!(hd_sd >= 1.0, "formations' headings sd {hd_sd}°");
+        assert!(worst <= 15.0, "a formation {worst}° off the course");
+        assert!(cv >= 0.25, "nearest-formation distance CV {cv}");
+    }
+    for (h_sd, _, _, cv) in measure(formation::skein::SkeinLayout::Grid, 0) {
+        assert!(h_sd < 0.5, "grid heights sd {h_sd}");
+        assert!(cv < 0.25, "grid nearest-formation CV {cv}");
+    }
+}

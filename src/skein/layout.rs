@@ -93,16 +93,42 @@ impl Drift {
     }
 
     /// Moves every bird of `anim` (frames from `from` on, time measured from that frame) by the
-    /// drift and adds its velocity to their headings and speeds.
+    /// drift and adds its velocity to their headings and speeds. The formation turns with its
+    /// heading: each frame's positions are turned about the formation's centre by the angle the
+    /// drift turns the mean flight direction, so the line formation stays set to the direction
+    /// it flies (a V flying 3° off the course is a V seen 3° turned, not a V crabbing).
     pub fn apply(&self, anim: &mut Animation, from: usize) {
         let t0 = anim.frames.get(from).map_or(0.0, |f| f.t);
         for f in anim.frames.iter_mut().skip(from) {
+            let n = f.x.len();
+            if n == 0 {
+                continue;
+            }
             let t = f.t - t0;
             let [dx, dy] = self.offset(t);
             let [vx, vy] = self.velocity(t);
-            for i in 0..f.x.len() {
-                f.x[i] += dx;
-                f.y[i] += dy;
+            // The flock's mean velocity before and after the drift's is added: the turn.
+            let (mut sx, mut sy) = (0.0, 0.0);
+            for i in 0..n {
+                let (s, c) = f.heading[i].sin_cos();
+                sx += f.speed[i] * s;
+                sy += f.speed[i] * c;
+            }
+            let (sx, sy) = (sx / n as f64, sy / n as f64);
+            let turn = if sx.hypot(sy) > 1e-9 {
+                let a = (sx + vx).atan2(sy + vy) - sx.atan2(sy);
+                (a + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI
+            } else {
+                0.0
+            };
+            let (ts, tc) = turn.sin_cos();
+            let cx = f.x.iter().sum::<f64>() / n as f64;
+            let cy = f.y.iter().sum::<f64>() / n as f64;
+            for i in 0..n {
+                // Turned clockwise by `turn` (headings are clockwise from north) about the centre.
+                let (rx, ry) = (f.x[i] - cx, f.y[i] - cy);
+                f.x[i] = cx + rx * tc + ry * ts + dx;
+                f.y[i] = cy - rx * ts + ry * tc + dy;
                 let (s, c) = f.heading[i].sin_cos();
                 let (ux, uy) = (f.speed[i] * s + vx, f.speed[i] * c + vy);
                 f.heading[i] = ux.atan2(uy);

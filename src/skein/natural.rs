@@ -13,11 +13,14 @@
 //!
 //! **Natural.** The flock grows formation by formation in a random order: the next one is put
 //! beside a formation already placed, chosen at random, in a random direction (wider than deep:
-//! directions are drawn on an ellipse of [`super::layout::ASPECT`] : 1), with a gap of the
-//! clearance plus s·w̃·E, E exponential of mean 1 (w̃ the median formation width, s
-//! `skein.spread`): most formations sit near a neighbour and a few farther out, so the distances
-//! between neighbours vary as in a real sky rather than on a lattice. A place that would bring it
-//! within the clearance of another formation in some window is rejected and another is drawn.
+//! directions are drawn on an ellipse of [`super::layout::ASPECT`] : 1). Each formation has a
+//! *room* drawn exponential with mean [`ROOM`]·s·w̃ (w̃ the median formation width, s
+//! `skein.spread`); two formations keep the clearance plus the larger of their rooms apart in
+//! every window, and the new one is put that far from its neighbour plus a small extra gap
+//! ([`CLOSE_GAP`]·s·w̃·E, E exponential of mean 1). Most formations sit near a neighbour and a few
+//! farther out, so the distances between neighbours vary as in a real sky rather than on a
+//! lattice. A place that would bring it within that distance of another formation in some window
+//! is rejected and another is drawn; after 40 rejections the gaps are widened by half.
 //!
 //! **Compound.** The formations, in a random order, go alternately to the right and the left arm
 //! of one large V, each behind and outside the one before it on its arm, at a neighbour angle (the
