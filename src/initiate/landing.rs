@@ -7,8 +7,10 @@
 //!
 //! 1. *Loosen and slow down.* Every bird slows from the cruise speed V to the approach speed
 //!    V_a over [`LandingOptions::slow_seconds`], all with the same along-track speed, so the
-//!    formation's along-track gaps are kept; the lateral offsets from the flock's middle grow by
-//!    the factor [`LandingOptions::loosen`] (one common blend: lateral gaps only grow).
+//!    formation's along-track gaps are kept; the lateral offsets from the formation's middle grow
+//!    by the factor [`LandingOptions::loosen`] (one common blend: lateral gaps only grow; in a
+//!    flock of several formations each loosens about its own middle, as much as its neighbours
+//!    side by side leave room for).
 //! 2. *Glide.* Each bird descends on the glide slope (sink rate V_a tan γ in the world, ramped in
 //!    over a second) so that it reaches the ground at its touch-down time.
 //! 3. *Flare.* Over [`LandingOptions::flare_seconds`] before touch-down the sink rate and the
@@ -52,7 +54,7 @@ pub struct LandingOptions {
     pub slow_seconds: f64,
     /// Length of the flare, seconds.
     pub flare_seconds: f64,
-    /// Factor by which the lateral offsets from the flock's middle grow, ≥ 1.
+    /// Factor by which the lateral offsets from the formation's middle grow, ≥ 1.
     pub loosen: f64,
     /// Fraction β of an along-track gap used up by the later touch-down, in [0, 0.8].
     pub stagger: f64,
@@ -212,6 +214,9 @@ struct BirdPlan {
     z0: f64,
     /// Lateral position at rest.
     x1: f64,
+    /// The part of `x1 − x0` that pulls apart two birds ending abreast, made over the first
+    /// [`PULL_S`] (the rest over the loosening).
+    pull: f64,
     /// Start of the descent, start of the flare, touch-down, rest.
     descend: f64,
     flare: f64,
@@ -241,6 +246,10 @@ struct Plan {
 
 /// Time over which each bird's initial velocity difference is blended out, seconds.
 const BLEND_S: f64 = 1.0;
+
+/// Time over which birds that would end the landing abreast are pulled apart, seconds: as short
+/// as the blend of velocities, which can close their gap fore and aft.
+const PULL_S: f64 = 0.5;
 /// Time over which the sink rate ramps in, seconds.
 const RAMP_S: f64 = 1.0;
 
@@ -304,7 +313,14 @@ impl Plan {
         } else {
             0.0
         };
-        (b.x0 + (b.x1 - b.x0) * s, (b.x1 - b.x0) * ds)
+        let p = t / PULL_S;
+        let dp = if (0.0..1.0).contains(&p) {
+            6.0 * p * (1.0 - p) / PULL_S
+        } else {
+            0.0
+        };
+        let d = b.x1 - b.pull - b.x0;
+        (b.x0 + d * s + b.pull * smooth(p), d * ds + b.pull * dp)
     }
 
     /// World-frame state (course frame) of bird `b` at `t`: x, y, z, vx, vy.
@@ -392,18 +408,16 @@ fn plan_from(
         ));
     }
     let y_front = start.iter().map(|s| s[1]).fold(f64::MIN, f64::max);
-    let (xmin, xmax) = start
-        .iter()
-        .fold((f64::MAX, f64::MIN), |(a, b), s| (a.min(s[0]), b.max(s[0])));
-    let x_mid = 0.5 * (xmin + xmax);
+    // Each bird's formation loosens about its own middle (a flock of one formation about the
+    // flock's), by its own factor.
+    let (x1, pull, loosen) = loosening(anim, &start, v, opts.loosen);
     // Length of the descent of a bird starting at height z (the area of its sink profile is z),
     // at least the ramp and the flare (a bird low down sinks more slowly).
     let descent_len = |z: f64| (z / sink + 0.5 * (ramp + flare)).max(ramp + flare);
-    let loosen = clear_loosen(&start, v, opts.loosen);
     // On a bent course an along-track gap of the course frame shrinks by up to 1 − κ d on the
     // inside of a turn, and the loosened flock is wider by `loosen`.
     let bend = (1.0 - (1.0 - site.along_scale.clamp(0.0, 1.0)) * loosen).max(0.2);
-    let beta = clear_stagger(&start, x_mid, v, loosen, opts.stagger, bend);
+    let beta = clear_stagger(&start, &x1, v, opts.stagger, bend);
     let lag = |y: f64| beta * (y_front - y) / va;
     // The front bird's touch-down: after the slowdown and the flare, and late enough that no
     // bird needs to start descending before the landing starts (at half the slowdown).
@@ -413,14 +427,16 @@ fn plan_from(
     }
     let birds: Vec<BirdPlan> = start
         .iter()
-        .map(|s| {
+        .zip(x1.iter().zip(&pull))
+        .map(|(s, (&x1, &pull))| {
             let touchdown = t_front + lag(s[1]);
             let len = descent_len(s[2]);
             BirdPlan {
                 x0: s[0],
                 y0: s[1],
                 z0: s[2],
-                x1: x_mid + loosen * (s[0] - x_mid),
+                x1,
+                pull,
                 descend: touchdown - len,
                 sink: s[2] / (len - 0.5 * (ramp + flare)),
                 flare: touchdown - flare,
@@ -445,6 +461,133 @@ fn plan_from(
     };
     Ok((p, last.t + dt))
 }
+
+/// Each bird's lateral place at the end of the loosening (course frame, wingspans), and the
+/// widest ratio by which a formation widened.
+///
+/// A flock of one formation loosens about its middle by [`clear_loosen`]'s factor. In a flock of
+/// several formations each formation loosens about its own middle (loosening a flock hundreds of
+/// wingspans wide about its middle would move its outer formations sideways at tens of degrees
+/// off the course), by a factor capped so that the formations flying side by side (their
+/// along-track extents within [`SIDE_BY_SIDE`] of each other) keep more than a span and a margin
+/// between them (each may grow towards a neighbour by at most half the gap beyond that), and
+/// birds that would still end abreast within the wing envelope are pulled apart locally
+/// ([`pulled_apart`]).
+fn loosening(
+    anim: &Animation,
+    start: &[[f64; 5]],
+    v: f64,
+    loosen: f64,
+) -> (Vec<f64>, Vec<f64>, f64) {
+    use crate::animation::clearance::SPAN;
+    let n = start.len();
+    let of = anim.formation_of_birds();
+    let k = of.iter().copied().max().map_or(1, |m| m + 1);
+    // Each formation's extent at the start: [x_min, x_max, y_min, y_max].
+    let mut ext = vec![[f64::MAX, f64::MIN, f64::MAX, f64::MIN]; k];
+    for (s, &f) in start.iter().zip(&of) {
+        let e = &mut ext[f];
+        e[0] = e[0].min(s[0]);
+        e[1] = e[1].max(s[0]);
+        e[2] = e[2].min(s[1]);
+        e[3] = e[3].max(s[1]);
+    }
+    let mids: Vec<f64> = ext.iter().map(|e| 0.5 * (e[0] + e[1])).collect();
+    if k <= 1 {
+        let f = clear_loosen(start, v, loosen);
+        let m = mids[0];
+        return (
+            start.iter().map(|s| m + f * (s[0] - m)).collect(),
+            vec![0.0; n],
+            f,
+        );
+    }
+    let mut x1 = vec![0.0; n];
+    let mut pull = vec![0.0; n];
+    let mut widest = 1.0f64;
+    for f in 0..k {
+        let members: Vec<usize> = (0..n).filter(|&i| of[i] == f).collect();
+        let half = 0.5 * (ext[f][1] - ext[f][0]);
+        let room = (0..k)
+            .filter(|&g| g != f)
+            .filter(|&g| {
+                ext[g][2] - SIDE_BY_SIDE < ext[f][3] && ext[f][2] - SIDE_BY_SIDE < ext[g][3]
+            })
+            .map(|g| {
+                let gap = (ext[g][0] - ext[f][1]).max(ext[f][0] - ext[g][1]);
+                (0.5 * (gap - SPAN - STAGGER_MARGIN)).max(0.0)
+            })
+            .fold(f64::INFINITY, f64::min);
+        let factor = if half > 1e-9 {
+            loosen.min(1.0 + room / half).max(1.0)
+        } else {
+            loosen
+        };
+        let own = pulled_apart(start, &members, v, factor);
+        let m = mids[f];
+        for (&i, &(x, p)) in members.iter().zip(&own) {
+            x1[i] = m + x;
+            pull[i] = p;
+        }
+        if half > 1e-9 {
+            let (lo, hi) = own
+                .iter()
+                .fold((f64::MAX, f64::MIN), |(a, b), &(x, _)| (a.min(x), b.max(x)));
+            widest = widest.max((hi - lo) / (2.0 * half));
+        }
+    }
+    (x1, pull, widest)
+}
+
+/// The loosened lateral offsets of `members` (birds of one formation) from their middle: every
+/// offset times `factor`, and the gaps between birds that would still fly abreast within the
+/// wing envelope after the blend of their velocities (less than a span and a margin aside,
+/// within a chord and a margin fore and aft) widened to a span and a margin, locally:
+/// the widening is added to the gaps between those two birds only, so lateral gaps only grow and
+/// the formation widens by the widenings, not by a larger factor everywhere.
+/// Each member's (offset, the part of it that pulls apart).
+fn pulled_apart(start: &[[f64; 5]], members: &[usize], v: f64, factor: f64) -> Vec<(f64, f64)> {
+    use crate::animation::clearance::{CHORD, SPAN};
+    let span = SPAN + STAGGER_MARGIN;
+    let drift = 0.5 * BLEND_S;
+    let (lo, hi) = members.iter().fold((f64::MAX, f64::MIN), |(a, b), &i| {
+        (a.min(start[i][0]), b.max(start[i][0]))
+    });
+    let m = 0.5 * (lo + hi);
+    // Sorted by lateral place; `extra[r]` widens the gap between ranks r − 1 and r.
+    let mut order: Vec<usize> = members.to_vec();
+    let base = |i: usize| factor * (start[i][0] - m);
+    order.sort_by(|&a, &b| base(a).total_cmp(&base(b)).then(a.cmp(&b)));
+    // Where the bird is when the blend of velocities is done, before any loosening: the pull,
+    // made by then, must part the two birds a span on its own.
+    let x = |i: usize| start[i][0] + start[i][3] * drift;
+    let y = |i: usize| start[i][1] + (start[i][4] - v) * drift;
+    let mut extra = vec![0.0f64; order.len()];
+    for a in 0..order.len() {
+        for b in a + 1..order.len() {
+            let added: f64 = extra[a + 1..=b].iter().sum();
+            let dx = x(order[b]) - x(order[a]) + added;
+            if x(order[b]) - x(order[a]) >= span {
+                break;
+            }
+            if (y(order[a]) - y(order[b])).abs() < CHORD + STAGGER_MARGIN && dx < span {
+                extra[b] += span - dx;
+            }
+        }
+    }
+    let total: f64 = extra.iter().sum();
+    let mut out = vec![(0.0, 0.0); start.len()];
+    let mut acc = 0.0;
+    for (r, &i) in order.iter().enumerate() {
+        acc += extra[r];
+        out[i] = (base(i) + acc - 0.5 * total, acc - 0.5 * total);
+    }
+    members.iter().map(|&i| out[i]).collect()
+}
+
+/// Along-track distance within which two formations count as side by side for the landing's
+/// loosening, wingspans.
+const SIDE_BY_SIDE: f64 = 2.0;
 
 /// Largest factor the landing loosens the formation by to bring birds abreast a span apart.
 pub const MAX_CLEAR_LOOSEN: f64 = 2.0;
@@ -484,26 +627,20 @@ pub const STAGGER_MARGIN: f64 = 0.03;
 /// first touch-down) and its along-track gaps only shrink (to (1 − β) of the start's, after the
 /// first touch-down), so a pair clear at the start and at the end is clear throughout; a pair
 /// abreast at the end (loosened offset under a span) keeps (1 − β) g ≥ chord + margin.
-/// `start` holds each bird's [x, y, vx, vy] at the landing's start, `x_mid` the flock's middle,
+/// `start` holds each bird's [x, y, vx, vy] at the landing's start, `loosened` each bird's
+/// lateral place at the end of the loosening ([`loosening`]),
 /// `v` the flight speed: each bird's velocity difference from the plan is blended out over the
 /// first [`BLEND_S`], moving it by half that difference times the blend, which counts here.
 /// `bend` is the least ratio of a world along-track gap to its course-frame one (1 on a straight
 /// course): the kept gap is the chord and margin over it.
-fn clear_stagger(
-    start: &[[f64; 5]],
-    x_mid: f64,
-    v: f64,
-    loosen: f64,
-    stagger: f64,
-    bend: f64,
-) -> f64 {
+fn clear_stagger(start: &[[f64; 5]], loosened: &[f64], v: f64, stagger: f64, bend: f64) -> f64 {
     use crate::animation::clearance::{CHORD, SPAN};
     let span = SPAN + STAGGER_MARGIN;
     let clear = CHORD + STAGGER_MARGIN;
     let chord = clear / bend.clamp(0.2, 1.0);
     let mut order: Vec<usize> = (0..start.len()).collect();
     let drift = 0.5 * BLEND_S;
-    let x1 = |i: usize| x_mid + loosen * (start[i][0] - x_mid) + start[i][3] * drift;
+    let x1 = |i: usize| loosened[i] + start[i][3] * drift;
     let y1 = |i: usize| start[i][1] + (start[i][4] - v) * drift;
     order.sort_by(|&a, &b| x1(a).total_cmp(&x1(b)));
     let mut beta = stagger;
