@@ -626,7 +626,9 @@ pub const STAGGER_MARGIN: f64 = 0.03;
 /// they started it so. The landing's lateral offsets only grow (by `loosen`, done before the
 /// first touch-down) and its along-track gaps only shrink (to (1 − β) of the start's, after the
 /// first touch-down), so a pair clear at the start and at the end is clear throughout; a pair
-/// abreast at the end (loosened offset under a span) keeps (1 − β) g ≥ chord + margin.
+/// abreast at the end (loosened offset under a span) keeps d1 − β d0 ≥ chord + margin (d1 its
+/// along-track gap after the blend of velocities, d0 at the start: the touch-down lag is reckoned
+/// from the start's places, so the gap closes by β d0, not β d1).
 /// `start` holds each bird's [x, y, vx, vy] at the landing's start, `loosened` each bird's
 /// lateral place at the end of the loosening ([`loosening`]),
 /// `v` the flight speed: each bird's velocity difference from the plan is blended out over the
@@ -634,10 +636,9 @@ pub const STAGGER_MARGIN: f64 = 0.03;
 /// `bend` is the least ratio of a world along-track gap to its course-frame one (1 on a straight
 /// course): the kept gap is the chord and margin over it.
 fn clear_stagger(start: &[[f64; 5]], loosened: &[f64], v: f64, stagger: f64, bend: f64) -> f64 {
-    use crate::animation::clearance::{CHORD, SPAN};
+    use crate::animation::clearance::{BODY, CHORD, SPAN};
     let span = SPAN + STAGGER_MARGIN;
     let clear = CHORD + STAGGER_MARGIN;
-    let chord = clear / bend.clamp(0.2, 1.0);
     let mut order: Vec<usize> = (0..start.len()).collect();
     let drift = 0.5 * BLEND_S;
     let x1 = |i: usize| loosened[i] + start[i][3] * drift;
@@ -649,11 +650,30 @@ fn clear_stagger(start: &[[f64; 5]], loosened: &[f64], v: f64, stagger: f64, ben
             if x1(b) - x1(a) >= span {
                 break;
             }
-            let g = (y1(a) - y1(b)).abs();
-            if g >= chord {
-                beta = beta.min(1.0 - chord / g);
-            } else if g >= clear {
-                // Clear now, but with no room to close up on a bent course: no stagger.
+            // The gap after the blend, d1, shrinks by β times the gap at the start, d0 (the
+            // touch-down lag is reckoned from the start's places), to d1 − β d0.
+            let (mut d1, mut d0) = (y1(a) - y1(b), start[a][1] - start[b][1]);
+            if d1 < 0.0 {
+                (d1, d0) = (-d1, -d0);
+            }
+            let g = d1;
+            // Birds at rest are held to the body test: a pair nearly in line must stop a body's
+            // distance apart, not only a chord.
+            let dx = x1(b) - x1(a);
+            let body = BODY + STAGGER_MARGIN;
+            let need = if dx < body {
+                clear.max((body * body - dx * dx).sqrt())
+            } else {
+                clear
+            };
+            let bent = need / bend.clamp(0.2, 1.0);
+            if g >= bent {
+                if d0 > 0.0 {
+                    beta = beta.min((g - bent) / d0);
+                }
+            } else if g >= clear || dx < body {
+                // Clear now, but with no room to close up (on a bent course, or in line): no
+                // stagger.
                 beta = 0.0;
             }
         }
