@@ -405,7 +405,8 @@ fn csv_columns_match_the_json_in_every_frame() {
         first.contains("flock saving in steady flight, a model estimate: ")
             && first.contains(" % of induced power (field: models at measured spacings 14–36 %)")
             && first.contains(" % of total power (field and flapping studies 2–11 %)")
-            && first.contains("over models, wakes and cores; by hummel, planar wake, core"),
+            && first.contains("over models, wakes and cores; a flapping wake gives about ")
+            && first.contains("× at the field's offsets); by hummel, planar wake, core"),
         "{first}"
     );
     assert!(

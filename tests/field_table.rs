@@ -10,10 +10,13 @@
 //! stereo-filmed geese's median), and, for the 3-D wake, 0.06 wingspans above it (the filmed
 //! geese's median height difference between neighbours). With level wakes both models obey
 //! Munk's stagger theorem, so the flock's mean saving does not depend on the 1.24. `d` = 1 +
-//! WTS / span with WTS the midpoint of the study's published range (the range is what our sources
-//! give; the studies' own means or medians were not available to us) and a span of 1.5 m (the
-//! tool's goose). Savings of total power use the goose's (pelican's) power curve at its
-//! minimum-power speed.
+//! WTS / span with a span of 1.5 m (the tool's goose) and WTS the study's published mean or
+//! median spacing, the statistic its saving was computed at (Hainsworth: the median; Cutts &
+//! Speakman: the mean; Speakman & Banks: the measured spacing, taken as the mean). Our sources
+//! give the saving each study computed at that spacing but not the spacing's value, so it is
+//! reconstructed: the WTS at which a lifting-line model of the kind the study used (the tool's
+//! `--aero-model lissaman`, planar, this flock) gives the published saving. Savings of total power
+//! use the goose's (pelican's) power curve at its minimum-power speed.
 
 use formation::aero::flight::{Morphology, PowerCurve};
 use formation::aero::{AeroModel, AeroOptions, Wake};
@@ -81,6 +84,8 @@ struct Study {
     n: usize,
     wts_m: (f64, f64),
     published: &'static str,
+    /// The statistic of the spacing the study computed its saving at.
+    statistic: &'static str,
     /// The published induced saving, when one.
     induced: Option<f64>,
     species: Species,
@@ -94,6 +99,7 @@ fn studies() -> Vec<Study> {
             n: 7,
             wts_m: (-1.71, 1.83),
             published: "36 % induced (Lissaman & Shollenberger's model at the median WTS)",
+            statistic: "median",
             induced: Some(0.36),
             species: Species::Goose,
         },
@@ -103,6 +109,7 @@ fn studies() -> Vec<Study> {
             n: 7,
             wts_m: (-0.90, 1.89),
             published: "14 % induced, perhaps 2.4 % of total (a model at the mean WTS)",
+            statistic: "mean",
             induced: Some(0.14),
             species: Species::Goose,
         },
@@ -112,6 +119,7 @@ fn studies() -> Vec<Study> {
             n: 11,
             wts_m: (-1.00, 1.60),
             published: "27 % induced, 5–9 % of total (a model at the measured WTS)",
+            statistic: "mean (the statistic is not named in our sources)",
             induced: Some(0.27),
             species: Species::Goose,
         },
@@ -126,15 +134,25 @@ fn pct(v: f64) -> String {
 fn rows() -> Vec<String> {
     let mut out = Vec::new();
     for s in studies() {
-        let mid = 0.5 * (s.wts_m.0 + s.wts_m.1);
-        let d = 1.0 + mid / SPAN_M;
+        // The published mean or median, reconstructed from the saving the study computed there.
+        let at = s
+            .induced
+            .and_then(|t| wts_for(s.n, t, AeroModel::Lissaman))
+            .expect("every goose study published an induced saving its range can give");
+        assert!(
+            (s.wts_m.0..=s.wts_m.1).contains(&at),
+            "{}: the reconstructed {} {at} lies outside the published range",
+            s.source,
+            s.statistic
+        );
+        let d = 1.0 + at / SPAN_M;
         let sh = share(s.species);
         let mut cells = vec![
             s.source.to_string(),
             s.birds.to_string(),
             format!(
-                "{:+.2} to {:+.2} m → {:+.3} m, d = {:.3}",
-                s.wts_m.0, s.wts_m.1, mid, d
+                "{:+.2} to {:+.2} m; {} {:+.3} m (reconstructed), d = {:.3}",
+                s.wts_m.0, s.wts_m.1, s.statistic, at, d
             ),
             s.published.to_string(),
         ];

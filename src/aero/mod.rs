@@ -62,6 +62,7 @@ use serde::{Deserialize, Serialize};
 pub mod band;
 mod far;
 mod field;
+pub mod flapping;
 pub mod flight;
 pub mod lissaman;
 pub mod species;

@@ -30,10 +30,11 @@ pub fn label(o: &AeroOptions) -> String {
 }
 
 /// The leading statement: `lo`–`hi` of induced power over the band, the same times `share` of
-/// total, then the chosen model's `point`.
+/// total, what a flapping wake gives of it, then the chosen model's `point`.
 pub fn range_line(lo: f64, hi: f64, share: f64, point: f64, chosen: &str) -> String {
+    let flapping = formation::aero::flapping::flapping_note();
     format!(
-        "flock saving, a model estimate: {:.1}–{:.1} % of induced power ({FIELD_INDUCED}), {:.1}–{:.1} % of total power ({FIELD_TOTAL}) over models, wakes and cores; by {chosen}: {:.1} % of induced, {:.1} % of total power",
+        "flock saving, a model estimate: {:.1}–{:.1} % of induced power ({FIELD_INDUCED}), {:.1}–{:.1} % of total power ({FIELD_TOTAL}) over models, wakes and cores; {flapping}; by {chosen}: {:.1} % of induced, {:.1} % of total power",
         100.0 * lo,
         100.0 * hi,
         100.0 * lo * share,

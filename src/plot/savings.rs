@@ -149,12 +149,24 @@ impl Chart for SavingsChart {
                 pc(flock)
             ),
         };
-        let (head, rest) = root.split_vertically(26);
+        // Under the range, what a flapping wake gives of it (a second line: too long for one).
+        let second = match self.range {
+            Some(_) => crate::aero::flapping::flapping_note(),
+            None => String::new(),
+        };
+        let (head, rest) = root.split_vertically(if second.is_empty() { 26 } else { 46 });
         head.draw(&Text::new(
             lead,
             (14, 2),
             (FONT_FAMILY, 15).into_font().color(&RGBColor(40, 40, 40)),
         ))?;
+        if !second.is_empty() {
+            head.draw(&Text::new(
+                second,
+                (14, 22),
+                (FONT_FAMILY, 15).into_font().color(&RGBColor(40, 40, 40)),
+            ))?;
+        }
         let (_, h) = rest.dim_in_pixel();
         let (panels, legends) = rest.split_vertically(h.saturating_sub(96));
         let (w, _) = panels.dim_in_pixel();

@@ -270,7 +270,7 @@ fn band_section(
     }
     let (lo, hi) = band_range(entries);
     page.p(&format!(
-        "Sensitivity of the flock saving to modelling choices no measurement fixes ({what}): {} to {} of induced power over Hummel's model at vortex cores of 0.02 to 0.32 wingspans{}{}.",
+        "Sensitivity of the flock saving to modelling choices no measurement fixes ({what}): {} to {} of induced power over Hummel's model at vortex cores of 0.02 to 0.32 wingspans{}{}; {} (an unsteady vortex-lattice computation of flapping wings; docs/model.md).",
         pct(lo),
         pct(hi),
         if entries.iter().any(|e| !e.aero.model.is_hummel()) {
@@ -285,7 +285,8 @@ fn band_section(
             ", each with the planar and the 3-D wake"
         } else {
             " (the birds have no heights: the 3-D wake equals the planar one)"
-        }
+        },
+        crate::aero::flapping::flapping_note()
     ));
     let svg = band_svg(entries, main);
     page.raw_chart(
