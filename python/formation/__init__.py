@@ -438,3 +438,9 @@ def solve(x, xi, y=None, *, tolerance: float | None = None, patience: int | None
 
 # ``from __future__ import annotations`` binds the name ``annotations``: not part of the API.
 del annotations
+
+
+def _unpickle(kind: str, state: bytes):
+    """Rebuilds a pickled ``Params``, ``Animation`` or ``Annotations`` (what their
+    ``__reduce__`` names); the state is their exact native form."""
+    return _native.from_state(kind, state)
