@@ -19,6 +19,7 @@ class ``formation.FormationWarning`` (Python's ``warnings``: filter it, or turn 
 with ``warnings.simplefilter("error", formation.FormationWarning)``); ``strict=True`` makes
 ``extract`` and ``animate`` raise ``ValueError`` on the first one instead. ``formation.example(NAME)``
 gives the path of an example bundled with the package (``formation.examples()`` lists them).
+``Params``, ``Animation`` and ``Annotations`` pickle exactly (``multiprocessing``, joblib, Dask).
 """
 
 from __future__ import annotations
