@@ -14,8 +14,11 @@ except ImportError:
           " `python -m pip install numpy`)", file=sys.stderr)
     print("FAILED numpy missing")
     sys.exit(1)
-if not hasattr(numpy, "bool"):
-    numpy.bool = numpy.bool_
+import warnings
+with warnings.catch_warnings():  # numpy 1.24-1.26 warn on the attribute's lookup
+    warnings.simplefilter("ignore")
+    if not hasattr(numpy, "bool"):
+        numpy.bool = numpy.bool_
 import bpy, mathutils
 
 args = sys.argv[sys.argv.index("--") + 1:]
