@@ -1,8 +1,24 @@
 # Renders a close-up of the first birds of a .glb written by `formation` (Blender headless, Cycles
 # on the CPU), for docs/export.md: the skinned bird, its wings mid-beat, as a studio would see it.
 # Usage: blender -b --python scripts/blender_closeup.py -- flock.glb out.png [FRAME] [FPS] [CLIP]
-import sys; sys.path.insert(0, "/usr/lib/python3/dist-packages"); [sys.modules.pop(m) for m in list(sys.modules) if m.startswith("numpy")]
-import numpy; numpy.bool = bool
+# Blender's glTF add-on needs numpy (Debian's Blender: `apt install python3-numpy`); Debian's
+# Blender 3.4 add-on also uses `numpy.bool`, which numpy 1.24-1.26 lack (numpy 2 has it again):
+# the alias is restored when missing, with whatever numpy Blender's Python imports (numpy 1 or 2;
+# no path changes and no second import, which numpy 2 refuses).
+import sys
+try:
+    import numpy
+except ImportError:
+    print("FAILED Blender's glTF add-on needs numpy, which this Blender's Python cannot import"
+          " (Debian/Ubuntu: apt install python3-numpy; another Blender: its bundled Python's"
+          " `python -m pip install numpy`)", file=sys.stderr)
+    print("FAILED numpy missing")
+    sys.exit(1)
+import warnings
+with warnings.catch_warnings():  # numpy 1.24-1.26 warn on the attribute's lookup
+    warnings.simplefilter("ignore")
+    if not hasattr(numpy, "bool"):
+        numpy.bool = numpy.bool_
 import bpy, mathutils
 
 args = sys.argv[sys.argv.index("--") + 1:]

@@ -5,8 +5,24 @@
 # `--bird-model`. Also a check that a Blender-made rig works: `formation render ... --bird-model`
 # on this file gives the same birds as the built-in one.
 # Usage: blender -b --python scripts/blender_rig_template.py -- flock.glb rig_template.glb
-import sys; sys.path.insert(0, "/usr/lib/python3/dist-packages"); [sys.modules.pop(m) for m in list(sys.modules) if m.startswith("numpy")]
-import numpy; numpy.bool = bool
+# Blender's glTF add-on needs numpy (Debian's Blender: `apt install python3-numpy`); Debian's
+# Blender 3.4 add-on also uses `numpy.bool`, which numpy 1.24-1.26 lack (numpy 2 has it again):
+# the alias is restored when missing, with whatever numpy Blender's Python imports (numpy 1 or 2;
+# no path changes and no second import, which numpy 2 refuses).
+import sys
+try:
+    import numpy
+except ImportError:
+    print("FAILED Blender's glTF add-on needs numpy, which this Blender's Python cannot import"
+          " (Debian/Ubuntu: apt install python3-numpy; another Blender: its bundled Python's"
+          " `python -m pip install numpy`)", file=sys.stderr)
+    print("FAILED numpy missing")
+    sys.exit(1)
+import warnings
+with warnings.catch_warnings():  # numpy 1.24-1.26 warn on the attribute's lookup
+    warnings.simplefilter("ignore")
+    if not hasattr(numpy, "bool"):
+        numpy.bool = numpy.bool_
 import bpy
 
 src, out = sys.argv[-2], sys.argv[-1]

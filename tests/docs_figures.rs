@@ -1,7 +1,11 @@
 //! The figures the README and the docs quote from the tool's own runs are the runs' figures: the
 //! README job is run as the README gives it and its summary, durations and file sizes are held
-//! against README.md, docs/usage.md and docs/export.md (sizes within 10 %, the summary exactly);
-//! the large-flock sentence of docs/usage.md against a 1000-bird run.
+//! against README.md, docs/usage.md and docs/export.md (sizes within 10 %, the summary exactly),
+//! the .glb's last frame against the Blender steps of usage.md and export.md, and the CSV's
+//! columns against usage.md's list; the large-flock sentence of docs/usage.md against a
+//! 1000-bird run; usage.md's studio shot (frames, numbering, sizes) and its staged pipeline
+//! (`extract`, `steady`, `initiate`, `render` against `animate`, within the bounds it states);
+//! docs/performance.md's README-job GIF size.
 
 mod support;
 
@@ -129,6 +133,65 @@ fn the_readme_job_s_figures_are_the_run_s() {
         0.1,
     );
 
+    // The .glb's last frame (its scene extras' `frame_end`) where usage.md and export.md give it.
+    let frame_end = glb_frame_end(&dir.join("flock.glb"));
+    // usage.md's flock is animated from the extracted parameters without `--species`.
+    let out = bin()
+        .current_dir(&dir)
+        .args(["animate"])
+        .arg(repo_file("examples_data/barnacle_geese_v.json"))
+        .args(["--birds", "14", "--quiet", "-o", "usage.glb"])
+        .output()
+        .unwrap();
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    let usage_end = glb_frame_end(&dir.join("usage.glb"));
+    let usage_says = |before: &str| number_after(&usage, before, "usage frame_end");
+    assert_eq!(
+        usage_says("in the file's scene extras: ") as u64,
+        usage_end,
+        "docs/usage.md frame_end"
+    );
+    assert_eq!(
+        usage_says("bird playing frames 0–") as u64,
+        usage_end,
+        "docs/usage.md frames played"
+    );
+    let export_doc = doc("docs/export.md");
+    assert_eq!(
+        number_after(&export_doc, "(the README job: 0 and ", "export frame_end") as u64,
+        frame_end,
+        "docs/export.md frame_end"
+    );
+    assert_eq!(
+        number_after(
+            &export_doc,
+            "one action per bird playing frames 0–",
+            "export"
+        ) as u64,
+        frame_end,
+        "docs/export.md frames played"
+    );
+
+    // usage.md names every column of the CSV.
+    let header = std::fs::read_to_string(dir.join("flock.csv")).unwrap();
+    let header = header.lines().next().unwrap().to_string();
+    let para = &usage[usage
+        .find("`flock.csv` has one row per frame and bird")
+        .unwrap()..];
+    let para = &para[..para.find("formats.md").unwrap()];
+    let named: Vec<&str> = para
+        .split('`')
+        .skip(1)
+        .step_by(2)
+        .flat_map(|t| t.split(','))
+        .collect();
+    for column in header.split(',') {
+        assert!(
+            named.contains(&column),
+            "docs/usage.md's CSV paragraph does not name the column `{column}` ({header})"
+        );
+    }
+
     // docs/export.md: the GIF's length and size.
     let export = doc("docs/export.md");
     let marker = "The README job's GIF (14 birds, 960×540, ";
@@ -173,5 +236,212 @@ fn the_large_flock_sentence_is_the_run_s() {
     assert!(
         usage.contains(&want),
         "docs/usage.md should say {want:?} ({err})"
+    );
+}
+
+/// The scene extras' `frame_end` of a .glb (its JSON chunk).
+fn glb_frame_end(path: &Path) -> u64 {
+    let glb = std::fs::read(path).unwrap();
+    let chunk = u32::from_le_bytes(glb[12..16].try_into().unwrap()) as usize;
+    let json: serde_json::Value = serde_json::from_slice(&glb[20..20 + chunk]).unwrap();
+    json["scenes"][0]["extras"]["frame_end"].as_u64().unwrap()
+}
+
+/// Columns of a CSV file: the header and the rows as text fields.
+fn csv_table(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let header = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .map(str::to_string)
+        .collect();
+    let rows = lines
+        .map(|l| l.split(',').map(str::to_string).collect())
+        .collect();
+    (header, rows)
+}
+
+#[test]
+fn the_studio_shot_is_as_usage_md_says() {
+    let usage = doc("docs/usage.md");
+    let command = "formation animate examples_data/barnacle_geese_v.json --birds 14 --fps 24 --shot-seconds 40 \\ --start-frame 1001 --subframes 4 --units m --up y --path-out layout.json \\ -o shot.glb -o shot.usda -o shot.csv";
+    assert!(
+        usage.contains(command),
+        "docs/usage.md: the shot's command changed; update this test"
+    );
+    let dir = scratch("docs-figures-shot");
+    let out = bin()
+        .current_dir(&dir)
+        .arg("animate")
+        .arg(repo_file("examples_data/barnacle_geese_v.json"))
+        .args([
+            "--birds",
+            "14",
+            "--fps",
+            "24",
+            "--shot-seconds",
+            "40",
+            "--start-frame",
+            "1001",
+            "--subframes",
+            "4",
+            "--units",
+            "m",
+            "--up",
+            "y",
+            "--path-out",
+            "layout.json",
+            "-o",
+            "shot.glb",
+            "-o",
+            "shot.usda",
+            "-o",
+            "shot.csv",
+            "--quiet",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    let (_, rows) = csv_table(&dir.join("shot.csv"));
+    let first: u64 = rows.first().unwrap()[0].parse().unwrap();
+    let last: u64 = rows.last().unwrap()[0].parse().unwrap();
+    let frames = number_after(&usage, "gives exactly ", "usage shot") as u64;
+    assert_eq!(
+        last - first + 1,
+        frames,
+        "docs/usage.md: frames of the shot"
+    );
+    assert_eq!(first, 1001);
+    assert_eq!(
+        number_after(&usage, "numbered 1001–", "usage shot") as u64,
+        last,
+        "docs/usage.md: the shot's last frame"
+    );
+    let sizes = &usage[usage.find("This takes about ").unwrap()..];
+    close(
+        "usage shot .glb",
+        number_after(sizes, "writes a ", "usage"),
+        mb(&dir.join("shot.glb")),
+        0.1,
+    );
+    close(
+        "usage shot .usda",
+        number_after(sizes, "`.glb`, a ", "usage"),
+        mb(&dir.join("shot.usda")),
+        0.1,
+    );
+    close(
+        "usage shot .csv",
+        number_after(sizes, "`.usda` and a ", "usage"),
+        mb(&dir.join("shot.csv")),
+        0.1,
+    );
+}
+
+#[test]
+fn the_staged_pipeline_is_animate_s_within_the_files_precision() {
+    let dir = scratch("docs-figures-staged");
+    let example = repo_file("examples_data/barnacle_geese_v.json");
+    let ex = example.to_str().unwrap();
+    for args in [
+        vec!["animate", ex, "--birds", "14", "-o", "animate.csv"],
+        vec!["extract", ex, "-o", "params.json"],
+        vec![
+            "steady",
+            "params.json",
+            "--birds",
+            "14",
+            "--seconds",
+            "20",
+            "-o",
+            "steady.json",
+        ],
+        vec!["initiate", "steady.json", "-o", "flight.json"],
+        vec!["render", "flight.json", "-o", "flock.csv"],
+    ] {
+        let out = bin()
+            .current_dir(&dir)
+            .args(&args)
+            .arg("--quiet")
+            .output()
+            .unwrap();
+        assert_eq!(code(&out), 0, "{args:?}: {}", stderr(&out));
+    }
+    let (ha, a) = csv_table(&dir.join("animate.csv"));
+    let (hb, b) = csv_table(&dir.join("flock.csv"));
+    assert_eq!(ha, hb);
+    assert_eq!(a.len(), b.len(), "rows");
+    let bound = |column: &str| -> f64 {
+        match column {
+            "frame" | "t" | "bird" | "stage" | "formation" | "rank" | "leader" => 0.0,
+            "x" | "y" | "z" | "lateral" | "behind" | "speed" => 2e-5,
+            "e" | "xi" | "saving_total" => 5e-5,
+            // Angles: heading, bank, pitch, wing phase and the quaternion.
+            _ => 6e-5,
+        }
+    };
+    let mut differ = 0;
+    for (ra, rb) in a.iter().zip(&b) {
+        differ += usize::from(ra != rb);
+        for ((column, va), vb) in ha.iter().zip(ra).zip(rb) {
+            if va == vb {
+                continue;
+            }
+            let d = match (va.parse::<f64>(), vb.parse::<f64>()) {
+                (Ok(x), Ok(y)) => (x - y).abs(),
+                _ => f64::INFINITY,
+            };
+            assert!(
+                d <= bound(column) + 1e-12,
+                "frame {} bird {}: {column} {va} (animate) against {vb} (staged), over {}",
+                ra[0],
+                ra[2],
+                bound(column)
+            );
+        }
+    }
+    let usage = doc("docs/usage.md");
+    let said = number_after(&usage, "On the README job ", "usage staged");
+    let tail = &usage[usage.find("On the README job ").unwrap()..];
+    let tail = &tail[tail.find(" of the ").unwrap() + " of the ".len()..];
+    // The row count is written with a space between thousands ("18 047").
+    let digits: String = tail
+        .chars()
+        .take_while(|c| c.is_ascii_digit() || c.is_whitespace())
+        .filter(char::is_ascii_digit)
+        .collect();
+    assert_eq!(
+        digits.parse::<usize>().unwrap(),
+        a.len(),
+        "docs/usage.md: rows of the CSV"
+    );
+    assert!(
+        (said - differ as f64).abs() <= 0.1 * differ as f64,
+        "docs/usage.md says {said} rows differ, the run gives {differ}"
+    );
+}
+
+#[test]
+fn the_performance_page_s_readme_job_gif_is_the_run_s() {
+    let dir = scratch("docs-figures-perf-gif");
+    let out = bin()
+        .current_dir(&dir)
+        .arg("animate")
+        .arg(repo_file("examples_data/barnacle_geese_v.json"))
+        .args(["--birds", "14", "-o", "flock.gif", "--quiet"])
+        .output()
+        .unwrap();
+    assert_eq!(code(&out), 0, "{}", stderr(&out));
+    let perf = doc("docs/performance.md");
+    let row = &perf[perf
+        .find("| GIF size | 42.2 MB | 9.18 MB")
+        .expect("the README job's table")..];
+    close(
+        "docs/performance.md README job GIF (re-measured column)",
+        number_after(row, "| **", "performance"),
+        mb(&dir.join("flock.gif")),
+        0.1,
     );
 }

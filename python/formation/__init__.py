@@ -19,6 +19,7 @@ class ``formation.FormationWarning`` (Python's ``warnings``: filter it, or turn 
 with ``warnings.simplefilter("error", formation.FormationWarning)``); ``strict=True`` makes
 ``extract`` and ``animate`` raise ``ValueError`` on the first one instead. ``formation.example(NAME)``
 gives the path of an example bundled with the package (``formation.examples()`` lists them).
+``Params``, ``Animation`` and ``Annotations`` pickle exactly (``multiprocessing``, joblib, Dask).
 """
 
 from __future__ import annotations
@@ -438,3 +439,9 @@ def solve(x, xi, y=None, *, tolerance: float | None = None, patience: int | None
 
 # ``from __future__ import annotations`` binds the name ``annotations``: not part of the API.
 del annotations
+
+
+def _unpickle(kind: str, state: bytes):
+    """Rebuilds a pickled ``Params``, ``Animation`` or ``Annotations`` (what their
+    ``__reduce__`` names); the state is their exact native form."""
+    return _native.from_state(kind, state)

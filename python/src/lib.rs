@@ -28,6 +28,8 @@ use serde_json::Value;
 #[path = "../../src/main.rs"]
 mod cli_main;
 
+mod pickle;
+
 /// A library error as a Python exception carrying the library's one-line message.
 fn py_err(e: Error) -> PyErr {
     let message = one_line(&e.to_string());
@@ -244,6 +246,26 @@ impl PyAnnotations {
             self.inner.frames.len()
         )
     }
+    /// Equal when every frame, point and setting is.
+    fn __eq__(&self, other: &Bound<'_, PyAny>) -> bool {
+        other
+            .cast::<PyAnnotations>()
+            .is_ok_and(|o| o.get().inner == self.inner)
+    }
+    /// Pickles as the annotations' JSON (exact: the shortest text of each number).
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Reduced<'py>> {
+        let state =
+            serde_json::to_vec(&self.inner).map_err(|e| PyValueError::new_err(e.to_string()))?;
+        reduced(py, "Annotations", state)
+    }
+    /// Immutable: a copy is the object itself.
+    fn __copy__(slf: Py<Self>) -> Py<Self> {
+        slf
+    }
+    /// Immutable: a deep copy is the object itself.
+    fn __deepcopy__(slf: Py<Self>, _memo: &Bound<'_, PyAny>) -> Py<Self> {
+        slf
+    }
 }
 
 /// Formation parameters extracted from annotations (or read from a params file).
@@ -294,6 +316,26 @@ impl PyParams {
             self.inner.birds,
             self.inner.frames.len()
         )
+    }
+    /// Equal when every frame's parameters and the summary are.
+    fn __eq__(&self, other: &Bound<'_, PyAny>) -> bool {
+        other
+            .cast::<PyParams>()
+            .is_ok_and(|o| o.get().inner == self.inner)
+    }
+    /// Pickles as the params JSON (exact: the shortest text of each number).
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Reduced<'py>> {
+        let state =
+            serde_json::to_vec(&self.inner).map_err(|e| PyValueError::new_err(e.to_string()))?;
+        reduced(py, "Params", state)
+    }
+    /// Immutable: a copy is the object itself.
+    fn __copy__(slf: Py<Self>) -> Py<Self> {
+        slf
+    }
+    /// Immutable: a deep copy is the object itself.
+    fn __deepcopy__(slf: Py<Self>, _memo: &Bound<'_, PyAny>) -> Py<Self> {
+        slf
     }
 }
 
@@ -489,6 +531,67 @@ impl PyAnimation {
             self.inner.fps,
             self.inner.frames.last().map_or(0.0, |f| f.t)
         )
+    }
+    /// Equal when every frame of every bird, the stages, key shapes and the rest of the file,
+    /// and the run's options (which `write` uses) are.
+    fn __eq__(&self, other: &Bound<'_, PyAny>) -> bool {
+        other.cast::<PyAnimation>().is_ok_and(|o| {
+            let o = o.get();
+            o.inner == self.inner && o.config == self.config
+        })
+    }
+    /// Pickles exactly: the frames as their raw 64-bit values (not the JSON file's rounded
+    /// text), with the run's options.
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Reduced<'py>> {
+        let state = py
+            .detach(|| pickle::animation_state(&self.inner, &self.config))
+            .map_err(PyValueError::new_err)?;
+        reduced(py, "Animation", state)
+    }
+    /// Immutable: a copy is the object itself.
+    fn __copy__(slf: Py<Self>) -> Py<Self> {
+        slf
+    }
+    /// Immutable: a deep copy is the object itself.
+    fn __deepcopy__(slf: Py<Self>, _memo: &Bound<'_, PyAny>) -> Py<Self> {
+        slf
+    }
+}
+
+/// What `__reduce__` returns: `formation._unpickle` and its arguments (the class's name and its
+/// state).
+type Reduced<'py> = (
+    Bound<'py, PyAny>,
+    (&'static str, Bound<'py, pyo3::types::PyBytes>),
+);
+
+fn reduced<'py>(py: Python<'py>, kind: &'static str, state: Vec<u8>) -> PyResult<Reduced<'py>> {
+    let unpickle = py.import("formation")?.getattr("_unpickle")?;
+    Ok((unpickle, (kind, pyo3::types::PyBytes::new(py, &state))))
+}
+
+/// A `Params`, `Animation` or `Annotations` from the state its `__reduce__` gave.
+#[pyfunction]
+fn from_state(py: Python<'_>, kind: &str, state: &[u8]) -> PyResult<Py<PyAny>> {
+    let bad = |e: String| PyValueError::new_err(format!("unpickling a formation.{kind}: {e}"));
+    match kind {
+        "Params" => {
+            let inner = serde_json::from_slice(state).map_err(|e| bad(e.to_string()))?;
+            Ok(Py::new(py, PyParams { inner })?.into_any())
+        }
+        "Annotations" => {
+            let inner = serde_json::from_slice(state).map_err(|e| bad(e.to_string()))?;
+            Ok(Py::new(py, PyAnnotations { inner })?.into_any())
+        }
+        "Animation" => {
+            let (inner, config) = py
+                .detach(|| pickle::animation_from_state(state))
+                .map_err(bad)?;
+            Ok(Py::new(py, PyAnimation { inner, config })?.into_any())
+        }
+        _ => Err(PyValueError::new_err(format!(
+            "unpickling: `{kind}` is not a formation class (Params, Animation or Annotations)"
+        ))),
     }
 }
 
@@ -870,6 +973,7 @@ fn formation_native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(solve, m)?)?;
     m.add_function(wrap_pyfunction!(run_cli, m)?)?;
     m.add_function(wrap_pyfunction!(default_options, m)?)?;
+    m.add_function(wrap_pyfunction!(from_state, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }
