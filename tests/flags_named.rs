@@ -108,6 +108,7 @@ fn commands() -> Vec<Command> {
         ("--formations", "0", None),
         ("--formation-size", "1", None),
         ("--clearance", "-1", None),
+        ("--skein-layout", "lattice", None),
     ];
     let course: Vec<(&str, &str, Option<String>)> = vec![
         ("--path", "OUT/no-path.json", Some("no-path.json".into())),

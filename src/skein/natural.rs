@@ -44,7 +44,7 @@ use serde::{Deserialize, Serialize};
 use super::layout::{Envelope, Placement, ASPECT};
 use crate::keyshape::spacing::median;
 
-/// How the formations of a flock are arranged (`skein.layout`, `--skein-layout`).
+/// How the formations of a flock are arranged (`skein.layout`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum SkeinLayout {
