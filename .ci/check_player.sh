@@ -18,7 +18,10 @@ flags=(--headless --no-sandbox --use-angle=swiftshader --enable-unsafe-swiftshad
        --no-first-run --disable-background-networking --disable-component-update --disable-sync
        --user-data-dir="$dir/profile" --window-size=1280,720 --hide-scrollbars)
 $f animate examples_data/barnacle_geese_v.json --birds 14 --quiet -o "$dir/a14.json"
-$f animate examples_data/barnacle_geese_v.json --birds 1000 --seconds 10 --quiet -o "$dir/a1000.json"
+# The grid layout of formations: the default natural layout spreads 1000 birds over about 2.4
+# times the area, where at this canvas size most birds are far under a pixel (866 of 1000 in
+# view changed pixels when measured, under the 90 % asked below).
+$f animate examples_data/barnacle_geese_v.json --birds 1000 --seconds 10 --skein-layout grid --quiet -o "$dir/a1000.json"
 cat > "$dir/drive.html" <<'JS'
 <script>
 window.addEventListener("load", () => {
