@@ -11,23 +11,10 @@
 mod support;
 
 use formation::animation::clearance::Clearance;
-use formation::animation::Animation;
 use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
-use support::{example_arg, run, s, scratch};
-
-/// (input, read flags) of every example footage.
-fn examples() -> Vec<(String, Vec<&'static str>)> {
-    vec![
-        (example_arg("barnacle_geese_v.json"), vec![]),
-        (example_arg("snow_geese_j.csv"), vec![]),
-        (
-            example_arg("cranes_v_dltdv.csv"),
-            vec!["--wingspan-px", "22", "--heading", "300"],
-        ),
-        (example_arg("pelicans_u_labelme"), vec![]),
-    ]
-}
+use support::clearance::{animate, examples};
+use support::scratch;
 
 proptest! {
     #![proptest_config(ProptestConfig {
@@ -47,13 +34,11 @@ proptest! {
         joiners in 0usize..3,
         water in any::<bool>(),
     ) {
-        let (input, read) = &examples()[example];
+        let (_, input, read) = &examples()[example];
         let dir = scratch(&format!("clearance-props-{seed}"));
-        let out = dir.join("a.json");
         let (seed_s, fps_s, birds_s) = (seed.to_string(), fps.to_string(), birds.to_string());
         let (lc, sw, jo) = (leader_changes.to_string(), swaps.to_string(), joiners.to_string());
-        let mut args = vec!["animate", input.as_str(), "-o", s(&out), "--quiet"];
-        args.extend_from_slice(read);
+        let mut args = read.clone();
         args.extend_from_slice(&[
             "--birds", &birds_s, "--seconds", "20", "--land", "--fps", &fps_s, "--seed", &seed_s,
             "--leader-changes", &lc, "--swaps", &sw, "--joiners", &jo,
@@ -65,9 +50,7 @@ proptest! {
         if water {
             args.extend_from_slice(&["--land-on", "water"]);
         }
-        let o = run(&args);
-        prop_assert!(o.status.success(), "{args:?}: {}", String::from_utf8_lossy(&o.stderr));
-        let anim = Animation::read(&out).expect("read the animation back");
+        let anim = animate(&dir, input, &args);
         for (stage, c) in Clearance::by_stage(&anim) {
             // The take-off is a simulation of the paper's rules with the wing envelope kept by
             // steering, not by construction: in 6 × 64 random flights 2 took off with 4 wing

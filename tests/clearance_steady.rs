@@ -8,60 +8,15 @@
 mod support;
 
 use formation::animation::clearance::Clearance;
-use formation::animation::Animation;
-use support::{example_arg, run, s, scratch};
+use support::clearance::{animate, assert_clear, examples};
+use support::{example_arg, scratch};
 
 /// Runs `animate` on `input` with `args` (steady flight only) and returns the clearance of
 /// what it wrote.
 fn clearance(dir: &std::path::Path, input: &str, args: &[&str]) -> Clearance {
-    let out = dir.join("a.json");
-    let mut all = vec![
-        "animate",
-        input,
-        "--no-initiation",
-        "-o",
-        s(&out),
-        "--quiet",
-    ];
+    let mut all = vec!["--no-initiation"];
     all.extend_from_slice(args);
-    let o = run(&all);
-    assert!(
-        o.status.success(),
-        "{all:?}: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    let anim = Animation::read(&out).expect("read the animation back");
-    Clearance::of(&anim)
-}
-
-fn assert_clear(c: &Clearance, what: &str) {
-    assert_eq!(
-        (c.wing, c.body),
-        (0, 0),
-        "{what}: {} wing and {} body clashes in {} frames, closest {:?}",
-        c.wing,
-        c.body,
-        c.frames_with_clash,
-        c.closest
-    );
-}
-
-/// (name, input, read flags) of every example footage.
-fn examples() -> Vec<(&'static str, String, Vec<&'static str>)> {
-    vec![
-        (
-            "barnacle geese V",
-            example_arg("barnacle_geese_v.json"),
-            vec![],
-        ),
-        ("snow geese J", example_arg("snow_geese_j.csv"), vec![]),
-        (
-            "cranes",
-            example_arg("cranes_v_dltdv.csv"),
-            vec!["--wingspan-px", "22", "--heading", "300"],
-        ),
-        ("pelicans U", example_arg("pelicans_u_labelme"), vec![]),
-    ]
+    Clearance::of(&animate(dir, input, &all))
 }
 
 #[test]

@@ -10,22 +10,12 @@
 mod support;
 
 use formation::animation::clearance::Clearance;
-use formation::animation::Animation;
-use support::{example_arg, run, s, scratch};
+use support::clearance::{animate, assert_clear, examples};
+use support::{example_arg, scratch};
 
 /// Runs `animate` on `input` with `args` and returns the clearance of each stage it wrote.
 fn stages(dir: &std::path::Path, input: &str, args: &[&str]) -> Vec<(String, Clearance)> {
-    let out = dir.join("a.json");
-    let mut all = vec!["animate", input, "-o", s(&out), "--quiet"];
-    all.extend_from_slice(args);
-    let o = run(&all);
-    assert!(
-        o.status.success(),
-        "{all:?}: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    let anim = Animation::read(&out).expect("read the animation back");
-    Clearance::by_stage(&anim)
+    Clearance::by_stage(&animate(dir, input, args))
 }
 
 /// Asserts that stage `name` of `stages` was written and is clear.
@@ -36,33 +26,7 @@ fn assert_stage_clear(stages: &[(String, Clearance)], name: &str, what: &str) {
         .unwrap_or_else(|| panic!("{what}: no {name} stage"))
         .1;
     assert!(c.frames > 0, "{what}: an empty {name} stage");
-    assert_eq!(
-        (c.wing, c.body),
-        (0, 0),
-        "{what}, {name}: {} wing and {} body clashes in {} frames, closest {:?}",
-        c.wing,
-        c.body,
-        c.frames_with_clash,
-        c.closest
-    );
-}
-
-/// (name, input, read flags) of every example footage.
-fn examples() -> Vec<(&'static str, String, Vec<&'static str>)> {
-    vec![
-        (
-            "barnacle geese V",
-            example_arg("barnacle_geese_v.json"),
-            vec![],
-        ),
-        ("snow geese J", example_arg("snow_geese_j.csv"), vec![]),
-        (
-            "cranes",
-            example_arg("cranes_v_dltdv.csv"),
-            vec!["--wingspan-px", "22", "--heading", "300"],
-        ),
-        ("pelicans U", example_arg("pelicans_u_labelme"), vec![]),
-    ]
+    assert_clear(&c, &format!("{what}, {name}"));
 }
 
 #[test]

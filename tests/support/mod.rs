@@ -5,6 +5,7 @@
 
 #![allow(dead_code)]
 
+pub mod clearance;
 pub mod glb;
 pub mod rig;
 
