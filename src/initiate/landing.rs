@@ -523,8 +523,8 @@ fn loosening(
         } else {
             loosen
         };
-        let own = pulled_apart(start, &members, v, factor);
         let m = mids[f];
+        let own = pulled_apart(start, &members, m, v, factor);
         for (&i, &(x, p)) in members.iter().zip(&own) {
             x1[i] = m + x;
             pull[i] = p;
@@ -539,50 +539,58 @@ fn loosening(
     (x1, pull, widest)
 }
 
-/// The loosened lateral offsets of `members` (birds of one formation) from their middle: every
-/// offset times `factor`, and the gaps between birds that would still fly abreast within the
-/// wing envelope after the blend of their velocities (less than a span and a margin aside,
-/// within a chord and a margin fore and aft) widened to a span and a margin, locally:
-/// the widening is added to the gaps between those two birds only, so lateral gaps only grow and
-/// the formation widens by the widenings, not by a larger factor everywhere.
-/// Each member's (offset, the part of it that pulls apart).
-fn pulled_apart(start: &[[f64; 5]], members: &[usize], v: f64, factor: f64) -> Vec<(f64, f64)> {
+/// The loosened lateral offsets of `members` (birds of one formation) from their middle `m`:
+/// every offset times `factor`, and the gaps between birds that would still fly abreast within
+/// the wing envelope after the blend of their velocities (less than a span and a margin aside,
+/// within a chord and a margin fore and aft) widened to a span and a margin, locally: the
+/// widening is added to the gaps between those two birds only, so lateral gaps only grow and the
+/// formation widens by the widenings, not by a larger factor everywhere.
+///
+/// Returns each member's (offset, the part of it that pulls apart), in the order of `members`.
+fn pulled_apart(
+    start: &[[f64; 5]],
+    members: &[usize],
+    m: f64,
+    v: f64,
+    factor: f64,
+) -> Vec<(f64, f64)> {
     use crate::animation::clearance::{CHORD, SPAN};
     let span = SPAN + STAGGER_MARGIN;
     let drift = 0.5 * BLEND_S;
-    let (lo, hi) = members.iter().fold((f64::MAX, f64::MIN), |(a, b), &i| {
-        (a.min(start[i][0]), b.max(start[i][0]))
+    // Positions in `members`, sorted by lateral place; `extra[r]` widens the gap between ranks
+    // r − 1 and r.
+    let base = |k: usize| factor * (start[members[k]][0] - m);
+    let mut order: Vec<usize> = (0..members.len()).collect();
+    order.sort_by(|&a, &b| {
+        base(a)
+            .total_cmp(&base(b))
+            .then(members[a].cmp(&members[b]))
     });
-    let m = 0.5 * (lo + hi);
-    // Sorted by lateral place; `extra[r]` widens the gap between ranks r − 1 and r.
-    let mut order: Vec<usize> = members.to_vec();
-    let base = |i: usize| factor * (start[i][0] - m);
-    order.sort_by(|&a, &b| base(a).total_cmp(&base(b)).then(a.cmp(&b)));
     // Where the bird is when the blend of velocities is done, before any loosening: the pull,
     // made by then, must part the two birds a span on its own.
-    let x = |i: usize| start[i][0] + start[i][3] * drift;
-    let y = |i: usize| start[i][1] + (start[i][4] - v) * drift;
+    let x = |k: usize| start[members[k]][0] + start[members[k]][3] * drift;
+    let y = |k: usize| start[members[k]][1] + (start[members[k]][4] - v) * drift;
     let mut extra = vec![0.0f64; order.len()];
     for a in 0..order.len() {
         for b in a + 1..order.len() {
-            let added: f64 = extra[a + 1..=b].iter().sum();
-            let dx = x(order[b]) - x(order[a]) + added;
-            if x(order[b]) - x(order[a]) >= span {
+            let apart = x(order[b]) - x(order[a]);
+            if apart >= span {
                 break;
             }
+            let dx = apart + extra[a + 1..=b].iter().sum::<f64>();
             if (y(order[a]) - y(order[b])).abs() < CHORD + STAGGER_MARGIN && dx < span {
                 extra[b] += span - dx;
             }
         }
     }
     let total: f64 = extra.iter().sum();
-    let mut out = vec![(0.0, 0.0); start.len()];
+    let mut out = vec![(0.0, 0.0); members.len()];
     let mut acc = 0.0;
-    for (r, &i) in order.iter().enumerate() {
+    for (r, &k) in order.iter().enumerate() {
         acc += extra[r];
-        out[i] = (base(i) + acc - 0.5 * total, acc - 0.5 * total);
+        out[k] = (base(k) + acc - 0.5 * total, acc - 0.5 * total);
     }
-    members.iter().map(|&i| out[i]).collect()
+    out
 }
 
 /// Along-track distance within which two formations count as side by side for the landing's
@@ -656,7 +664,6 @@ fn clear_stagger(start: &[[f64; 5]], loosened: &[f64], v: f64, stagger: f64, ben
             if d1 < 0.0 {
                 (d1, d0) = (-d1, -d0);
             }
-            let g = d1;
             // Birds at rest are held to the body test: a pair nearly in line must stop a body's
             // distance apart, not only a chord.
             let dx = x1(b) - x1(a);
@@ -667,11 +674,11 @@ fn clear_stagger(start: &[[f64; 5]], loosened: &[f64], v: f64, stagger: f64, ben
                 clear
             };
             let bent = need / bend.clamp(0.2, 1.0);
-            if g >= bent {
+            if d1 >= bent {
                 if d0 > 0.0 {
-                    beta = beta.min((g - bent) / d0);
+                    beta = beta.min((d1 - bent) / d0);
                 }
-            } else if g >= clear || dx < body {
+            } else if d1 >= clear || dx < body {
                 // Clear now, but with no room to close up (on a bent course, or in line): no
                 // stagger.
                 beta = 0.0;
