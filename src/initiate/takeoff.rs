@@ -165,7 +165,13 @@ impl TakeoffPlan {
         let seconds = opts.takeoff.unwrap_or(natural);
         let sitting = Self::sitting(opts);
         let flying = (seconds - sitting).max(1e-3);
-        let drive = (Self::natural_form_flying(n) / flying).clamp(Self::MIN_DRIVE, Self::MAX_DRIVE);
+        // The natural take-off is driven at exactly 1 (no rounding of the sitting time).
+        let drive = match opts.takeoff {
+            None => 1.0,
+            Some(_) => {
+                (Self::natural_form_flying(n) / flying).clamp(Self::MIN_DRIVE, Self::MAX_DRIVE)
+            }
+        };
         let root = (n.max(1) as f64).sqrt();
         let (width, depth, stagger) = match &opts.start {
             Start::Ground(g) => {
