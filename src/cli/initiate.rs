@@ -92,15 +92,16 @@ fn climb_rate_help() -> String {
 /// The help of `--takeoff`, with the library's natural and shortest take-offs for two flock sizes
 /// of geese.
 fn takeoff_help() -> String {
-    let (o, c) = (InitiateOptions::default(), Cruise::new(0.0, 10.0));
-    let nat = |n| TakeoffPlan::natural_seconds(n, &o, &c);
-    let short = |n| TakeoffPlan::shortest_seconds(n, &o, &c);
+    let o = InitiateOptions::default();
+    let nat = |n| TakeoffPlan::natural_form_seconds(n, &o);
+    let short = |n| TakeoffPlan::shortest_form_seconds(n, &o);
+    let long = |n| TakeoffPlan::longest_form_seconds(n, &o);
     format!(
-        "Take-off duration, seconds: the birds start closer or farther apart and drive harder or softer to form in about this time; outside what the flock can fly a warning gives the duration it will have [default: the natural one, for geese {:.1} s for 14 birds and {:.1} s for 100; the shortest about {:.1} and {:.1} s; `--json` reports it as planned_seconds]",
+        "Time until the V has formed, seconds from the start of the take-off (the birds' sitting included): the birds start closer or farther apart and drive harder or softer to form in about this time, and climb to the cruise altitude at their own pace meanwhile (harder for a fast formation); outside what the flock can fly a warning gives the range it can [default: the natural one, for geese {:.1} s for 14 birds and {:.1} s for 100; from about {:.1} to {:.1} s for 14 birds; the summary says when the V formed, `--json` reports it as formed_seconds]",
         nat(14),
         nat(100),
         short(14),
-        short(100)
+        long(14)
     )
 }
 
@@ -350,7 +351,7 @@ pub fn run(args: InitiateArgs, g: Global) -> Result<()> {
         super::stdout::println(&text)?;
     }
     let written = formation::export::written_files(&args.output, &args.scene.options());
-    super::summary::initiate(g, &anim, stats.converged, &written);
+    super::summary::initiate(g, &anim, &stats, &written);
     Ok(())
 }
 

@@ -114,6 +114,34 @@ pub fn kinds_text(p: &FormationParams) -> String {
 
 /// The summary of an animation: `what` names the command.
 pub fn animation_text(what: &str, anim: &Animation, params: Option<&FormationParams>) -> String {
+    animation_text_with(what, anim, params, None)
+}
+
+/// When the take-off's V formed and how long the climb took, for the summary:
+/// `V formed after 8.9 s, climb to cruise height 20.4 s` (the climb from the first lift-off
+/// until every bird is at the cruise altitude and level).
+pub fn takeoff_text(s: &formation::initiate::InitiateStats) -> Option<String> {
+    let mut parts = Vec::new();
+    match s.formed_seconds {
+        Some(t) => parts.push(format!("V formed after {t:.1} s")),
+        None => parts.push("the V did not form".to_string()),
+    }
+    if let Some(t) = s.cruise_height_seconds {
+        parts.push(format!(
+            "climb to cruise height {:.1} s",
+            (t - s.first_liftoff).max(0.0)
+        ));
+    }
+    Some(parts.join(", "))
+}
+
+/// [`animation_text`] with the take-off's details from its statistics `takeoff`.
+pub fn animation_text_with(
+    what: &str,
+    anim: &Animation,
+    params: Option<&FormationParams>,
+    takeoff: Option<&formation::initiate::InitiateStats>,
+) -> String {
     let s = formation::animation::stats::AnimationStats::of(anim);
     let mut parts = vec![format!("{what}: {} birds", anim.birds)];
     if let Some(p) = params {
@@ -129,7 +157,10 @@ pub fn animation_text(what: &str, anim: &Animation, params: Option<&FormationPar
         if s.formations == 1 { "" } else { "s" }
     ));
     if let Some(t) = s.takeoff_s {
-        parts.push(format!("take-off {t:.1} s"));
+        match takeoff.and_then(takeoff_text) {
+            Some(d) => parts.push(format!("take-off {t:.1} s ({d})")),
+            None => parts.push(format!("take-off {t:.1} s")),
+        }
     }
     if let Some(t) = s.steady_s {
         parts.push(format!("steady flight {t:.1} s"));
@@ -154,12 +185,17 @@ pub fn dominant(p: &FormationParams) -> String {
 }
 
 /// `initiate`'s summary (one call from its command, so that its file stays its own).
-pub fn initiate(g: super::Global, anim: &Animation, converged: bool, outputs: &[PathBuf]) {
+pub fn initiate(
+    g: super::Global,
+    anim: &Animation,
+    stats: &formation::initiate::InitiateStats,
+    outputs: &[PathBuf],
+) {
     if g.quiet {
         return;
     }
-    let mut text = animation_text("initiate", anim, None);
-    if !converged {
+    let mut text = animation_text_with("initiate", anim, None, Some(stats));
+    if !stats.converged {
         text.push_str(" (the take-off did not converge)");
     }
     defer(text, outputs);
@@ -175,7 +211,12 @@ pub fn animate(
     if g.quiet {
         return;
     }
-    let mut text = animation_text("animate", anim, Some(&report.params));
+    let mut text = animation_text_with(
+        "animate",
+        anim,
+        Some(&report.params),
+        report.initiate.as_ref(),
+    );
     if report.initiate.as_ref().is_some_and(|s| !s.converged) {
         text.push_str(" (the take-off did not converge)");
     }

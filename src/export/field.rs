@@ -21,10 +21,13 @@ use super::raster::Canvas;
 
 /// A bird whose body is less than this high, wingspans, is on the surface.
 pub const ON_SURFACE: f64 = 0.45;
-/// How far the field reaches around a bird on it, wingspans (full opacity).
-pub const REACH: f64 = 2.5;
-/// Width of the field's soft edge, wingspans.
-pub const EDGE: f64 = 2.0;
+/// How far the field reaches around a bird on it, wingspans (full opacity): far enough that a
+/// sitting flock fills the follow camera's picture with its field (the camera frames the flock
+/// with a small margin), so the birds are seen on the ground, not on a patch of it.
+pub const REACH: f64 = 9.0;
+/// Width of the field's soft edge, wingspans: the field fades into the sky over it as the
+/// camera carries the flock away, like ground falling away below a climbing bird.
+pub const EDGE: f64 = 8.0;
 /// Spacing of the surface points kept, wingspans.
 const POINT_STEP: f64 = 0.5;
 /// Backdrop sample spacing, pixels.
@@ -44,6 +47,34 @@ pub struct Field {
     /// (true: water).
     cells: Bins,
     ground: [u8; 3],
+    /// Bounding box of the surface points `[x0, y0, x1, y1]`, wingspans.
+    bounds: [f64; 4],
+    /// [`Field::at`] sampled every [`RASTER`] wingspans over the bounds widened by the reach
+    /// and edge (from their corner), opacity and water, for painting: a picture looks it up
+    /// instead of searching the points at every sample.
+    raster: Vec<(f32, bool)>,
+    /// Columns of `raster`.
+    raster_w: usize,
+}
+
+/// Spacing of the field's raster, wingspans (its edge is [`EDGE`] wide, so a bilinear lookup
+/// shows no steps).
+const RASTER: f64 = 1.0;
+
+/// Colour of the ground over the plain background colour `c`: the grass field's colour, or, where
+/// that would hardly stand out from `c` (a difference of less than 40 levels of luminance), `c`
+/// made darker (or lighter, for a dark `c`), so the field and its edge are always seen.
+pub fn ground_for(c: [u8; 3]) -> [u8; 3] {
+    let g = super::scene::Style::default().ground;
+    let lum = |c: [u8; 3]| 0.299 * c[0] as f64 + 0.587 * c[1] as f64 + 0.114 * c[2] as f64;
+    if (lum(g) - lum(c)).abs() >= 40.0 {
+        return g;
+    }
+    if lum(c) >= 96.0 {
+        c.map(|v| (v as f64 * 0.55).round() as u8)
+    } else {
+        c.map(|v| (v as f64 + (255.0 - v as f64) * 0.45).round() as u8)
+    }
 }
 
 impl Field {
@@ -53,6 +84,7 @@ impl Field {
     /// The field of `points` `(x, y, on_water)`, ground coloured `ground`.
     pub fn new(points: impl IntoIterator<Item = (f64, f64, bool)>, ground: [u8; 3]) -> Field {
         let mut seen = std::collections::BTreeSet::new();
+        let mut bounds = [f64::MAX, f64::MAX, f64::MIN, f64::MIN];
         let mut cells: Bins = HashMap::new();
         for (x, y, water) in points {
             if !(x.is_finite() && y.is_finite()) {
@@ -67,12 +99,36 @@ impl Field {
                 continue;
             }
             let (qx, qy) = (key.0 as f64 * POINT_STEP, key.1 as f64 * POINT_STEP);
+            bounds = [
+                bounds[0].min(qx),
+                bounds[1].min(qy),
+                bounds[2].max(qx),
+                bounds[3].max(qy),
+            ];
             cells
                 .entry(Field::cell(qx, qy))
                 .or_default()
                 .push((qx, qy, water));
         }
-        Field { cells, ground }
+        let mut f = Field {
+            cells,
+            ground,
+            bounds,
+            raster: Vec::new(),
+            raster_w: 0,
+        };
+        if !f.is_empty() {
+            let m = REACH + EDGE;
+            let rw = ((bounds[2] - bounds[0] + 2.0 * m) / RASTER).ceil() as usize + 2;
+            let rh = ((bounds[3] - bounds[1] + 2.0 * m) / RASTER).ceil() as usize + 2;
+            let (x0, y0) = (bounds[0] - m, bounds[1] - m);
+            f.raster = (0..rh)
+                .flat_map(|j| (0..rw).map(move |i| (i, j)))
+                .map(|(i, j)| f.at(x0 + i as f64 * RASTER, y0 + j as f64 * RASTER))
+                .collect();
+            f.raster_w = rw;
+        }
+        f
     }
 
     /// True when no bird is ever on the surface.
@@ -119,6 +175,26 @@ impl Field {
         (u * u * (3.0 - 2.0 * u), best.1)
     }
 
+    /// [`Field::at`] from the raster: bilinear in opacity, the nearest sample's surface.
+    fn lookup(&self, x: f64, y: f64) -> (f32, bool) {
+        let m = REACH + EDGE;
+        let u = (x - (self.bounds[0] - m)) / RASTER;
+        let v = (y - (self.bounds[1] - m)) / RASTER;
+        let rw = self.raster_w;
+        let rh = self.raster.len() / rw.max(1);
+        if !(u >= 0.0 && v >= 0.0 && u < (rw - 1) as f64 && v < (rh - 1) as f64) {
+            return (0.0, false);
+        }
+        let (i, j) = (u as usize, v as usize);
+        let (fx, fy) = ((u - i as f64) as f32, (v - j as f64) as f32);
+        let k = j * rw + i;
+        let r = &self.raster;
+        let a = (r[k].0 * (1.0 - fx) + r[k + 1].0 * fx) * (1.0 - fy)
+            + (r[k + rw].0 * (1.0 - fx) + r[k + rw + 1].0 * fx) * fy;
+        let near = r[k + (fy >= 0.5) as usize * rw + (fx >= 0.5) as usize].1;
+        (a, near)
+    }
+
     /// Lays the field over `canvas` (a top-down `view`; other views are left as they are).
     pub fn paint(&self, view: &View, canvas: &mut Canvas) {
         let View::Top { cx, cy, scale } = *view else {
@@ -128,6 +204,12 @@ impl Field {
             return;
         }
         let (w, h) = (canvas.width, canvas.height);
+        // Nothing to do when the picture is wholly beyond the field's reach.
+        let (hw, hh, m) = (0.5 * w as f64 / scale, 0.5 * h as f64 / scale, REACH + EDGE);
+        let b = self.bounds;
+        if cx + hw < b[0] - m || cx - hw > b[2] + m || cy + hh < b[1] - m || cy - hh > b[3] + m {
+            return;
+        }
         let gw = w / GRID + 2;
         let gh = h / GRID + 2;
         let mut alpha = vec![0f32; gw * gh];
@@ -139,7 +221,7 @@ impl Field {
             for gx in 0..gw {
                 let col = (gx * GRID) as f64 + 0.5;
                 let x = cx + (col - 0.5 * w as f64) / scale;
-                let (a, wt) = self.at(x, y);
+                let (a, wt) = self.lookup(x, y);
                 alpha[gy * gw + gx] = a;
                 water[gy * gw + gx] = wt;
                 any |= a > 0.0;
@@ -150,30 +232,39 @@ impl Field {
         }
         for r in 0..h {
             let (gy, fy) = (r / GRID, (r % GRID) as f32 / GRID as f32);
-            for c in 0..w {
-                let (gx, fx) = (c / GRID, (c % GRID) as f32 / GRID as f32);
+            for gx in 0..w.div_ceil(GRID) {
                 let i = gy * gw + gx;
                 let (a00, a10, a01, a11) =
                     (alpha[i], alpha[i + 1], alpha[i + gw], alpha[i + gw + 1]);
                 if a00 == 0.0 && a10 == 0.0 && a01 == 0.0 && a11 == 0.0 {
                     continue;
                 }
-                let a =
-                    (a00 * (1.0 - fx) + a10 * fx) * (1.0 - fy) + (a01 * (1.0 - fx) + a11 * fx) * fy;
                 let colour = if water[i] { WATER } else { self.ground };
-                let px = &mut canvas.rgba[(r * w + c) * 4..(r * w + c) * 4 + 4];
-                if a >= 1.0 {
-                    px[..3].copy_from_slice(&colour);
-                    px[3] = 255;
+                let cols = gx * GRID..((gx + 1) * GRID).min(w);
+                let run = &mut canvas.rgba[(r * w + cols.start) * 4..(r * w + cols.end) * 4];
+                if a00 >= 1.0 && a10 >= 1.0 && a01 >= 1.0 && a11 >= 1.0 {
+                    for px in run.chunks_exact_mut(4) {
+                        px.copy_from_slice(&[colour[0], colour[1], colour[2], 255]);
+                    }
                     continue;
                 }
-                // Over a transparent background the field is laid with its own opacity
-                // (premultiplied, like the canvas).
-                let a8 = (a * 255.0).round() as u32;
-                for k in 0..3 {
-                    px[k] = ((px[k] as u32 * (255 - a8) + colour[k] as u32 * a8 + 127) / 255) as u8;
+                for (c, px) in run.chunks_exact_mut(4).enumerate() {
+                    let fx = c as f32 / GRID as f32;
+                    let a = (a00 * (1.0 - fx) + a10 * fx) * (1.0 - fy)
+                        + (a01 * (1.0 - fx) + a11 * fx) * fy;
+                    if a >= 1.0 {
+                        px.copy_from_slice(&[colour[0], colour[1], colour[2], 255]);
+                        continue;
+                    }
+                    // Over a transparent background the field is laid with its own opacity
+                    // (premultiplied, like the canvas).
+                    let a8 = (a * 255.0).round() as u32;
+                    for k in 0..3 {
+                        px[k] =
+                            ((px[k] as u32 * (255 - a8) + colour[k] as u32 * a8 + 127) / 255) as u8;
+                    }
+                    px[3] = ((px[3] as u32 * (255 - a8) + 255 * a8 + 127) / 255) as u8;
                 }
-                px[3] = ((px[3] as u32 * (255 - a8) + 255 * a8 + 127) / 255) as u8;
             }
         }
     }

@@ -38,6 +38,7 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::mpsc;
 
 use super::camera::{self, CameraParams, View};
+use super::field::Field;
 use super::lzw::Lzw;
 use super::palette::{Lookup, Palette, TRANSPARENT};
 use super::raster::{Canvas, Mask};
@@ -79,6 +80,8 @@ pub struct Film<'a> {
     backdrop: Backdrop,
     /// The GIF's scrolled sky, shared by the workers.
     sky: SkyCache,
+    /// The ground or water under the birds on it (top-down cameras).
+    field: Field,
     gif_tolerance: i32,
     /// One cycle of a loop: the GIF's last frame is written exactly (no tolerance), so that the
     /// step back to the first frame (always drawn whole) is a true step.
@@ -128,6 +131,7 @@ impl<'a> Film<'a> {
             ..CameraParams::default()
         };
         let views = camera::track(&places, fps, width, height, &params);
+        let field = surface_field(anim, &times, &places, opts);
         drop(places);
         let flapper = Flapper::from_animation(anim);
         let style = Style {
@@ -146,6 +150,7 @@ impl<'a> Film<'a> {
             species,
             backdrop: Backdrop::new(width, height, &style, opts.background, anim.seed),
             sky: SkyCache::default(),
+            field,
             gif_tolerance: opts.gif_tolerance.round().clamp(0.0, 255.0) as i32,
             looped: anim.looped,
         }
@@ -198,6 +203,7 @@ impl<'a> Film<'a> {
         } else {
             self.backdrop.paint(&self.views[k], canvas);
         }
+        self.field.paint(&self.views[k], canvas);
         scene::draw_birds(canvas, &self.states(k), &self.views[k], self.species, mask);
     }
 
@@ -228,8 +234,16 @@ impl<'a> Film<'a> {
                 train.extend_from_slice(p);
             }
         }
+        Palette::learn(&train, &self.exact_colours())
+    }
+
+    /// The colours the GIF palette holds exactly and maps undithered: the plumage, and the flat
+    /// colours of the field under the birds.
+    fn exact_colours(&self) -> Vec<[u8; 3]> {
         let pl = super::silhouette::plumage(self.species);
-        Palette::learn(&train, &[pl.body, pl.arm, pl.hand, pl.head])
+        let mut v = vec![pl.body, pl.arm, pl.hand, pl.head];
+        v.extend(self.field.colours());
+        v
     }
 }
 
@@ -587,6 +601,41 @@ fn loop_tolerance(base: i32, looped: bool, k: usize, total: usize, ramp: usize) 
     (base as f64 * left as f64 / ramp as f64).floor() as i32
 }
 
+/// The field under the birds that sit, run or float ([`Field`]) at the picture frames `times`
+/// (the birds' `places` there), for a top-down camera over the sky or a plain colour; empty
+/// otherwise (the ground camera has its own ground and horizon, and a transparent background
+/// stays transparent for compositing). Ground where the flock takes off and where it lands on a
+/// field, water where it lands on water.
+fn surface_field(
+    anim: &Animation,
+    times: &[f64],
+    places: &[Vec<Place>],
+    opts: &RenderOptions,
+) -> Field {
+    let top_down = !matches!(opts.camera, camera::CameraKind::Ground);
+    if !top_down || opts.background == Background::None {
+        return Field::default();
+    }
+    let water_from = anim
+        .landing
+        .as_ref()
+        .filter(|l| l.surface == crate::animation::landing::Surface::Water)
+        .and_then(|_| anim.stage("landing"))
+        .and_then(|s| anim.frames.get(s.start))
+        .map(|f| f.t);
+    let points = times.iter().zip(places).flat_map(|(&t, st)| {
+        let water = water_from.is_some_and(|t0| t >= t0);
+        st.iter()
+            .filter(|b| b.z < super::field::ON_SURFACE)
+            .map(move |b| (b.x, b.y, water))
+    });
+    let ground = match opts.background {
+        Background::Colour(c) => super::field::ground_for(c),
+        _ => Style::default().ground,
+    };
+    Field::new(points, ground)
+}
+
 /// A value borrowed from a pool for one worker of [`run_frames`], handed back when dropped.
 struct Pooled<'a, T: Default> {
     item: Option<T>,
@@ -644,8 +693,7 @@ pub fn write_gif(film: &Film, path: &Path, threads: usize, progress: &dyn Progre
         let band = h.div_ceil(threads.max(1)).max(1) * w;
         let mut shown = vec![0u8; w * h];
         let mut dirty = vec![0u8; w * h];
-        let pl = super::silhouette::plumage(film.species);
-        let plain = [pl.body, pl.arm, pl.hand, pl.head];
+        let plain = film.exact_colours();
         let mut lookups: Vec<Lookup> = shown.chunks(band).map(|_| Lookup::new(&palette)).collect();
         // The previous frame's picture, the batch's sub-frames, and spare picture buffers.
         let mut last = vec![0u8; w * h * 4];

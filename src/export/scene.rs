@@ -416,8 +416,36 @@ impl Backdrop {
                 for p in canvas.rgba.chunks_exact_mut(4) {
                     p.copy_from_slice(&[c[0], c[1], c[2], 255]);
                 }
+                if let View::Ground(e) = view {
+                    self.paint_plain_ground(e, c, canvas);
+                }
             }
             Background::Sky => self.paint_sky(view, canvas),
+        }
+    }
+
+    /// The ground camera over a plain colour `c`: the ground below the horizon, in a colour that
+    /// stands out from `c` ([`super::field::ground_for`]), hazy towards the horizon as over the
+    /// sky, so the horizon shows on any colour (dark ones too). The eye does not roll, so the
+    /// horizon is level and one ray per row decides it.
+    fn paint_plain_ground(&self, e: &super::camera::Eye, c: [u8; 3], canvas: &mut Canvas) {
+        let (w, h) = (self.width, self.height);
+        let g = super::field::ground_for(c);
+        for r in 0..h {
+            let d = e.ray(0.5 * w as f64, r as f64 + 0.5, w, h);
+            let el = d[2] / (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+            if el.is_nan() || el >= 0.0 {
+                continue;
+            }
+            let haze = (el / GROUND_HAZE_RAD).exp() as f32;
+            let px = [0, 1, 2].map(|k| {
+                (g[k] as f32 + (c[k] as f32 - g[k] as f32) * haze)
+                    .round()
+                    .clamp(0.0, 255.0) as u8
+            });
+            for p in canvas.rgba[r * w * 4..(r + 1) * w * 4].chunks_exact_mut(4) {
+                p.copy_from_slice(&[px[0], px[1], px[2], 255]);
+            }
         }
     }
 

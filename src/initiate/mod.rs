@@ -101,6 +101,20 @@ pub struct InitiateStats {
     pub max_stray: f64,
     /// Time at which the last bird left the ground, seconds (0 for an airborne start).
     pub last_liftoff: f64,
+    /// Time at which the first bird left the ground, seconds (0 for an airborne start).
+    #[serde(default)]
+    pub first_liftoff: f64,
+    /// When the V formed, seconds from the start of the take-off: the start of the first
+    /// stretch of at least `initiate.hold` seconds over which the convergence test holds in the
+    /// horizontal (every bird in its own slot, at the cruise heading and speed, flying steadily;
+    /// [`sim::Simulation::formed`]), whatever the height. `None` if it never did.
+    #[serde(default)]
+    pub formed_seconds: Option<f64>,
+    /// When every bird reached the cruise altitude and levelled off, seconds from the start of
+    /// the take-off (held for `initiate.hold` seconds, as `formed_seconds`). `None` if they never
+    /// did.
+    #[serde(default)]
+    pub cruise_height_seconds: Option<f64>,
     /// How often the leader changed.
     pub leader_changes: usize,
     /// Birds within the tolerance of a slot of their own at the end.
@@ -223,6 +237,9 @@ pub fn simulate(
             max_bank: 0.0,
             max_stray: 0.0,
             last_liftoff: 0.0,
+            first_liftoff: 0.0,
+            formed_seconds: None,
+            cruise_height_seconds: None,
             leader_changes: 0,
             birds_in_slot: 0,
             field_per_eye: params.opts.perception.fov_per_eye,
@@ -246,6 +263,8 @@ pub fn simulate(
     let total = (limit / dt).ceil() as u64;
     progress.start("initiate", total);
     let mut in_formation_since: Option<f64> = None;
+    let (mut formed_since, mut high_since): (Option<f64>, Option<f64>) = (None, None);
+    let mut lifted = sim.all_airborne();
     let mut converged = false;
     let mut liftoff_done = sim.all_airborne();
     let mut cur: Vec<sim::BirdState> = prev.clone();
@@ -285,7 +304,29 @@ pub fn simulate(
         if liftoff_done && sim.steps % (8 * params.opts.substeps as usize) == 0 {
             run.stats.max_stray = run.stats.max_stray.max(sim.stray_distance());
         }
-        if sim.in_formation(&tol) {
+        if !lifted && sim.any_airborne() {
+            lifted = true;
+            run.stats.first_liftoff = sim.time;
+        }
+        let formed = sim.formed(&tol);
+        let high = sim.at_cruise_height(&tol);
+        for (holds, since, at) in [
+            (formed, &mut formed_since, &mut run.stats.formed_seconds),
+            (high, &mut high_since, &mut run.stats.cruise_height_seconds),
+        ] {
+            if at.is_some() {
+                continue;
+            }
+            if holds {
+                let t0 = *since.get_or_insert(sim.time);
+                if sim.time - t0 >= opts.hold - 1e-9 {
+                    *at = Some(t0);
+                }
+            } else {
+                *since = None;
+            }
+        }
+        if formed && high {
             let since = *in_formation_since.get_or_insert(sim.time);
             if sim.time - since >= opts.hold - 1e-9 {
                 converged = true;

@@ -59,10 +59,11 @@ pub struct InitiateOptions {
     pub vertical_accel: f64,
     /// Acceleration of the take-off run on the ground, wingspans per second squared.
     pub run_accel: f64,
-    /// Wanted take-off duration, seconds (`None`: the natural one of the flock size, see
-    /// [`TakeoffPlan::natural_seconds`]). The take-off plan scales the start area, the departure
-    /// stagger and how hard the birds drive (accelerations, climb, approach) to it
-    /// ([`TakeoffPlan::drive`]); the simulation is never cut.
+    /// Wanted time until the V has formed, seconds from the start of the take-off, the sitting
+    /// included (`None`: the natural one of the flock size, see
+    /// [`TakeoffPlan::natural_form_seconds`]). The take-off plan scales the start area, the
+    /// departure stagger and how hard the birds drive (run, approach; the climb only harder) to
+    /// it ([`TakeoffPlan::drive`]); the simulation is never cut.
     pub takeoff: Option<f64>,
     /// Time the birds sit on the ground before the first one starts its run, seconds (a ground
     /// start only).
@@ -631,7 +632,11 @@ impl InitiateOptions {
     /// catch-up distance and drive (accelerations of the run and the climb, the climb rate and,
     /// up to [`TakeoffPlan::MAX_APPROACH_DRIVE`], the approach scaled by it).
     pub fn plan_params(&self, cruise: &Cruise, plan: &TakeoffPlan) -> StepParams {
-        self.derive_params(cruise, plan.k, plan.catchup_distance, plan.drive)
+        let mut p = self.derive_params(cruise, plan.k, plan.catchup_distance, plan.drive);
+        // The climb at the plan's climb drive (not slowed with a slow formation).
+        p.climb_rate = self.climb_rate_for(cruise) * plan.climb_drive;
+        p.vertical_accel = self.vertical_accel * plan.climb_drive;
+        p
     }
 
     /// The options and the values derived from them: the speeds in wingspans per second from

@@ -739,7 +739,7 @@ pub fn start_simulation(
                 .iter()
                 .map(|d| d - first + opts.ground_seconds)
                 .collect();
-            check_climb(opts, &params, plan.drive, &depart)?;
+            check_climb(opts, &params, plan.climb_drive, &depart)?;
             (pos, vec![0.0; n], heading, vec![0.0; n], depart)
         }
         Start::Random(region) => {

@@ -670,6 +670,15 @@ pub fn flock_stats(report: &SkeinReport) -> Option<InitiateStats> {
         s.max_bank = s.max_bank.max(o.max_bank);
         s.max_stray = s.max_stray.max(o.max_stray);
         s.last_liftoff = s.last_liftoff.max(o.last_liftoff);
+        s.first_liftoff = s.first_liftoff.min(o.first_liftoff);
+        s.formed_seconds = s
+            .formed_seconds
+            .zip(o.formed_seconds)
+            .map(|(a, b)| a.max(b));
+        s.cruise_height_seconds = s
+            .cruise_height_seconds
+            .zip(o.cruise_height_seconds)
+            .map(|(a, b)| a.max(b));
         s.leader_changes += o.leader_changes;
         s.birds_in_slot += o.birds_in_slot;
         s.field_per_eye = s.field_per_eye.max(o.field_per_eye);
@@ -841,6 +850,9 @@ mod tests {
                 max_bank: 0.0,
                 max_stray: 0.0,
                 last_liftoff: 0.0,
+                first_liftoff: 0.0,
+                formed_seconds: Some(0.0),
+                cruise_height_seconds: Some(0.0),
                 leader_changes: 0,
                 birds_in_slot: 1,
                 field_per_eye: 1.0,

@@ -578,6 +578,11 @@ impl Simulation {
         self.flock.phase.iter().all(|&p| p == Phase::Airborne)
     }
 
+    /// Whether any bird has left the ground.
+    pub fn any_airborne(&self) -> bool {
+        self.flock.phase.contains(&Phase::Airborne)
+    }
+
     /// The state of bird `i`.
     pub fn bird(&self, i: usize) -> BirdState {
         let f = &self.flock;

@@ -162,6 +162,12 @@ impl Simulation {
     /// (fraction) of the cruise speed, and flying steadily (turn rate, acceleration and climb
     /// rate small, so that the hand-over to the steady flight has no jerk).
     pub fn in_formation(&self, tol: &Tolerances) -> bool {
+        self.formed(tol) && self.at_cruise_height(tol)
+    }
+
+    /// The convergence test in the horizontal alone (the V is formed, whatever the height):
+    /// [`Self::in_formation`] without its altitude and climb-rate conditions.
+    pub fn formed(&self, tol: &Tolerances) -> bool {
         let n = self.len();
         let f = &self.flock;
         if !self.all_airborne() {
@@ -179,13 +185,23 @@ impl Simulation {
         (0..n).all(|i| {
             let s = f.slot[i].unwrap_or(0);
             (f.pos[i] - slots[s]).length() <= tol.distance
-                && (f.z[i] - p.opts.cruise_altitude).abs() <= tol.distance
                 && wrap_angle(f.heading[i] - p.cruise_heading).abs() <= tol.heading
                 && (f.speed[i] - p.cruise_speed).abs() <= tol.speed * p.cruise_speed
                 && f.turn_rate[i].abs() <= tol.turn_rate
                 && f.accel[i].abs() <= tol.accel
-                && f.climb[i].abs() <= tol.climb
         })
+    }
+
+    /// The height part of the convergence test: every bird is airborne, within `tol.distance`
+    /// wingspans of the cruise altitude and levelled off (climb rate within `tol.climb`).
+    pub fn at_cruise_height(&self, tol: &Tolerances) -> bool {
+        let f = &self.flock;
+        let p = &self.params;
+        self.all_airborne()
+            && (0..self.len()).all(|i| {
+                (f.z[i] - p.opts.cruise_altitude).abs() <= tol.distance
+                    && f.climb[i].abs() <= tol.climb
+            })
     }
 
     /// Number of birds within `tolerance` of their (uniquely held) slot.
