@@ -10,6 +10,9 @@
 //! same pixel always gets the same entry, so frame differencing still works, while the palette's
 //! steps become a fine pattern instead of contour bands.
 //!
+//! NeuQuant leaves rare colours far from every entry; the last 48 learnt entries go instead
+//! where the sampled pixels are worst served ([`cover`]).
+//!
 //! Lookups go through a table indexed by the colour's top 6 bits per channel, filled lazily with
 //! the nearest palette entry (perceptually weighted squared RGB distance
 //! `3Δr² + 4Δg² + 2Δb²`), which makes mapping a 960×540 frame a few milliseconds and the result
@@ -18,6 +21,8 @@
 /// Palette index reserved for "unchanged since the previous frame" (GIF transparency); the
 /// colours are entries `0..TRANSPARENT`.
 pub const TRANSPARENT: u8 = 255;
+
+use std::collections::BTreeMap;
 
 /// The 8×8 Bayer matrix (ordered-dither thresholds 0..64).
 const BAYER8: [[u8; 8]; 8] = [
@@ -70,12 +75,17 @@ impl Palette {
             for p in train.chunks_exact_mut(4) {
                 p[3] = 255;
             }
-            let nq = color_quant::NeuQuant::new(SAMPLE_FACTOR, learnt, &train);
+            let nq = color_quant::NeuQuant::new(
+                SAMPLE_FACTOR,
+                learnt.saturating_sub(COVER).max(2),
+                &train,
+            );
             for p in nq.color_map_rgba().chunks_exact(4) {
                 c.push([p[0], p[1], p[2]]);
             }
         }
-        c.truncate(learnt);
+        c.truncate(learnt.saturating_sub(COVER).max(2));
+        cover(&mut c, rgba, learnt);
         c.extend(exact);
         c.truncate(TRANSPARENT as usize);
         while c.len() < 256 {
@@ -87,6 +97,61 @@ impl Palette {
     /// The palette as `r, g, b` bytes, the layout GIF wants.
     pub fn to_bytes(&self) -> Vec<u8> {
         self.colours.iter().flatten().copied().collect()
+    }
+}
+
+/// Palette entries kept back from NeuQuant and chosen by [`cover`] instead.
+const COVER: usize = 48;
+
+/// Adds colours to `c` (up to `len` entries) where the palette fits the sampled pixels `rgba`
+/// worst. NeuQuant places its entries where most pixels are, so rare but wide-apart colours (the
+/// pale haze low over the horizon late in a film, a bright cloud seen for a few seconds) can be
+/// 10 to 30 levels from every entry, further than the ordered dither can bridge: those show as
+/// flat patches of the wrong colour. Greedily, the colour (on a 4-level grid) with the largest
+/// `pixels × distance⁴` to its nearest entry (distance to the fourth: a few pixels far off
+/// outweigh many a level or two off) is added, until `len` entries.
+fn cover(c: &mut Vec<[u8; 3]>, rgba: &[u8], len: usize) {
+    let mut cells: BTreeMap<[u8; 3], u32> = BTreeMap::new();
+    for p in rgba.chunks_exact(4) {
+        *cells.entry([p[0] >> 2, p[1] >> 2, p[2] >> 2]).or_insert(0) += 1;
+    }
+    if cells.is_empty() {
+        return;
+    }
+    let colour = |k: &[u8; 3]| k.map(|v| (v << 2) | 2);
+    let dist = |a: [u8; 3], b: [u8; 3]| -> i64 {
+        let (dr, dg, db) = (
+            a[0] as i64 - b[0] as i64,
+            a[1] as i64 - b[1] as i64,
+            a[2] as i64 - b[2] as i64,
+        );
+        3 * dr * dr + 4 * dg * dg + 2 * db * db
+    };
+    let mut best: Vec<(i64, [u8; 3], u32)> = cells
+        .iter()
+        .map(|(k, &n)| {
+            let q = colour(k);
+            let d = c.iter().map(|&e| dist(q, e)).min().unwrap_or(i64::MAX / 4);
+            (d, q, n)
+        })
+        .collect();
+    while c.len() < len {
+        let Some(pick) = best
+            .iter()
+            .enumerate()
+            .max_by_key(|(i, (d, _, n))| (d * d * *n as i64, std::cmp::Reverse(*i)))
+            .map(|(i, _)| i)
+        else {
+            break;
+        };
+        if best[pick].0 == 0 {
+            break;
+        }
+        let q = best[pick].1;
+        c.push(q);
+        for b in best.iter_mut() {
+            b.0 = b.0.min(dist(b.1, q));
+        }
     }
 }
 

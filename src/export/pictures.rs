@@ -207,13 +207,14 @@ impl<'a> Film<'a> {
         scene::draw_birds(canvas, &self.states(k), &self.views[k], self.species, mask);
     }
 
-    /// The GIF palette: NeuQuant over pixels of up to 17 frames spread over the film (every
-    /// 13th pixel of each: as many pixels as 9 frames at every 7th, over more of the film's
-    /// skies, so a camera that tilts to a deeper blue for a few seconds still finds it), plus the
+    /// The GIF palette: NeuQuant over pixels of up to 60 frames spread over the film (every
+    /// 47th pixel of each: as many pixels as 17 frames at every 13th, over more of the film's
+    /// skies, so a camera that tilts to a deeper blue or a pale haze seen for a few seconds is
+    /// still in the sample; 17 frames left the README job's last seconds 8 levels off), plus the
     /// species' plumage exactly.
     pub fn palette(&self) -> Palette {
-        const PALETTE_FRAMES: usize = 17;
-        const PALETTE_STEP: usize = 13;
+        const PALETTE_FRAMES: usize = 60;
+        const PALETTE_STEP: usize = 47;
         let (w, h) = (self.width, self.height);
         let n = self.len();
         let picks: Vec<usize> = if n == 0 {
@@ -476,6 +477,91 @@ fn delta_step(
     }
 }
 
+/// Side of the blocks whose mean error [`block_refresh`] bounds, pixels.
+pub const REFRESH_BLOCK: usize = 4;
+
+/// Largest mean error, levels in some channel, that a [`REFRESH_BLOCK`]-square block of the
+/// GIF may keep against the true picture before it is sent again at its own colours. Every
+/// 8 × 8 box on the block grid averages four blocks, so no such box strays from the true
+/// picture by more than this on top of what the palette and dither leave in a freshly sent
+/// block.
+pub const BLOCK_MEAN_TOLERANCE: f64 = 4.0;
+
+/// The second pass of the differencing over a band of rows (after [`delta_step`]): the
+/// per-pixel tolerance alone lets many pixels lag the same way at once (the soft edge of a cloud
+/// sliding by, the faint trail of a bird, a slow gradient), which the eye sees as a stale patch
+/// once the dither's grain is averaged out. So the band is cut into
+/// [`REFRESH_BLOCK`]-square blocks on a screen-fixed grid (the band starts on a block row), and
+/// every block whose true colours changed, or which sent something this frame, is checked: when
+/// the mean of `shown − true` over the block exceeds [`BLOCK_MEAN_TOLERANCE`] in some channel,
+/// every pixel of the block is set to its own (dithered) index. Blocks that did not change keep
+/// the state that was checked when they last did, so the bound holds in every frame.
+#[allow(clippy::too_many_arguments)]
+fn block_refresh(
+    shown: &mut [u8],
+    dirty: &mut [u8],
+    rgba: &[u8],
+    prev: &[u8],
+    out: &mut [u8],
+    lookup: &mut Lookup,
+    palette: &Palette,
+    all: bool,
+    (start, width): (usize, usize),
+    plain: &[[u8; 3]],
+) {
+    let width = width.max(1);
+    let n = shown.len().min(dirty.len()).min(out.len());
+    let rows = n / width;
+    let y_base = start / width;
+    let limit = (BLOCK_MEAN_TOLERANCE * (REFRESH_BLOCK * REFRESH_BLOCK) as f64) as i32;
+    for by in (0..rows).step_by(REFRESH_BLOCK) {
+        let y1 = (by + REFRESH_BLOCK).min(rows);
+        for bx in (0..width).step_by(REFRESH_BLOCK) {
+            let x1 = (bx + REFRESH_BLOCK).min(width);
+            let touched = all
+                || (by..y1).any(|y| {
+                    let (a, b) = (y * width + bx, y * width + x1);
+                    rgba[a * 4..b * 4] != prev[a * 4..b * 4]
+                        || out[a..b].iter().any(|&o| o != TRANSPARENT)
+                });
+            if !touched {
+                continue;
+            }
+            let mut sum = [0i32; 3];
+            for y in by..y1 {
+                for i in y * width + bx..y * width + x1 {
+                    let c = palette.colours[shown[i] as usize];
+                    for k in 0..3 {
+                        sum[k] += c[k] as i32 - rgba[i * 4 + k] as i32;
+                    }
+                }
+            }
+            let count = ((y1 - by) * (x1 - bx)) as i32;
+            // Scaled to a full block: `limit` is the tolerance times a full block's pixels.
+            let full = (REFRESH_BLOCK * REFRESH_BLOCK) as i32;
+            if sum.iter().all(|s| s.abs() * full <= limit * count) {
+                continue;
+            }
+            for y in by..y1 {
+                for i in y * width + bx..y * width + x1 {
+                    let p = &rgba[i * 4..i * 4 + 3];
+                    let rgb = [p[0], p[1], p[2]];
+                    let q = if plain.contains(&rgb) {
+                        lookup.index(rgb)
+                    } else {
+                        lookup.index_dithered(rgb, i % width, y_base + y)
+                    };
+                    dirty[i] = 0;
+                    if q != shown[i] {
+                        shown[i] = q;
+                        out[i] = q;
+                    }
+                }
+            }
+        }
+    }
+}
+
 /// Pixels [`delta_step`] skips in one comparison when nothing changed there.
 const DELTA_BLOCK: usize = 32;
 
@@ -690,7 +776,12 @@ pub fn write_gif(film: &Film, path: &Path, threads: usize, progress: &dyn Progre
         progress.start("gif", film.len() as u64);
         // Palette indices the viewer sees after the frames written so far, in bands of rows
         // (one per worker), each with its own lookup table.
-        let band = h.div_ceil(threads.max(1)).max(1) * w;
+        // Bands start on a row of the refresh blocks' grid.
+        let band = h
+            .div_ceil(threads.max(1))
+            .next_multiple_of(REFRESH_BLOCK)
+            .max(REFRESH_BLOCK)
+            * w;
         let mut shown = vec![0u8; w * h];
         let mut dirty = vec![0u8; w * h];
         let plain = film.exact_colours();
@@ -770,6 +861,20 @@ pub fn write_gif(film: &Film, path: &Path, threads: usize, progress: &dyn Progre
                                     (lo, w),
                                     plain,
                                 );
+                                if start + k > 0 {
+                                    block_refresh(
+                                        s,
+                                        dt,
+                                        &drawn[k][lo * 4..hi * 4],
+                                        &prev[lo * 4..hi * 4],
+                                        o,
+                                        lookup,
+                                        palette,
+                                        tol < tolerance,
+                                        (lo, w),
+                                        plain,
+                                    );
+                                }
                             }
                         });
                     }

@@ -38,6 +38,9 @@ pub struct PowerChart {
     pub ranges: Option<Vec<[f64; 2]>>,
     /// Index of the leader, drawn in a distinct colour.
     pub leader: Option<usize>,
+    /// Distance of each bird behind the leader, wingspans (same order as `x`): the bars are
+    /// coloured by rank, front to back ([`super::bird_colour`]); empty for one colour.
+    pub behind: Vec<f64>,
 }
 
 /// What part of an animation a [`PowerChart`] shows.
@@ -69,7 +72,7 @@ impl PowerChart {
         metric: PowerMetric,
     ) -> Result<PowerChart> {
         let name = file_name(origin);
-        let (x, e, xi, what) = match of {
+        let (x, behind, e, xi, what) = match of {
             PowerOf::Frame(k) => {
                 let fr = anim.frames.get(k).ok_or_else(|| {
                     Error::parameter(
@@ -86,15 +89,15 @@ impl PowerChart {
                 // offsets to the right of the leader's heading, distances behind it along it.
                 let rel = anim.relative(k);
                 let lateral: Vec<f64> = rel.iter().map(|r| r.lateral).collect();
+                let behind: Vec<f64> = rel.iter().map(|r| r.behind).collect();
                 let (e, xi) = match (&fr.e, &fr.xi) {
                     (Some(e), Some(xi)) => (e.clone(), xi.clone()),
                     _ => {
-                        let behind: Vec<f64> = rel.iter().map(|r| r.behind).collect();
                         let p = power_reduction(&lateral, &behind)?;
                         (p.e, p.xi)
                     }
                 };
-                (lateral, e, xi, format!("frame {k}"))
+                (lateral, behind, e, xi, format!("frame {k}"))
             }
             PowerOf::Key(k) => {
                 let ks = anim.key_shapes.get(k).ok_or_else(|| {
@@ -110,22 +113,21 @@ impl PowerChart {
                 let x: Vec<f64> = ks.birds.iter().map(|b| b.x).collect();
                 let y: Vec<f64> = ks.birds.iter().map(|b| b.y).collect();
                 let p = power_reduction(&x, &y)?;
-                (x, p.e, p.xi, format!("key shape {k} (frame {})", ks.frame))
+                (
+                    x,
+                    y,
+                    p.e,
+                    p.xi,
+                    format!("key shape {k} (frame {})", ks.frame),
+                )
             }
         };
-        let leader = if let PowerOf::Key(k) = of {
-            anim.key_shapes
-                .get(k)
-                .and_then(|ks| {
-                    ks.birds
-                        .iter()
-                        .enumerate()
-                        .min_by(|a, b| a.1.y.total_cmp(&b.1.y))
-                })
-                .map(|(i, _)| i)
-        } else {
-            None
-        };
+        // The front-most bird (a frame's distances are behind its leader: the one at 0).
+        let leader = behind
+            .iter()
+            .enumerate()
+            .min_by(|a, b| a.1.total_cmp(b.1))
+            .map(|(i, _)| i);
         Ok(PowerChart {
             title: format!("{name}: {what}"),
             values: match metric {
@@ -147,6 +149,7 @@ impl PowerChart {
                 _ => r.clone(),
             }),
             leader,
+            behind,
         })
     }
 
@@ -197,8 +200,21 @@ impl PowerChart {
             metric,
             ranges: None,
             leader: shape.leader(),
+            behind: shape.ys(),
         })
     }
+}
+
+/// Rank of each bird (0 = front) from its distance behind the leader; ties keep index order.
+/// Empty when `behind` is.
+fn ranks_of(behind: &[f64]) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..behind.len()).collect();
+    order.sort_by(|&a, &b| behind[a].total_cmp(&behind[b]).then(a.cmp(&b)));
+    let mut rank = vec![0; behind.len()];
+    for (r, i) in order.into_iter().enumerate() {
+        rank[i] = r;
+    }
+    rank
 }
 
 impl Chart for PowerChart {
@@ -222,7 +238,13 @@ impl Chart for PowerChart {
                 bottom = bottom.min(*lo);
             }
         }
-        let top = if top > 0.0 { top * 1.12 } else { 1.0 };
+        // Headroom above the tallest bar or whisker for the legend's box (two lines), so it
+        // covers no bar.
+        let top = if top > 0.0 {
+            top + 0.3 * (top - bottom)
+        } else {
+            1.0
+        };
         let ylabel = match self.metric {
             PowerMetric::Xi => "relative power reduction ξ",
             PowerMetric::E => "power reduction e",
@@ -238,10 +260,14 @@ impl Chart for PowerChart {
             .x_desc("lateral position x (wingspans, right of the flight direction)")
             .y_desc(ylabel)
             .label_style((FONT_FAMILY, 14))
+            .x_label_formatter(&super::tick_label)
+            .y_label_formatter(&super::tick_label)
             .light_line_style(WHITE.mix(0.0))
             .draw()?;
-        let bar = RGBColor(70, 120, 180);
         let lead = super::LEADER;
+        let ranks = ranks_of(&self.behind);
+        let n = self.x.len();
+        let bar = super::bird_colour(n / 2, n);
         let half = 0.25;
         chart
             .draw_series(
@@ -250,14 +276,19 @@ impl Chart for PowerChart {
                     .zip(&self.values)
                     .enumerate()
                     .map(|(i, (&x, &v))| {
-                        let c = if Some(i) == self.leader { lead } else { bar };
+                        let c = if Some(i) == self.leader {
+                            lead
+                        } else {
+                            ranks.get(i).map_or(bar, |&r| super::bird_colour(r, n))
+                        };
                         Rectangle::new([(x - half, 0.0), (x + half, v)], c.filled())
                     }),
             )?
-            .label(if self.leader.is_some() {
-                "bird (red: leader)"
-            } else {
-                "bird"
+            .label(match (self.leader.is_some(), ranks.is_empty()) {
+                (true, false) => "bird by rank: leader red, then front dark to back green",
+                (true, true) => "bird (red: leader)",
+                (false, false) => "bird by rank: front dark to back green",
+                (false, true) => "bird",
             })
             .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 14, y + 5)], bar.filled()));
         if let (Some(r), PowerMetric::Xi) = (&self.ranges, self.metric) {

@@ -52,6 +52,10 @@ const ANGLES: [(&str, Getter, RGBColor); 6] = [
     ("hand twist (g2)", |p| p.hand_twist, RGBColor(255, 127, 14)),
 ];
 
+/// Headroom above the joint-angle curves, as a fraction of their span: the legend's box sits
+/// there.
+const LEGEND_HEADROOM: f64 = 0.6;
+
 impl Chart for WingbeatChart {
     fn size(&self) -> (u32, u32) {
         (960, 720)
@@ -71,7 +75,9 @@ impl Chart for WingbeatChart {
             (lo, hi) = (-45.0, 45.0);
         }
         let pad = 0.08 * (hi - lo).max(1.0);
-        let (lo, hi) = (lo - pad, hi + pad);
+        // Headroom above the curves for the legend (six lines, about a third of the plot's
+        // height), so it never covers a curve.
+        let (lo, hi) = (lo - pad, hi + LEGEND_HEADROOM * (hi - lo).max(1.0));
         let ua = self.timing.u_alpha;
         let mid = self.timing.mid_upstroke() / TAU;
         let half = self.timing.blend_half_width() / TAU;
@@ -91,6 +97,8 @@ impl Chart for WingbeatChart {
             .x_desc("wingbeat phase φ / 2π (0 = start of downstroke)")
             .y_desc("joint angle, degrees")
             .label_style((FONT_FAMILY, 13))
+            .x_label_formatter(&super::tick_label)
+            .y_label_formatter(&super::tick_label)
             .max_light_lines(2)
             .draw()?;
         shade(&mut chart, ua, mid, half, lo, hi)?;
@@ -117,6 +125,8 @@ impl Chart for WingbeatChart {
             .x_desc("wingbeat phase φ / 2π")
             .y_desc("wing spread")
             .label_style((FONT_FAMILY, 13))
+            .x_label_formatter(&super::tick_label)
+            .y_label_formatter(&super::tick_label)
             .max_light_lines(2)
             .draw()?;
         shade(&mut spread, ua, mid, half, 0.0, 1.1)?;
