@@ -67,7 +67,10 @@ fn gif_frames_stay_close_to_the_full_colour_frames() {
     assert!(e.seam <= SEAM_BOUND, "seam {e:?}");
 }
 
-/// Bounds on this film, levels: measured 5.48 and 4.64 (the palette and dither's own error over
-/// a pale cloud is most of it; the differencing adds at most the 4-level block tolerance).
+/// Bounds on this film, levels: measured 5.16 and 9.39. Over the sky the palette and dither's
+/// own error over a pale cloud is most of it (5.5 and 4.6 before the take-off's field was drawn;
+/// the differencing adds at most the 4-level block tolerance); the seam is at the field's soft
+/// edge into the sky, a gradient across two hues that 255 colours step through in visible bands
+/// (20 before the palette learnt the edge's blends).
 const LF_BOUND: f64 = 6.0;
-const SEAM_BOUND: f64 = 5.5;
+const SEAM_BOUND: f64 = 9.5;

@@ -122,7 +122,7 @@ fn birds_at_rest_are_drawn_on_the_ground_and_the_sky_comes_in_as_they_climb() {
         ..RenderOptions::default()
     };
     let c = frame(&anim, &plain, 0.5);
-    let g = formation::export::field::ground_for(dark);
+    let g = formation::export::scene::ground_for(dark);
     assert!(share_near(&c, g) > 0.9);
     assert!(
         (0..3)

@@ -2,8 +2,9 @@
 //!
 //! The top-down sky is a stylised backdrop: it shows the flock's travel, not what lies under
 //! it. Birds sitting, running or floating must be seen on something they can sit on, so every
-//! place where a bird is on the surface (its body less than [`ON_SURFACE`] wingspans up, at
-//! any picture frame) lays a patch of ground, or of water where the flock lands on water,
+//! place where a bird rests on the surface in a take-off or a landing (its body less than
+//! [`ON_SURFACE`] wingspans up, slower than a walk) lays a patch of ground, or of water where
+//! the flock lands on water,
 //! [`REACH`] wingspans around it, with a soft edge [`EDGE`] wide, drawn over the sky at its
 //! place in the world. The patch stays where it is while the camera follows the flock, so as
 //! the birds run, lift off and climb, the camera carries them off the field and brings in the
@@ -60,22 +61,6 @@ pub struct Field {
 /// Spacing of the field's raster, wingspans (its edge is [`EDGE`] wide, so a bilinear lookup
 /// shows no steps).
 const RASTER: f64 = 1.0;
-
-/// Colour of the ground over the plain background colour `c`: the grass field's colour, or, where
-/// that would hardly stand out from `c` (a difference of less than 40 levels of luminance), `c`
-/// made darker (or lighter, for a dark `c`), so the field and its edge are always seen.
-pub fn ground_for(c: [u8; 3]) -> [u8; 3] {
-    let g = super::scene::Style::default().ground;
-    let lum = |c: [u8; 3]| 0.299 * c[0] as f64 + 0.587 * c[1] as f64 + 0.114 * c[2] as f64;
-    if (lum(g) - lum(c)).abs() >= 40.0 {
-        return g;
-    }
-    if lum(c) >= 96.0 {
-        c.map(|v| (v as f64 * 0.55).round() as u8)
-    } else {
-        c.map(|v| (v as f64 + (255.0 - v as f64) * 0.45).round() as u8)
-    }
-}
 
 impl Field {
     /// Side of a bin, wingspans: a point further than this from a bin's cells does not reach it.
@@ -295,7 +280,7 @@ mod tests {
         let view = View::Top {
             cx: 0.0,
             cy: 0.0,
-            scale: 4.0,
+            scale: 2.0, // px per wingspan: the corner is 22 wingspans out, past the fade
         };
         f.paint(&view, &mut c);
         let px = |x: usize, y: usize| c.rgba[(y * 64 + x) * 4..(y * 64 + x) * 4 + 3].to_vec();

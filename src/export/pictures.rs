@@ -131,7 +131,7 @@ impl<'a> Film<'a> {
             ..CameraParams::default()
         };
         let views = camera::track(&places, fps, width, height, &params);
-        let field = surface_field(anim, &times, &places, opts);
+        let field = surface_field(anim, opts);
         drop(places);
         let flapper = Flapper::from_animation(anim);
         let style = Style {
@@ -235,6 +235,28 @@ impl<'a> Film<'a> {
                 train.extend_from_slice(p);
             }
         }
+        // The field's soft edge blends its colours into the sky for the few seconds it is in
+        // view, too few of the sampled frames to teach the palette those blends (the edge came
+        // out in bands 20 levels deep): every 8th sampled pixel, blended into each field
+        // colour along the fade.
+        let blends: Vec<u8> = self
+            .field
+            .colours()
+            .iter()
+            .flat_map(|&g| {
+                train.chunks_exact(4).step_by(8).flat_map(move |p| {
+                    [0.1f32, 0.22, 0.34, 0.46, 0.58, 0.7, 0.82, 0.94]
+                        .into_iter()
+                        .flat_map(move |a| {
+                            let mix = |k: usize| {
+                                (p[k] as f32 + (g[k] as f32 - p[k] as f32) * a).round() as u8
+                            };
+                            [mix(0), mix(1), mix(2), 255]
+                        })
+                })
+            })
+            .collect();
+        train.extend_from_slice(&blends);
         Palette::learn(&train, &self.exact_colours())
     }
 
@@ -687,17 +709,19 @@ fn loop_tolerance(base: i32, looped: bool, k: usize, total: usize, ramp: usize) 
     (base as f64 * left as f64 / ramp as f64).floor() as i32
 }
 
-/// The field under the birds that sit, run or float ([`Field`]) at the picture frames `times`
-/// (the birds' `places` there), for a top-down camera over the sky or a plain colour; empty
-/// otherwise (the ground camera has its own ground and horizon, and a transparent background
-/// stays transparent for compositing). Ground where the flock takes off and where it lands on a
-/// field, water where it lands on water.
-fn surface_field(
-    anim: &Animation,
-    times: &[f64],
-    places: &[Vec<Place>],
-    opts: &RenderOptions,
-) -> Field {
+/// The field under the birds at rest ([`Field`]), for a top-down camera over the sky or a plain
+/// colour; empty otherwise (the ground camera has its own ground and horizon, and a transparent
+/// background stays transparent for compositing). Ground where the flock takes off and where it
+/// lands on a field, water where it lands on water.
+///
+/// A bird lays field where it is at rest on the surface: in a take-off or landing stage (the
+/// stages whose heights are above the ground), its body under [`ON_SURFACE`] wingspans up and
+/// slower than [`REST_SPEED`]. Steady flight, and flights made by hand or tracked, have a level
+/// at z = 0 but no ground, and birds flying low through it are not sitting. The field reaches far
+/// enough round the resting places to hold the take-off's run and the landing's roll-out.
+///
+/// [`ON_SURFACE`]: super::field::ON_SURFACE
+fn surface_field(anim: &Animation, opts: &RenderOptions) -> Field {
     let top_down = !matches!(opts.camera, camera::CameraKind::Ground);
     if !top_down || opts.background == Background::None {
         return Field::default();
@@ -707,20 +731,31 @@ fn surface_field(
         .as_ref()
         .filter(|l| l.surface == crate::animation::landing::Surface::Water)
         .and_then(|_| anim.stage("landing"))
-        .and_then(|s| anim.frames.get(s.start))
-        .map(|f| f.t);
-    let points = times.iter().zip(places).flat_map(|(&t, st)| {
-        let water = water_from.is_some_and(|t0| t >= t0);
-        st.iter()
-            .filter(|b| b.z < super::field::ON_SURFACE)
-            .map(move |b| (b.x, b.y, water))
-    });
+        .map(|s| s.start);
+    let points = anim
+        .stages
+        .iter()
+        .filter(|s| s.name == "initiation" || s.name == "landing")
+        .flat_map(|s| s.start..s.end.min(anim.frames.len()))
+        .flat_map(|k| {
+            let f = &anim.frames[k];
+            let water = water_from.is_some_and(|k0| k >= k0);
+            (0..f.x.len())
+                .filter(move |&i| {
+                    f.z[i] < super::field::ON_SURFACE && f.speed[i].abs() < REST_SPEED
+                })
+                .map(move |i| (f.x[i], f.y[i], water))
+        });
     let ground = match opts.background {
-        Background::Colour(c) => super::field::ground_for(c),
+        Background::Colour(c) => super::scene::ground_for(c),
         _ => Style::default().ground,
     };
     Field::new(points, ground)
 }
+
+/// Below this speed, wingspans per second, a bird on the surface is at rest (sitting, or
+/// floating): a walking goose's pace; a take-off run or a landing's roll-out is faster.
+const REST_SPEED: f64 = 1.0;
 
 /// A value borrowed from a pool for one worker of [`run_frames`], handed back when dropped.
 struct Pooled<'a, T: Default> {

@@ -425,12 +425,12 @@ impl Backdrop {
     }
 
     /// The ground camera over a plain colour `c`: the ground below the horizon, in a colour that
-    /// stands out from `c` ([`super::field::ground_for`]), hazy towards the horizon as over the
+    /// stands out from `c` ([`ground_for`]), hazy towards the horizon as over the
     /// sky, so the horizon shows on any colour (dark ones too). The eye does not roll, so the
     /// horizon is level and one ray per row decides it.
     fn paint_plain_ground(&self, e: &super::camera::Eye, c: [u8; 3], canvas: &mut Canvas) {
         let (w, h) = (self.width, self.height);
-        let g = super::field::ground_for(c);
+        let g = ground_for(c);
         for r in 0..h {
             let d = e.ray(0.5 * w as f64, r as f64 + 0.5, w, h);
             let el = d[2] / (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
@@ -830,6 +830,22 @@ pub fn draw_birds(
                 canvas.fill(&layers[k], colours[k], 1.0, mask);
             }
         }
+    }
+}
+
+/// Colour of the ground over the plain background colour `c`: the grass field's colour, or, where
+/// that would hardly stand out from `c` (a difference of less than 40 levels of luminance), `c`
+/// made darker (or lighter, for a dark `c`), so the field and its edge are always seen.
+pub fn ground_for(c: [u8; 3]) -> [u8; 3] {
+    let g = Style::default().ground;
+    let lum = |c: [u8; 3]| 0.299 * c[0] as f64 + 0.587 * c[1] as f64 + 0.114 * c[2] as f64;
+    if (lum(g) - lum(c)).abs() >= 40.0 {
+        return g;
+    }
+    if lum(c) >= 96.0 {
+        c.map(|v| (v as f64 * 0.55).round() as u8)
+    } else {
+        c.map(|v| (v as f64 + (255.0 - v as f64) * 0.45).round() as u8)
     }
 }
 
