@@ -14,6 +14,45 @@ fn report(input: &str, out: &std::path::Path, extra: &[&str]) -> String {
     std::fs::read_to_string(out).unwrap()
 }
 
+/// The page's text as a reader sees it: tags, styles and charts removed, entities decoded,
+/// whitespace collapsed.
+fn visible_text(page: &str) -> String {
+    let mut rest = page.to_string();
+    for tag in ["style", "script", "svg"] {
+        let (open, close) = (format!("<{tag}"), format!("</{tag}>"));
+        let mut kept = String::new();
+        let mut r = rest.as_str();
+        while let Some(a) = r.find(&open) {
+            kept.push_str(&r[..a]);
+            r = r[a..]
+                .find(&close)
+                .map_or("", |b| &r[a + b + close.len()..]);
+        }
+        kept.push_str(r);
+        rest = kept;
+    }
+    let mut text = String::new();
+    let mut in_tag = false;
+    for c in rest.chars() {
+        match c {
+            '<' => in_tag = true,
+            '>' => {
+                in_tag = false;
+                text.push(' ');
+            }
+            _ if !in_tag => text.push(c),
+            _ => {}
+        }
+    }
+    let text = text
+        .replace("&amp;", "&")
+        .replace("&lt;", "<")
+        .replace("&gt;", ">")
+        .replace("&quot;", "\"")
+        .replace("&#39;", "'");
+    text.split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
 fn charts(page: &str) -> Vec<String> {
     page.split("<figure class=\"chart\" data-chart=\"")
         .skip(1)
@@ -110,6 +149,43 @@ fn the_page_of_an_animation_has_savings_take_off_and_its_charts() {
     ] {
         assert!(page.contains(needle), "missing {needle:?}");
     }
+    // The range over the modelling choices leads the table, induced and total, and holds the
+    // chosen model's value.
+    let text = visible_text(&page);
+    let row = text
+        .split("range over models, wakes and cores (model estimates)")
+        .nth(1)
+        .expect("no range row");
+    let pcts: Vec<f64> = row
+        .split(" %")
+        .take(4)
+        .map(|p| p.rsplit(' ').next().unwrap().parse().unwrap())
+        .collect();
+    let point: f64 = text
+        .split("flock saving in steady flight (of induced power,")
+        .nth(1)
+        .and_then(|r| r.split(" %").next())
+        .and_then(|r| r.rsplit(' ').next())
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(
+        pcts[0] <= point && point <= pcts[1] && pcts[2] < pcts[0] && pcts[3] < pcts[1],
+        "range row {pcts:?}, point {point}"
+    );
+    assert!(
+        row[..200.min(row.len())].contains("of total power"),
+        "{row}"
+    );
+    // Clean numbers: no negative zeros, no empty lists.
+    for bad in ["[]", "NaN"] {
+        assert!(!text.contains(bad), "the page shows {bad:?}");
+    }
+    let negative_zero = text.split_whitespace().find(|w| {
+        let w = w.trim_matches(|c: char| !(c.is_ascii_digit() || c == '-' || c == '.'));
+        w.starts_with('-') && w.parse::<f64>() == Ok(0.0)
+    });
+    assert_eq!(negative_zero, None, "the page shows a negative zero");
     // Same input, same bytes.
     let again = report(s(&json), &dir.join("b.html"), &[]);
     assert_eq!(page, again);

@@ -29,23 +29,21 @@ fn esc(s: &str) -> String {
 
 /// `v` with 3 decimals, never "-0.000".
 fn clean3(v: f64) -> String {
-    let s = format!("{v:.3}");
-    if s == "-0.000" {
-        "0.000".into()
-    } else {
-        s
-    }
+    num(v, 3)
 }
 
 fn pct(v: f64) -> String {
-    format!("{:.1} %", 100.0 * v)
+    format!("{} %", num(100.0 * v, 1))
 }
 
 fn stat(s: &Option<Stat>, unit: &str, prec: usize) -> String {
     match s {
         Some(s) => format!(
-            "{:.prec$}{unit} (median; {:.prec$} to {:.prec$} over {} frames)",
-            s.median, s.min, s.max, s.frames
+            "{}{unit} (median; {} to {} over {} frames)",
+            num(s.median, prec),
+            num(s.min, prec),
+            num(s.max, prec),
+            s.frames
         ),
         None => "–".into(),
     }
@@ -109,9 +107,24 @@ impl Page {
     }
 }
 
-/// Shortest decimal form of `v` with `prec` digits.
+/// `v` with `prec` decimals; a value that rounds to zero is written without a sign (never
+/// "-0.000").
 fn num(v: f64, prec: usize) -> String {
-    format!("{v:.prec$}")
+    let s = format!("{v:.prec$}");
+    match s.strip_prefix('-') {
+        Some(rest) if rest.bytes().all(|b| b == b'0' || b == b'.') => rest.to_string(),
+        _ => s,
+    }
+}
+
+/// `v` with `prec` decimals and a sign ("+0.00" for a value that rounds to zero).
+fn signed(v: f64, prec: usize) -> String {
+    let s = num(v, prec);
+    if s.starts_with('-') {
+        s
+    } else {
+        format!("+{s}")
+    }
 }
 
 /// One error bar: a quantity's interval and point estimate.
@@ -263,14 +276,18 @@ fn band_section(
     name: &str,
     entries: &[crate::report::BandEntry],
     main: Option<f64>,
+    share: Option<f64>,
     what: &str,
 ) {
     if entries.is_empty() {
         return;
     }
     let (lo, hi) = band_range(entries);
+    let total = share.map_or(String::new(), |k| {
+        format!(" ({} to {} of total power)", pct(lo * k), pct(hi * k))
+    });
     page.p(&format!(
-        "Sensitivity of the flock saving to modelling choices no measurement fixes ({what}): {} to {} of induced power over Hummel's model at vortex cores of 0.02 to 0.32 wingspans{}{}; {} (an unsteady vortex-lattice computation of flapping wings; docs/model.md).",
+        "Sensitivity of the flock saving to modelling choices no measurement fixes ({what}): {} to {} of induced power{total} over Hummel's model at vortex cores of 0.02 to 0.32 wingspans{}{}; {} (an unsteady vortex-lattice computation of flapping wings; docs/model.md).",
         pct(lo),
         pct(hi),
         if entries.iter().any(|e| !e.aero.model.is_hummel()) {
@@ -466,7 +483,7 @@ fn params_sections(page: &mut Page, p: &FormationParams, s: &Subject<'_>) -> Res
         .iter()
         .map(|f| {
             let g = f.geometry;
-            let o = |v: Option<f64>, prec: usize| v.map_or("–".into(), |v| format!("{v:.prec$}"));
+            let o = |v: Option<f64>, prec: usize| v.map_or("–".into(), |v| num(v, prec));
             vec![
                 f.index.to_string(),
                 f.order.len().to_string(),
@@ -540,6 +557,7 @@ fn params_sections(page: &mut Page, p: &FormationParams, s: &Subject<'_>) -> Res
         "saving-band",
         &crate::report::footage_band(p),
         st.steady_saving,
+        None,
         "the annotated frames",
     );
     if !st.birds.is_empty() {
@@ -588,6 +606,30 @@ fn animation_sections(page: &mut Page, a: &Animation, s: &Subject<'_>) -> Result
         .savings_model
         .as_ref()
         .map_or("Hummel's model".to_string(), |m| m.to_string());
+    // The range over the modelling choices leads; the chosen model's values follow.
+    let band = crate::report::animation_band(a);
+    let total = crate::aero::flight::steady_saving_total(a);
+    let share = match (st.steady_saving, total) {
+        (Some(e), Some(t)) if e.abs() > 1e-12 => Some(t / e),
+        _ => None,
+    };
+    if let (Some(e), false) = (st.steady_saving, band.is_empty()) {
+        let (lo, hi) = band_range(&band);
+        let (lo, hi) = (lo.min(e), hi.max(e));
+        let mut v = format!("{} to {} of induced power", pct(lo), pct(hi));
+        if let Some(k) = share {
+            v.push_str(&format!(
+                "; {} to {} of total power",
+                pct(lo * k),
+                pct(hi * k)
+            ));
+        }
+        rows.push(vec![
+            "flock saving in steady flight, range over models, wakes and cores (model estimates)"
+                .into(),
+            v,
+        ]);
+    }
     if let Some(e) = st.steady_saving {
         rows.push(vec![
             format!("flock saving in steady flight (of induced power, {used})"),
@@ -614,7 +656,7 @@ fn animation_sections(page: &mut Page, a: &Animation, s: &Subject<'_>) -> Result
             ),
         ]);
     }
-    if let Some(t) = crate::aero::flight::steady_saving_total(a) {
+    if let Some(t) = total {
         rows.push(vec![
             format!(
                 "flock saving in steady flight (of total power, {used}, Pennycuick's power curve)"
@@ -638,8 +680,9 @@ fn animation_sections(page: &mut Page, a: &Animation, s: &Subject<'_>) -> Result
     band_section(
         page,
         "saving-band",
-        &crate::report::animation_band(a),
+        &band,
         st.steady_saving,
+        share,
         &format!(
             "steady flight, up to {} frames evenly spaced",
             crate::report::BAND_FRAMES
@@ -686,7 +729,11 @@ fn animation_sections(page: &mut Page, a: &Animation, s: &Subject<'_>) -> Result
             vec!["flock saving at the hand-over".into(), save(f1)],
             vec![
                 "mean height at the start / hand-over".into(),
-                format!("{:.2} / {:.2} wingspans", mean(&f0.z), mean(&f1.z)),
+                format!(
+                    "{} / {} wingspans",
+                    num(mean(&f0.z), 2),
+                    num(mean(&f1.z), 2)
+                ),
             ],
             vec![
                 "mean speed at the start / hand-over".into(),
@@ -822,9 +869,9 @@ fn bird_tables(page: &mut Page, birds: &[BirdStats]) {
                 b.bird.to_string(),
                 b.formation.to_string(),
                 if b.leader { "yes".into() } else { "".into() },
-                format!("{:.1}", b.rank),
-                format!("{:+.2}", b.lateral),
-                format!("{:.2}", b.behind),
+                num(b.rank, 1),
+                signed(b.lateral, 2),
+                num(b.behind, 2),
                 pct(b.saving),
             ]
         })
@@ -915,7 +962,12 @@ fn field_section(
     let mut rows: Vec<Vec<String>> = Vec::new();
     let geo = p.and_then(|p| p.summary.as_ref()).map(|s| s.geometry);
     let ours_apex = geo.and_then(|g| g.apex_deg).map_or("–".into(), |s| {
-        format!("{:.1}° ({:.1}–{:.1})", s.median, s.min, s.max)
+        format!(
+            "{}° ({}–{})",
+            num(s.median, 1),
+            num(s.min, 1),
+            num(s.max, 1)
+        )
     });
     for f in field::APEX_ANGLE {
         rows.push(vec![
@@ -987,4 +1039,23 @@ fn pick_frames(p: &FormationParams) -> Vec<i64> {
     let mut k = vec![0, n / 2, n.saturating_sub(1)];
     k.dedup();
     k.into_iter().map(|i| p.frames[i].index).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numbers_that_round_to_zero_have_no_minus_sign() {
+        assert_eq!(num(-0.0001, 3), "0.000");
+        assert_eq!(num(-0.0, 1), "0.0");
+        assert_eq!(num(-0.04, 1), "0.0");
+        assert_eq!(num(-0.05001, 1), "-0.1");
+        assert_eq!(num(-12.5, 0), "-12");
+        assert_eq!(clean3(-1e-9), "0.000");
+        assert_eq!(pct(-1e-6), "0.0 %");
+        assert_eq!(signed(-0.001, 2), "+0.00");
+        assert_eq!(signed(0.5, 2), "+0.50");
+        assert_eq!(signed(-0.5, 2), "-0.50");
+    }
 }
