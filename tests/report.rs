@@ -146,6 +146,10 @@ fn the_page_of_an_animation_has_savings_take_off_and_its_charts() {
         "closest approach of two birds",
         "flock saving at the hand-over",
         "#C81E1E",
+        // The 3-D player, in a frame of its own.
+        "<h2 id=\"player\">",
+        "<iframe class=\"player\"",
+        "srcdoc=\"&lt;!DOCTYPE html&gt;",
     ] {
         assert!(page.contains(needle), "missing {needle:?}");
     }

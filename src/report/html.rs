@@ -762,6 +762,43 @@ fn animation_sections(page: &mut Page, a: &Animation, s: &Subject<'_>) -> Result
             &c,
         )?;
     }
+    player_section(page, a, s)?;
+    Ok(())
+}
+
+/// Most bird-frames the report's player embeds before it keeps only every n-th frame (about 20
+/// bytes each: a page of 12 MB at most for the player).
+const REPORT_PLAYER_BIRD_FRAMES: usize = 600_000;
+
+/// The flock in 3-D: the page `formation view` writes, in an `<iframe srcdoc>` (its script and
+/// styles kept apart from the report's), frames thinned for long or large flocks.
+fn player_section(page: &mut Page, a: &Animation, s: &Subject<'_>) -> Result<()> {
+    if a.frames.is_empty() || a.birds == 0 {
+        return Ok(());
+    }
+    let every = (a.birds * a.frames.len())
+        .div_ceil(REPORT_PLAYER_BIRD_FRAMES)
+        .clamp(1, crate::player::MAX_EVERY);
+    let opts = crate::player::PlayerOptions {
+        title: crate::plot::power::file_name(s.origin),
+        start_frame: None,
+        every,
+    };
+    let html = crate::player::page(a, &opts)?;
+    page.h2("player", "The flock in 3-D");
+    let thinned = if every > 1 {
+        format!(" Every {every}th frame is kept here (the player interpolates between them); `formation view` writes a page with them all.")
+    } else {
+        String::new()
+    };
+    page.p(&format!(
+        "The animation played in 3-D (WebGL): drag to turn the view, scroll to zoom, pick a camera, colour the birds by saving, rank or formation, scrub the timeline to a stage or an event, click a bird for its numbers.{thinned}"
+    ));
+    let _ = writeln!(
+        page.body,
+        "<iframe class=\"player\" title=\"3-D player\" srcdoc=\"{}\" style=\"width:100%;height:560px;border:1px solid #ccc\" sandbox=\"allow-scripts\"></iframe>",
+        esc(&html).replace('\'', "&#39;")
+    );
     Ok(())
 }
 
