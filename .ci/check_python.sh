@@ -25,6 +25,9 @@ py="$dir/venv/bin/python"
 # maturin (and the package's `formation` command) from the venv.
 export PATH="$dir/venv/bin:$PATH"
 retry "$py" -m pip install --quiet --disable-pip-version-check maturin pytest numpy pandas matplotlib
+# Dask for the sweep test (python/tests/test_dask.py), required here rather than skipped.
+retry "$py" -m pip install --quiet --disable-pip-version-check "dask==2026.8.0" "distributed==2026.8.0"
+export FORMATION_REQUIRE_DASK=1
 # The documented `pip install ./python`, without build isolation (maturin is installed above).
 CARGO_TARGET_DIR="$PWD/target" retry "$py" -m pip install --quiet --disable-pip-version-check \
     --no-build-isolation ./python
