@@ -16,7 +16,7 @@ browser=$(command -v chromium || command -v chromium-headless-shell || true)
 [ -n "$browser" ] || { echo "no headless Chromium (apt-get install chromium)"; exit 1; }
 flags=(--headless --no-sandbox --use-angle=swiftshader --enable-unsafe-swiftshader --ignore-gpu-blocklist
        --no-first-run --disable-background-networking --disable-component-update --disable-sync
-       --user-data-dir="$dir/profile" --window-size=1280,720 --hide-scrollbars)
+       --user-data-dir="$dir/profile" --hide-scrollbars)
 $f animate examples_data/barnacle_geese_v.json --birds 14 --quiet -o "$dir/a14.json"
 # The grid layout of formations: the default natural layout spreads 1000 birds over about 2.4
 # times the area, where at this canvas size most birds are far under a pixel (866 of 1000 in
@@ -28,6 +28,9 @@ window.addEventListener("load", () => {
   const P = window.formationPlayer, out = { ready: !!(P && P.ready) };
   if (out.ready) {
     P.pause(); P.setCamera("follow");
+    // The birds sitting at the start, in a canvas as small as a report's frame.
+    P.seek(P.startFrame);
+    out.seenAtRest = P.birdsSeen();
     const pick = Math.floor(P.frames * 0.6);
     out.frame = P.seek(P.startFrame + pick);
     out.drawn = P.drawn();
@@ -47,7 +50,9 @@ for n in 14 1000; do
     $f view "$dir/a$n.json" --quiet -o "$dir/v$n.html"
     if grep -Eq '(src|href)="(https?:)?//' "$dir/v$n.html"; then echo "player $n: fetches from the network"; exit 1; fi
     sed -e "/<\/body>/e cat $dir/drive.html" "$dir/v$n.html" > "$dir/t$n.html"
-    "$browser" "${flags[@]}" --enable-logging=stderr --v=0 --dump-dom "file://$dir/t$n.html" \
+    # The 14 birds in a smaller canvas (a report's frame is 560 px high), the 1000 in a larger.
+    size=1280,560; [ "$n" = 1000 ] && size=1280,720
+    "$browser" "${flags[@]}" --window-size=$size --enable-logging=stderr --v=0 --dump-dom "file://$dir/t$n.html" \
         > "$dir/dom$n.html" 2> "$dir/log$n.txt"
     if grep -q ':CONSOLE' "$dir/log$n.txt"; then echo "player $n: console messages:"; grep ':CONSOLE' "$dir/log$n.txt"; exit 1; fi
     python3 - "$dir/a$n.json" "$dir/dom$n.html" "$dir/v$n.html" <<'PY'
@@ -71,6 +76,10 @@ assert err < 1e-3, "positions drawn differ from the animation"
 assert r["seen"]["inView"] > 0 and (n != 14 or r["seen"]["big"] == n), "birds out of view"
 assert r["seen"]["bigSeen"] == r["seen"]["big"], f"birds at least 3 px wide not drawn: {r['seen']['missed']}"
 assert r["seen"]["seen"] >= 0.9 * r["seen"]["inView"], "birds in view not drawn"
+# The 14 sitting birds, every one drawn (among 1000 sitting birds seen low over the field, near
+# ones hide some far ones).
+rest = r["seenAtRest"]
+assert n != 14 or (rest["big"] == n and rest["bigSeen"] == n), f"birds at rest not drawn: {rest}"
 assert r["changed"] > 100 and r["after"] > r["frame"], "the view did not change while playing"
 limit = {14: 8e6, 1000: 40e6}[n]
 assert size <= limit, f"page over {limit / 1e6:.0f} MB"
@@ -80,8 +89,8 @@ PY
         $f animate examples_data/barnacle_geese_v.json --birds 14 --leader-changes 3 --quiet -o "$dir/e14.json"
         $f view "$dir/e14.json" --quiet -o "$dir/e14.html"
         ev=$(python3 -c "import json,sys;a=json.load(open(sys.argv[1]));e=[x for x in a.get('events',[]) if x['kind']=='leader_change'];print(round((e[0]['t']+0.5*e[0]['duration'])*a['fps'])+a.get('start_frame',0) if e else len(a['frames'])*2//3)" "$dir/e14.json")
-        "$browser" "${flags[@]}" --virtual-time-budget=3000 --screenshot="$shots/player-follow.png" "file://$dir/v14.html#frame=900&camera=follow&play=0&trails=all" 2>/dev/null
-        "$browser" "${flags[@]}" --virtual-time-budget=3000 --screenshot="$shots/player-savings.png" "file://$dir/v14.html#frame=1100&camera=orbit&colour=saving&play=0&select=3&wake=1" 2>/dev/null
-        "$browser" "${flags[@]}" --virtual-time-budget=3000 --screenshot="$shots/player-leader-change.png" "file://$dir/e14.html#frame=$ev&camera=top&colour=rank&play=0" 2>/dev/null
+        "$browser" "${flags[@]}" --window-size=1280,720 --virtual-time-budget=3000 --screenshot="$shots/player-follow.png" "file://$dir/v14.html#frame=900&camera=follow&play=0&trails=all" 2>/dev/null
+        "$browser" "${flags[@]}" --window-size=1280,720 --virtual-time-budget=3000 --screenshot="$shots/player-savings.png" "file://$dir/v14.html#frame=1100&camera=orbit&colour=saving&play=0&select=3&wake=1" 2>/dev/null
+        "$browser" "${flags[@]}" --window-size=1280,720 --virtual-time-budget=3000 --screenshot="$shots/player-leader-change.png" "file://$dir/e14.html#frame=$ev&camera=top&colour=rank&play=0" 2>/dev/null
     fi
 done

@@ -237,7 +237,11 @@ float l=1.-min(min(f.x,f.y),1.);float d=length(w-eye);vec3 c=mix(col,col*.8,l*.7
     gl.disable(gl.BLEND); gl.enable(gl.DEPTH_TEST); gl.clearColor(.8, .88, .95, 1); gl.clear(gl.COLOR_BUFFER_BIT | gl.DEPTH_BUFFER_BIT);
     gl.depthMask(false); gl.useProgram(skyP.p); gl.uniformMatrix4fv(skyP.u.ivp, false, inv(cam.vp)); gl.uniform3fv(skyP.u.eye, cam.eye); gl.bindVertexArray(null); gl.drawArrays(gl.TRIANGLES, 0, 3); gl.depthMask(true);
     gl.useProgram(grP.p); gl.uniformMatrix4fv(grP.u.vp, false, cam.vp); gl.uniform3fv(grP.u.c, [cam.tgt[0], cam.tgt[1], 0]); gl.uniform3fv(grP.u.eye, cam.eye);
-    gl.uniform3fv(grP.u.col, M.surface === "water" ? [.27, .45, .58] : [.45, .55, .35]); gl.bindVertexArray(grVao); gl.drawArrays(gl.TRIANGLES, 0, 6);
+    gl.uniform3fv(grP.u.col, M.surface === "water" ? [.27, .45, .58] : [.45, .55, .35]); gl.bindVertexArray(grVao);
+    // The ground writes no depth: nothing is ever below it, and the depth of its two huge
+    // triangles, interpolated across thousands of wingspans, can land above a sitting bird's body
+    // (the birds vanished into the field at some viewport sizes).
+    gl.depthMask(false); gl.drawArrays(gl.TRIANGLES, 0, 6); gl.depthMask(true);
     if (!opts.noBirds) {
       gl.useProgram(birdP.p); gl.uniformMatrix4fv(birdP.u.vp, false, cam.vp);
       gl.uniform4f(birdP.u.geo, me.shoulder, me.arm, FOLD.arm, FOLD.hand); gl.uniform3fv(birdP.u.hip, me.hip);

@@ -11,7 +11,7 @@
 //! steps become a fine pattern instead of contour bands.
 //!
 //! NeuQuant leaves rare colours far from every entry; the last 48 learnt entries go instead
-//! where the sampled pixels are worst served ([`cover`]).
+//! where the sampled pixels are worst served (`cover`).
 //!
 //! Lookups go through a table indexed by the colour's top 6 bits per channel, filled lazily with
 //! the nearest palette entry (perceptually weighted squared RGB distance

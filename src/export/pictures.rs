@@ -499,7 +499,7 @@ fn delta_step(
     }
 }
 
-/// Side of the blocks whose mean error [`block_refresh`] bounds, pixels.
+/// Side of the blocks whose mean error `block_refresh` bounds, pixels.
 pub const REFRESH_BLOCK: usize = 4;
 
 /// Largest mean error, levels in some channel, that a [`REFRESH_BLOCK`]-square block of the
