@@ -468,4 +468,31 @@ mod tests {
             }
         }
     }
+
+    #[test]
+    fn the_side_view_is_as_deep_as_the_plan_is_wide_and_banks_with_the_bird() {
+        let extent = |p: &[Piece], k: usize| {
+            let v = p.iter().flat_map(|q| q.points.iter().map(move |v| v[k]));
+            let (lo, hi) = v.fold((f32::MAX, f32::MIN), |(a, b), x| (a.min(x), b.max(x)));
+            hi - lo
+        };
+        for s in Species::ALL {
+            let b = build(s);
+            let side = profile(s, 0.0);
+            // Level: in the vertical plane, the body as deep as the plan is wide (within the
+            // outline's sampling).
+            assert!(extent(&side, 0).abs() < 1e-6, "{s:?}");
+            let depth = extent(&side, 2) / (2.0 * b.body_w);
+            assert!((0.98..=1.0 + 1e-6).contains(&depth), "{s:?}: {depth}");
+            // Same length as the plan's body, neck and head.
+            let plan = trunk(&b);
+            assert!((extent(&side, 1) - extent(&plan, 1)).abs() < 1e-6);
+            // Banked 90°, the side view lies flat (across).
+            let rolled = profile(s, std::f64::consts::FRAC_PI_2);
+            assert!(
+                extent(&rolled, 2) < 1e-5 && extent(&rolled, 0) > 0.1,
+                "{s:?}"
+            );
+        }
+    }
 }
