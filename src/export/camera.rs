@@ -10,8 +10,9 @@
 //!   its leading formations.
 //! - **ground**: an observer standing on the ground beside the flock's course
 //!   ([`GroundParams::distance`] to the right of it where the flock passes), who turns and
-//!   zooms a perspective lens to keep the flock in the picture from the take-off on the field,
-//!   low over the horizon, to the pass overhead and away.
+//!   zooms a perspective lens to keep the flock in the picture and large, from the take-off on
+//!   the field far away (a long lens framing the sitting flock by the picture's width), low over
+//!   the horizon, to the pass overhead and away.
 //! - **fixed**: a given rectangle of the world (`render.camera` = fixed with `[x0, y0, x1, y1]`, wingspans), top-down.
 //!
 //! The follow path is computed offline over all output frames. The centre (the flock's bounding
@@ -391,14 +392,16 @@ pub fn track(
 /// a take-off from a field), wingspans: about a standing person's eye for a goose's span.
 pub const EYE_HEIGHT: f64 = 1.2;
 
-/// Narrowest vertical field of view the ground camera zooms in to, degrees (a long lens).
-pub const GROUND_MIN_FOV_DEG: f64 = 3.0;
+/// Narrowest vertical field of view the ground camera zooms in to, degrees (a long lens: about
+/// 1400 mm on a 35 mm still camera, what frames a sitting flock hundreds of wingspans away).
+pub const GROUND_MIN_FOV_DEG: f64 = 1.0;
 
 /// Highest elevation the ground camera tilts up to, degrees (short of the zenith, where the
 /// image's up direction is undefined).
 pub const GROUND_MAX_ELEVATION_DEG: f64 = 80.0;
 
-/// Share of the picture's shorter side the ground camera fills with the flock.
+/// Share of the picture's width and height (each from the centre) the ground camera fills with
+/// the flock.
 const GROUND_FILL: f64 = 0.7;
 
 /// Where the ground observer stands: `distance` to the right of the flock's course at the pass
@@ -432,11 +435,14 @@ pub fn ground_position(states: &[Vec<Place>], g: &GroundParams) -> [f64; 3] {
 
 /// The ground camera: an observer standing beside the course ([`ground_position`]) who turns
 /// and zooms to keep the flock in the picture, as a camera operator would. Each frame aims at
-/// the flock's centre and needs the vertical field of view that shows every bird within
-/// [`GROUND_FILL`] of the shorter side (between [`GROUND_MIN_FOV_DEG`] and `fov_deg`). The aim is
-/// smoothed by a Gaussian of `smoothing_s` (on unit vectors), the zoom like the follow camera's
-/// (a maximum filter, then a Gaussian in log tan(fov/2)), so the flock is never cut off by the
-/// zoom; the elevation is capped at [`GROUND_MAX_ELEVATION_DEG`].
+/// the flock's centre and needs the narrowest vertical field of view (between
+/// [`GROUND_MIN_FOV_DEG`] and `fov_deg`) that shows every bird, with its outline, within
+/// [`GROUND_FILL`] of the picture's half-width and half-height: a flock sitting far away on a
+/// field, wide and flat, is framed by the width and drawn large from the first frame. The aim
+/// is smoothed by a Gaussian of `smoothing_s` (on unit vectors), the zoom like the follow
+/// camera's (a maximum filter, then a Gaussian in log tan(fov/2)), both over windows in
+/// seconds and wrapping around a loop, so the flock is never cut off by the zoom; the
+/// elevation is capped at [`GROUND_MAX_ELEVATION_DEG`] and the horizon stays level.
 fn ground(
     states: &[Vec<Place>],
     fps: f64,
@@ -450,8 +456,8 @@ fn ground(
     let sigma = (p.smoothing_s * fps).max(0.5);
     let half = ((2.0 * sigma).ceil() as usize).min(n.max(1));
     let kernel = gaussian(sigma, half);
-    // Aim (unit vectors) and the angular radius of the flock around it, per frame.
-    let (aims, radii): (Vec<[f64; 3]>, Vec<f64>) = states
+    // Aim (unit vectors at the flock's centre), per frame.
+    let aims: Vec<[f64; 3]> = states
         .iter()
         .map(|s| {
             let m = s.len().max(1) as f64;
@@ -459,18 +465,19 @@ fn ground(
                 .iter()
                 .fold([0.0; 3], |a, q| [a[0] + q.x, a[1] + q.y, a[2] + q.z])
                 .map(|v| v / m);
-            let aim = unit([c[0] - eye[0], c[1] - eye[1], c[2] - eye[2]]);
-            let r = s
-                .iter()
-                .map(|q| {
-                    let d = unit([q.x - eye[0], q.y - eye[1], q.z - eye[2]]);
-                    dot(d, aim).clamp(-1.0, 1.0).acos()
-                })
-                .fold(0.0, f64::max);
-            (aim, r)
+            unit([c[0] - eye[0], c[1] - eye[1], c[2] - eye[2]])
         })
-        .unzip();
-    let at = |i: isize| i.clamp(0, n as isize - 1) as usize;
+        .collect();
+    // A loop wraps around (as the follow camera's smoothing does) when it is longer than the
+    // smoothing window; otherwise the window is clamped to the ends.
+    let cyclic = p.cyclic && n > 2 * half + 1;
+    let at = |i: isize| {
+        if cyclic {
+            i.rem_euclid(n as isize) as usize
+        } else {
+            i.clamp(0, n as isize - 1) as usize
+        }
+    };
     let max_el = GROUND_MAX_ELEVATION_DEG.to_radians();
     let smoothed: Vec<[f64; 3]> = (0..n as isize)
         .map(|i| {
@@ -496,22 +503,33 @@ fn ground(
             }
         })
         .collect();
-    // Zoom: the half-angle of the shorter side that holds every bird around the smoothed aim.
+    // Zoom: the narrowest lens (tan of the vertical half-angle) that holds every bird, with its
+    // outline, within GROUND_FILL of the picture's half-width and half-height around the
+    // smoothed aim. A flock sitting on a field far away is wide and flat: it is framed by the
+    // picture's width, not its height.
     let (w, h) = (width as f64, height as f64);
-    let short_over_h = w.min(h) / h;
+    let aspect = w / h;
     let widest = (0.5 * g.fov_deg.clamp(10.0, 150.0)).to_radians().tan();
     let narrowest = (0.5 * GROUND_MIN_FOV_DEG).to_radians().tan();
     let log_need: Vec<f64> = (0..n)
         .map(|i| {
-            let spread = states[i]
+            let f = smoothed[i];
+            let r = unit(cross(f, [0.0, 0.0, 1.0]));
+            let u = cross(r, f);
+            let t = states[i]
                 .iter()
                 .map(|q| {
-                    let d = unit([q.x - eye[0], q.y - eye[1], q.z - eye[2]]);
-                    dot(d, smoothed[i]).clamp(-1.0, 1.0).acos()
+                    let d = [q.x - eye[0], q.y - eye[1], q.z - eye[2]];
+                    let depth = dot(d, f);
+                    if depth < NEAR + p.bird_radius {
+                        return widest;
+                    }
+                    let rad = p.bird_radius / depth;
+                    let across = (dot(d, r).abs() / depth + rad) / (GROUND_FILL * aspect);
+                    let up = (dot(d, u).abs() / depth + rad) / GROUND_FILL;
+                    across.max(up)
                 })
-                .fold(radii[i], f64::max);
-            // tan of the vertical half-angle whose shorter side shows `spread` at GROUND_FILL.
-            let t = (spread.min(1.5)).tan() / GROUND_FILL / short_over_h;
+                .fold(narrowest, f64::max);
             t.clamp(narrowest, widest).ln()
         })
         .collect();
@@ -713,6 +731,54 @@ mod tests {
         let d = eye.ray(c, r, 300, 200);
         let t = 2.0 / d[0];
         assert!((d[1] * t - 10.0).abs() < 1e-6 && (d[2] * t - 8.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn a_wide_flat_flock_far_away_is_framed_by_the_picture_width() {
+        // 15 birds in a row 16 wingspans wide sit for 3 s, then fly north at 13 wingspans a
+        // second, climbing, and pass the observer 230 wingspans away: in the first second the
+        // sitting row fills about 70 % of the picture's width (it used to fill 70 % of its
+        // height).
+        let n = 300;
+        let states: Vec<Vec<Place>> = (0..n)
+            .map(|k| {
+                let y = if k < 30 { 0.0 } else { 1.3 * (k - 30) as f64 };
+                (0..15)
+                    .map(|b| Place {
+                        x: b as f64 * 16.0 / 14.0 - 8.0,
+                        y,
+                        z: if k < 30 { 0.0 } else { 0.05 * (k - 30) as f64 }.min(10.0),
+                        ..Default::default()
+                    })
+                    .collect()
+            })
+            .collect();
+        let p = CameraParams {
+            kind: CameraKind::Ground,
+            ..CameraParams::default()
+        };
+        let (w, h) = (960, 540);
+        let views = track(&states, 10.0, w, h, &p);
+        let mut widest_row = 0.0f64;
+        for (k, (s, v)) in states.iter().zip(&views).enumerate() {
+            let View::Ground(e) = v else { panic!() };
+            assert!(e.right[2].abs() < 1e-12, "level horizon");
+            let cols: Vec<f64> = s
+                .iter()
+                .map(|b| v.project([b.x, b.y, b.z], w, h).expect("in front").0)
+                .collect();
+            let (lo, hi) = cols
+                .iter()
+                .fold((f64::MAX, f64::MIN), |(a, b), &c| (a.min(c), b.max(c)));
+            assert!(lo >= 0.0 && hi <= w as f64, "frame {k}: {lo:.0}..{hi:.0}");
+            if k < 10 {
+                widest_row = widest_row.max(hi - lo);
+            }
+        }
+        assert!(
+            widest_row > 0.6 * w as f64,
+            "the sitting row spans {widest_row:.0} of {w} px"
+        );
     }
 
     #[test]

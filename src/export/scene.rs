@@ -801,7 +801,16 @@ pub fn draw_birds(
         for l in layers.iter_mut() {
             l.clear();
         }
-        for piece in silhouette::pieces(species, &b.pose, b.bank) {
+        // From the ground the birds also show their side view (body, neck, head): the plan is
+        // flat, and a bird level with the eye would otherwise be a line.
+        let side = match view {
+            View::Top { .. } => Vec::new(),
+            View::Ground(_) => silhouette::profile(species, b.bank),
+        };
+        for piece in silhouette::pieces(species, &b.pose, b.bank)
+            .into_iter()
+            .chain(side)
+        {
             let mut pts = Vec::with_capacity(piece.points.len());
             for q in &piece.points {
                 let p = to_world(q);

@@ -206,11 +206,9 @@ fn yaw_z(p: [f32; 3], o: [f32; 3], a: f32) -> [f32; 3] {
     [o[0] + x * c - y * s, o[1] + x * s + y * c, p[2]]
 }
 
-/// The polygons of one bird of `species` in wing pose `pose`, banked by `bank` radians (right
-/// wing down positive), in the body frame. Drawn in order: wings, body, head.
-pub fn pieces(species: Species, pose: &WingPose, bank: f64) -> Vec<Piece> {
-    let b = build(species);
-    let mut out = Vec::with_capacity(9);
+/// Body, neck and head of `b` as flat outlines in the body's horizontal plane (plan view).
+fn trunk(b: &Build) -> Vec<Piece> {
+    let mut out = Vec::with_capacity(3);
     // Body: a rounded spindle from the tail root to the breast.
     let body: Vec<(f32, f32)> = (0..=8)
         .map(|k| {
@@ -251,6 +249,32 @@ pub fn pieces(species: Species, pose: &WingPose, bank: f64) -> Vec<Piece> {
             (b.bill_w * 0.3, head_end + b.bill),
         ],
     ));
+    out
+}
+
+/// The side view of one bird of `species` banked by `bank` radians: its body, neck and head as
+/// outlines in the body's vertical plane, the body as deep as it is wide. The plan view
+/// ([`pieces`]) is flat, so a bird seen level with the eye (sitting or running on a field,
+/// seen from the ground) would be a line; with its side view it is seen as a bird. From above
+/// the side view is a line inside the plan's outline.
+pub fn profile(species: Species, bank: f64) -> Vec<Piece> {
+    let bank = bank as f32;
+    let mut out = trunk(&build(species));
+    for p in &mut out {
+        for q in &mut p.points {
+            // The plan's x (across) becomes up: [x, y, 0] -> [0, y, x].
+            *q = roll_y([q[2], q[1], q[0]], [0.0; 3], -bank);
+        }
+    }
+    out
+}
+
+/// The polygons of one bird of `species` in wing pose `pose`, banked by `bank` radians (right
+/// wing down positive), in the body frame. Drawn in order: wings, body, head.
+pub fn pieces(species: Species, pose: &WingPose, bank: f64) -> Vec<Piece> {
+    let b = build(species);
+    let mut out = Vec::with_capacity(9);
+    out.extend(trunk(&b));
     // Legs (cranes): two thin strips from the hips as long as the rig's, swung by the pose's
     // leg swing from trailing behind the tail (0) to down under the body (π/2) and folded
     // forward (towards π).
@@ -442,6 +466,33 @@ mod tests {
                     );
                 }
             }
+        }
+    }
+
+    #[test]
+    fn the_side_view_is_as_deep_as_the_plan_is_wide_and_banks_with_the_bird() {
+        let extent = |p: &[Piece], k: usize| {
+            let v = p.iter().flat_map(|q| q.points.iter().map(move |v| v[k]));
+            let (lo, hi) = v.fold((f32::MAX, f32::MIN), |(a, b), x| (a.min(x), b.max(x)));
+            hi - lo
+        };
+        for s in Species::ALL {
+            let b = build(s);
+            let side = profile(s, 0.0);
+            // Level: in the vertical plane, the body as deep as the plan is wide (within the
+            // outline's sampling).
+            assert!(extent(&side, 0).abs() < 1e-6, "{s:?}");
+            let depth = extent(&side, 2) / (2.0 * b.body_w);
+            assert!((0.98..=1.0 + 1e-6).contains(&depth), "{s:?}: {depth}");
+            // Same length as the plan's body, neck and head.
+            let plan = trunk(&b);
+            assert!((extent(&side, 1) - extent(&plan, 1)).abs() < 1e-6);
+            // Banked 90°, the side view lies flat (across).
+            let rolled = profile(s, std::f64::consts::FRAC_PI_2);
+            assert!(
+                extent(&rolled, 2) < 1e-5 && extent(&rolled, 0) > 0.1,
+                "{s:?}"
+            );
         }
     }
 }
