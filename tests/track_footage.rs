@@ -1,13 +1,16 @@
 //! Footage as a real camera writes it, generated here with formation's own renderer: the
 //! renderer's sky with its clouds, a procedural cloud field of this test's own (sharper,
-//! brighter, drifting), haze that flattens the contrast, sensor noise, H.264 through the system
-//! ffmpeg (libx264 at CRF 18, 23 and 28), 1080p with 200 birds, and two birds crossing. Each
+//! brighter, drifting), haze that flattens the contrast, sensor noise, video through the system
+//! ffmpeg (H.264 by libx264 at CRF 18, 23 and 28, H.265 by libx265 at CRF 28 and VP9 by
+//! libvpx-vp9 at CRF 32), 1080p with 200 birds, and two birds crossing. Each
 //! case is tracked and scored against the animation that drew it: detection precision and
 //! recall, centroid error in wingspans, the measured wingspan and heading, and the share of
 //! frames where `extract` on the tracked points reads the generating shape. Needs ffmpeg with
-//! libx264, as `.ci/run` installs it.
+//! libx264, libx265 and libvpx-vp9, as Debian's (which `.ci/run` installs) has.
 //!
-//! `FORMATION_TRACK_REPORT=1` prints every case's figures without failing (to measure).
+//! `FORMATION_TRACK_REPORT=1` prints every case's figures without failing (to measure);
+//! `FORMATION_TRACK_KEEP=1` keeps each case's footage and prints where (to look at it with
+//! `formation track --debug-frames`).
 
 mod support;
 mod track_support;
@@ -79,16 +82,30 @@ impl Clouds {
 struct Case {
     name: &'static str,
     shot: Shot,
-    /// libx264 CRF, or `None` for lossless frames (PNG).
-    crf: Option<u32>,
+    /// How the frames are written.
+    codec: Codec,
     /// Whether the birds fly a V (extract's shape is checked).
     v: bool,
     /// Whether the heading is one direction (checked).
     one_heading: bool,
 }
 
-/// Cases measured but not yet held to the targets (printed with every run).
-const OPEN: [&str; 2] = ["own clouds h264 crf23", "two birds crossing png"];
+/// How a case's frames reach the tracker: lossless PNG frames, or a video encoded by the
+/// system ffmpeg at a constant-quality setting (yuv420p, the encoder's default preset, as a
+/// phone or a camera writes).
+#[derive(Debug, Clone, Copy)]
+enum Codec {
+    Png,
+    /// libx264 at this CRF (23 is its default).
+    H264(u32),
+    /// libx265 at this CRF (28 is its default, what phones write as HEVC).
+    H265(u32),
+    /// libvpx-vp9 in constant-quality mode (`-b:v 0`) at this CRF.
+    Vp9(u32),
+}
+
+/// Cases measured but not yet held to the targets (printed with every run); none now.
+const OPEN: [&str; 0] = [];
 
 /// Renders `a` through `opts` and composes the grey frames: the renderer's own sky, or (with
 /// `clouds`) the birds over a blue-grey gradient with this test's cloud field behind them; then
@@ -152,40 +169,49 @@ fn shoot(
     }
 }
 
-/// Writes the frames as PNGs (`crf` none) or encodes them with libx264 at `crf` (yuv420p, the
-/// default preset, as a phone writes), and gives what `track` reads.
-fn write_footage(dir: &Path, frames: &[Gray], crf: Option<u32>) -> PathBuf {
-    match crf {
-        None => {
+/// Writes the frames as PNGs or encodes them with `codec`, and gives what `track` reads.
+fn write_footage(dir: &Path, frames: &[Gray], codec: Codec) -> PathBuf {
+    let (encoder, crf, file): (&[&str], u32, &str) = match codec {
+        Codec::Png => {
             let d = dir.join("frames");
             std::fs::create_dir_all(&d).unwrap();
             for (k, g) in frames.iter().enumerate() {
                 track_support::save_png(g, &d.join(format!("f{k:04}.png")));
             }
-            d
+            return d;
         }
-        Some(crf) => {
-            let out = dir.join(format!("clip_crf{crf}.mp4"));
-            let (w, h) = (frames[0].width, frames[0].height);
-            let mut child = Command::new("ffmpeg")
-                .args(["-v", "error", "-y", "-f", "rawvideo", "-pix_fmt", "gray"])
-                .args(["-s", &format!("{w}x{h}"), "-r", "25", "-i", "-"])
-                .args(["-c:v", "libx264", "-crf", &crf.to_string()])
-                .args(["-threads", "2", "-pix_fmt", "yuv420p"])
-                .arg(&out)
-                .stdin(Stdio::piped())
-                .spawn()
-                .expect("ffmpeg runs");
-            {
-                let mut stdin = child.stdin.take().unwrap();
-                for g in frames {
-                    stdin.write_all(&g.data).unwrap();
-                }
-            }
-            assert!(child.wait().unwrap().success(), "ffmpeg encodes");
-            out
+        Codec::H264(crf) => (&["-c:v", "libx264"], crf, "clip.mp4"),
+        // Quiet: libx265 prints its settings on stderr otherwise.
+        Codec::H265(crf) => (
+            &["-c:v", "libx265", "-x265-params", "log-level=error"],
+            crf,
+            "clip.mp4",
+        ),
+        Codec::Vp9(crf) => (&["-c:v", "libvpx-vp9", "-b:v", "0"], crf, "clip.webm"),
+    };
+    let out = dir.join(file);
+    let (w, h) = (frames[0].width, frames[0].height);
+    let mut child = Command::new("ffmpeg")
+        .args(["-v", "error", "-y", "-f", "rawvideo", "-pix_fmt", "gray"])
+        .args(["-s", &format!("{w}x{h}"), "-r", "25", "-i", "-"])
+        .args(encoder)
+        .args(["-crf", &crf.to_string()])
+        .args(["-threads", "2", "-pix_fmt", "yuv420p"])
+        .arg(&out)
+        .stdin(Stdio::piped())
+        .spawn()
+        .expect("ffmpeg runs");
+    {
+        let mut stdin = child.stdin.take().unwrap();
+        for g in frames {
+            stdin.write_all(&g.data).unwrap();
         }
     }
+    assert!(
+        child.wait().unwrap().success(),
+        "ffmpeg encodes with {codec:?}"
+    );
+    out
 }
 
 #[derive(Debug, Default)]
@@ -262,10 +288,10 @@ fn score(case: &Case, tr: &Tracked) -> Score {
     s
 }
 
-/// Tracks a case from what a camera would write and checks the targets.
-fn run(case: &Case, failures: &mut Vec<String>) {
+/// Tracks a case from what a camera would write and checks the targets; gives the result.
+fn run(case: &Case, failures: &mut Vec<String>) -> Option<Tracked> {
     let dir = support::scratch(&format!("footage-{}", case.name.replace(' ', "-")));
-    let input = write_footage(&dir, &case.shot.frames, case.crf);
+    let input = write_footage(&dir, &case.shot.frames, case.codec);
     let opts = TrackOptions {
         fps: Some(25.0),
         ..TrackOptions::default()
@@ -274,7 +300,7 @@ fn run(case: &Case, failures: &mut Vec<String>) {
         Ok(t) => t,
         Err(e) => {
             failures.push(format!("{}: track failed: {e}", case.name));
-            return;
+            return None;
         }
     };
     let s = score(case, &tr);
@@ -303,7 +329,12 @@ fn run(case: &Case, failures: &mut Vec<String>) {
     bad(s.worst_span.abs() <= 0.10, "wingspan");
     bad(!case.one_heading || s.worst_heading <= 5.0, "heading");
     bad(!case.v || s.same_shape >= 0.95, "extract's shape");
-    let _ = std::fs::remove_dir_all(&dir);
+    if std::env::var_os("FORMATION_TRACK_KEEP").is_some() {
+        eprintln!("{}: footage kept in {}", case.name, input.display());
+    } else {
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+    Some(tr)
 }
 
 fn finish(failures: Vec<String>) {
@@ -328,25 +359,27 @@ fn geese(frames: usize, heading: f64) -> (Animation, RenderOptions) {
 }
 
 #[test]
-fn the_renderers_sky_with_noise_as_png_and_h264_at_three_qualities() {
+fn the_renderers_sky_with_noise_as_png_h264_at_three_qualities_h265_and_vp9() {
     let (a, o) = geese(20, 70.0);
     let shot = shoot(&a, &o, None, 0.0, 3.0);
     let mut failures = Vec::new();
-    for crf in [None, Some(18), Some(23), Some(28)] {
+    for (name, codec) in [
+        ("renderer sky png", Codec::Png),
+        ("renderer sky h264 crf18", Codec::H264(18)),
+        ("renderer sky h264 crf23", Codec::H264(23)),
+        ("renderer sky h264 crf28", Codec::H264(28)),
+        ("renderer sky h265 crf28", Codec::H265(28)),
+        ("renderer sky vp9 crf32", Codec::Vp9(32)),
+    ] {
         let case = Case {
-            name: match crf {
-                None => "renderer sky png",
-                Some(18) => "renderer sky h264 crf18",
-                Some(23) => "renderer sky h264 crf23",
-                _ => "renderer sky h264 crf28",
-            },
+            name,
             shot: Shot {
                 frames: shot.frames.clone(),
                 truth: shot.truth.clone(),
                 span: shot.span.clone(),
                 heading: shot.heading,
             },
-            crf,
+            codec,
             v: true,
             one_heading: true,
         };
@@ -363,18 +396,31 @@ fn a_cloud_field_of_our_own_with_haze_and_compression() {
         drift: (0.6, 0.25),
         seed: 5,
     };
+    // The clear sky is shot once for every codec.
+    let clear = shoot(&a, &o, Some(&clouds), 0.0, 3.0);
     let mut failures = Vec::new();
-    for (name, haze, crf) in [
-        ("own clouds png", 0.0, None),
-        ("own clouds h264 crf23", 0.0, Some(23)),
-        ("own clouds haze h264 crf28", 0.55, Some(28)),
+    for (name, haze, codec) in [
+        ("own clouds png", 0.0, Codec::Png),
+        ("own clouds h264 crf23", 0.0, Codec::H264(23)),
+        ("own clouds h265 crf28", 0.0, Codec::H265(28)),
+        ("own clouds vp9 crf32", 0.0, Codec::Vp9(32)),
+        ("own clouds haze h264 crf28", 0.55, Codec::H264(28)),
     ] {
-        let shot = shoot(&a, &o, Some(&clouds), haze, 3.0);
+        let shot = if haze > 0.0 {
+            shoot(&a, &o, Some(&clouds), haze, 3.0)
+        } else {
+            Shot {
+                frames: clear.frames.clone(),
+                truth: clear.truth.clone(),
+                span: clear.span.clone(),
+                heading: clear.heading,
+            }
+        };
         run(
             &Case {
                 name,
                 shot,
-                crf,
+                codec,
                 v: true,
                 one_heading: true,
             },
@@ -437,7 +483,7 @@ fn two_hundred_birds_at_1080p_in_h264() {
         &Case {
             name: "200 birds 1080p h264 crf23",
             shot,
-            crf: Some(23),
+            codec: Codec::H264(23),
             v: false,
             one_heading: true,
         },
@@ -448,11 +494,11 @@ fn two_hundred_birds_at_1080p_in_h264() {
 
 #[test]
 fn two_birds_crossing_are_split_not_merged() {
-    // Two geese on crossing paths, 24 px across, meeting in the middle of the clip: their
-    // silhouettes overlap for a few frames.
-    let frames = 24;
+    // Two geese on crossing paths, 24 px across, meeting in the middle of the clip (frame 16
+    // of 32): their silhouettes overlap for a few frames, then part.
+    let frames = 32;
     let mut a = v_flock(1, 60.0, frames, "goose", (0.0, 0.0));
-    let b = v_flock(1, 120.0, frames, "goose", (0.0, 4.6));
+    let b = v_flock(1, 120.0, frames, "goose", (0.0, 3.2));
     for (f, g) in a.frames.iter_mut().zip(b.frames) {
         f.x.extend(g.x);
         f.y.extend(g.y);
@@ -463,16 +509,41 @@ fn two_birds_crossing_are_split_not_merged() {
     a.birds = 2;
     let o = fixed(&a, 24.0, false);
     let shot = shoot(&a, &o, None, 0.0, 3.0);
+    let truth = shot.truth.clone();
     let mut failures = Vec::new();
-    run(
+    let tr = run(
         &Case {
             name: "two birds crossing png",
             shot,
-            crf: None,
+            codec: Codec::Png,
             v: false,
             one_heading: false,
         },
         &mut failures,
     );
+    // Each bird keeps its id through the crossing: every id stays on the bird it started on.
+    if let Some(tr) = tr {
+        let mut of_id: std::collections::BTreeMap<usize, usize> = Default::default();
+        for (f, t) in tr.frames.iter().zip(&truth) {
+            for b in &f.birds {
+                let near = (0..t.len())
+                    .min_by(|&i, &j| {
+                        let d = |k: usize| (b.x - t[k].0).hypot(b.y - t[k].1);
+                        d(i).total_cmp(&d(j))
+                    })
+                    .unwrap();
+                let first = *of_id.entry(b.id).or_insert(near);
+                if first != near && f.index.abs_diff(16) > 1 {
+                    failures.push(format!(
+                        "two birds crossing: track {} moved from bird {first} to bird {near} at frame {}",
+                        b.id, f.index
+                    ));
+                }
+            }
+        }
+        if of_id.len() != 2 {
+            failures.push(format!("two birds crossing: {} tracks, not 2", of_id.len()));
+        }
+    }
     finish(failures);
 }

@@ -484,9 +484,17 @@ pub fn blobs_with(s: &[f32], width: usize, sigma: f32, roi: [usize; 4], hints: &
     let peak_of = |r: &[(usize, usize, f32)]| r.iter().fold(0f32, |m, p| m.max(p.2)) as f64;
     // Regions far fainter than the birds are sky (a cloud's edge, compression's blocks), and
     // regions far smaller than a bird are specks.
-    let typical = hints
-        .peak
-        .unwrap_or_else(|| weighted_median(regions.iter().map(|r| (peak_of(r), r.len() as f64))));
+    // Before the birds are known, regions vote by their signal energy (area × peak²): the birds
+    // the camera was pointed at stand out most, and dozens of faint texture regions, each as
+    // large as a bird (cloud detail, a codec's blocks, where compression has flattened the
+    // noise the thresholds scale with), do not outvote fifteen dark geese.
+    let typical = hints.peak.unwrap_or_else(|| {
+        weighted_median(
+            regions
+                .iter()
+                .map(|r| (peak_of(r), r.len() as f64 * peak_of(r).powi(2))),
+        )
+    });
     let unit = hints.area.unwrap_or_else(|| {
         weighted_median(regions.iter().map(|r| (r.len() as f64, r.len() as f64)))
     });

@@ -177,7 +177,8 @@ pub struct TrackedFrame {
     /// Image file name, for image frames.
     pub image: Option<String>,
     /// Wingspan, pixels: the median over the frame's birds of each one's widest span within
-    /// 6 processed frames either side.
+    /// 6 processed frames either side (its 7 nearest whole detections when fewer are there:
+    /// a bird cut from a larger region has no span of its own).
     pub wingspan_px: f64,
     /// Flight direction, degrees clockwise from image-up.
     pub heading_deg: f64,
@@ -300,7 +301,7 @@ impl Tracking {
         let polarity = *self
             .polarity
             .get_or_insert_with(|| detect::auto_polarity(g, &sky));
-        let found = detect::detect_with(g, &sky, polarity, self.roi, &self.hints);
+        let mut found = detect::detect_with(g, &sky, polarity, self.roi, &self.hints);
         let blobs = &found.blobs;
         if blobs.is_empty() {
             return Err(Error::format(
@@ -345,9 +346,11 @@ impl Tracking {
             }
         });
         let gate_span = self.hints.wingspan_px.unwrap_or(span);
-        let ids = self
-            .tracker
-            .step(blobs, self.last_span.unwrap_or(gate_span).max(gate_span));
+        let ids = self.tracker.step(
+            &mut found.blobs,
+            self.last_span.unwrap_or(gate_span).max(gate_span),
+        );
+        let blobs = &found.blobs;
         self.last_span = Some(gate_span);
         self.learn(blobs, &ids, found.sigma);
         if let Some(dir) = &self.opts.debug_frames {
@@ -412,7 +415,12 @@ impl Tracking {
         let w = |b: &&Blob| b.area as f64;
         let span = detect::weighted_median(lasting.iter().map(|b| (b.span, w(b))));
         let area = detect::weighted_median(lasting.iter().map(|b| (b.area as f64, w(b))));
-        let peak = detect::weighted_median(lasting.iter().map(|b| (b.snr * noise, w(b))));
+        // The contrast by signal energy, as the detection's first guess (see `detect`).
+        let peak = detect::weighted_median(
+            lasting
+                .iter()
+                .map(|b| (b.snr * noise, w(b) * (b.snr * noise).powi(2))),
+        );
         let blend = |old: Option<f64>, new: f64| {
             Some(match old {
                 Some(o) => 0.7 * o + 0.3 * new,
@@ -490,18 +498,27 @@ impl Tracking {
             }
             m
         };
+        // A bird cut from a larger region for a while (crossing another) has fewer whole
+        // observations in the window than a wingbeat needs: its nearest SPAN_WINDOW + 1 whole
+        // observations in time are taken instead.
         for (k, f) in frames.iter_mut().enumerate() {
             let (lo, hi) = (k.saturating_sub(SPAN_WINDOW), k + SPAN_WINDOW);
             let widest: Vec<f64> = f
                 .birds
                 .iter()
                 .filter_map(|b| {
-                    spans.get(&b.id).and_then(|v| {
-                        v.iter()
-                            .filter(|o| o.0 >= lo && o.0 <= hi)
-                            .map(|o| o.1)
-                            .fold(None, |m: Option<f64>, s| Some(m.map_or(s, |m| m.max(s))))
-                    })
+                    let v = spans.get(&b.id)?;
+                    let near: Vec<&(usize, f64)> =
+                        v.iter().filter(|o| o.0 >= lo && o.0 <= hi).collect();
+                    let near = if near.len() > SPAN_WINDOW {
+                        near
+                    } else {
+                        let mut all: Vec<&(usize, f64)> = v.iter().collect();
+                        all.sort_by_key(|o| (o.0.abs_diff(k), o.0));
+                        all.truncate(SPAN_WINDOW + 1);
+                        all
+                    };
+                    near.iter().map(|o| o.1).reduce(f64::max)
                 })
                 .collect();
             if let Some(w) = median(widest) {
@@ -602,7 +619,9 @@ const FLOCK_BIRDS: usize = 6;
 /// Keeps the detections that belong to birds: on a track seen in at least
 /// [`MIN_TRACK_FRAMES`] processed frames (half the footage when it is shorter) and, where the
 /// frame holds a flock ([`FLOCK_BIRDS`] lasting tracks or more), moving with it: a track whose
-/// velocity differs from the flock's (the median of the lasting tracks', frame by frame) by
+/// velocity differs from the flock's (the median of the lasting tracks', frame by frame, each
+/// weighted by its detection's signal energy, area × contrast², so that faint texture drifting
+/// with the clouds, however many its regions, does not set the flock's motion) by
 /// more than half the flock's speed plus half a wingspan a second, in the median over its
 /// frames, is texture of the sky drifting with the clouds, not a bird. A frame that would be
 /// left with no bird keeps its detections. Gives each kept track's coherence factor (1 when
@@ -636,13 +655,18 @@ fn keep_lasting(
             if let Some(o) = lasting.get(&b.id) {
                 if let Some(v) = velocity_at(o, k) {
                     vel.insert((b.id, k), v);
-                    vx.push(v.0);
-                    vy.push(v.1);
+                    // Weighted by signal energy: the flock is what stands out most.
+                    let w = b.blob.area as f64 * b.blob.snr.powi(2);
+                    vx.push((v.0, w));
+                    vy.push((v.1, w));
                 }
             }
         }
         if vx.len() >= FLOCK_BIRDS {
-            flock[k] = Some((median(vx).unwrap_or(0.0), median(vy).unwrap_or(0.0)));
+            flock[k] = Some((
+                detect::weighted_median(vx.into_iter()),
+                detect::weighted_median(vy.into_iter()),
+            ));
         }
     }
     let mut coherence = BTreeMap::new();

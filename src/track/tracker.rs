@@ -9,11 +9,22 @@
 //! prediction for up to `MAX_MISSED` processed frames and is then closed; an unmatched
 //! detection starts a track. Ids are given in the order tracks start, and the tracks that start
 //! in the same frame are numbered left to right.
+//!
+//! Two birds crossing merge into one region for a few frames, too overlapped to be split by
+//! its size. The track that lost the assignment is then not coasted out of sight: a track seen
+//! `HIDDEN_HITS` times or more whose prediction falls within the gate of a detection another
+//! track took is hidden in it, and both birds are placed at their predictions moved together by
+//! the detection's centroid minus the predictions' mean (marked `split`, so their merged size
+//! does not count as a wingspan). Birds in formation keep a wingspan or so apart, twice the
+//! gate: only birds whose silhouettes overlap share a detection.
 
 use super::detect::Blob;
 
 /// Processed frames a track may go unseen before it is closed.
 pub const MAX_MISSED: usize = 5;
+
+/// Times a track must have been seen before it may be hidden in another bird's detection.
+pub const HIDDEN_HITS: usize = 3;
 
 /// One bird's track.
 #[derive(Debug, Clone)]
@@ -28,6 +39,8 @@ pub struct Track {
     pub missed: usize,
     /// Times it was seen.
     pub hits: usize,
+    /// Processed frames in a row it has been hidden in another bird's detection.
+    pub hidden: usize,
 }
 
 /// The tracker's state between frames.
@@ -253,7 +266,10 @@ impl Tracker {
 
     /// Links this frame's detections; gives each detection's track id, in `blobs` order.
     /// `wingspan` is the frame's bird size in pixels (it sets the gate).
-    pub fn step(&mut self, blobs: &[Blob], wingspan: f64) -> Vec<usize> {
+    ///
+    /// A bird hidden in another's detection (see the module) is added to `blobs` (marked
+    /// `split`) and the detection it shares is moved to its owner's share.
+    pub fn step(&mut self, blobs: &mut Vec<Blob>, wingspan: f64) -> Vec<usize> {
         let gate = (0.5 * wingspan).max(3.0);
         let shift = if self.tracks.iter().any(|t| t.vel.is_none()) {
             self.flock_shift(blobs, gate)
@@ -276,13 +292,86 @@ impl Tracker {
         };
         let of_blob = assign(blobs, &pred, gate, cost);
         let mut matched = vec![false; m];
-        let mut ids = vec![usize::MAX; n];
+        let mut owner: Vec<Option<usize>> = vec![None; n];
         for i in 0..n {
             let j = of_blob[i];
-            if j == usize::MAX || cost(i, j) > gate * gate {
+            if j != usize::MAX && cost(i, j) <= gate * gate {
+                matched[j] = true;
+                owner[i] = Some(j);
+            }
+        }
+        // Birds hidden in another's detection: a confirmed track left without a detection
+        // whose prediction falls within the gate of a detection another track took (two birds
+        // crossing, their silhouettes merged into one region too small to split). It stays
+        // where its motion puts it, and the detection's position is shared: each bird at its
+        // prediction shifted by the detection's centroid minus the predictions' mean (the
+        // centroid of two like silhouettes is the mean of theirs).
+        let mut hidden: Vec<(usize, usize)> = Vec::new();
+        for j in 0..m {
+            let t = &self.tracks[j];
+            if matched[j]
+                || t.hits < HIDDEN_HITS
+                || t.vel.is_none()
+                || t.missed > 0
+                || t.hidden >= MAX_MISSED
+            {
                 continue;
             }
-            matched[j] = true;
+            let confirmed = |a: usize| {
+                let o = &self.tracks[a];
+                o.hits >= HIDDEN_HITS && o.vel.is_some()
+            };
+            let near = (0..n)
+                .filter(|&i| owner[i].is_some_and(confirmed))
+                .map(|i| {
+                    let d = (blobs[i].x - pred[j].0).powi(2) + (blobs[i].y - pred[j].1).powi(2);
+                    (i, d)
+                })
+                .filter(|&(_, d)| d <= gate * gate)
+                .min_by(|a, b| a.1.total_cmp(&b.1));
+            if let Some((i, _)) = near {
+                hidden.push((i, j));
+            }
+        }
+        let mut extra: Vec<(Blob, usize)> = Vec::new();
+        for i in 0..n {
+            let Some(a) = owner[i] else { continue };
+            let with: Vec<usize> = hidden.iter().filter(|h| h.0 == i).map(|h| h.1).collect();
+            if with.is_empty() {
+                continue;
+            }
+            let k = (with.len() + 1) as f64;
+            let mean = with
+                .iter()
+                .fold(pred[a], |s, &j| (s.0 + pred[j].0, s.1 + pred[j].1));
+            let off = (blobs[i].x - mean.0 / k, blobs[i].y - mean.1 / k);
+            let shared = Blob {
+                split: true,
+                ..blobs[i]
+            };
+            blobs[i] = Blob {
+                x: pred[a].0 + off.0,
+                y: pred[a].1 + off.1,
+                ..shared
+            };
+            for &j in &with {
+                let b = Blob {
+                    x: pred[j].0 + off.0,
+                    y: pred[j].1 + off.1,
+                    ..shared
+                };
+                let t = &mut self.tracks[j];
+                t.pos = (b.x, b.y);
+                t.missed = 0;
+                t.hits += 1;
+                t.hidden += 1;
+                matched[j] = true;
+                extra.push((b, t.id));
+            }
+        }
+        let mut ids = vec![usize::MAX; n];
+        for i in 0..n {
+            let Some(j) = owner[i] else { continue };
             let t = &mut self.tracks[j];
             let steps = (t.missed + 1) as f64;
             let d = (
@@ -295,6 +384,7 @@ impl Tracker {
             });
             t.pos = (blobs[i].x, blobs[i].y);
             t.missed = 0;
+            t.hidden = 0;
             t.hits += 1;
             ids[i] = t.id;
         }
@@ -322,8 +412,13 @@ impl Tracker {
                 vel: None,
                 missed: 0,
                 hits: 1,
+                hidden: 0,
             });
             self.next_id += 1;
+        }
+        for (b, id) in extra {
+            blobs.push(b);
+            ids.push(id);
         }
         ids
     }
@@ -349,13 +444,16 @@ mod tests {
     fn a_flock_moving_more_than_its_spacing_keeps_its_ids() {
         // Birds 12 px apart moving 30 px a frame: nearest-neighbour linking would swap them.
         let mut t = Tracker::default();
-        let first: Vec<usize> = t.step(&[blob(0.0, 0.0), blob(12.0, 5.0), blob(24.0, 10.0)], 10.0);
+        let first: Vec<usize> = t.step(
+            &mut vec![blob(0.0, 0.0), blob(12.0, 5.0), blob(24.0, 10.0)],
+            10.0,
+        );
         assert_eq!(first, vec![0, 1, 2]);
         for k in 1..10 {
             let s = 30.0 * k as f64;
             // Listed in another order each frame.
             let ids = t.step(
-                &[blob(24.0 + s, 10.0), blob(s, 0.0), blob(12.0 + s, 5.0)],
+                &mut vec![blob(24.0 + s, 10.0), blob(s, 0.0), blob(12.0 + s, 5.0)],
                 10.0,
             );
             assert_eq!(ids, vec![2, 0, 1], "frame {k}");
@@ -365,10 +463,55 @@ mod tests {
     #[test]
     fn a_bird_missed_for_a_frame_keeps_its_id() {
         let mut t = Tracker::default();
-        t.step(&[blob(0.0, 0.0), blob(40.0, 0.0)], 10.0);
-        t.step(&[blob(5.0, 0.0), blob(45.0, 0.0)], 10.0);
-        t.step(&[blob(10.0, 0.0)], 10.0);
-        let ids = t.step(&[blob(55.0, 0.0), blob(15.0, 0.0)], 10.0);
+        t.step(&mut vec![blob(0.0, 0.0), blob(40.0, 0.0)], 10.0);
+        t.step(&mut vec![blob(5.0, 0.0), blob(45.0, 0.0)], 10.0);
+        t.step(&mut vec![blob(10.0, 0.0)], 10.0);
+        let ids = t.step(&mut vec![blob(55.0, 0.0), blob(15.0, 0.0)], 10.0);
         assert_eq!(ids, vec![1, 0]);
+    }
+
+    #[test]
+    fn two_birds_merged_while_crossing_keep_their_ids_and_positions() {
+        // Two birds 10 px across on crossing paths (one down-right, one up-right), merged into
+        // one detection at their centroids' mean for frames 5 and 6.
+        let mut t = Tracker::default();
+        let at = |k: f64| ((3.0 * k, 2.0 * k), (3.0 * k, 20.0 - 2.0 * k));
+        for k in 0..5 {
+            let (a, b) = at(k as f64);
+            let mut blobs = vec![blob(a.0, a.1), blob(b.0, b.1)];
+            assert_eq!(t.step(&mut blobs, 10.0), vec![0, 1], "frame {k}");
+        }
+        for k in 5..7 {
+            let (a, b) = at(k as f64);
+            let mut blobs = vec![blob(0.5 * (a.0 + b.0), 0.5 * (a.1 + b.1))];
+            let ids = t.step(&mut blobs, 10.0);
+            assert_eq!(ids.len(), 2, "frame {k}: both birds");
+            for (bl, id) in blobs.iter().zip(&ids) {
+                let truth = if *id == 0 { a } else { b };
+                assert!(
+                    (bl.x - truth.0).hypot(bl.y - truth.1) < 0.5,
+                    "frame {k}: bird {id} at {bl:?}, truth {truth:?}"
+                );
+                assert!(bl.split);
+            }
+        }
+        for k in 7..10 {
+            let (a, b) = at(k as f64);
+            let mut blobs = vec![blob(b.0, b.1), blob(a.0, a.1)];
+            assert_eq!(t.step(&mut blobs, 10.0), vec![1, 0], "frame {k}");
+        }
+    }
+
+    #[test]
+    fn a_bird_that_leaves_is_not_kept_beside_a_neighbour() {
+        // Birds a wingspan and more apart: one vanishes; it is not placed into the other.
+        let mut t = Tracker::default();
+        for k in 0..5 {
+            let s = 4.0 * k as f64;
+            t.step(&mut vec![blob(s, 0.0), blob(s, 12.0)], 10.0);
+        }
+        let mut blobs = vec![blob(20.0, 0.0)];
+        assert_eq!(t.step(&mut blobs, 10.0), vec![0]);
+        assert_eq!(blobs.len(), 1);
     }
 }
