@@ -767,8 +767,9 @@ fn animation_sections(page: &mut Page, a: &Animation, s: &Subject<'_>) -> Result
 }
 
 /// Most bird-frames the report's player embeds before it keeps only every n-th frame (about 20
-/// bytes each: a page of 12 MB at most for the player).
-const REPORT_PLAYER_BIRD_FRAMES: usize = 600_000;
+/// bytes each: a player of about 5 MB at most, so the report stays near the animation file's
+/// size in memory).
+const REPORT_PLAYER_BIRD_FRAMES: usize = 250_000;
 
 /// The flock in 3-D: the page `formation view` writes, in an `<iframe srcdoc>` (its script and
 /// styles kept apart from the report's), frames thinned for long or large flocks.
@@ -794,11 +795,22 @@ fn player_section(page: &mut Page, a: &Animation, s: &Subject<'_>) -> Result<()>
     page.p(&format!(
         "The animation played in 3-D (WebGL): drag to turn the view, scroll to zoom, pick a camera, colour the birds by saving, rank or formation, scrub the timeline to a stage or an event, click a bird for its numbers.{thinned}"
     ));
-    let _ = writeln!(
-        page.body,
-        "<iframe class=\"player\" title=\"3-D player\" srcdoc=\"{}\" style=\"width:100%;height:560px;border:1px solid #ccc\" sandbox=\"allow-scripts\"></iframe>",
-        esc(&html).replace('\'', "&#39;")
-    );
+    // Escaped straight into the page: no second copy of the player.
+    page.body
+        .push_str("<iframe class=\"player\" title=\"3-D player\" srcdoc=\"");
+    page.body.reserve(html.len() + html.len() / 16);
+    for c in html.chars() {
+        match c {
+            '&' => page.body.push_str("&amp;"),
+            '<' => page.body.push_str("&lt;"),
+            '>' => page.body.push_str("&gt;"),
+            '"' => page.body.push_str("&quot;"),
+            '\'' => page.body.push_str("&#39;"),
+            c => page.body.push(c),
+        }
+    }
+    drop(html);
+    page.body.push_str("\" style=\"width:100%;height:560px;border:1px solid #ccc\" sandbox=\"allow-scripts\"></iframe>\n");
     Ok(())
 }
 
