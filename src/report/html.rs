@@ -21,10 +21,24 @@ pub struct Page {
 
 /// `s` with `<`, `>`, `&` and `"` escaped.
 fn esc(s: &str) -> String {
-    s.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-        .replace('"', "&quot;")
+    let mut out = String::with_capacity(s.len());
+    esc_into(&mut out, s);
+    out
+}
+
+/// Appends `s` to `out` with `<`, `>`, `&` and `"` escaped (safe as text and inside a
+/// double-quoted attribute).
+fn esc_into(out: &mut String, s: &str) {
+    out.reserve(s.len());
+    for c in s.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            c => out.push(c),
+        }
+    }
 }
 
 /// `v` with 3 decimals, never "-0.000".
@@ -798,17 +812,7 @@ fn player_section(page: &mut Page, a: &Animation, s: &Subject<'_>) -> Result<()>
     // Escaped straight into the page: no second copy of the player.
     page.body
         .push_str("<iframe class=\"player\" title=\"3-D player\" srcdoc=\"");
-    page.body.reserve(html.len() + html.len() / 16);
-    for c in html.chars() {
-        match c {
-            '&' => page.body.push_str("&amp;"),
-            '<' => page.body.push_str("&lt;"),
-            '>' => page.body.push_str("&gt;"),
-            '"' => page.body.push_str("&quot;"),
-            '\'' => page.body.push_str("&#39;"),
-            c => page.body.push(c),
-        }
-    }
+    esc_into(&mut page.body, &html);
     drop(html);
     page.body.push_str("\" style=\"width:100%;height:560px;border:1px solid #ccc\" sandbox=\"allow-scripts\"></iframe>\n");
     Ok(())
